@@ -1,0 +1,2 @@
+//! rpbrt's renderer: shapes, accelerators, scene building and integrators.
+#![deny(missing_docs)]
