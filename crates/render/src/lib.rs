@@ -1,2 +1,8 @@
 //! rpbrt's renderer: shapes, accelerators, scene building and integrators.
 #![deny(missing_docs)]
+
+pub mod rng;
+pub mod sampling;
+pub mod shape;
+
+pub use rpbrt_geometry as geometry;

@@ -1,0 +1,156 @@
+//! Shapes (book chapter 6; pbrt-v4 `base/shape.h`, `shapes.h`): geometric
+//! surfaces that rays can hit and lights can sample.
+//!
+//! Every concrete shape implements [`ShapeMethods`]; [`Shape`] is the closed
+//! set of them, each method a one-line delegation (the Rust form of
+//! pbrt-v4's tagged pointer). Shapes live in rendering space: quadrics keep
+//! their render-from-object transformation, meshes store rendering-space
+//! vertices.
+
+use rpbrt_geometry::float::*;
+use rpbrt_geometry::interaction::SurfaceInteraction;
+use rpbrt_geometry::ray::{offset_ray_origin, Ray};
+use rpbrt_geometry::spherical::DirectionCone;
+use rpbrt_geometry::tuple::*;
+use rpbrt_geometry::Bounds3f;
+use std::fmt;
+
+/// A ray's hit on a shape.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShapeIntersection {
+    /// The surface geometry at the hit.
+    pub intr: SurfaceInteraction,
+    /// The ray parameter of the hit.
+    pub t_hit: Float,
+}
+
+/// A point sampled on a shape's surface and its density: per unit area for
+/// [`ShapeMethods::sample_area`], per unit solid angle from the reference
+/// point for [`ShapeMethods::sample`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShapeSample {
+    /// The sampled point with its error bounds.
+    pub pi: Point3fi,
+    /// The surface normal there (flipped like intersection normals).
+    pub n: Normal3f,
+    /// Surface (u, v) of the point.
+    pub uv: Point2f,
+    /// Time of the sample.
+    pub time: Float,
+    /// The sample's density.
+    pub pdf: Float,
+}
+
+impl ShapeSample {
+    /// The sampled point.
+    #[inline]
+    pub fn p(&self) -> Point3f {
+        self.pi.midpoint()
+    }
+}
+
+/// The reference point from which a shape is sampled by solid angle
+/// (pbrt-v4's `ShapeSampleContext`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ShapeSampleContext {
+    /// The reference point with error bounds.
+    pub pi: Point3fi,
+    /// Geometric normal at the reference point (zero in a medium).
+    pub n: Normal3f,
+    /// Shading normal at the reference point (zero in a medium).
+    pub ns: Normal3f,
+    /// Time.
+    pub time: Float,
+}
+
+impl ShapeSampleContext {
+    /// A context at a point in space (no surface).
+    pub fn from_point(p: Point3f, time: Float) -> Self {
+        ShapeSampleContext { pi: Point3fi::from(p), n: Normal3f::default(), ns: Normal3f::default(), time }
+    }
+    /// The reference point.
+    #[inline]
+    pub fn p(&self) -> Point3f {
+        self.pi.midpoint()
+    }
+    /// The origin of a ray leaving toward `w`, offset off the surface.
+    #[inline]
+    pub fn offset_ray_origin(&self, w: Vector3f) -> Point3f {
+        offset_ray_origin(self.p(), self.pi.error(), self.n, w)
+    }
+    /// A ray leaving the reference point toward `w`.
+    #[inline]
+    pub fn spawn_ray(&self, w: Vector3f) -> Ray {
+        Ray::with_time(self.offset_ray_origin(w), w, self.time, None)
+    }
+}
+
+/// Why a shape could not be built from its parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShapeError(pub String);
+
+impl fmt::Display for ShapeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for ShapeError {}
+
+/// The interface every shape provides.
+pub trait ShapeMethods {
+    /// Bounds in rendering space.
+    fn bounds(&self) -> Bounds3f;
+    /// A cone bounding the surface normals (for the light BVH).
+    fn normal_bounds(&self) -> DirectionCone;
+    /// The closest hit with `t` in (0, `t_max`), with full geometry.
+    fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection>;
+    /// Whether any hit with `t` in (0, `t_max`) exists (shadow rays).
+    fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool;
+    /// Surface area in rendering space.
+    fn area(&self) -> Float;
+    /// A point sampled on the surface with density per unit area.
+    fn sample_area(&self, u: Point2f) -> Option<ShapeSample>;
+    /// Density per unit area of [`ShapeMethods::sample_area`] (1/area for
+    /// uniform sampling).
+    fn pdf_area(&self) -> Float {
+        1.0 / self.area()
+    }
+    /// A point sampled as seen from `ctx`, density per unit solid angle.
+    fn sample(&self, ctx: &ShapeSampleContext, u: Point2f) -> Option<ShapeSample>;
+    /// Density per unit solid angle of sampling direction `wi` from `ctx`.
+    fn pdf(&self, ctx: &ShapeSampleContext, wi: Vector3f) -> Float;
+}
+
+/// Converts an area-density sample into a solid-angle density sample from
+/// `ctx` (the generic `Shape::Sample(ctx, u)` of pbrt-v4); `None` when the
+/// density is infinite.
+pub fn area_sample_to_solid_angle(ctx: &ShapeSampleContext, mut ss: ShapeSample) -> Option<ShapeSample> {
+    let wi = ss.p() - ctx.p();
+    let d2 = wi.length_squared();
+    if d2 == 0.0 {
+        return None;
+    }
+    let wi = wi / d2.sqrt();
+    ss.pdf /= abs_dot(ss.n, -wi) / d2;
+    if ss.pdf.is_infinite() || ss.pdf.is_nan() {
+        return None;
+    }
+    Some(ss)
+}
+
+/// The generic solid-angle pdf of pbrt-v4: intersect the ray from `ctx`
+/// toward `wi` with the shape and convert 1/area to solid angle.
+pub fn pdf_by_intersection<S: ShapeMethods + ?Sized>(shape: &S, ctx: &ShapeSampleContext, wi: Vector3f) -> Float {
+    let ray = ctx.spawn_ray(wi);
+    let isect = match shape.intersect(&ray, Float::INFINITY) {
+        Some(i) => i,
+        None => return 0.0,
+    };
+    let pdf = (1.0 / shape.area()) / (abs_dot(isect.intr.n, -wi) / ctx.p().distance_squared(isect.intr.p()));
+    if pdf.is_infinite() {
+        0.0
+    } else {
+        pdf
+    }
+}
