@@ -2,6 +2,8 @@
 //! warps of uniform samples to the distributions rendering needs, with
 //! their densities and, where pbrt has them, their inverses.
 
+pub mod spherical;
+
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;
 

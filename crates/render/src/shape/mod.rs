@@ -15,6 +15,17 @@ use rpbrt_geometry::tuple::*;
 use rpbrt_geometry::Bounds3f;
 use std::fmt;
 
+pub mod bilinear;
+pub mod cone;
+pub mod curve;
+pub mod cylinder;
+pub mod disk;
+pub mod hyperboloid;
+pub mod loopsubdiv;
+pub mod paraboloid;
+pub mod sphere;
+pub mod triangle;
+
 /// A ray's hit on a shape.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShapeIntersection {
