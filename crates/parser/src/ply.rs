@@ -1231,7 +1231,15 @@ fn read_ascii(
 }
 
 fn gunzip(bytes: &[u8]) -> Result<Vec<u8>, PlyErrorKind> {
-    let mut out = Vec::new();
+    // The trailer's ISIZE (uncompressed size mod 2^32) is a capacity hint;
+    // capped at a modest ratio so that a forged trailer cannot drive the
+    // allocation.
+    let hint = bytes
+        .len()
+        .checked_sub(4)
+        .and_then(|i| bytes.get(i..))
+        .map_or(0, |t| u32::from_le_bytes([t[0], t[1], t[2], t[3]]) as usize);
+    let mut out = Vec::with_capacity(hint.min(bytes.len().saturating_mul(16)));
     flate2::read::MultiGzDecoder::new(bytes)
         .read_to_end(&mut out)
         .map_err(PlyErrorKind::Gzip)?;
@@ -1786,7 +1794,7 @@ mod tests {
     #[test]
     fn writer_rejects_inconsistent_meshes() {
         let cases: [fn(&mut PlyMesh); 6] = [
-            |m| drop(m.normals.pop()),
+            |m| m.normals.truncate(4),
             |m| m.uvs.push([0.0, 0.0]),
             |m| m.tri_indices.push(0),
             |m| m.quad_indices.push(0),
