@@ -1833,6 +1833,68 @@ mod tests {
     }
 
     #[test]
+    fn fast_face_layout_with_face_indices_and_odd_faces() {
+        for format in FORMATS {
+            for (index_ty, fi_ty) in [("int", "int"), ("uint", "uint"), ("int", "uint")] {
+                let header = format!(
+                    "element vertex 5\nproperty float x\nproperty float y\nproperty float z\n\
+                     element face 5\nproperty list uchar {index_ty} vertex_indices\n\
+                     property {fi_ty} face_indices\n"
+                );
+                let mut b = Body::new(format);
+                for i in 0..15 {
+                    b.f32(i as f32);
+                }
+                let faces: [&[u32]; 5] = [
+                    &[0, 1, 2],
+                    &[1, 2, 3, 4],
+                    &[0, 1, 2, 3, 4],
+                    &[4],
+                    &[2, 3, 4],
+                ];
+                for (f, face) in faces.iter().enumerate() {
+                    b.u8(face.len() as u8);
+                    for &i in *face {
+                        if index_ty == "int" {
+                            b.i32(i as i32);
+                        } else {
+                            b.u32(i);
+                        }
+                    }
+                    if fi_ty == "int" {
+                        b.i32(100 + f as i32);
+                    } else {
+                        b.u32(100 + f as u32);
+                    }
+                    b.nl();
+                }
+                let m = parse_ply(&file(format, &header, &b.out)).unwrap();
+                assert_eq!(m.positions[4], [12.0, 13.0, 14.0]);
+                assert_eq!(
+                    m.tri_indices,
+                    vec![0, 1, 2, 0, 1, 2, 0, 2, 3, 0, 3, 4, 2, 3, 4]
+                );
+                assert_eq!(m.quad_indices, vec![1, 2, 4, 3]);
+                assert_eq!(m.face_indices, vec![100, 102, 102, 102, 104, 101]);
+                assert_eq!(m.warnings.len(), 2, "{:?}", m.warnings);
+            }
+        }
+        // A uint face index beyond i32 is reported, not wrapped.
+        let header = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                      element face 1\nproperty list uchar int vertex_indices\n\
+                      property uint face_indices\n";
+        let mut b = Body::new(Format::BinaryLittleEndian);
+        for _ in 0..9 {
+            b.f32(0.0);
+        }
+        b.u8(3).i32(0).i32(1).i32(2).u32(u32::MAX);
+        assert!(matches!(
+            err_kind(&file(Format::BinaryLittleEndian, header, &b.out)),
+            PlyErrorKind::BadValue { .. }
+        ));
+    }
+
+    #[test]
     fn crlf_header_and_trailing_data() {
         let mut bytes = encode_ply(&sample_mesh()).unwrap();
         let text = String::from_utf8_lossy(&bytes).into_owned();
@@ -2206,6 +2268,13 @@ mod tests {
             rich_file(Format::BinaryLittleEndian),
             rich_file(Format::BinaryBigEndian),
             encode_ply(&sample_mesh()).unwrap(),
+            {
+                let mut enc =
+                    flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+                enc.write_all(&rich_file(Format::BinaryLittleEndian))
+                    .unwrap();
+                enc.finish().unwrap()
+            },
         ];
         let mut ok = 0;
         for iter in 0..6000 {
