@@ -1,0 +1,2377 @@
+//! Reading and writing PLY polygon meshes, the files behind pbrt-v4's `plymesh`
+//! shape (Physically Based Rendering, 4th ed., Section 6.5 "Triangle Meshes"
+//! and the bilinear patches of Section 6.6).
+//!
+//! The reader accepts `ascii 1.0`, `binary_little_endian 1.0` and
+//! `binary_big_endian 1.0` bodies, optionally gzip-compressed. Binary files with
+//! the layouts that exporters (and `rpbrt --toply`) actually write take a fast
+//! path that decodes fixed-size records straight from the byte slice; anything
+//! else goes through a general property-by-property decoder.
+//!
+//! Robustness: every count read from the file is checked against the bytes that
+//! remain before anything is allocated from it, so a corrupt header cannot make
+//! the reader reserve gigabytes, and no input makes it panic.
+
+use std::fmt;
+use std::io::{self, Read, Write};
+use std::path::{Path, PathBuf};
+
+/// A polygon mesh as read from (or written to) a PLY file.
+///
+/// Per-vertex arrays are either empty or exactly as long as `positions`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PlyMesh {
+    /// Vertex positions (`x`, `y`, `z`).
+    pub positions: Vec<[f32; 3]>,
+    /// Per-vertex normals (`nx`, `ny`, `nz`); empty when the file has none.
+    pub normals: Vec<[f32; 3]>,
+    /// Per-vertex texture coordinates (`u`/`v`, `s`/`t`, `texture_u`/`texture_v`
+    /// or `texture_s`/`texture_t`); empty when the file has none.
+    pub uvs: Vec<[f32; 2]>,
+    /// Triangle vertex indices, three per triangle. Faces with more than four
+    /// vertices are triangulated as fans and end up here too.
+    pub tri_indices: Vec<u32>,
+    /// Quad vertex indices, four per quad, in pbrt-v4's bilinear-patch order:
+    /// a PLY face `v0 v1 v2 v3` is stored as `v0 v1 v3 v2`.
+    pub quad_indices: Vec<u32>,
+    /// Per-primitive face indices (the `face_indices` property), empty when the
+    /// file has none. When present it holds one entry per triangle followed by
+    /// one entry per quad, i.e. `tri_indices.len() / 3 + quad_indices.len() / 4`
+    /// entries; a fan-triangulated polygon repeats its index for each triangle.
+    pub face_indices: Vec<i32>,
+    /// Non-fatal problems found while reading (fan-triangulated or ignored faces,
+    /// non-finite coordinates, trailing data). Not written by [`write_ply`].
+    pub warnings: Vec<String>,
+}
+
+impl PlyMesh {
+    /// Number of triangles in `tri_indices`.
+    pub fn triangle_count(&self) -> usize {
+        self.tri_indices.len() / 3
+    }
+
+    /// Number of quads in `quad_indices`.
+    pub fn quad_count(&self) -> usize {
+        self.quad_indices.len() / 4
+    }
+}
+
+/// An error reading or writing a PLY file, with the file it concerns.
+#[derive(Debug)]
+pub struct PlyError {
+    /// The file, or `None` for [`parse_ply`] / [`encode_ply`] on memory.
+    pub path: Option<PathBuf>,
+    /// What went wrong.
+    pub kind: PlyErrorKind,
+}
+
+/// What went wrong while reading or writing a PLY file.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum PlyErrorKind {
+    /// The file could not be opened, read or written.
+    Io(io::Error),
+    /// The file looked gzip-compressed but could not be decompressed.
+    Gzip(io::Error),
+    /// The file does not start with the `ply` magic line.
+    BadMagic,
+    /// The header is malformed.
+    Header {
+        /// 1-based header line.
+        line: usize,
+        /// What is wrong with it.
+        message: String,
+    },
+    /// A required element (`vertex` or `face`) is not declared.
+    MissingElement(&'static str),
+    /// A required property (`x`, `y`, `z`, `vertex_indices`) is not declared.
+    MissingProperty {
+        /// The element that lacks it.
+        element: &'static str,
+        /// The missing property.
+        property: &'static str,
+    },
+    /// A property the reader needs is declared with an unusable type.
+    UnsupportedProperty {
+        /// The element that declares it.
+        element: String,
+        /// The property.
+        property: String,
+        /// Why it cannot be used.
+        reason: &'static str,
+    },
+    /// The body ends before all records the header declares.
+    Truncated {
+        /// The element being read.
+        element: String,
+        /// Records the header declares.
+        expected: u64,
+        /// Complete records present before the data ran out.
+        read: u64,
+    },
+    /// A value in the body cannot be decoded (bad ASCII number, negative list
+    /// count, non-integral index...).
+    BadValue {
+        /// The element being read.
+        element: String,
+        /// 0-based record within the element.
+        record: u64,
+        /// What is wrong.
+        message: String,
+    },
+    /// A face refers to a vertex that does not exist.
+    IndexOutOfRange {
+        /// 0-based face record.
+        face: u64,
+        /// The offending index.
+        index: i64,
+        /// Number of vertices in the file.
+        vertex_count: u64,
+    },
+    /// The mesh given to the writer is inconsistent.
+    InvalidMesh(String),
+}
+
+impl PlyError {
+    fn new(path: Option<&Path>, kind: PlyErrorKind) -> PlyError {
+        PlyError {
+            path: path.map(Path::to_path_buf),
+            kind,
+        }
+    }
+}
+
+fn element_noun(element: &str, n: u64) -> String {
+    match (element, n == 1) {
+        ("vertex", true) => "vertex".to_string(),
+        ("vertex", false) => "vertices".to_string(),
+        ("face", true) => "face".to_string(),
+        ("face", false) => "faces".to_string(),
+        (name, _) => format!("'{name}' records"),
+    }
+}
+
+impl fmt::Display for PlyErrorKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PlyErrorKind::Io(e) => write!(f, "{e}"),
+            PlyErrorKind::Gzip(e) => write!(f, "gzip decompression failed: {e}"),
+            PlyErrorKind::BadMagic => write!(f, "not a PLY file (missing 'ply' magic line)"),
+            PlyErrorKind::Header { line, message } => {
+                write!(f, "malformed PLY header, line {line}: {message}")
+            }
+            PlyErrorKind::MissingElement(e) => write!(f, "no '{e}' element declared"),
+            PlyErrorKind::MissingProperty { element, property } => {
+                write!(f, "element '{element}' has no '{property}' property")
+            }
+            PlyErrorKind::UnsupportedProperty {
+                element,
+                property,
+                reason,
+            } => write!(f, "property '{property}' of element '{element}' {reason}"),
+            PlyErrorKind::Truncated {
+                element,
+                expected,
+                read,
+            } => write!(
+                f,
+                "truncated data: expected {expected} {}, file ends after {read}",
+                element_noun(element, *expected)
+            ),
+            PlyErrorKind::BadValue {
+                element,
+                record,
+                message,
+            } => write!(f, "element '{element}' record {record}: {message}"),
+            PlyErrorKind::IndexOutOfRange {
+                face,
+                index,
+                vertex_count,
+            } => write!(
+                f,
+                "face {face}: vertex index {index} is out of range [0, {vertex_count})"
+            ),
+            PlyErrorKind::InvalidMesh(m) => write!(f, "invalid mesh: {m}"),
+        }
+    }
+}
+
+impl fmt::Display for PlyError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.path {
+            Some(p) => write!(f, "{}: {}", p.display(), self.kind),
+            None => write!(f, "<memory>: {}", self.kind),
+        }
+    }
+}
+
+impl std::error::Error for PlyError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match &self.kind {
+            PlyErrorKind::Io(e) | PlyErrorKind::Gzip(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Header
+
+/// A PLY scalar type.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn from_name(name: &[u8]) -> Option<Scalar> {
+        Some(match name {
+            b"char" | b"int8" => Scalar::I8,
+            b"uchar" | b"uint8" => Scalar::U8,
+            b"short" | b"int16" => Scalar::I16,
+            b"ushort" | b"uint16" => Scalar::U16,
+            b"int" | b"int32" => Scalar::I32,
+            b"uint" | b"uint32" => Scalar::U32,
+            b"float" | b"float32" => Scalar::F32,
+            b"double" | b"float64" => Scalar::F64,
+            _ => return None,
+        })
+    }
+
+    fn size(self) -> usize {
+        match self {
+            Scalar::I8 | Scalar::U8 => 1,
+            Scalar::I16 | Scalar::U16 => 2,
+            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+            Scalar::F64 => 8,
+        }
+    }
+
+    fn is_integer(self) -> bool {
+        !matches!(self, Scalar::F32 | Scalar::F64)
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum PropKind {
+    Scalar(Scalar),
+    List { count: Scalar, item: Scalar },
+}
+
+#[derive(Clone, Debug)]
+struct Property {
+    name: String,
+    kind: PropKind,
+}
+
+#[derive(Clone, Debug)]
+struct Element {
+    name: String,
+    count: u64,
+    props: Vec<Property>,
+}
+
+impl Element {
+    /// Size in bytes of one binary record, if every property is a scalar.
+    fn fixed_size(&self) -> Option<usize> {
+        self.props
+            .iter()
+            .map(|p| match p.kind {
+                PropKind::Scalar(t) => Some(t.size()),
+                PropKind::List { .. } => None,
+            })
+            .sum()
+    }
+
+    /// A lower bound on the bytes one record occupies in a binary body.
+    fn min_binary_size(&self) -> usize {
+        self.props
+            .iter()
+            .map(|p| match p.kind {
+                PropKind::Scalar(t) => t.size(),
+                PropKind::List { count, .. } => count.size(),
+            })
+            .sum()
+    }
+
+    fn find(&self, name: &str) -> Option<usize> {
+        self.props.iter().position(|p| p.name == name)
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Format {
+    Ascii,
+    BinaryLittleEndian,
+    BinaryBigEndian,
+}
+
+#[derive(Debug)]
+struct Header {
+    format: Format,
+    elements: Vec<Element>,
+    /// Offset of the first body byte.
+    data_start: usize,
+}
+
+/// Returns the next `\n`-terminated line (without `\r\n`) and advances `pos`.
+fn next_line<'a>(bytes: &'a [u8], pos: &mut usize) -> Option<&'a [u8]> {
+    let rest = bytes.get(*pos..)?;
+    if rest.is_empty() {
+        return None;
+    }
+    let (line, advance) = match rest.iter().position(|&b| b == b'\n') {
+        Some(i) => (&rest[..i], i + 1),
+        None => (rest, rest.len()),
+    };
+    *pos += advance;
+    Some(line.strip_suffix(b"\r").unwrap_or(line))
+}
+
+fn lossy(bytes: &[u8]) -> String {
+    const MAX: usize = 40;
+    let s = String::from_utf8_lossy(&bytes[..bytes.len().min(MAX)]).into_owned();
+    if bytes.len() > MAX {
+        s + "..."
+    } else {
+        s
+    }
+}
+
+fn parse_header(bytes: &[u8]) -> Result<Header, PlyErrorKind> {
+    let mut pos = 0;
+    match next_line(bytes, &mut pos) {
+        Some(l) if l.trim_ascii() == b"ply" => {}
+        _ => return Err(PlyErrorKind::BadMagic),
+    }
+    let mut line_no = 1;
+    let mut format = None;
+    let mut elements: Vec<Element> = Vec::new();
+    loop {
+        let Some(line) = next_line(bytes, &mut pos) else {
+            return Err(PlyErrorKind::Header {
+                line: line_no,
+                message: "missing 'end_header'".into(),
+            });
+        };
+        line_no += 1;
+        let err = |message: String| PlyErrorKind::Header {
+            line: line_no,
+            message,
+        };
+        let tokens: Vec<&[u8]> = line
+            .split(|b| b.is_ascii_whitespace())
+            .filter(|t| !t.is_empty())
+            .collect();
+        let Some(&keyword) = tokens.first() else {
+            continue;
+        };
+        match keyword {
+            b"comment" | b"obj_info" => {}
+            b"end_header" => break,
+            b"format" => {
+                if format.is_some() {
+                    return Err(err("duplicate 'format' line".into()));
+                }
+                let [_, name, version] = tokens[..] else {
+                    return Err(err("expected 'format <type> 1.0'".into()));
+                };
+                format = Some(match name {
+                    b"ascii" => Format::Ascii,
+                    b"binary_little_endian" => Format::BinaryLittleEndian,
+                    b"binary_big_endian" => Format::BinaryBigEndian,
+                    other => return Err(err(format!("unknown format '{}'", lossy(other)))),
+                });
+                if version != b"1.0" && version != b"1" {
+                    return Err(err(format!("unsupported version '{}'", lossy(version))));
+                }
+            }
+            b"element" => {
+                let [_, name, count] = tokens[..] else {
+                    return Err(err("expected 'element <name> <count>'".into()));
+                };
+                let count = std::str::from_utf8(count)
+                    .ok()
+                    .and_then(|s| s.parse::<u64>().ok())
+                    .ok_or_else(|| err(format!("invalid element count '{}'", lossy(count))))?;
+                let name = String::from_utf8_lossy(name).into_owned();
+                if (name == "vertex" || name == "face") && elements.iter().any(|e| e.name == name) {
+                    return Err(err(format!("duplicate '{name}' element")));
+                }
+                elements.push(Element {
+                    name,
+                    count,
+                    props: Vec::new(),
+                });
+            }
+            b"property" => {
+                let Some(element) = elements.last_mut() else {
+                    return Err(err("'property' before any 'element'".into()));
+                };
+                let ty = |name: &[u8]| {
+                    Scalar::from_name(name)
+                        .ok_or_else(|| err(format!("unknown property type '{}'", lossy(name))))
+                };
+                let (kind, name) = match tokens[..] {
+                    [_, b"list", count, item, name] => {
+                        let count = ty(count)?;
+                        if !count.is_integer() {
+                            return Err(err("list count type must be an integer type".into()));
+                        }
+                        (
+                            PropKind::List {
+                                count,
+                                item: ty(item)?,
+                            },
+                            name,
+                        )
+                    }
+                    [_, t, name] if t != b"list" => (PropKind::Scalar(ty(t)?), name),
+                    _ => {
+                        return Err(err("expected 'property <type> <name>' or \
+                             'property list <count type> <item type> <name>'"
+                            .into()))
+                    }
+                };
+                element.props.push(Property {
+                    name: String::from_utf8_lossy(name).into_owned(),
+                    kind,
+                });
+            }
+            other => return Err(err(format!("unknown keyword '{}'", lossy(other)))),
+        }
+    }
+    let format = format.ok_or(PlyErrorKind::Header {
+        line: line_no,
+        message: "no 'format' line".into(),
+    })?;
+    Ok(Header {
+        format,
+        elements,
+        data_start: pos,
+    })
+}
+
+// ---------------------------------------------------------------------------
+// What to extract from the vertex and face elements
+
+const SLOT_COUNT: usize = 8;
+
+struct VertexLayout {
+    /// For each property, which of x y z nx ny nz u v it feeds, if any.
+    slots: Vec<Option<usize>>,
+    normals: bool,
+    uvs: bool,
+}
+
+const UV_NAMES: [(&str, &str); 4] = [
+    ("u", "v"),
+    ("s", "t"),
+    ("texture_u", "texture_v"),
+    ("texture_s", "texture_t"),
+];
+
+fn vertex_layout(el: &Element) -> Result<VertexLayout, PlyErrorKind> {
+    let scalar = |name: &str| {
+        el.find(name)
+            .filter(|&i| matches!(el.props[i].kind, PropKind::Scalar(_)))
+    };
+    let mut slots = vec![None; el.props.len()];
+    for (slot, name) in ["x", "y", "z"].into_iter().enumerate() {
+        let Some(i) = el.find(name) else {
+            return Err(PlyErrorKind::MissingProperty {
+                element: "vertex",
+                property: name,
+            });
+        };
+        if scalar(name).is_none() {
+            return Err(PlyErrorKind::UnsupportedProperty {
+                element: el.name.clone(),
+                property: name.into(),
+                reason: "is a list, not a scalar",
+            });
+        }
+        slots[i] = Some(slot);
+    }
+    let normals = match (scalar("nx"), scalar("ny"), scalar("nz")) {
+        (Some(a), Some(b), Some(c)) => {
+            slots[a] = Some(3);
+            slots[b] = Some(4);
+            slots[c] = Some(5);
+            true
+        }
+        _ => false,
+    };
+    let mut uvs = false;
+    for (un, vn) in UV_NAMES {
+        if let (Some(a), Some(b)) = (scalar(un), scalar(vn)) {
+            slots[a] = Some(6);
+            slots[b] = Some(7);
+            uvs = true;
+            break;
+        }
+    }
+    Ok(VertexLayout {
+        slots,
+        normals,
+        uvs,
+    })
+}
+
+struct FaceLayout {
+    indices: usize,
+    face_index: Option<usize>,
+}
+
+fn face_layout(el: &Element) -> Result<FaceLayout, PlyErrorKind> {
+    let Some(indices) = el
+        .find("vertex_indices")
+        .or_else(|| el.find("vertex_index"))
+    else {
+        return Err(PlyErrorKind::MissingProperty {
+            element: "face",
+            property: "vertex_indices",
+        });
+    };
+    if !matches!(el.props[indices].kind, PropKind::List { .. }) {
+        return Err(PlyErrorKind::UnsupportedProperty {
+            element: el.name.clone(),
+            property: el.props[indices].name.clone(),
+            reason: "is a scalar, not a list",
+        });
+    }
+    let face_index = el.find("face_indices");
+    if let Some(i) = face_index {
+        if !matches!(el.props[i].kind, PropKind::Scalar(_)) {
+            return Err(PlyErrorKind::UnsupportedProperty {
+                element: el.name.clone(),
+                property: "face_indices".into(),
+                reason: "is a list, not a scalar",
+            });
+        }
+    }
+    Ok(FaceLayout {
+        indices,
+        face_index,
+    })
+}
+
+// ---------------------------------------------------------------------------
+// Decoding values
+
+/// Why a value could not be read; turned into a [`PlyErrorKind`] by the
+/// element loop, which knows the element and record.
+enum ReadErr {
+    Eof,
+    Bad(String),
+    Index(i64),
+}
+
+#[inline(always)]
+fn array_at<const N: usize>(b: &[u8], off: usize) -> [u8; N] {
+    let mut a = [0u8; N];
+    a.copy_from_slice(&b[off..off + N]);
+    a
+}
+
+macro_rules! decode_num {
+    ($t:ty, $n:literal, $be:expr, $b:expr, $off:expr) => {{
+        let a = array_at::<$n>($b, $off);
+        if $be {
+            <$t>::from_be_bytes(a)
+        } else {
+            <$t>::from_le_bytes(a)
+        }
+    }};
+}
+
+/// Decodes a scalar at `off` (which the caller has bounds-checked) as `f32`.
+#[inline(always)]
+fn decode_f32<const BE: bool>(ty: Scalar, b: &[u8], off: usize) -> f32 {
+    match ty {
+        Scalar::I8 => f32::from(b[off] as i8),
+        Scalar::U8 => f32::from(b[off]),
+        Scalar::I16 => f32::from(decode_num!(i16, 2, BE, b, off)),
+        Scalar::U16 => f32::from(decode_num!(u16, 2, BE, b, off)),
+        Scalar::I32 => decode_num!(i32, 4, BE, b, off) as f32,
+        Scalar::U32 => decode_num!(u32, 4, BE, b, off) as f32,
+        Scalar::F32 => decode_num!(f32, 4, BE, b, off),
+        Scalar::F64 => decode_num!(f64, 8, BE, b, off) as f32,
+    }
+}
+
+fn float_to_int(f: f64) -> Result<i64, ReadErr> {
+    if f.is_finite() && f.fract() == 0.0 && f.abs() < 9.0e15 {
+        Ok(f as i64)
+    } else {
+        Err(ReadErr::Bad(format!("expected an integer, found {f}")))
+    }
+}
+
+/// Decodes a scalar at `off` (which the caller has bounds-checked) as an integer.
+#[inline(always)]
+fn decode_int<const BE: bool>(ty: Scalar, b: &[u8], off: usize) -> Result<i64, ReadErr> {
+    Ok(match ty {
+        Scalar::I8 => i64::from(b[off] as i8),
+        Scalar::U8 => i64::from(b[off]),
+        Scalar::I16 => i64::from(decode_num!(i16, 2, BE, b, off)),
+        Scalar::U16 => i64::from(decode_num!(u16, 2, BE, b, off)),
+        Scalar::I32 => i64::from(decode_num!(i32, 4, BE, b, off)),
+        Scalar::U32 => i64::from(decode_num!(u32, 4, BE, b, off)),
+        Scalar::F32 => return float_to_int(f64::from(decode_num!(f32, 4, BE, b, off))),
+        Scalar::F64 => return float_to_int(decode_num!(f64, 8, BE, b, off)),
+    })
+}
+
+/// A stream of property values: a binary slice or ASCII tokens.
+trait Source {
+    fn remaining(&self) -> usize;
+    /// A lower bound on the bytes one record of `el` occupies.
+    fn min_record_size(&self, el: &Element) -> usize;
+    fn read_f32(&mut self, ty: Scalar) -> Result<f32, ReadErr>;
+    fn read_int(&mut self, ty: Scalar) -> Result<i64, ReadErr>;
+    fn skip(&mut self, ty: Scalar, n: u64) -> Result<(), ReadErr>;
+}
+
+struct BinarySource<'a, const BE: bool> {
+    data: &'a [u8],
+    pos: usize,
+}
+
+impl<'a, const BE: bool> BinarySource<'a, BE> {
+    #[inline(always)]
+    fn take(&mut self, n: usize) -> Result<&'a [u8], ReadErr> {
+        let end = self.pos.checked_add(n).ok_or(ReadErr::Eof)?;
+        let s = self.data.get(self.pos..end).ok_or(ReadErr::Eof)?;
+        self.pos = end;
+        Ok(s)
+    }
+}
+
+impl<const BE: bool> Source for BinarySource<'_, BE> {
+    fn remaining(&self) -> usize {
+        self.data.len().saturating_sub(self.pos)
+    }
+
+    fn min_record_size(&self, el: &Element) -> usize {
+        el.min_binary_size()
+    }
+
+    fn read_f32(&mut self, ty: Scalar) -> Result<f32, ReadErr> {
+        let b = self.take(ty.size())?;
+        Ok(decode_f32::<BE>(ty, b, 0))
+    }
+
+    fn read_int(&mut self, ty: Scalar) -> Result<i64, ReadErr> {
+        let b = self.take(ty.size())?;
+        decode_int::<BE>(ty, b, 0)
+    }
+
+    fn skip(&mut self, ty: Scalar, n: u64) -> Result<(), ReadErr> {
+        let bytes = n
+            .checked_mul(ty.size() as u64)
+            .and_then(|b| usize::try_from(b).ok())
+            .ok_or(ReadErr::Eof)?;
+        self.take(bytes).map(|_| ())
+    }
+}
+
+struct AsciiSource<'a> {
+    data: &'a [u8],
+    pos: usize,
+}
+
+impl<'a> AsciiSource<'a> {
+    fn token(&mut self) -> Option<&'a [u8]> {
+        let rest = self.data.get(self.pos..)?;
+        let start = rest.iter().position(|b| !b.is_ascii_whitespace())?;
+        let rest = &rest[start..];
+        let len = rest
+            .iter()
+            .position(|b| b.is_ascii_whitespace())
+            .unwrap_or(rest.len());
+        self.pos += start + len;
+        Some(&rest[..len])
+    }
+
+    fn text(&mut self) -> Result<&'a str, ReadErr> {
+        let tok = self.token().ok_or(ReadErr::Eof)?;
+        std::str::from_utf8(tok)
+            .map_err(|_| ReadErr::Bad(format!("invalid number '{}'", lossy(tok))))
+    }
+}
+
+impl Source for AsciiSource<'_> {
+    fn remaining(&self) -> usize {
+        self.data.len().saturating_sub(self.pos)
+    }
+
+    fn min_record_size(&self, el: &Element) -> usize {
+        // Every value is at least one character plus a separator.
+        el.props.len()
+    }
+
+    fn read_f32(&mut self, _ty: Scalar) -> Result<f32, ReadErr> {
+        let s = self.text()?;
+        s.parse::<f32>()
+            .map_err(|_| ReadErr::Bad(format!("invalid number '{}'", lossy(s.as_bytes()))))
+    }
+
+    fn read_int(&mut self, _ty: Scalar) -> Result<i64, ReadErr> {
+        let s = self.text()?;
+        match s.parse::<i64>() {
+            Ok(i) => Ok(i),
+            Err(_) => match s.parse::<f64>() {
+                Ok(f) => float_to_int(f),
+                Err(_) => Err(ReadErr::Bad(format!(
+                    "invalid integer '{}'",
+                    lossy(s.as_bytes())
+                ))),
+            },
+        }
+    }
+
+    fn skip(&mut self, _ty: Scalar, n: u64) -> Result<(), ReadErr> {
+        for _ in 0..n {
+            self.token().ok_or(ReadErr::Eof)?;
+        }
+        Ok(())
+    }
+}
+
+// ---------------------------------------------------------------------------
+// Assembling the mesh
+
+struct Builder {
+    vertex_count: u64,
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    uvs: Vec<[f32; 2]>,
+    tris: Vec<u32>,
+    quads: Vec<u32>,
+    tri_faces: Vec<i32>,
+    quad_faces: Vec<i32>,
+    /// Scratch space for the indices of one face.
+    poly: Vec<u32>,
+    fans: u64,
+    ignored: u64,
+}
+
+impl Builder {
+    #[inline]
+    fn push_vertex(&mut self, v: &[f32; SLOT_COUNT], normals: bool, uvs: bool) {
+        self.positions.push([v[0], v[1], v[2]]);
+        if normals {
+            self.normals.push([v[3], v[4], v[5]]);
+        }
+        if uvs {
+            self.uvs.push([v[6], v[7]]);
+        }
+    }
+
+    fn reserve_vertices(&mut self, n: usize, layout: &VertexLayout) {
+        self.positions.reserve(n);
+        if layout.normals {
+            self.normals.reserve(n);
+        }
+        if layout.uvs {
+            self.uvs.reserve(n);
+        }
+    }
+
+    /// Emits the face in `self.poly`.
+    fn emit_face(&mut self, face_index: Option<i32>) {
+        let p = &self.poly;
+        match p.len() {
+            0..=2 => self.ignored += 1,
+            3 => {
+                self.tris.extend_from_slice(p);
+                self.tri_faces.extend(face_index);
+            }
+            4 => {
+                self.quads.extend_from_slice(&[p[0], p[1], p[3], p[2]]);
+                self.quad_faces.extend(face_index);
+            }
+            n => {
+                for i in 1..n - 1 {
+                    self.tris.extend_from_slice(&[p[0], p[i], p[i + 1]]);
+                    self.tri_faces.extend(face_index);
+                }
+                self.fans += 1;
+            }
+        }
+    }
+
+    #[inline]
+    fn check_index(&self, i: i64) -> Result<u32, ReadErr> {
+        match u32::try_from(i) {
+            Ok(u) if u64::from(u) < self.vertex_count => Ok(u),
+            _ => Err(ReadErr::Index(i)),
+        }
+    }
+}
+
+fn map_err(e: ReadErr, el: &Element, record: u64, vertex_count: u64) -> PlyErrorKind {
+    match e {
+        ReadErr::Eof => PlyErrorKind::Truncated {
+            element: el.name.clone(),
+            expected: el.count,
+            read: record,
+        },
+        ReadErr::Bad(message) => PlyErrorKind::BadValue {
+            element: el.name.clone(),
+            record,
+            message,
+        },
+        ReadErr::Index(index) => PlyErrorKind::IndexOutOfRange {
+            face: record,
+            index,
+            vertex_count,
+        },
+    }
+}
+
+/// How many records of `el` can possibly fit in what `src` has left: caps
+/// reservations so that a lying count never drives an allocation.
+fn plausible_records<S: Source>(src: &S, el: &Element) -> usize {
+    let cap = src.remaining() / src.min_record_size(el).max(1);
+    usize::try_from(el.count).unwrap_or(usize::MAX).min(cap)
+}
+
+fn skip_property<S: Source>(src: &mut S, kind: PropKind) -> Result<(), ReadErr> {
+    match kind {
+        PropKind::Scalar(t) => src.skip(t, 1),
+        PropKind::List { count, item } => {
+            let n = src.read_int(count)?;
+            let n =
+                u64::try_from(n).map_err(|_| ReadErr::Bad(format!("negative list count {n}")))?;
+            src.skip(item, n)
+        }
+    }
+}
+
+fn skip_element<S: Source>(src: &mut S, el: &Element) -> Result<(), PlyErrorKind> {
+    if el.props.is_empty() {
+        return Ok(());
+    }
+    // Each record consumes at least one byte, so this loop is bounded by the
+    // data actually present, whatever the header claims.
+    for rec in 0..el.count {
+        for p in &el.props {
+            skip_property(src, p.kind).map_err(|e| map_err(e, el, rec, 0))?;
+        }
+    }
+    Ok(())
+}
+
+fn read_vertices_general<S: Source>(
+    src: &mut S,
+    el: &Element,
+    layout: &VertexLayout,
+    b: &mut Builder,
+) -> Result<(), PlyErrorKind> {
+    b.reserve_vertices(plausible_records(src, el), layout);
+    for rec in 0..el.count {
+        let mut v = [0.0f32; SLOT_COUNT];
+        for (p, slot) in el.props.iter().zip(&layout.slots) {
+            let r = match (p.kind, slot) {
+                (PropKind::Scalar(t), Some(s)) => src.read_f32(t).map(|x| v[*s] = x),
+                (kind, _) => skip_property(src, kind),
+            };
+            r.map_err(|e| map_err(e, el, rec, 0))?;
+        }
+        b.push_vertex(&v, layout.normals, layout.uvs);
+    }
+    Ok(())
+}
+
+fn read_face_record<S: Source>(
+    src: &mut S,
+    el: &Element,
+    layout: &FaceLayout,
+    b: &mut Builder,
+) -> Result<(), ReadErr> {
+    b.poly.clear();
+    let mut face_index = None;
+    for (i, p) in el.props.iter().enumerate() {
+        match p.kind {
+            PropKind::List { count, item } if i == layout.indices => {
+                let n = src.read_int(count)?;
+                let n = u64::try_from(n)
+                    .map_err(|_| ReadErr::Bad(format!("negative vertex count {n}")))?;
+                // Reading stops at the end of the data, so `n` needs no check.
+                for _ in 0..n {
+                    let idx = src.read_int(item)?;
+                    let idx = b.check_index(idx)?;
+                    b.poly.push(idx);
+                }
+            }
+            PropKind::Scalar(t) if Some(i) == layout.face_index => {
+                let v = src.read_int(t)?;
+                let v = i32::try_from(v)
+                    .map_err(|_| ReadErr::Bad(format!("face index {v} does not fit in 32 bits")))?;
+                face_index = Some(v);
+            }
+            kind => skip_property(src, kind)?,
+        }
+    }
+    b.emit_face(face_index);
+    Ok(())
+}
+
+fn read_faces_general<S: Source>(
+    src: &mut S,
+    el: &Element,
+    layout: &FaceLayout,
+    b: &mut Builder,
+) -> Result<(), PlyErrorKind> {
+    b.tris.reserve(plausible_records(src, el).saturating_mul(3));
+    for rec in 0..el.count {
+        read_face_record(src, el, layout, b).map_err(|e| map_err(e, el, rec, b.vertex_count))?;
+    }
+    Ok(())
+}
+
+/// Fixed-size binary vertex records: decode each field at its offset.
+fn read_vertices_fixed<const BE: bool>(
+    data: &[u8],
+    pos: &mut usize,
+    el: &Element,
+    layout: &VertexLayout,
+    record_size: usize,
+    b: &mut Builder,
+) -> Result<(), PlyErrorKind> {
+    let remaining = data.len().saturating_sub(*pos);
+    let truncated = || PlyErrorKind::Truncated {
+        element: el.name.clone(),
+        expected: el.count,
+        read: (remaining / record_size.max(1)) as u64,
+    };
+    let bytes = usize::try_from(el.count)
+        .ok()
+        .and_then(|n| n.checked_mul(record_size))
+        .filter(|&n| n <= remaining)
+        .ok_or_else(truncated)?;
+    let count = bytes / record_size.max(1);
+    let body = &data[*pos..*pos + bytes];
+    *pos += bytes;
+    b.reserve_vertices(count, layout);
+    if record_size == 0 {
+        return Ok(());
+    }
+
+    // (offset, type) of each slot; unused slots read field 0 harmlessly.
+    let mut fields = [(0usize, Scalar::U8); SLOT_COUNT];
+    let mut offset = 0;
+    for (p, slot) in el.props.iter().zip(&layout.slots) {
+        if let PropKind::Scalar(t) = p.kind {
+            if let Some(s) = slot {
+                fields[*s] = (offset, t);
+            }
+            offset += t.size();
+        }
+    }
+    let mut needed = vec![0, 1, 2];
+    if layout.normals {
+        needed.extend([3, 4, 5]);
+    }
+    if layout.uvs {
+        needed.extend([6, 7]);
+    }
+    let all_f32 = needed.iter().all(|&s| fields[s].1 == Scalar::F32);
+
+    let (normals, uvs) = (layout.normals, layout.uvs);
+    if all_f32 {
+        let f = |rec: &[u8], s: usize| decode_num!(f32, 4, BE, rec, fields[s].0);
+        for rec in body.chunks_exact(record_size) {
+            b.positions.push([f(rec, 0), f(rec, 1), f(rec, 2)]);
+            if normals {
+                b.normals.push([f(rec, 3), f(rec, 4), f(rec, 5)]);
+            }
+            if uvs {
+                b.uvs.push([f(rec, 6), f(rec, 7)]);
+            }
+        }
+    } else {
+        let f = |rec: &[u8], s: usize| decode_f32::<BE>(fields[s].1, rec, fields[s].0);
+        for rec in body.chunks_exact(record_size) {
+            b.positions.push([f(rec, 0), f(rec, 1), f(rec, 2)]);
+            if normals {
+                b.normals.push([f(rec, 3), f(rec, 4), f(rec, 5)]);
+            }
+            if uvs {
+                b.uvs.push([f(rec, 6), f(rec, 7)]);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The face layout nearly every exporter writes: `list uchar int|uint
+/// vertex_indices`, optionally followed by a 32-bit `face_indices`.
+fn fast_face_layout(el: &Element, layout: &FaceLayout) -> Option<(bool, bool)> {
+    let signed = match el.props[layout.indices].kind {
+        PropKind::List {
+            count: Scalar::U8,
+            item: Scalar::I32,
+        } => true,
+        PropKind::List {
+            count: Scalar::U8,
+            item: Scalar::U32,
+        } => false,
+        _ => return None,
+    };
+    match (layout.indices, layout.face_index, el.props.len()) {
+        (0, None, 1) => Some((signed, false)),
+        (0, Some(1), 2)
+            if matches!(
+                el.props[1].kind,
+                PropKind::Scalar(Scalar::I32) | PropKind::Scalar(Scalar::U32)
+            ) =>
+        {
+            Some((signed, true))
+        }
+        _ => None,
+    }
+}
+
+fn read_faces_fast<const BE: bool>(
+    data: &[u8],
+    pos: &mut usize,
+    el: &Element,
+    layout: &FaceLayout,
+    signed: bool,
+    with_face_index: bool,
+    b: &mut Builder,
+) -> Result<(), PlyErrorKind> {
+    let fi_len = if with_face_index { 4 } else { 0 };
+    let tri_len = 13 + fi_len;
+    let quad_len = 17 + fi_len;
+    let plausible = usize::try_from(el.count)
+        .unwrap_or(usize::MAX)
+        .min(data.len().saturating_sub(*pos) / tri_len);
+    b.tris.reserve(plausible.saturating_mul(3));
+    if with_face_index {
+        b.tri_faces.reserve(plausible);
+    }
+    // Valid indices are below `limit`; a negative `int` read as `u32` is at
+    // least 2^31 and so fails the same comparison.
+    let limit = if signed {
+        b.vertex_count.min(1 << 31)
+    } else {
+        b.vertex_count.min(1 << 32)
+    };
+    let index_err = |raw: u32| {
+        let index = if signed {
+            i64::from(raw as i32)
+        } else {
+            i64::from(raw)
+        };
+        ReadErr::Index(index)
+    };
+    let face_index = |rec: &[u8], off: usize| -> Result<i32, ReadErr> {
+        let raw = decode_num!(u32, 4, BE, rec, off);
+        if signed_face_index(el) {
+            Ok(raw as i32)
+        } else {
+            i32::try_from(raw)
+                .map_err(|_| ReadErr::Bad(format!("face index {raw} does not fit in 32 bits")))
+        }
+    };
+    let mut rec = 0u64;
+    while rec < el.count {
+        let rest = &data[*pos..];
+        let r: Result<(), ReadErr> = match rest.first() {
+            Some(3) if rest.len() >= tri_len => {
+                let i = [
+                    decode_num!(u32, 4, BE, rest, 1),
+                    decode_num!(u32, 4, BE, rest, 5),
+                    decode_num!(u32, 4, BE, rest, 9),
+                ];
+                match i.iter().find(|&&v| u64::from(v) >= limit) {
+                    Some(&bad) => Err(index_err(bad)),
+                    None => {
+                        b.tris.extend_from_slice(&i);
+                        if with_face_index {
+                            face_index(rest, 13).map(|f| b.tri_faces.push(f))
+                        } else {
+                            Ok(())
+                        }
+                    }
+                }
+                .map(|()| *pos += tri_len)
+            }
+            Some(4) if rest.len() >= quad_len => {
+                let i = [
+                    decode_num!(u32, 4, BE, rest, 1),
+                    decode_num!(u32, 4, BE, rest, 5),
+                    decode_num!(u32, 4, BE, rest, 9),
+                    decode_num!(u32, 4, BE, rest, 13),
+                ];
+                match i.iter().find(|&&v| u64::from(v) >= limit) {
+                    Some(&bad) => Err(index_err(bad)),
+                    None => {
+                        b.quads.extend_from_slice(&[i[0], i[1], i[3], i[2]]);
+                        if with_face_index {
+                            face_index(rest, 17).map(|f| b.quad_faces.push(f))
+                        } else {
+                            Ok(())
+                        }
+                    }
+                }
+                .map(|()| *pos += quad_len)
+            }
+            _ => {
+                let mut src = BinarySource::<BE> { data, pos: *pos };
+                let r = read_face_record(&mut src, el, layout, b);
+                *pos = src.pos;
+                r
+            }
+        };
+        r.map_err(|e| map_err(e, el, rec, b.vertex_count))?;
+        rec += 1;
+    }
+    Ok(())
+}
+
+fn signed_face_index(el: &Element) -> bool {
+    matches!(
+        el.props.get(1).map(|p| p.kind),
+        Some(PropKind::Scalar(Scalar::I32))
+    )
+}
+
+struct Plan {
+    vertex: usize,
+    vertex_layout: VertexLayout,
+    face: usize,
+    face_layout: FaceLayout,
+}
+
+fn plan(header: &Header) -> Result<Plan, PlyErrorKind> {
+    let find = |name| header.elements.iter().position(|e| e.name == name);
+    let vertex = find("vertex").ok_or(PlyErrorKind::MissingElement("vertex"))?;
+    let face = find("face").ok_or(PlyErrorKind::MissingElement("face"))?;
+    Ok(Plan {
+        vertex,
+        vertex_layout: vertex_layout(&header.elements[vertex])?,
+        face,
+        face_layout: face_layout(&header.elements[face])?,
+    })
+}
+
+fn read_binary<const BE: bool>(
+    data: &[u8],
+    header: &Header,
+    plan: &Plan,
+    b: &mut Builder,
+) -> Result<usize, PlyErrorKind> {
+    let mut pos = 0;
+    for (i, el) in header.elements.iter().enumerate() {
+        if i == plan.vertex {
+            if let Some(size) = el.fixed_size() {
+                read_vertices_fixed::<BE>(data, &mut pos, el, &plan.vertex_layout, size, b)?;
+                continue;
+            }
+        } else if i == plan.face {
+            if let Some((signed, fi)) = fast_face_layout(el, &plan.face_layout) {
+                read_faces_fast::<BE>(data, &mut pos, el, &plan.face_layout, signed, fi, b)?;
+                continue;
+            }
+        } else if let Some(size) = el.fixed_size() {
+            let skip = usize::try_from(el.count)
+                .ok()
+                .and_then(|n| n.checked_mul(size))
+                .filter(|&n| n <= data.len() - pos)
+                .ok_or_else(|| PlyErrorKind::Truncated {
+                    element: el.name.clone(),
+                    expected: el.count,
+                    read: ((data.len() - pos) / size.max(1)) as u64,
+                })?;
+            pos += skip;
+            continue;
+        }
+        let mut src = BinarySource::<BE> { data, pos };
+        if i == plan.vertex {
+            read_vertices_general(&mut src, el, &plan.vertex_layout, b)?;
+        } else if i == plan.face {
+            read_faces_general(&mut src, el, &plan.face_layout, b)?;
+        } else {
+            skip_element(&mut src, el)?;
+        }
+        pos = src.pos;
+    }
+    Ok(data.len() - pos)
+}
+
+fn read_ascii(
+    data: &[u8],
+    header: &Header,
+    plan: &Plan,
+    b: &mut Builder,
+) -> Result<bool, PlyErrorKind> {
+    let mut src = AsciiSource { data, pos: 0 };
+    for (i, el) in header.elements.iter().enumerate() {
+        if i == plan.vertex {
+            read_vertices_general(&mut src, el, &plan.vertex_layout, b)?;
+        } else if i == plan.face {
+            read_faces_general(&mut src, el, &plan.face_layout, b)?;
+        } else {
+            skip_element(&mut src, el)?;
+        }
+    }
+    Ok(src.token().is_some())
+}
+
+fn gunzip(bytes: &[u8]) -> Result<Vec<u8>, PlyErrorKind> {
+    // The trailer's ISIZE (uncompressed size mod 2^32) is a capacity hint;
+    // capped at a modest ratio so that a forged trailer cannot drive the
+    // allocation.
+    let hint = bytes
+        .len()
+        .checked_sub(4)
+        .and_then(|i| bytes.get(i..))
+        .map_or(0, |t| u32::from_le_bytes([t[0], t[1], t[2], t[3]]) as usize);
+    let mut out = Vec::with_capacity(hint.min(bytes.len().saturating_mul(16)));
+    flate2::read::MultiGzDecoder::new(bytes)
+        .read_to_end(&mut out)
+        .map_err(PlyErrorKind::Gzip)?;
+    Ok(out)
+}
+
+fn is_gzip(bytes: &[u8]) -> bool {
+    bytes.starts_with(&[0x1f, 0x8b])
+}
+
+fn parse_uncompressed(bytes: &[u8]) -> Result<PlyMesh, PlyErrorKind> {
+    let header = parse_header(bytes)?;
+    let plan = plan(&header)?;
+    let data = bytes.get(header.data_start..).unwrap_or(&[]);
+    let mut b = Builder {
+        vertex_count: header.elements[plan.vertex].count,
+        positions: Vec::new(),
+        normals: Vec::new(),
+        uvs: Vec::new(),
+        tris: Vec::new(),
+        quads: Vec::new(),
+        tri_faces: Vec::new(),
+        quad_faces: Vec::new(),
+        poly: Vec::new(),
+        fans: 0,
+        ignored: 0,
+    };
+    let mut warnings = Vec::new();
+    match header.format {
+        Format::Ascii => {
+            if read_ascii(data, &header, &plan, &mut b)? {
+                warnings.push("ignored trailing data after the last element".to_string());
+            }
+        }
+        Format::BinaryLittleEndian | Format::BinaryBigEndian => {
+            let trailing = if header.format == Format::BinaryBigEndian {
+                read_binary::<true>(data, &header, &plan, &mut b)?
+            } else {
+                read_binary::<false>(data, &header, &plan, &mut b)?
+            };
+            if trailing > 0 {
+                warnings.push(format!(
+                    "ignored {trailing} bytes of trailing data after the last element"
+                ));
+            }
+        }
+    }
+    if b.fans > 0 {
+        warnings.push(format!(
+            "triangulated {} faces with more than 4 vertices as triangle fans",
+            b.fans
+        ));
+    }
+    if b.ignored > 0 {
+        warnings.push(format!(
+            "ignored {} faces with fewer than 3 vertices",
+            b.ignored
+        ));
+    }
+    let non_finite = b
+        .positions
+        .iter()
+        .filter(|p| !(p[0].is_finite() && p[1].is_finite() && p[2].is_finite()))
+        .count();
+    if non_finite > 0 {
+        warnings.push(format!(
+            "{non_finite} vertices have non-finite (NaN or infinite) coordinates"
+        ));
+    }
+    let mut face_indices = Vec::new();
+    if plan.face_layout.face_index.is_some() {
+        face_indices = b.tri_faces;
+        face_indices.extend_from_slice(&b.quad_faces);
+    }
+    Ok(PlyMesh {
+        positions: b.positions,
+        normals: b.normals,
+        uvs: b.uvs,
+        tri_indices: b.tris,
+        quad_indices: b.quads,
+        face_indices,
+        warnings,
+    })
+}
+
+fn parse_any(bytes: &[u8], gzip: bool) -> Result<PlyMesh, PlyErrorKind> {
+    if gzip || is_gzip(bytes) {
+        parse_uncompressed(&gunzip(bytes)?)
+    } else {
+        parse_uncompressed(bytes)
+    }
+}
+
+fn has_gz_extension(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gz"))
+}
+
+/// Parses a PLY file held in memory; gzip-compressed data (recognised by its
+/// magic bytes) is decompressed first.
+pub fn parse_ply(bytes: &[u8]) -> Result<PlyMesh, PlyError> {
+    parse_any(bytes, false).map_err(|kind| PlyError::new(None, kind))
+}
+
+/// Reads a PLY file; files named `*.gz` or starting with the gzip magic bytes
+/// are decompressed transparently.
+pub fn read_ply(path: &Path) -> Result<PlyMesh, PlyError> {
+    let err = |kind| PlyError::new(Some(path), kind);
+    let bytes = std::fs::read(path).map_err(|e| err(PlyErrorKind::Io(e)))?;
+    parse_any(&bytes, has_gz_extension(path)).map_err(err)
+}
+
+// ---------------------------------------------------------------------------
+// Writing
+
+// `is_multiple_of` is newer than the workspace's rust-version (1.80).
+#[allow(clippy::manual_is_multiple_of)]
+fn check_mesh(mesh: &PlyMesh) -> Result<(), String> {
+    let nv = mesh.positions.len();
+    if !mesh.normals.is_empty() && mesh.normals.len() != nv {
+        return Err(format!("{} normals for {nv} vertices", mesh.normals.len()));
+    }
+    if !mesh.uvs.is_empty() && mesh.uvs.len() != nv {
+        return Err(format!("{} uvs for {nv} vertices", mesh.uvs.len()));
+    }
+    if mesh.tri_indices.len() % 3 != 0 {
+        return Err(format!(
+            "{} triangle indices is not a multiple of 3",
+            mesh.tri_indices.len()
+        ));
+    }
+    if mesh.quad_indices.len() % 4 != 0 {
+        return Err(format!(
+            "{} quad indices is not a multiple of 4",
+            mesh.quad_indices.len()
+        ));
+    }
+    let faces = mesh.triangle_count() + mesh.quad_count();
+    if !mesh.face_indices.is_empty() && mesh.face_indices.len() != faces {
+        return Err(format!(
+            "{} face indices for {faces} faces",
+            mesh.face_indices.len()
+        ));
+    }
+    let bad = mesh
+        .tri_indices
+        .iter()
+        .chain(&mesh.quad_indices)
+        .find(|&&i| i as usize >= nv);
+    if let Some(i) = bad {
+        return Err(format!("vertex index {i} out of range [0, {nv})"));
+    }
+    Ok(())
+}
+
+/// Encodes `mesh` as a `binary_little_endian` PLY file in memory: the bytes
+/// [`write_ply`] writes (before any compression).
+///
+/// Quads are written in PLY polygon order (undoing the bilinear-patch order
+/// of [`PlyMesh::quad_indices`]), so [`parse_ply`] reads back an identical mesh.
+pub fn encode_ply(mesh: &PlyMesh) -> Result<Vec<u8>, PlyError> {
+    check_mesh(mesh).map_err(|m| PlyError::new(None, PlyErrorKind::InvalidMesh(m)))?;
+    let nv = mesh.positions.len();
+    let (nt, nq) = (mesh.triangle_count(), mesh.quad_count());
+    let has_n = !mesh.normals.is_empty();
+    let has_uv = !mesh.uvs.is_empty();
+    let has_fi = !mesh.face_indices.is_empty();
+    let index_type = if nv <= i32::MAX as usize {
+        "int"
+    } else {
+        "uint"
+    };
+
+    let mut header =
+        String::from("ply\nformat binary_little_endian 1.0\ncomment written by rpbrt\n");
+    header +=
+        &format!("element vertex {nv}\nproperty float x\nproperty float y\nproperty float z\n");
+    if has_n {
+        header += "property float nx\nproperty float ny\nproperty float nz\n";
+    }
+    if has_uv {
+        header += "property float u\nproperty float v\n";
+    }
+    header += &format!(
+        "element face {}\nproperty list uchar {index_type} vertex_indices\n",
+        nt + nq
+    );
+    if has_fi {
+        header += "property int face_indices\n";
+    }
+    header += "end_header\n";
+
+    let stride = 12 + if has_n { 12 } else { 0 } + if has_uv { 8 } else { 0 };
+    let fi = if has_fi { 4 } else { 0 };
+    let mut out = Vec::with_capacity(header.len() + nv * stride + nt * (13 + fi) + nq * (17 + fi));
+    out.extend_from_slice(header.as_bytes());
+    for i in 0..nv {
+        for c in mesh.positions[i] {
+            out.extend_from_slice(&c.to_le_bytes());
+        }
+        if has_n {
+            for c in mesh.normals[i] {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        if has_uv {
+            for c in mesh.uvs[i] {
+                out.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+    }
+    let mut face = 0;
+    for t in mesh.tri_indices.chunks_exact(3) {
+        out.push(3);
+        for &i in t {
+            out.extend_from_slice(&i.to_le_bytes());
+        }
+        if has_fi {
+            out.extend_from_slice(&mesh.face_indices[face].to_le_bytes());
+        }
+        face += 1;
+    }
+    for q in mesh.quad_indices.chunks_exact(4) {
+        out.push(4);
+        for i in [q[0], q[1], q[3], q[2]] {
+            out.extend_from_slice(&i.to_le_bytes());
+        }
+        if has_fi {
+            out.extend_from_slice(&mesh.face_indices[face].to_le_bytes());
+        }
+        face += 1;
+    }
+    Ok(out)
+}
+
+/// Writes `mesh` as a `binary_little_endian` PLY file (gzip-compressed when
+/// `path` ends in `.gz`) that [`read_ply`] reads back identically.
+pub fn write_ply(path: &Path, mesh: &PlyMesh) -> Result<(), PlyError> {
+    let err = |kind| PlyError::new(Some(path), kind);
+    let bytes = encode_ply(mesh).map_err(|e| err(e.kind))?;
+    let bytes = if has_gz_extension(path) {
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+        enc.write_all(&bytes)
+            .and_then(|()| enc.finish())
+            .map_err(|e| err(PlyErrorKind::Io(e)))?
+    } else {
+        bytes
+    };
+    std::fs::write(path, bytes).map_err(|e| err(PlyErrorKind::Io(e)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Writes PLY bodies value by value in any of the three formats.
+    struct Body {
+        format: Format,
+        out: Vec<u8>,
+    }
+
+    macro_rules! put {
+        ($name:ident, $t:ty) => {
+            fn $name(&mut self, v: $t) -> &mut Self {
+                match self.format {
+                    Format::Ascii => self.out.extend_from_slice(format!("{v} ").as_bytes()),
+                    Format::BinaryLittleEndian => self.out.extend_from_slice(&v.to_le_bytes()),
+                    Format::BinaryBigEndian => self.out.extend_from_slice(&v.to_be_bytes()),
+                }
+                self
+            }
+        };
+    }
+
+    impl Body {
+        fn new(format: Format) -> Body {
+            Body {
+                format,
+                out: Vec::new(),
+            }
+        }
+        put!(i8, i8);
+        put!(u8, u8);
+        put!(i16, i16);
+        put!(u16, u16);
+        put!(i32, i32);
+        put!(u32, u32);
+        put!(f32, f32);
+        put!(f64, f64);
+        fn nl(&mut self) -> &mut Self {
+            if self.format == Format::Ascii {
+                self.out.push(b'\n');
+            }
+            self
+        }
+    }
+
+    fn format_name(f: Format) -> &'static str {
+        match f {
+            Format::Ascii => "ascii",
+            Format::BinaryLittleEndian => "binary_little_endian",
+            Format::BinaryBigEndian => "binary_big_endian",
+        }
+    }
+
+    const FORMATS: [Format; 3] = [
+        Format::Ascii,
+        Format::BinaryLittleEndian,
+        Format::BinaryBigEndian,
+    ];
+
+    fn file(format: Format, header_body: &str, body: &[u8]) -> Vec<u8> {
+        let mut v = format!(
+            "ply\nformat {} 1.0\ncomment test\n{header_body}end_header\n",
+            format_name(format)
+        )
+        .into_bytes();
+        v.extend_from_slice(body);
+        v
+    }
+
+    /// A mesh exercising most of the reader: mixed types, skipped scalar and
+    /// list properties, a skipped element between vertex and face, and faces of
+    /// 3, 4, 5 and 2 vertices.
+    fn rich_file(format: Format) -> Vec<u8> {
+        let header = "element vertex 5\n\
+            property float x\nproperty float y\nproperty float z\n\
+            property uchar confidence\n\
+            property list uchar ushort tags\n\
+            property double nx\nproperty double ny\nproperty double nz\n\
+            property float u\nproperty float v\n\
+            element material 2\nproperty list uint8 float32 rgb\nproperty int id\n\
+            element face 4\n\
+            property ushort flags\n\
+            property list uchar int vertex_indices\n\
+            property int face_indices\n";
+        let mut b = Body::new(format);
+        for i in 0..5 {
+            let f = i as f32;
+            b.f32(f).f32(f + 0.5).f32(-f).u8(200);
+            b.u8(2).u16(7).u16(9);
+            b.f64(0.0)
+                .f64(0.0)
+                .f64(1.0)
+                .f32(f * 0.25)
+                .f32(1.0 - f * 0.25)
+                .nl();
+        }
+        for m in 0..2 {
+            b.u8(3).f32(0.1).f32(0.2).f32(0.3).i32(m).nl();
+        }
+        b.u16(1).u8(3).i32(0).i32(1).i32(2).i32(10).nl();
+        b.u16(1).u8(4).i32(0).i32(1).i32(2).i32(3).i32(11).nl();
+        b.u16(1)
+            .u8(5)
+            .i32(0)
+            .i32(1)
+            .i32(2)
+            .i32(3)
+            .i32(4)
+            .i32(12)
+            .nl();
+        b.u16(1).u8(2).i32(0).i32(1).i32(13).nl();
+        file(format, header, &b.out)
+    }
+
+    #[test]
+    fn rich_file_in_every_format() {
+        for format in FORMATS {
+            let m = parse_ply(&rich_file(format)).unwrap();
+            assert_eq!(m.positions.len(), 5, "{format:?}");
+            assert_eq!(m.positions[3], [3.0, 3.5, -3.0]);
+            assert_eq!(m.normals, vec![[0.0, 0.0, 1.0]; 5]);
+            assert_eq!(m.uvs[2], [0.5, 0.5]);
+            // Triangle, then the pentagon's fan; the quad in bilinear order.
+            assert_eq!(m.tri_indices, vec![0, 1, 2, 0, 1, 2, 0, 2, 3, 0, 3, 4]);
+            assert_eq!(m.quad_indices, vec![0, 1, 3, 2]);
+            assert_eq!(m.face_indices, vec![10, 12, 12, 12, 11]);
+            assert_eq!(m.warnings.len(), 2, "{:?}", m.warnings);
+            assert!(m.warnings.iter().any(|w| w.contains("fans")));
+            assert!(m.warnings.iter().any(|w| w.contains("fewer than 3")));
+        }
+    }
+
+    fn tri_file(format: Format, vertex_props: &str, values: &[[f64; 5]]) -> Vec<u8> {
+        let header = format!(
+            "element vertex {}\n{vertex_props}element face 1\n\
+             property list uchar uint vertex_indices\n",
+            values.len()
+        );
+        let mut b = Body::new(format);
+        for v in values {
+            for &x in v {
+                b.f32(x as f32);
+            }
+            b.nl();
+        }
+        b.u8(3).u32(0).u32(1).u32(2);
+        file(format, &header, &b.out)
+    }
+
+    #[test]
+    fn uv_aliases() {
+        for (u, v) in UV_NAMES {
+            let props = format!(
+                "property float x\nproperty float y\nproperty float z\n\
+                 property float {u}\nproperty float {v}\n"
+            );
+            let vals = [
+                [0., 0., 0., 0.1, 0.2],
+                [1., 0., 0., 0.3, 0.4],
+                [0., 1., 0., 0.5, 0.6],
+            ];
+            for format in FORMATS {
+                let m = parse_ply(&tri_file(format, &props, &vals)).unwrap();
+                assert_eq!(
+                    m.uvs,
+                    vec![[0.1, 0.2], [0.3, 0.4], [0.5, 0.6]],
+                    "{u} {format:?}"
+                );
+                assert!(m.normals.is_empty());
+            }
+        }
+        // An incomplete pair is not a uv.
+        let props = "property float x\nproperty float y\nproperty float z\n\
+                     property float u\nproperty float t\n";
+        let vals = [[0.; 5]; 3];
+        let m = parse_ply(&tri_file(Format::BinaryLittleEndian, props, &vals)).unwrap();
+        assert!(m.uvs.is_empty());
+    }
+
+    #[test]
+    fn every_scalar_type() {
+        let names = [
+            ["char", "uchar", "short"],
+            ["ushort", "int", "uint"],
+            ["float", "double", "int8"],
+            ["uint8", "int16", "uint16"],
+            ["int32", "uint32", "float32"],
+            ["float64", "float", "float"],
+        ];
+        for format in FORMATS {
+            for [a, b, c] in names {
+                let header = format!(
+                    "element vertex 3\nproperty {a} x\nproperty {b} y\nproperty {c} z\n\
+                     element face 1\nproperty list uchar int vertex_indices\n"
+                );
+                let mut body = Body::new(format);
+                for i in 0..3u8 {
+                    for ty in [a, b, c] {
+                        match ty {
+                            "char" | "int8" => body.i8(i as i8 - 1),
+                            "uchar" | "uint8" => body.u8(i),
+                            "short" | "int16" => body.i16(i as i16 - 1),
+                            "ushort" | "uint16" => body.u16(i as u16),
+                            "int" | "int32" => body.i32(i as i32 - 1),
+                            "uint" | "uint32" => body.u32(i as u32),
+                            "float" | "float32" => body.f32(f32::from(i) + 0.5),
+                            _ => body.f64(f64::from(i) + 0.25),
+                        };
+                    }
+                    body.nl();
+                }
+                body.u8(3).i32(0).i32(1).i32(2);
+                let m = parse_ply(&file(format, &header, &body.out)).unwrap();
+                for (slot, ty) in [a, b, c].into_iter().enumerate() {
+                    let expect = |i: u8| match ty {
+                        "char" | "int8" | "short" | "int16" | "int" | "int32" => f32::from(i) - 1.0,
+                        "float" | "float32" => f32::from(i) + 0.5,
+                        "double" | "float64" => f32::from(i) + 0.25,
+                        _ => f32::from(i),
+                    };
+                    for i in 0..3u8 {
+                        assert_eq!(m.positions[i as usize][slot], expect(i), "{ty} {format:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    fn sample_mesh() -> PlyMesh {
+        PlyMesh {
+            positions: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.5, 0.5, 1.0],
+            ],
+            normals: vec![[0.0, 0.0, 1.0]; 5],
+            uvs: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.5, 0.5]],
+            tri_indices: vec![0, 1, 4, 1, 2, 4],
+            quad_indices: vec![0, 1, 3, 2],
+            face_indices: vec![7, 8, 9],
+            warnings: Vec::new(),
+        }
+    }
+
+    fn temp_path(name: &str) -> PathBuf {
+        std::env::temp_dir().join(format!("rpbrt-ply-test-{}-{name}", std::process::id()))
+    }
+
+    #[test]
+    fn write_read_round_trip() {
+        let mut variants = vec![sample_mesh()];
+        let mut m = sample_mesh();
+        m.normals.clear();
+        m.face_indices.clear();
+        variants.push(m);
+        let mut m = sample_mesh();
+        m.uvs.clear();
+        m.quad_indices.clear();
+        m.face_indices.truncate(2);
+        variants.push(m);
+        variants.push(PlyMesh::default());
+        for (i, mesh) in variants.iter().enumerate() {
+            let bytes = encode_ply(mesh).unwrap();
+            assert_eq!(&parse_ply(&bytes).unwrap(), mesh);
+            for name in [format!("{i}.ply"), format!("{i}.ply.gz")] {
+                let path = temp_path(&name);
+                write_ply(&path, mesh).unwrap();
+                let on_disk = std::fs::read(&path).unwrap();
+                assert_eq!(is_gzip(&on_disk), name.ends_with(".gz"));
+                assert_eq!(&read_ply(&path).unwrap(), mesh, "{name}");
+                // Gzip is recognised by its magic bytes too, whatever the name.
+                assert_eq!(&parse_ply(&on_disk).unwrap(), mesh);
+                std::fs::remove_file(&path).unwrap();
+            }
+        }
+    }
+
+    #[test]
+    fn quads_use_bilinear_patch_order() {
+        let mesh = sample_mesh();
+        let bytes = encode_ply(&mesh).unwrap();
+        // In the file the quad is a polygon 0 1 2 3.
+        let header_end = bytes
+            .windows(11)
+            .position(|w| w == b"end_header\n")
+            .unwrap()
+            + 11;
+        let quad = &bytes[header_end + 5 * 32 + 2 * 17..][..17];
+        assert_eq!(quad[0], 4);
+        let idx: Vec<i32> = quad[1..]
+            .chunks(4)
+            .map(|c| i32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        assert_eq!(idx, vec![0, 1, 2, 3]);
+        assert_eq!(parse_ply(&bytes).unwrap().quad_indices, vec![0, 1, 3, 2]);
+    }
+
+    #[test]
+    fn writer_rejects_inconsistent_meshes() {
+        let cases: [fn(&mut PlyMesh); 6] = [
+            |m| m.normals.truncate(4),
+            |m| m.uvs.push([0.0, 0.0]),
+            |m| m.tri_indices.push(0),
+            |m| m.quad_indices.push(0),
+            |m| m.face_indices.push(0),
+            |m| m.tri_indices[0] = 5,
+        ];
+        for f in cases {
+            let mut m = sample_mesh();
+            f(&mut m);
+            let e = encode_ply(&m).unwrap_err();
+            assert!(matches!(e.kind, PlyErrorKind::InvalidMesh(_)), "{e}");
+        }
+    }
+
+    #[test]
+    fn faces_before_vertices_and_general_layouts() {
+        // ushort list counts and uint indices take the general binary path.
+        for format in FORMATS {
+            let header = "element face 2\nproperty list ushort uint vertex_index\n\
+                          element vertex 4\nproperty double x\nproperty double y\nproperty double z\n\
+                          property list uchar float extra\n";
+            let mut b = Body::new(format);
+            b.u16(3).u32(0).u32(1).u32(2).nl();
+            b.u16(4).u32(0).u32(1).u32(2).u32(3).nl();
+            for i in 0..4 {
+                b.f64(i as f64).f64(0.0).f64(0.0).u8(1).f32(9.0).nl();
+            }
+            let m = parse_ply(&file(format, header, &b.out)).unwrap();
+            assert_eq!(m.positions.len(), 4);
+            assert_eq!(m.positions[3], [3.0, 0.0, 0.0]);
+            assert_eq!(m.tri_indices, vec![0, 1, 2]);
+            assert_eq!(m.quad_indices, vec![0, 1, 3, 2]);
+            assert!(m.face_indices.is_empty());
+            assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+        }
+    }
+
+    #[test]
+    fn fast_face_layout_with_face_indices_and_odd_faces() {
+        for format in FORMATS {
+            for (index_ty, fi_ty) in [("int", "int"), ("uint", "uint"), ("int", "uint")] {
+                let header = format!(
+                    "element vertex 5\nproperty float x\nproperty float y\nproperty float z\n\
+                     element face 5\nproperty list uchar {index_ty} vertex_indices\n\
+                     property {fi_ty} face_indices\n"
+                );
+                let mut b = Body::new(format);
+                for i in 0..15 {
+                    b.f32(i as f32);
+                }
+                let faces: [&[u32]; 5] = [
+                    &[0, 1, 2],
+                    &[1, 2, 3, 4],
+                    &[0, 1, 2, 3, 4],
+                    &[4],
+                    &[2, 3, 4],
+                ];
+                for (f, face) in faces.iter().enumerate() {
+                    b.u8(face.len() as u8);
+                    for &i in *face {
+                        if index_ty == "int" {
+                            b.i32(i as i32);
+                        } else {
+                            b.u32(i);
+                        }
+                    }
+                    if fi_ty == "int" {
+                        b.i32(100 + f as i32);
+                    } else {
+                        b.u32(100 + f as u32);
+                    }
+                    b.nl();
+                }
+                let m = parse_ply(&file(format, &header, &b.out)).unwrap();
+                assert_eq!(m.positions[4], [12.0, 13.0, 14.0]);
+                assert_eq!(
+                    m.tri_indices,
+                    vec![0, 1, 2, 0, 1, 2, 0, 2, 3, 0, 3, 4, 2, 3, 4]
+                );
+                assert_eq!(m.quad_indices, vec![1, 2, 4, 3]);
+                assert_eq!(m.face_indices, vec![100, 102, 102, 102, 104, 101]);
+                assert_eq!(m.warnings.len(), 2, "{:?}", m.warnings);
+            }
+        }
+        // A uint face index beyond i32 is reported, not wrapped.
+        let header = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                      element face 1\nproperty list uchar int vertex_indices\n\
+                      property uint face_indices\n";
+        let mut b = Body::new(Format::BinaryLittleEndian);
+        for _ in 0..9 {
+            b.f32(0.0);
+        }
+        b.u8(3).i32(0).i32(1).i32(2).u32(u32::MAX);
+        assert!(matches!(
+            err_kind(&file(Format::BinaryLittleEndian, header, &b.out)),
+            PlyErrorKind::BadValue { .. }
+        ));
+    }
+
+    #[test]
+    fn crlf_header_and_trailing_data() {
+        let mut bytes = encode_ply(&sample_mesh()).unwrap();
+        let text = String::from_utf8_lossy(&bytes).into_owned();
+        let header_len = text.find("end_header\n").unwrap() + 11;
+        let crlf = text[..header_len].replace('\n', "\r\n");
+        let mut v = crlf.into_bytes();
+        v.extend_from_slice(&bytes[header_len..]);
+        let m = parse_ply(&v).unwrap();
+        assert_eq!(m, sample_mesh());
+        bytes.extend_from_slice(b"junk");
+        let m = parse_ply(&bytes).unwrap();
+        assert_eq!(m.warnings.len(), 1);
+        assert!(m.warnings[0].contains("4 bytes"));
+    }
+
+    #[test]
+    fn non_finite_coordinates_are_kept_with_a_warning() {
+        let mut mesh = sample_mesh();
+        mesh.positions[1][2] = f32::NAN;
+        mesh.positions[2][0] = f32::INFINITY;
+        let m = parse_ply(&encode_ply(&mesh).unwrap()).unwrap();
+        assert!(m.positions[1][2].is_nan());
+        assert_eq!(m.positions[2][0], f32::INFINITY);
+        assert_eq!(m.warnings.len(), 1);
+        assert!(m.warnings[0].starts_with("2 vertices"), "{:?}", m.warnings);
+    }
+
+    fn err_kind(bytes: &[u8]) -> PlyErrorKind {
+        match parse_ply(bytes) {
+            Ok(m) => panic!("expected an error, got {m:?}"),
+            Err(e) => {
+                assert!(e.to_string().starts_with("<memory>: "), "{e}");
+                e.kind
+            }
+        }
+    }
+
+    #[test]
+    fn header_errors() {
+        assert!(matches!(err_kind(b""), PlyErrorKind::BadMagic));
+        assert!(matches!(err_kind(b"plyx\n"), PlyErrorKind::BadMagic));
+        assert!(matches!(
+            err_kind(b"PLY\nformat ascii 1.0\n"),
+            PlyErrorKind::BadMagic
+        ));
+        let cases: &[(&str, usize)] = &[
+            ("format ascii 1.0\nelement vertex 3\n", 3),
+            ("format ascii 2.0\nend_header\n", 2),
+            ("format utf8 1.0\nend_header\n", 2),
+            ("format ascii 1.0\nformat ascii 1.0\nend_header\n", 3),
+            ("element vertex 3\nend_header\n", 3),
+            ("format ascii 1.0\nproperty float x\nend_header\n", 3),
+            ("format ascii 1.0\nelement vertex -3\nend_header\n", 3),
+            (
+                "format ascii 1.0\nelement vertex 99999999999999999999999\nend_header\n",
+                3,
+            ),
+            ("format ascii 1.0\nelement vertex\nend_header\n", 3),
+            (
+                "format ascii 1.0\nelement vertex 1\nproperty float128 x\nend_header\n",
+                4,
+            ),
+            (
+                "format ascii 1.0\nelement vertex 1\nproperty list float int x\nend_header\n",
+                4,
+            ),
+            (
+                "format ascii 1.0\nelement vertex 1\nproperty list int x\nend_header\n",
+                4,
+            ),
+            (
+                "format ascii 1.0\nelement vertex 1\nelement vertex 1\nend_header\n",
+                4,
+            ),
+            ("format ascii 1.0\nvertices 3\nend_header\n", 3),
+        ];
+        for (text, line) in cases {
+            let bytes = format!("ply\n{text}");
+            match err_kind(bytes.as_bytes()) {
+                PlyErrorKind::Header { line: l, .. } => assert_eq!(l, *line, "{text}"),
+                k => panic!("{text}: unexpected {k}"),
+            }
+        }
+    }
+
+    #[test]
+    fn structural_errors() {
+        let xyz = "property float x\nproperty float y\nproperty float z\n";
+        let faces = "element face 0\nproperty list uchar int vertex_indices\n";
+        let f = |h: String| file(Format::BinaryLittleEndian, &h, &[]);
+        assert!(matches!(
+            err_kind(&f(format!("element vertex 0\n{xyz}"))),
+            PlyErrorKind::MissingElement("face")
+        ));
+        assert!(matches!(
+            err_kind(&f(faces.to_string())),
+            PlyErrorKind::MissingElement("vertex")
+        ));
+        assert!(matches!(
+            err_kind(&f(format!(
+                "element vertex 0\nproperty float x\nproperty float z\n{faces}"
+            ))),
+            PlyErrorKind::MissingProperty { property: "y", .. }
+        ));
+        assert!(matches!(
+            err_kind(&f(format!(
+                "element vertex 0\nproperty float x\nproperty float y\n\
+                 property list uchar float z\n{faces}"
+            ))),
+            PlyErrorKind::UnsupportedProperty { .. }
+        ));
+        assert!(matches!(
+            err_kind(&f(format!(
+                "element vertex 0\n{xyz}element face 0\nproperty list uchar int indices\n"
+            ))),
+            PlyErrorKind::MissingProperty {
+                property: "vertex_indices",
+                ..
+            }
+        ));
+        assert!(matches!(
+            err_kind(&f(format!(
+                "element vertex 0\n{xyz}element face 0\nproperty int vertex_indices\n"
+            ))),
+            PlyErrorKind::UnsupportedProperty { .. }
+        ));
+        assert!(matches!(
+            err_kind(&f(format!(
+                "element vertex 0\n{xyz}{faces}property list uchar int face_indices\n"
+            ))),
+            PlyErrorKind::UnsupportedProperty { .. }
+        ));
+        // Zero vertices and faces is a valid, empty mesh.
+        let m = parse_ply(&f(format!("element vertex 0\n{xyz}{faces}"))).unwrap();
+        assert_eq!(m, PlyMesh::default());
+    }
+
+    #[test]
+    fn truncation_is_reported_with_counts() {
+        for format in FORMATS {
+            let full = rich_file(format);
+            let header_len = full.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+            let mut truncations = 0;
+            for cut in header_len..full.len() {
+                let cut_bytes = &full[..cut];
+                match parse_ply(cut_bytes) {
+                    Err(PlyError {
+                        kind:
+                            PlyErrorKind::Truncated {
+                                element,
+                                expected,
+                                read,
+                            },
+                        ..
+                    }) => {
+                        let n = match element.as_str() {
+                            "vertex" => 5,
+                            "material" => 2,
+                            "face" => 4,
+                            e => panic!("{e}"),
+                        };
+                        assert_eq!(expected, n);
+                        assert!(read < n);
+                        truncations += 1;
+                    }
+                    // ASCII cut inside the final number still parses.
+                    Ok(_) if format == Format::Ascii && cut + 4 >= full.len() => {}
+                    // ASCII cut right after a minus sign.
+                    Err(PlyError {
+                        kind: PlyErrorKind::BadValue { message, .. },
+                        ..
+                    }) if format == Format::Ascii && message.contains("'-'") => {}
+                    other => panic!("{format:?} cut at {cut}: {other:?}"),
+                }
+            }
+            assert!(truncations > 10);
+        }
+    }
+
+    #[test]
+    fn truncated_vertices_message() {
+        let mut mesh = sample_mesh();
+        mesh.positions.resize(10, [0.0; 3]);
+        mesh.normals.clear();
+        mesh.uvs.clear();
+        let bytes = encode_ply(&mesh).unwrap();
+        let header_len = bytes
+            .windows(11)
+            .position(|w| w == b"end_header\n")
+            .unwrap()
+            + 11;
+        let path = temp_path("truncated.ply");
+        std::fs::write(&path, &bytes[..header_len + 12 * 7 + 5]).unwrap();
+        let e = read_ply(&path).unwrap_err();
+        std::fs::remove_file(&path).unwrap();
+        let msg = e.to_string();
+        assert!(msg.starts_with(&path.display().to_string()), "{msg}");
+        assert!(
+            msg.ends_with("expected 10 vertices, file ends after 7"),
+            "{msg}"
+        );
+        let missing = read_ply(&temp_path("does-not-exist.ply")).unwrap_err();
+        assert!(matches!(missing.kind, PlyErrorKind::Io(_)));
+        assert!(missing.to_string().contains("does-not-exist.ply"));
+    }
+
+    #[test]
+    fn index_out_of_range() {
+        for format in FORMATS {
+            for (count_ty, index_ty, bad) in [
+                ("uchar", "int", 3i64),
+                ("uchar", "int", -1),
+                ("uchar", "uint", 3),
+                ("ushort", "int", 3),
+                ("ushort", "int", -2),
+                ("uchar", "short", -5),
+            ] {
+                for quad in [false, true] {
+                    let header = format!(
+                        "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                         element face 2\nproperty list {count_ty} {index_ty} vertex_indices\n"
+                    );
+                    let mut b = Body::new(format);
+                    for _ in 0..9 {
+                        b.f32(0.0);
+                    }
+                    let count = |b: &mut Body, n: u8| {
+                        if count_ty == "uchar" {
+                            b.u8(n);
+                        } else {
+                            b.u16(u16::from(n));
+                        }
+                    };
+                    let idx = |b: &mut Body, i: i64| {
+                        match index_ty {
+                            "int" => b.i32(i as i32),
+                            "uint" => b.u32(i as u32),
+                            _ => b.i16(i as i16),
+                        };
+                    };
+                    count(&mut b, 3);
+                    for i in 0..3 {
+                        idx(&mut b, i);
+                    }
+                    count(&mut b, if quad { 4 } else { 3 });
+                    idx(&mut b, 0);
+                    idx(&mut b, bad);
+                    idx(&mut b, 1);
+                    if quad {
+                        idx(&mut b, 2);
+                    }
+                    match err_kind(&file(format, &header, &b.out)) {
+                        PlyErrorKind::IndexOutOfRange {
+                            face,
+                            index,
+                            vertex_count,
+                        } => {
+                            assert_eq!((face, index, vertex_count), (1, bad, 3));
+                        }
+                        k => panic!("{format:?} {count_ty} {index_ty}: {k}"),
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn bad_values() {
+        let header = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+                      element face 1\nproperty list uchar int vertex_indices\n";
+        let body = b"0 0 0\n1 0 zero\n0 1 0\n3 0 1 2\n";
+        match err_kind(&file(Format::Ascii, header, body)) {
+            PlyErrorKind::BadValue {
+                element, record, ..
+            } => assert_eq!((element.as_str(), record), ("vertex", 1)),
+            k => panic!("{k}"),
+        }
+        let body = b"0 0 0\n1 0 0\n0 1 0\n3 0 1.5 2\n";
+        assert!(matches!(
+            err_kind(&file(Format::Ascii, header, body)),
+            PlyErrorKind::BadValue { .. }
+        ));
+        let body = b"0 0 0\n1 0 0\n0 1 0\n-3 0 1 2\n";
+        assert!(matches!(
+            err_kind(&file(Format::Ascii, header, body)),
+            PlyErrorKind::BadValue { .. }
+        ));
+        // Integral floats are fine as indices.
+        let body = b"0 0 0\n1 0 0\n0 1 0\n3 0 1.0 2e0\n";
+        let m = parse_ply(&file(Format::Ascii, header, body)).unwrap();
+        assert_eq!(m.tri_indices, vec![0, 1, 2]);
+    }
+
+    #[test]
+    fn absurd_counts_fail_fast_without_allocating() {
+        let xyz = "property float x\nproperty float y\nproperty float z\n";
+        let faces = "property list uchar int vertex_indices\n";
+        let start = std::time::Instant::now();
+        for format in FORMATS {
+            for header in [
+                format!("element vertex 2147483648\n{xyz}element face 1\n{faces}"),
+                format!("element vertex 18446744073709551615\n{xyz}element face 1\n{faces}"),
+                format!("element vertex 3\n{xyz}element face 1099511627776\n{faces}"),
+                format!(
+                    "element junk 1152921504606846976\nproperty list uint uint a\n\
+                     element vertex 3\n{xyz}element face 1\n{faces}"
+                ),
+                format!(
+                    "element junk 1152921504606846976\nproperty double a\n\
+                     element vertex 3\n{xyz}element face 1\n{faces}"
+                ),
+            ] {
+                let mut b = Body::new(format);
+                for i in 0..9 {
+                    b.f32(i as f32);
+                }
+                b.u8(3).i32(0).i32(1).i32(2);
+                let bytes = file(format, &header, &b.out);
+                assert!(bytes.len() < 400);
+                match err_kind(&bytes) {
+                    PlyErrorKind::Truncated { .. } => {}
+                    k => panic!("{format:?} {header}: {k}"),
+                }
+            }
+            // A zero-property element may claim any count.
+            let header = format!(
+                "element nothing 18446744073709551615\nelement vertex 0\n{xyz}element face 0\n{faces}"
+            );
+            assert!(parse_ply(&file(format, &header, &[])).is_ok());
+        }
+        assert!(start.elapsed().as_secs_f64() < 5.0);
+    }
+
+    #[test]
+    fn bad_gzip() {
+        let gz = {
+            let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+            enc.write_all(&encode_ply(&sample_mesh()).unwrap()).unwrap();
+            enc.finish().unwrap()
+        };
+        assert_eq!(parse_ply(&gz).unwrap(), sample_mesh());
+        assert!(matches!(
+            err_kind(&gz[..gz.len() / 2]),
+            PlyErrorKind::Gzip(_)
+        ));
+        let path = temp_path("plain-named.ply.gz");
+        std::fs::write(&path, encode_ply(&sample_mesh()).unwrap()).unwrap();
+        let e = read_ply(&path).unwrap_err();
+        std::fs::remove_file(&path).unwrap();
+        assert!(matches!(e.kind, PlyErrorKind::Gzip(_)), "{e}");
+    }
+
+    struct XorShift(u64);
+    impl XorShift {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            self.0
+        }
+        fn below(&mut self, n: usize) -> usize {
+            (self.next() % n.max(1) as u64) as usize
+        }
+    }
+
+    #[test]
+    fn mutation_fuzz_never_panics() {
+        let mut rng = XorShift(0x9e37_79b9_7f4a_7c15);
+        let seeds = [
+            rich_file(Format::Ascii),
+            rich_file(Format::BinaryLittleEndian),
+            rich_file(Format::BinaryBigEndian),
+            encode_ply(&sample_mesh()).unwrap(),
+            {
+                let mut enc =
+                    flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+                enc.write_all(&rich_file(Format::BinaryLittleEndian))
+                    .unwrap();
+                enc.finish().unwrap()
+            },
+        ];
+        let mut ok = 0;
+        for iter in 0..6000 {
+            let mut bytes = seeds[iter % seeds.len()].clone();
+            for _ in 0..1 + rng.below(4) {
+                let header_len = bytes
+                    .windows(10)
+                    .position(|w| w == b"end_header")
+                    .unwrap_or(bytes.len());
+                match rng.below(6) {
+                    // Flip a byte anywhere.
+                    0 | 1 => {
+                        let i = rng.below(bytes.len());
+                        bytes[i] ^= 1 << rng.below(8);
+                    }
+                    // Replace a byte in the header with a digit or space.
+                    2 => {
+                        let i = rng.below(header_len);
+                        bytes[i] = b"0123456789 9\n"[rng.below(13)];
+                    }
+                    // Random byte in the body.
+                    3 => {
+                        if header_len < bytes.len() {
+                            let i = header_len + rng.below(bytes.len() - header_len);
+                            bytes[i] = rng.next() as u8;
+                        }
+                    }
+                    // Truncate.
+                    4 => {
+                        let n = rng.below(bytes.len());
+                        bytes.truncate(n.max(1));
+                    }
+                    // Insert digits into a header count.
+                    _ => {
+                        let i = rng.below(header_len);
+                        for _ in 0..rng.below(12) {
+                            bytes.insert(i, b'9');
+                        }
+                    }
+                }
+            }
+            if let Ok(m) = parse_ply(&bytes) {
+                ok += 1;
+                let nv = m.positions.len() as u32;
+                assert!(m.tri_indices.iter().chain(&m.quad_indices).all(|&i| i < nv));
+                assert!(m.normals.is_empty() || m.normals.len() == m.positions.len());
+                assert!(m.uvs.is_empty() || m.uvs.len() == m.positions.len());
+                assert_eq!(m.tri_indices.len() % 3, 0);
+                assert_eq!(m.quad_indices.len() % 4, 0);
+            }
+        }
+        // Some mutations (e.g. of float payloads) leave the file valid.
+        assert!(ok > 100, "{ok}");
+    }
+
+    fn shared_dir() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes")
+    }
+
+    #[test]
+    fn real_scene_files_if_present() {
+        let dirs = [
+            "water-caustic/models",
+            "caustic-glass/geometry",
+            "killeroos/geometry",
+        ];
+        let mut checked = 0;
+        for dir in dirs {
+            let Ok(entries) = std::fs::read_dir(shared_dir().join(dir)) else {
+                continue;
+            };
+            for entry in entries.flatten() {
+                let path = entry.path();
+                let name = path.to_string_lossy().to_string();
+                if !(name.ends_with(".ply") || name.ends_with(".ply.gz")) {
+                    continue;
+                }
+                let m = read_ply(&path).unwrap_or_else(|e| panic!("{e}"));
+                assert!(!m.positions.is_empty(), "{name}");
+                assert!(m.triangle_count() + m.quad_count() > 0, "{name}");
+                assert!(m.warnings.is_empty(), "{name}: {:?}", m.warnings);
+                for n in &m.normals {
+                    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+                    assert!((len - 1.0).abs() < 1e-2 || len == 0.0, "{name}: {n:?}");
+                }
+                assert_eq!(parse_ply(&encode_ply(&m).unwrap()).unwrap(), m, "{name}");
+                checked += 1;
+            }
+        }
+        let mesh001 = shared_dir().join("water-caustic/models/Mesh001.ply");
+        if mesh001.exists() {
+            let m = read_ply(&mesh001).unwrap();
+            assert_eq!(m.positions.len(), 63768);
+            assert_eq!(m.normals.len(), 63768);
+            assert_eq!(m.uvs.len(), 63768);
+            assert_eq!(m.triangle_count(), 102938);
+        }
+        eprintln!("checked {checked} shared PLY files");
+    }
+}
