@@ -25,7 +25,7 @@ pub mod upgrade;
 
 pub use diag::{Diagnostic, Diagnostics, Severity, SourceMap};
 pub use driver::{parse_files, parse_string, read_scene_file, ParseOptions, Parser};
-// pub use format::FormattingTarget;
+pub use format::FormattingTarget;
 pub use loc::FileLoc;
 pub use params::{ParamError, ParameterDictionary, ParsedParameter, SpectrumValue, ValueKind};
 pub use target::{DirectiveResult, IncludeKind, ParamList, ParserTarget};
