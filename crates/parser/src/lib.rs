@@ -1,4 +1,33 @@
-//! Tokenizer and parser for pbrt-v4 and pbrt-v3 scene files.
+//! Tokenizer and parser for pbrt-v4 and pbrt-v3 scene files (book appendix C,
+//! pbrt-v4 `parser.h/.cpp`, `paramdict.h/.cpp`, `upgrade.cpp`).
+//!
+//! - [`Tokenizer`]: zero-copy tokens over an in-memory buffer, each with its
+//!   [`FileLoc`].
+//! - [`ParsedParameter`] / [`ParameterDictionary`]: parameter lists and typed,
+//!   usage-tracking access to them.
+//! - [`ParserTarget`]: one method per directive; [`parse_files`] and
+//!   [`parse_string`] drive it, following `Include`/`Import`.
+//! - [`Diagnostic`] / [`Diagnostics`]: located errors and warnings, rendered
+//!   with the source line and a caret.
+//! - [`FormattingTarget`]: prints a scene back as canonical pbrt-v4 text,
+//!   optionally upgrading pbrt-v3 constructs with the mappings in [`upgrade`].
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
+
+pub mod diag;
+pub mod driver;
+pub mod format;
+pub mod loc;
+pub mod params;
 pub mod ply;
+pub mod target;
+pub mod tokenizer;
+pub mod upgrade;
+
+pub use diag::{Diagnostic, Diagnostics, Severity, SourceMap};
+pub use driver::{parse_files, parse_string, read_scene_file, ParseOptions, Parser};
+pub use format::FormattingTarget;
+pub use loc::FileLoc;
+pub use params::{ParamError, ParameterDictionary, ParsedParameter, SpectrumValue, ValueKind};
+pub use target::{DirectiveResult, IncludeKind, ParamList, ParserTarget};
+pub use tokenizer::{Token, TokenKind, Tokenizer};

@@ -1,0 +1,982 @@
+//! The parser driver: reads files (gzip-aware), follows `Include`/`Import`
+//! relative to the including file, turns tokens into directive calls on a
+//! [`ParserTarget`] and collects diagnostics (pbrt-v4 `parser.cpp`,
+//! `parse`, `ParseFiles`, `ParseString`; book section C.2).
+//!
+//! Parsing is a flat loop over tokens with an explicit file stack, so deep
+//! nesting or long files cannot overflow the call stack. After an error the
+//! parser skips to the next directive keyword and continues, stopping after
+//! [`ParseOptions::max_errors`] errors.
+
+use std::collections::HashSet;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use crate::diag::{Diagnostic, Diagnostics, Severity};
+use crate::loc::FileLoc;
+use crate::params::{split_declaration, value_kind, ParsedParameter, ValueKind};
+use crate::target::{IncludeKind, ParserTarget};
+use crate::tokenizer::{escape_string, Token, TokenKind, Tokenizer};
+
+/// Limits and settings for one parse.
+#[derive(Clone, Debug)]
+pub struct ParseOptions {
+    /// Stop after this many errors (a note says so).
+    pub max_errors: usize,
+    /// Keep at most this many warnings (a note says how many were dropped).
+    pub max_warnings: usize,
+    /// Maximum `Include` nesting depth.
+    pub max_include_depth: usize,
+    /// Maximum number of values in one parameter.
+    pub max_values: usize,
+    /// Largest file (after decompression) the parser will read, in bytes.
+    pub max_file_bytes: u64,
+}
+
+impl Default for ParseOptions {
+    fn default() -> Self {
+        ParseOptions {
+            max_errors: 20,
+            max_warnings: 1000,
+            max_include_depth: 64,
+            max_values: 1 << 30,
+            max_file_bytes: 1 << 36,
+        }
+    }
+}
+
+/// Reads a scene file, decompressing it when it starts with the gzip magic
+/// bytes (whatever its extension).
+pub fn read_scene_file(path: impl AsRef<Path>) -> std::io::Result<Vec<u8>> {
+    read_limited(path.as_ref(), ParseOptions::default().max_file_bytes)
+}
+
+fn read_limited(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
+    let raw = std::fs::read(path)?;
+    if raw.starts_with(&[0x1f, 0x8b]) {
+        let mut out = Vec::with_capacity(raw.len() * 4);
+        flate2::read::MultiGzDecoder::new(&raw[..])
+            .take(limit.saturating_add(1))
+            .read_to_end(&mut out)?;
+        if out.len() as u64 > limit {
+            return Err(std::io::Error::other(format!(
+                "decompressed size exceeds the limit of {limit} bytes"
+            )));
+        }
+        Ok(out)
+    } else if raw.len() as u64 > limit {
+        Err(std::io::Error::other(format!(
+            "file size exceeds the limit of {limit} bytes"
+        )))
+    } else {
+        Ok(raw)
+    }
+}
+
+/// Parses the given files in order, then calls `end_of_files`.
+///
+/// `Ok` carries the warnings; `Err` carries every diagnostic when at least
+/// one error was reported (by the parser or by the target).
+pub fn parse_files<P: AsRef<Path>>(
+    paths: &[P],
+    target: &mut dyn ParserTarget,
+) -> Result<Diagnostics, Diagnostics> {
+    Parser::new(ParseOptions::default()).parse_files(paths, target)
+}
+
+/// Parses scene text held in memory (reported as `<string>`, includes
+/// resolved against the current directory), then calls `end_of_files`.
+pub fn parse_string(text: &str, target: &mut dyn ParserTarget) -> Result<Diagnostics, Diagnostics> {
+    Parser::new(ParseOptions::default()).parse_bytes(
+        "<string>",
+        text.as_bytes().into(),
+        Path::new("."),
+        target,
+    )
+}
+
+/// A parser with explicit [`ParseOptions`].
+#[derive(Clone, Debug, Default)]
+pub struct Parser {
+    /// The limits used.
+    pub options: ParseOptions,
+}
+
+impl Parser {
+    /// A parser with the given options.
+    pub fn new(options: ParseOptions) -> Self {
+        Parser { options }
+    }
+
+    /// See [`parse_files`].
+    pub fn parse_files<P: AsRef<Path>>(
+        &self,
+        paths: &[P],
+        target: &mut dyn ParserTarget,
+    ) -> Result<Diagnostics, Diagnostics> {
+        let mut run = Run::new(&self.options, target);
+        for path in paths {
+            if run.stopped {
+                break;
+            }
+            let path = path.as_ref();
+            match run.open(path) {
+                Ok(src) => {
+                    run.push(src);
+                    run.run();
+                }
+                Err(msg) => run.report(Diagnostic::unlocated_error(msg)),
+            }
+        }
+        run.finish()
+    }
+
+    /// Parses `data` as a file called `name`, resolving includes against `dir`.
+    pub fn parse_bytes(
+        &self,
+        name: &str,
+        data: Arc<[u8]>,
+        dir: &Path,
+        target: &mut dyn ParserTarget,
+    ) -> Result<Diagnostics, Diagnostics> {
+        let mut run = Run::new(&self.options, target);
+        run.push(Source {
+            tok: Tokenizer::new(Arc::from(name), data),
+            dir: dir.to_path_buf(),
+            canon: None,
+        });
+        run.run();
+        run.finish()
+    }
+}
+
+struct Source {
+    tok: Tokenizer,
+    dir: PathBuf,
+    canon: Option<PathBuf>,
+}
+
+/// An error was reported; abandon the directive and resynchronize.
+struct Abort;
+
+type P<T> = Result<T, Abort>;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Directive {
+    Accelerator,
+    ActiveTransform,
+    AreaLightSource,
+    Attribute,
+    AttributeBegin,
+    AttributeEnd,
+    Camera,
+    ColorSpace,
+    ConcatTransform,
+    CoordSysTransform,
+    CoordinateSystem,
+    Film,
+    Identity,
+    Import,
+    Include,
+    Integrator,
+    LightSource,
+    LookAt,
+    MakeNamedMaterial,
+    MakeNamedMedium,
+    Material,
+    MediumInterface,
+    NamedMaterial,
+    ObjectBegin,
+    ObjectEnd,
+    ObjectInstance,
+    Option,
+    PixelFilter,
+    ReverseOrientation,
+    Rotate,
+    Sampler,
+    Scale,
+    Shape,
+    Texture,
+    Transform,
+    TransformBegin,
+    TransformEnd,
+    TransformTimes,
+    Translate,
+    WorldBegin,
+    WorldEnd,
+}
+
+const DIRECTIVES: &[(&str, Directive)] = &[
+    ("Accelerator", Directive::Accelerator),
+    ("ActiveTransform", Directive::ActiveTransform),
+    ("AreaLightSource", Directive::AreaLightSource),
+    ("Attribute", Directive::Attribute),
+    ("AttributeBegin", Directive::AttributeBegin),
+    ("AttributeEnd", Directive::AttributeEnd),
+    ("Camera", Directive::Camera),
+    ("ColorSpace", Directive::ColorSpace),
+    ("ConcatTransform", Directive::ConcatTransform),
+    ("CoordSysTransform", Directive::CoordSysTransform),
+    ("CoordinateSystem", Directive::CoordinateSystem),
+    ("Film", Directive::Film),
+    ("Identity", Directive::Identity),
+    ("Import", Directive::Import),
+    ("Include", Directive::Include),
+    ("Integrator", Directive::Integrator),
+    ("LightSource", Directive::LightSource),
+    ("LookAt", Directive::LookAt),
+    ("MakeNamedMaterial", Directive::MakeNamedMaterial),
+    ("MakeNamedMedium", Directive::MakeNamedMedium),
+    ("Material", Directive::Material),
+    ("MediumInterface", Directive::MediumInterface),
+    ("NamedMaterial", Directive::NamedMaterial),
+    ("ObjectBegin", Directive::ObjectBegin),
+    ("ObjectEnd", Directive::ObjectEnd),
+    ("ObjectInstance", Directive::ObjectInstance),
+    ("Option", Directive::Option),
+    ("PixelFilter", Directive::PixelFilter),
+    ("ReverseOrientation", Directive::ReverseOrientation),
+    ("Rotate", Directive::Rotate),
+    ("Sampler", Directive::Sampler),
+    ("Scale", Directive::Scale),
+    ("Shape", Directive::Shape),
+    ("Texture", Directive::Texture),
+    ("Transform", Directive::Transform),
+    ("TransformBegin", Directive::TransformBegin),
+    ("TransformEnd", Directive::TransformEnd),
+    ("TransformTimes", Directive::TransformTimes),
+    ("Translate", Directive::Translate),
+    ("WorldBegin", Directive::WorldBegin),
+    ("WorldEnd", Directive::WorldEnd),
+];
+
+fn lookup_directive(word: &[u8]) -> Option<Directive> {
+    // Directive names start with an upper-case letter; numbers (the common
+    // case inside meshes) are rejected by the first byte.
+    if !word.first().is_some_and(u8::is_ascii_uppercase) {
+        return None;
+    }
+    DIRECTIVES
+        .iter()
+        .find(|(n, _)| n.as_bytes() == word)
+        .map(|&(_, d)| d)
+}
+
+/// Names of all directives the parser knows, for suggestions and tools.
+pub fn directive_names() -> impl Iterator<Item = &'static str> {
+    DIRECTIVES.iter().map(|(n, _)| *n)
+}
+
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, &cb) in b.iter().enumerate() {
+            let cost = usize::from(ca != cb);
+            cur[j + 1] = (prev[j] + cost).min(prev[j + 1] + 1).min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+/// The known directive closest to `word`, if it is close enough to be a typo.
+fn suggest(word: &str) -> Option<&'static str> {
+    if word.len() > 40 {
+        return None;
+    }
+    let lower = word.to_ascii_lowercase();
+    directive_names()
+        .map(|n| (edit_distance(&lower, &n.to_ascii_lowercase()), n))
+        .filter(|&(d, n)| d <= 2.max(n.len() / 5))
+        .min_by_key(|&(d, _)| d)
+        .map(|(_, n)| n)
+}
+
+struct Run<'a> {
+    opts: &'a ParseOptions,
+    target: &'a mut dyn ParserTarget,
+    stack: Vec<Source>,
+    unget: Option<Token>,
+    diags: Diagnostics,
+    errors: usize,
+    warnings: usize,
+    dropped_warnings: usize,
+    stopped: bool,
+    warned_transform_begin: bool,
+    kept: HashSet<Arc<str>>,
+}
+
+impl<'a> Run<'a> {
+    fn new(opts: &'a ParseOptions, target: &'a mut dyn ParserTarget) -> Self {
+        Run {
+            opts,
+            target,
+            stack: Vec::new(),
+            unget: None,
+            diags: Diagnostics::new(),
+            errors: 0,
+            warnings: 0,
+            dropped_warnings: 0,
+            stopped: false,
+            warned_transform_begin: false,
+            kept: HashSet::new(),
+        }
+    }
+
+    fn report(&mut self, d: Diagnostic) {
+        if self.stopped {
+            return;
+        }
+        match d.severity {
+            Severity::Warning => {
+                if self.warnings >= self.opts.max_warnings {
+                    self.dropped_warnings += 1;
+                    return;
+                }
+                self.warnings += 1;
+            }
+            Severity::Error => self.errors += 1,
+        }
+        self.diags.push(d);
+        if self.errors >= self.opts.max_errors {
+            self.diags.push(Diagnostic::unlocated_error(format!(
+                "too many errors ({}); stopping",
+                self.errors
+            )));
+            self.stopped = true;
+        }
+    }
+
+    fn finish(mut self) -> Result<Diagnostics, Diagnostics> {
+        if !self.stopped {
+            let r = self.target.end_of_files();
+            self.drain(r);
+        }
+        while let Some(src) = self.stack.pop() {
+            self.keep_source(&src);
+        }
+        if self.dropped_warnings > 0 {
+            self.diags.push(Diagnostic {
+                severity: Severity::Warning,
+                loc: None,
+                message: format!("{} more warnings not shown", self.dropped_warnings),
+            });
+        }
+        if self.diags.has_errors() {
+            Err(self.diags)
+        } else {
+            Ok(self.diags)
+        }
+    }
+
+    /// Keeps a file's text for rendering if a diagnostic points into it.
+    fn keep_source(&mut self, src: &Source) {
+        let name = src.tok.file_name();
+        if self.kept.contains(name) {
+            return;
+        }
+        let referenced = self
+            .diags
+            .items
+            .iter()
+            .any(|d| d.loc.as_ref().is_some_and(|l| l.file == *name));
+        if referenced {
+            self.kept.insert(name.clone());
+            self.diags
+                .sources
+                .insert(name.clone(), src.tok.data().clone());
+        }
+    }
+
+    fn drain(&mut self, r: Result<(), Diagnostic>) {
+        if let Err(d) = r {
+            self.report(d);
+        }
+        for d in self.target.take_diagnostics() {
+            self.report(d);
+        }
+    }
+
+    fn open(&self, path: &Path) -> Result<Source, String> {
+        let data = read_limited(path, self.opts.max_file_bytes)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        let dir = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        Ok(Source {
+            tok: Tokenizer::new(Arc::from(path.display().to_string()), Arc::from(data)),
+            dir,
+            canon: std::fs::canonicalize(path).ok(),
+        })
+    }
+
+    fn push(&mut self, src: Source) {
+        if let Some(d) = src.tok.check_encoding() {
+            self.report(d);
+            self.keep_source(&src);
+            return;
+        }
+        self.stack.push(src);
+    }
+
+    fn cur(&self) -> Option<&Tokenizer> {
+        self.stack.last().map(|s| &s.tok)
+    }
+
+    fn loc(&self, t: &Token) -> FileLoc {
+        match self.cur() {
+            Some(tk) => tk.loc(t),
+            None => FileLoc::new(Arc::from("<eof>"), t.line, t.column),
+        }
+    }
+
+    fn raw(&self, t: &Token) -> &[u8] {
+        self.cur().map_or(&[], |tk| tk.raw(t))
+    }
+
+    fn display(&self, t: &Token) -> String {
+        self.cur().map_or_else(String::new, |tk| tk.display(t))
+    }
+
+    /// The next token across the file stack; `Ok(None)` when all files are done.
+    fn next(&mut self) -> P<Option<Token>> {
+        if let Some(t) = self.unget.take() {
+            return Ok(Some(t));
+        }
+        loop {
+            let Some(src) = self.stack.last_mut() else {
+                return Ok(None);
+            };
+            match src.tok.next_token() {
+                Ok(Some(t)) => return Ok(Some(t)),
+                Ok(None) => {
+                    if let Some(src) = self.stack.pop() {
+                        self.keep_source(&src);
+                    }
+                }
+                Err(d) => {
+                    self.report(d);
+                    return Err(Abort);
+                }
+            }
+        }
+    }
+
+    /// The next token, which must exist; `what` describes it for the error.
+    fn next_required(&mut self, what: &str, at: &FileLoc) -> P<Token> {
+        match self.next()? {
+            Some(t) => Ok(t),
+            None => {
+                self.report(Diagnostic::error(
+                    at.clone(),
+                    format!("premature end of file: expected {what}"),
+                ));
+                Err(Abort)
+            }
+        }
+    }
+
+    /// Reports `msg` at `t` and puts `t` back so that a directive keyword
+    /// there is not lost to resynchronization.
+    fn fail_at(&mut self, t: Token, msg: String) -> Abort {
+        let loc = self.loc(&t);
+        self.report(Diagnostic::error(loc, msg));
+        if t.kind == TokenKind::Word {
+            self.unget = Some(t);
+        }
+        Abort
+    }
+
+    /// Skips tokens up to the next directive keyword (left unread).
+    fn resync(&mut self) {
+        while !self.stopped {
+            match self.next() {
+                Ok(None) => return,
+                Ok(Some(t)) => {
+                    if t.kind == TokenKind::Word && lookup_directive(self.raw(&t)).is_some() {
+                        self.unget = Some(t);
+                        return;
+                    }
+                }
+                Err(Abort) => {}
+            }
+        }
+    }
+
+    fn run(&mut self) {
+        while !self.stopped {
+            let t = match self.next() {
+                Ok(Some(t)) => t,
+                Ok(None) => return,
+                Err(Abort) => {
+                    self.resync();
+                    continue;
+                }
+            };
+            let loc = self.loc(&t);
+            let directive = if t.kind == TokenKind::Word {
+                lookup_directive(self.raw(&t))
+            } else {
+                None
+            };
+            let Some(directive) = directive else {
+                let shown = self.display(&t);
+                let msg = if t.kind == TokenKind::Word {
+                    match suggest(&shown) {
+                        Some(s) => format!("unknown directive \"{shown}\"; did you mean \"{s}\"?"),
+                        None => format!("unknown directive \"{shown}\""),
+                    }
+                } else {
+                    format!("expected a directive, found {shown}")
+                };
+                self.report(Diagnostic::error(loc, msg));
+                self.resync();
+                continue;
+            };
+            match self.directive(directive, loc) {
+                Ok(r) => self.drain(r),
+                Err(Abort) => self.resync(),
+            }
+        }
+    }
+
+    fn float(&mut self, at: &FileLoc) -> P<f32> {
+        let t = self.next_required("a number", at)?;
+        match self.cur().map(|tk| tk.parse_float(&t)) {
+            Some(Ok(v)) => Ok(v),
+            Some(Err(d)) => {
+                let msg = d.message;
+                Err(self.fail_at(t, msg))
+            }
+            None => Err(Abort),
+        }
+    }
+
+    fn floats<const N: usize>(&mut self, at: &FileLoc) -> P<[f32; N]> {
+        let mut v = [0.0; N];
+        for x in &mut v {
+            *x = self.float(at)?;
+        }
+        Ok(v)
+    }
+
+    /// 16 numbers, in brackets (pbrt-v4) or bare.
+    fn matrix(&mut self, at: &FileLoc) -> P<[f32; 16]> {
+        let t = self.next_required("'[' and 16 numbers", at)?;
+        let bracketed = t.kind == TokenKind::LBracket;
+        if !bracketed {
+            self.unget = Some(t);
+        }
+        let m = self.floats::<16>(at)?;
+        if bracketed {
+            let t = self.next_required("']'", at)?;
+            if t.kind != TokenKind::RBracket {
+                let shown = self.display(&t);
+                return Err(self.fail_at(
+                    t,
+                    format!("expected ']' after 16 matrix values, found {shown}"),
+                ));
+            }
+        }
+        Ok(m)
+    }
+
+    fn string_of(&mut self, t: Token) -> P<String> {
+        match self
+            .cur()
+            .map(|tk| tk.string_value(&t).map(|s| s.into_owned()))
+        {
+            Some(Ok(s)) => Ok(s),
+            Some(Err(d)) => {
+                self.report(d);
+                Err(Abort)
+            }
+            None => Err(Abort),
+        }
+    }
+
+    fn quoted(&mut self, what: &str, at: &FileLoc) -> P<String> {
+        let t = self.next_required(what, at)?;
+        if !t.is_string() {
+            let shown = self.display(&t);
+            return Err(self.fail_at(
+                t,
+                format!("expected {what} (a quoted string), found {shown}"),
+            ));
+        }
+        self.string_of(t)
+    }
+
+    fn params(&mut self) -> P<Vec<ParsedParameter>> {
+        let mut out = Vec::new();
+        loop {
+            let Some(t) = self.next()? else {
+                return Ok(out);
+            };
+            if !t.is_string() {
+                self.unget = Some(t);
+                return Ok(out);
+            }
+            let loc = self.loc(&t);
+            let decl = self.string_of(t)?;
+            let (ty, name) = match split_declaration(&decl) {
+                Ok(x) => x,
+                Err(msg) => {
+                    self.report(Diagnostic::error(loc, msg));
+                    return Err(Abort);
+                }
+            };
+            let kind = value_kind(ty);
+            if kind.is_none() {
+                self.report(Diagnostic::error(
+                    loc.clone(),
+                    format!("unknown parameter type \"{ty}\" in \"{decl}\""),
+                ));
+            }
+            let mut p = ParsedParameter::new(ty, name, loc.clone());
+            let first = self.next_required(&format!("a value for \"{decl}\""), &loc)?;
+            match first.kind {
+                TokenKind::LBracket => {
+                    let open = self.loc(&first);
+                    loop {
+                        let Some(v) = self.next()? else {
+                            self.report(Diagnostic::error(
+                                open,
+                                format!("unterminated '[' in the values of \"{decl}\""),
+                            ));
+                            return Err(Abort);
+                        };
+                        if v.kind == TokenKind::RBracket {
+                            break;
+                        }
+                        if v.kind == TokenKind::LBracket {
+                            return Err(self.fail_at(
+                                v,
+                                format!("unexpected '[' inside the values of \"{decl}\""),
+                            ));
+                        }
+                        self.add_value(&mut p, kind, v, &decl, Some(&open))?;
+                        if p.value_count() > self.opts.max_values {
+                            self.report(Diagnostic::error(
+                                loc,
+                                format!("\"{decl}\" has more than {} values", self.opts.max_values),
+                            ));
+                            return Err(Abort);
+                        }
+                    }
+                }
+                TokenKind::RBracket => {
+                    return Err(self.fail_at(first, format!("unexpected ']' after \"{decl}\"")));
+                }
+                _ => self.add_value(&mut p, kind, first, &decl, None)?,
+            }
+            if kind.is_some() {
+                out.push(p);
+            }
+        }
+    }
+
+    fn add_value(
+        &mut self,
+        p: &mut ParsedParameter,
+        kind: Option<ValueKind>,
+        t: Token,
+        decl: &str,
+        open: Option<&FileLoc>,
+    ) -> P<()> {
+        let Some(kind) = kind else {
+            return Ok(()); // unknown type, already reported: skip values
+        };
+        let Some(tk) = self.cur() else {
+            return Err(Abort);
+        };
+        let res = match (kind, t.kind) {
+            (ValueKind::Float, TokenKind::Word) => tk.parse_float(&t).map(|v| p.floats.push(v)),
+            (ValueKind::Spectrum, TokenKind::Word) if p.strings.is_empty() => {
+                tk.parse_float(&t).map(|v| p.floats.push(v))
+            }
+            (ValueKind::Int, TokenKind::Word) => tk.parse_int(&t).map(|v| p.ints.push(v)),
+            (ValueKind::Bool, _) => match tk.raw(&t) {
+                b"true" => Ok(p.bools.push(true)),
+                b"false" => Ok(p.bools.push(false)),
+                _ => Err(Diagnostic::error(
+                    tk.loc(&t),
+                    format!("{}: expected true or false for \"{decl}\"", tk.display(&t)),
+                )),
+            },
+            (ValueKind::String, TokenKind::Str { .. }) => {
+                tk.string_value(&t).map(|s| p.strings.push(s.into_owned()))
+            }
+            (ValueKind::Spectrum, TokenKind::Str { .. }) if p.floats.is_empty() => {
+                tk.string_value(&t).map(|s| p.strings.push(s.into_owned()))
+            }
+            (ValueKind::String, _) => Err(Diagnostic::error(
+                tk.loc(&t),
+                format!(
+                    "{}: expected a quoted string for \"{decl}\"",
+                    tk.display(&t)
+                ),
+            )),
+            (ValueKind::Spectrum, _) => Err(Diagnostic::error(
+                tk.loc(&t),
+                format!(
+                    "{}: \"{decl}\" mixes numbers and spectrum names",
+                    tk.display(&t)
+                ),
+            )),
+            (_, _) => Err(Diagnostic::error(
+                tk.loc(&t),
+                format!("{}: expected a number for \"{decl}\"", tk.display(&t)),
+            )),
+        };
+        match res {
+            Ok(()) => Ok(()),
+            Err(mut d) => {
+                // A directive keyword inside brackets means a missing ']'.
+                if let Some(open) = open {
+                    if t.kind == TokenKind::Word && lookup_directive(tk.raw(&t)).is_some() {
+                        d = Diagnostic::error(
+                            open.clone(),
+                            format!("missing ']' to close the values of \"{decl}\""),
+                        );
+                    }
+                }
+                self.report(d);
+                if t.kind == TokenKind::Word {
+                    self.unget = Some(t);
+                }
+                Err(Abort)
+            }
+        }
+    }
+
+    fn include(&mut self, name: &str, kind: IncludeKind, loc: &FileLoc) {
+        match self.target.include(name, kind, loc.clone()) {
+            Ok(true) => {}
+            Ok(false) => return,
+            Err(d) => {
+                self.report(d);
+                return;
+            }
+        }
+        if self.stack.len() >= self.opts.max_include_depth {
+            self.report(Diagnostic::error(
+                loc.clone(),
+                format!(
+                    "\"{name}\": includes nested more than {} deep",
+                    self.opts.max_include_depth
+                ),
+            ));
+            return;
+        }
+        let rel = Path::new(name);
+        let path = match self.stack.last() {
+            Some(s) if rel.is_relative() => s.dir.join(rel),
+            _ => rel.to_path_buf(),
+        };
+        if let Ok(canon) = std::fs::canonicalize(&path) {
+            if self.stack.iter().any(|s| s.canon.as_ref() == Some(&canon)) {
+                let chain: Vec<String> = self
+                    .stack
+                    .iter()
+                    .map(|s| s.tok.file_name().to_string())
+                    .collect();
+                self.report(Diagnostic::error(
+                    loc.clone(),
+                    format!(
+                        "include cycle: \"{}\" is already being read (via {})",
+                        path.display(),
+                        chain.join(" -> ")
+                    ),
+                ));
+                return;
+            }
+        }
+        match self.open(&path) {
+            Ok(src) => self.push(src),
+            Err(msg) => self.report(Diagnostic::error(loc.clone(), format!("cannot read {msg}"))),
+        }
+    }
+
+    fn directive(&mut self, d: Directive, loc: FileLoc) -> P<Result<(), Diagnostic>> {
+        use Directive as D;
+        let l = loc.clone();
+        Ok(match d {
+            D::Identity => self.target.identity(loc),
+            D::Translate => {
+                let v = self.floats::<3>(&l)?;
+                self.target.translate(v, loc)
+            }
+            D::Scale => {
+                let v = self.floats::<3>(&l)?;
+                self.target.scale(v, loc)
+            }
+            D::Rotate => {
+                let v = self.floats::<4>(&l)?;
+                self.target.rotate(v[0], [v[1], v[2], v[3]], loc)
+            }
+            D::LookAt => {
+                let v = self.floats::<9>(&l)?;
+                self.target.look_at(
+                    [v[0], v[1], v[2]],
+                    [v[3], v[4], v[5]],
+                    [v[6], v[7], v[8]],
+                    loc,
+                )
+            }
+            D::ConcatTransform => {
+                let m = self.matrix(&l)?;
+                self.target.concat_transform(m, loc)
+            }
+            D::Transform => {
+                let m = self.matrix(&l)?;
+                self.target.transform(m, loc)
+            }
+            D::CoordinateSystem => {
+                let n = self.quoted("a coordinate system name", &l)?;
+                self.target.coordinate_system(&n, loc)
+            }
+            D::CoordSysTransform => {
+                let n = self.quoted("a coordinate system name", &l)?;
+                self.target.coord_sys_transform(&n, loc)
+            }
+            D::ActiveTransform => {
+                let t = self.next_required("All, StartTime or EndTime", &l)?;
+                match self.raw(&t) {
+                    b"All" => self.target.active_transform_all(loc),
+                    b"StartTime" => self.target.active_transform_start_time(loc),
+                    b"EndTime" => self.target.active_transform_end_time(loc),
+                    _ => {
+                        let shown = self.display(&t);
+                        return Err(self.fail_at(
+                            t,
+                            format!("ActiveTransform: expected All, StartTime or EndTime, found {shown}"),
+                        ));
+                    }
+                }
+            }
+            D::TransformTimes => {
+                let v = self.floats::<2>(&l)?;
+                self.target.transform_times(v[0], v[1], loc)
+            }
+            D::ReverseOrientation => self.target.reverse_orientation(loc),
+            D::ColorSpace => {
+                let n = self.quoted("a color space name", &l)?;
+                self.target.color_space(&n, loc)
+            }
+            D::PixelFilter
+            | D::Film
+            | D::Sampler
+            | D::Accelerator
+            | D::Integrator
+            | D::Camera
+            | D::MakeNamedMedium
+            | D::Attribute
+            | D::Material
+            | D::MakeNamedMaterial
+            | D::LightSource
+            | D::AreaLightSource
+            | D::Shape => {
+                let n = self.quoted("a name", &l)?;
+                let p = self.params()?;
+                let t = &mut *self.target;
+                match d {
+                    D::PixelFilter => t.pixel_filter(&n, p, loc),
+                    D::Film => t.film(&n, p, loc),
+                    D::Sampler => t.sampler(&n, p, loc),
+                    D::Accelerator => t.accelerator(&n, p, loc),
+                    D::Integrator => t.integrator(&n, p, loc),
+                    D::Camera => t.camera(&n, p, loc),
+                    D::MakeNamedMedium => t.make_named_medium(&n, p, loc),
+                    D::Attribute => t.attribute(&n, p, loc),
+                    D::Material => t.material(&n, p, loc),
+                    D::MakeNamedMaterial => t.make_named_material(&n, p, loc),
+                    D::LightSource => t.light_source(&n, p, loc),
+                    D::AreaLightSource => t.area_light_source(&n, p, loc),
+                    _ => t.shape(&n, p, loc),
+                }
+            }
+            D::MediumInterface => {
+                let inside = self.quoted("a medium name", &l)?;
+                let outside = match self.next()? {
+                    Some(t) if t.is_string() => self.string_of(t)?,
+                    Some(t) => {
+                        self.unget = Some(t);
+                        inside.clone()
+                    }
+                    None => inside.clone(),
+                };
+                self.target.medium_interface(&inside, &outside, loc)
+            }
+            D::Option => {
+                let name = self.quoted("an option name", &l)?;
+                let t = self.next_required("an option value", &l)?;
+                let value = if t.is_string() {
+                    format!("\"{}\"", escape_string(&self.string_of(t)?))
+                } else if t.kind == TokenKind::Word {
+                    self.string_of(t)?
+                } else {
+                    let shown = self.display(&t);
+                    return Err(self.fail_at(t, format!("expected an option value, found {shown}")));
+                };
+                self.target.option(&name, &value, loc)
+            }
+            D::WorldBegin => self.target.world_begin(loc),
+            D::WorldEnd => self.target.world_end(loc),
+            D::AttributeBegin => self.target.attribute_begin(loc),
+            D::AttributeEnd => self.target.attribute_end(loc),
+            D::TransformBegin | D::TransformEnd => {
+                if !self.warned_transform_begin {
+                    self.warned_transform_begin = true;
+                    self.report(Diagnostic::warning(
+                        loc.clone(),
+                        "TransformBegin/TransformEnd are deprecated; use AttributeBegin/AttributeEnd",
+                    ));
+                }
+                if d == D::TransformBegin {
+                    self.target.transform_begin(loc)
+                } else {
+                    self.target.transform_end(loc)
+                }
+            }
+            D::Texture => {
+                let name = self.quoted("a texture name", &l)?;
+                let ty = self.quoted("a texture type (\"float\" or \"spectrum\")", &l)?;
+                let class = self.quoted("a texture class", &l)?;
+                let p = self.params()?;
+                self.target.texture(&name, &ty, &class, p, loc)
+            }
+            D::NamedMaterial => {
+                let n = self.quoted("a material name", &l)?;
+                self.target.named_material(&n, loc)
+            }
+            D::ObjectBegin => {
+                let n = self.quoted("an object name", &l)?;
+                self.target.object_begin(&n, loc)
+            }
+            D::ObjectEnd => self.target.object_end(loc),
+            D::ObjectInstance => {
+                let n = self.quoted("an object name", &l)?;
+                self.target.object_instance(&n, loc)
+            }
+            D::Include | D::Import => {
+                let n = self.quoted("a file name", &l)?;
+                let kind = if d == D::Include {
+                    IncludeKind::Include
+                } else {
+                    IncludeKind::Import
+                };
+                self.include(&n, kind, &l);
+                Ok(())
+            }
+        })
+    }
+}
+
+#[cfg(test)]
+#[path = "driver_tests.rs"]
+mod tests;

@@ -1,0 +1,463 @@
+//! A [`ParserTarget`] that prints the scene back as canonical pbrt-v4 text
+//! (pbrt-v4 `FormattingParserTarget`, `pbrt --format` / `--upgrade`).
+//!
+//! One directive per line, parameters on the following lines indented one
+//! step further, blocks (`AttributeBegin`, `ObjectBegin`) indented, numbers
+//! in the shortest form that reads back to the same `f32`. Formatting is a
+//! pure function of the directive stream, so formatting formatted output
+//! gives the same bytes. `Include`/`Import` are printed, not followed.
+//! Comments are not preserved.
+
+use std::fmt::Write as _;
+
+use crate::diag::Diagnostic;
+use crate::loc::FileLoc;
+use crate::params::{canonical_type, ParsedParameter};
+use crate::target::{DirectiveResult, IncludeKind, ParamList, ParserTarget};
+use crate::tokenizer::escape_string;
+use crate::upgrade::{self, Upgraded};
+
+/// Prints directives as canonical pbrt-v4 text into a string.
+#[derive(Clone, Debug, Default)]
+pub struct FormattingTarget {
+    out: String,
+    depth: usize,
+    upgrade: bool,
+    diags: Vec<Diagnostic>,
+}
+
+/// Formats `v` in the shortest decimal form that parses back to `v`.
+pub fn format_float(v: f32) -> String {
+    let s = format!("{v:?}");
+    match s.strip_suffix(".0") {
+        Some(t) => t.to_string(),
+        None => s,
+    }
+}
+
+impl FormattingTarget {
+    /// A formatter; with `upgrade` it also maps pbrt-v3 constructs to pbrt-v4.
+    pub fn new(upgrade: bool) -> Self {
+        FormattingTarget {
+            upgrade,
+            ..Self::default()
+        }
+    }
+
+    /// The text printed so far.
+    pub fn output(&self) -> &str {
+        &self.out
+    }
+
+    /// The printed text.
+    pub fn into_output(self) -> String {
+        self.out
+    }
+
+    fn indent(&mut self, extra: usize) {
+        for _ in 0..(self.depth + extra) {
+            self.out.push_str("    ");
+        }
+    }
+
+    fn line(&mut self, text: &str) {
+        self.indent(0);
+        self.out.push_str(text);
+        self.out.push('\n');
+    }
+
+    fn quoted(s: &str) -> String {
+        format!("\"{}\"", escape_string(s))
+    }
+
+    fn named(&mut self, directive: &str, name: &str, params: &[ParsedParameter]) {
+        self.line(&format!("{directive} {}", Self::quoted(name)));
+        self.params(params);
+    }
+
+    fn params(&mut self, params: &[ParsedParameter]) {
+        for p in params {
+            self.param(p);
+        }
+    }
+
+    fn param(&mut self, p: &ParsedParameter) {
+        let ty = if self.upgrade {
+            canonical_type(&p.ty).unwrap_or(&p.ty)
+        } else {
+            &p.ty
+        };
+        let mut vals: Vec<String> = Vec::with_capacity(p.value_count());
+        vals.extend(p.floats.iter().map(|&f| format_float(f)));
+        vals.extend(p.ints.iter().map(|i| i.to_string()));
+        vals.extend(p.strings.iter().map(|s| Self::quoted(s)));
+        vals.extend(
+            p.bools
+                .iter()
+                .map(|&b| if b { "true" } else { "false" }.to_string()),
+        );
+        let per_line = match canonical_type(ty) {
+            Some("point2" | "vector2") => 12,
+            Some("string" | "texture") => 4,
+            _ if !p.strings.is_empty() => 4,
+            _ => 12,
+        };
+        self.indent(1);
+        let _ = write!(self.out, "{} [", Self::quoted(&format!("{ty} {}", p.name)));
+        if vals.len() <= per_line {
+            for v in &vals {
+                self.out.push(' ');
+                self.out.push_str(v);
+            }
+            self.out.push_str(" ]\n");
+        } else {
+            self.out.push('\n');
+            for chunk in vals.chunks(per_line) {
+                self.indent(2);
+                self.out.push_str(&chunk.join(" "));
+                self.out.push('\n');
+            }
+            self.indent(1);
+            self.out.push_str("]\n");
+        }
+    }
+
+    fn take(&mut self, u: Upgraded) -> (String, ParamList) {
+        self.diags.extend(u.diagnostics);
+        (u.name, u.params)
+    }
+
+    fn nums(v: &[f32]) -> String {
+        v.iter()
+            .map(|&f| format_float(f))
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+
+    fn simple(
+        &mut self,
+        directive: &str,
+        name: &str,
+        params: ParamList,
+        loc: &FileLoc,
+        f: fn(&str, ParamList, &FileLoc) -> Upgraded,
+    ) -> DirectiveResult {
+        if self.upgrade {
+            let u = f(name, params, loc);
+            let (n, p) = self.take(u);
+            self.named(directive, &n, &p);
+        } else {
+            self.named(directive, name, &params);
+        }
+        Ok(())
+    }
+}
+
+fn identity(name: &str, mut params: ParamList, _: &FileLoc) -> Upgraded {
+    upgrade::upgrade_param_types(&mut params);
+    Upgraded {
+        name: name.to_string(),
+        params,
+        diagnostics: Vec::new(),
+    }
+}
+
+impl ParserTarget for FormattingTarget {
+    fn identity(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.line("Identity");
+        Ok(())
+    }
+    fn translate(&mut self, d: [f32; 3], _loc: FileLoc) -> DirectiveResult {
+        self.line(&format!("Translate {}", Self::nums(&d)));
+        Ok(())
+    }
+    fn scale(&mut self, s: [f32; 3], _loc: FileLoc) -> DirectiveResult {
+        self.line(&format!("Scale {}", Self::nums(&s)));
+        Ok(())
+    }
+    fn rotate(&mut self, angle: f32, axis: [f32; 3], _loc: FileLoc) -> DirectiveResult {
+        self.line(&format!(
+            "Rotate {} {}",
+            format_float(angle),
+            Self::nums(&axis)
+        ));
+        Ok(())
+    }
+    fn look_at(
+        &mut self,
+        eye: [f32; 3],
+        look: [f32; 3],
+        up: [f32; 3],
+        _loc: FileLoc,
+    ) -> DirectiveResult {
+        self.line(&format!("LookAt {}", Self::nums(&eye)));
+        self.line(&format!("       {}", Self::nums(&look)));
+        self.line(&format!("       {}", Self::nums(&up)));
+        Ok(())
+    }
+    fn concat_transform(&mut self, m: [f32; 16], _loc: FileLoc) -> DirectiveResult {
+        self.line(&format!("ConcatTransform [ {} ]", Self::nums(&m)));
+        Ok(())
+    }
+    fn transform(&mut self, m: [f32; 16], _loc: FileLoc) -> DirectiveResult {
+        self.line(&format!("Transform [ {} ]", Self::nums(&m)));
+        Ok(())
+    }
+    fn coordinate_system(&mut self, name: &str, _loc: FileLoc) -> DirectiveResult {
+        self.line(&format!("CoordinateSystem {}", Self::quoted(name)));
+        Ok(())
+    }
+    fn coord_sys_transform(&mut self, name: &str, _loc: FileLoc) -> DirectiveResult {
+        self.line(&format!("CoordSysTransform {}", Self::quoted(name)));
+        Ok(())
+    }
+    fn active_transform_all(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.line("ActiveTransform All");
+        Ok(())
+    }
+    fn active_transform_end_time(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.line("ActiveTransform EndTime");
+        Ok(())
+    }
+    fn active_transform_start_time(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.line("ActiveTransform StartTime");
+        Ok(())
+    }
+    fn transform_times(&mut self, start: f32, end: f32, _loc: FileLoc) -> DirectiveResult {
+        self.line(&format!(
+            "TransformTimes {} {}",
+            format_float(start),
+            format_float(end)
+        ));
+        Ok(())
+    }
+    fn reverse_orientation(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.line("ReverseOrientation");
+        Ok(())
+    }
+    fn color_space(&mut self, name: &str, _loc: FileLoc) -> DirectiveResult {
+        self.line(&format!("ColorSpace {}", Self::quoted(name)));
+        Ok(())
+    }
+    fn pixel_filter(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.simple(
+            "PixelFilter",
+            name,
+            params,
+            &loc,
+            upgrade::upgrade_pixel_filter,
+        )
+    }
+    fn film(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.simple("Film", name, params, &loc, upgrade::upgrade_film)
+    }
+    fn sampler(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.simple("Sampler", name, params, &loc, upgrade::upgrade_sampler)
+    }
+    fn accelerator(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.simple("Accelerator", name, params, &loc, identity)
+    }
+    fn integrator(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.simple(
+            "Integrator",
+            name,
+            params,
+            &loc,
+            upgrade::upgrade_integrator,
+        )
+    }
+    fn camera(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.simple("Camera", name, params, &loc, upgrade::upgrade_camera)
+    }
+    fn make_named_medium(
+        &mut self,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        // The medium's kind is its "string type" parameter.
+        if self.upgrade {
+            let mut params = params;
+            upgrade::upgrade_param_types(&mut params);
+            for p in &mut params {
+                if p.name == "type" && p.strings == ["heterogeneous"] {
+                    p.strings = vec!["uniformgrid".into()];
+                }
+            }
+            self.named("MakeNamedMedium", name, &params);
+            return Ok(());
+        }
+        self.named("MakeNamedMedium", name, &params);
+        let _ = loc;
+        Ok(())
+    }
+    fn medium_interface(&mut self, inside: &str, outside: &str, _loc: FileLoc) -> DirectiveResult {
+        self.line(&format!(
+            "MediumInterface {} {}",
+            Self::quoted(inside),
+            Self::quoted(outside)
+        ));
+        Ok(())
+    }
+    fn option(&mut self, name: &str, value: &str, _loc: FileLoc) -> DirectiveResult {
+        self.line(&format!("Option {} {value}", Self::quoted(name)));
+        Ok(())
+    }
+    fn world_begin(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.out.push('\n');
+        self.line("WorldBegin");
+        self.out.push('\n');
+        Ok(())
+    }
+    fn world_end(&mut self, _loc: FileLoc) -> DirectiveResult {
+        Ok(()) // pbrt-v3 only: dropped, as pbrt-v4 does.
+    }
+    fn attribute_begin(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.line("AttributeBegin");
+        self.depth += 1;
+        Ok(())
+    }
+    fn attribute_end(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.depth = self.depth.saturating_sub(1);
+        self.line("AttributeEnd");
+        Ok(())
+    }
+    fn attribute(&mut self, target: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.simple("Attribute", target, params, &loc, identity)
+    }
+    fn transform_begin(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.line(if self.upgrade {
+            "AttributeBegin"
+        } else {
+            "TransformBegin"
+        });
+        self.depth += 1;
+        Ok(())
+    }
+    fn transform_end(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.depth = self.depth.saturating_sub(1);
+        self.line(if self.upgrade {
+            "AttributeEnd"
+        } else {
+            "TransformEnd"
+        });
+        Ok(())
+    }
+    fn texture(
+        &mut self,
+        name: &str,
+        ty: &str,
+        texname: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        let (ty, class, params) = if self.upgrade {
+            let (ty, u) = upgrade::upgrade_texture(ty, texname, params, &loc);
+            let (class, p) = self.take(u);
+            (ty, class, p)
+        } else {
+            (ty.to_string(), texname.to_string(), params)
+        };
+        self.line(&format!(
+            "Texture {} {} {}",
+            Self::quoted(name),
+            Self::quoted(&ty),
+            Self::quoted(&class)
+        ));
+        self.params(&params);
+        Ok(())
+    }
+    fn material(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.simple("Material", name, params, &loc, upgrade::upgrade_material)
+    }
+    fn make_named_material(
+        &mut self,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        if !self.upgrade {
+            self.named("MakeNamedMaterial", name, &params);
+            return Ok(());
+        }
+        let mut params = params;
+        let ty = params
+            .iter()
+            .rposition(|p| p.name == "type" && p.ty == "string")
+            .map(|i| params.remove(i));
+        let old = ty
+            .as_ref()
+            .and_then(|p| p.strings.first().cloned())
+            .unwrap_or_default();
+        let u = upgrade::upgrade_material(&old, params, &loc);
+        let (new, mut p) = self.take(u);
+        let tloc = ty.map_or(loc, |t| t.loc);
+        p.insert(
+            0,
+            ParsedParameter::with_strings("string", "type", tloc, vec![new]),
+        );
+        self.named("MakeNamedMaterial", name, &p);
+        Ok(())
+    }
+    fn named_material(&mut self, name: &str, _loc: FileLoc) -> DirectiveResult {
+        self.line(&format!("NamedMaterial {}", Self::quoted(name)));
+        Ok(())
+    }
+    fn light_source(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.simple("LightSource", name, params, &loc, upgrade::upgrade_light)
+    }
+    fn area_light_source(
+        &mut self,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        self.simple(
+            "AreaLightSource",
+            name,
+            params,
+            &loc,
+            upgrade::upgrade_area_light,
+        )
+    }
+    fn shape(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.simple("Shape", name, params, &loc, upgrade::upgrade_shape)
+    }
+    fn object_begin(&mut self, name: &str, _loc: FileLoc) -> DirectiveResult {
+        self.line(&format!("ObjectBegin {}", Self::quoted(name)));
+        self.depth += 1;
+        Ok(())
+    }
+    fn object_end(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.depth = self.depth.saturating_sub(1);
+        self.line("ObjectEnd");
+        Ok(())
+    }
+    fn object_instance(&mut self, name: &str, _loc: FileLoc) -> DirectiveResult {
+        self.line(&format!("ObjectInstance {}", Self::quoted(name)));
+        Ok(())
+    }
+    fn end_of_files(&mut self) -> DirectiveResult {
+        Ok(())
+    }
+    fn include(
+        &mut self,
+        filename: &str,
+        kind: IncludeKind,
+        _loc: FileLoc,
+    ) -> Result<bool, Diagnostic> {
+        let d = match kind {
+            IncludeKind::Include => "Include",
+            IncludeKind::Import => "Import",
+        };
+        self.line(&format!("{d} {}", Self::quoted(filename)));
+        Ok(false)
+    }
+    fn take_diagnostics(&mut self) -> Vec<Diagnostic> {
+        std::mem::take(&mut self.diags)
+    }
+}
+
+#[cfg(test)]
+#[path = "format_tests.rs"]
+mod tests;

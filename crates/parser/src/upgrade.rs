@@ -1,0 +1,683 @@
+//! pbrt-v3 → pbrt-v4 mappings (pbrt-v4 `--upgrade`, `parser.cpp`'s
+//! formatting target and `upgrade.cpp`; book appendix C).
+//!
+//! Pure functions over a directive's type name and parameter list that
+//! return the pbrt-v4 name, the rewritten parameters and located
+//! diagnostics (warnings where the mapping is approximate, errors where it
+//! cannot be done). The formatter uses them for `--upgrade`; the scene
+//! builder can use them to read pbrt-v3 files directly.
+
+use crate::diag::Diagnostic;
+use crate::loc::FileLoc;
+use crate::params::{canonical_type, ParsedParameter};
+
+/// The result of upgrading one directive.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Upgraded {
+    /// The pbrt-v4 type name (e.g. `diffuse` for `matte`).
+    pub name: String,
+    /// The rewritten parameters.
+    pub params: Vec<ParsedParameter>,
+    /// Warnings (approximations) and errors (things that need manual work).
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// Renames pbrt-v3 parameter types to pbrt-v4 ones in place
+/// (`point`→`point3`, `vector`→`vector3`, `color`→`rgb`, `normal3`→`normal`).
+pub fn upgrade_param_types(params: &mut [ParsedParameter]) {
+    for p in params {
+        if let Some(ct) = canonical_type(&p.ty) {
+            if ct != p.ty {
+                p.ty = ct.to_string();
+            }
+        }
+    }
+}
+
+/// A small editing helper over a parameter list.
+struct Edit {
+    name: String,
+    params: Vec<ParsedParameter>,
+    diags: Vec<Diagnostic>,
+    loc: FileLoc,
+    /// Parameters to put first, in order (pbrt-v4 prints them first).
+    front: Vec<ParsedParameter>,
+}
+
+const SPECTRUM_TYPES: [&str; 3] = ["rgb", "spectrum", "blackbody"];
+
+impl Edit {
+    fn new(name: &str, mut params: Vec<ParsedParameter>, loc: &FileLoc) -> Self {
+        upgrade_param_types(&mut params);
+        Edit {
+            name: name.to_string(),
+            params,
+            diags: Vec::new(),
+            loc: loc.clone(),
+            front: Vec::new(),
+        }
+    }
+
+    fn finish(self) -> Upgraded {
+        let mut params = self.front;
+        params.extend(self.params);
+        Upgraded {
+            name: self.name,
+            params,
+            diagnostics: self.diags,
+        }
+    }
+
+    fn index(&self, name: &str, types: &[&str]) -> Option<usize> {
+        self.params
+            .iter()
+            .rposition(|p| p.name == name && types.contains(&p.canonical_type()))
+    }
+
+    fn get(&self, name: &str, types: &[&str]) -> Option<&ParsedParameter> {
+        self.index(name, types).map(|i| &self.params[i])
+    }
+
+    fn remove(&mut self, name: &str, types: &[&str]) -> Option<ParsedParameter> {
+        let i = self.index(name, types)?;
+        Some(self.params.remove(i))
+    }
+
+    fn remove_all(&mut self, name: &str, types: &[&str]) {
+        self.params
+            .retain(|p| !(p.name == name && types.contains(&p.canonical_type())));
+    }
+
+    fn rename(&mut self, from: &str, to: &str) {
+        for p in &mut self.params {
+            if p.name == from {
+                p.name = to.to_string();
+            }
+        }
+    }
+
+    fn add_front(&mut self, p: ParsedParameter) {
+        self.front.push(p);
+    }
+
+    fn float(&self, name: &str, v: &[f32]) -> ParsedParameter {
+        ParsedParameter::with_floats("float", name, self.loc.clone(), v.to_vec())
+    }
+
+    fn string(&self, ty: &str, name: &str, v: &[&str]) -> ParsedParameter {
+        ParsedParameter::with_strings(
+            ty,
+            name,
+            self.loc.clone(),
+            v.iter().map(|s| s.to_string()).collect(),
+        )
+    }
+
+    fn warn(&mut self, loc: Option<&FileLoc>, msg: String) {
+        self.diags
+            .push(Diagnostic::warning(loc.unwrap_or(&self.loc).clone(), msg));
+    }
+
+    fn error(&mut self, loc: Option<&FileLoc>, msg: String) {
+        self.diags
+            .push(Diagnostic::error(loc.unwrap_or(&self.loc).clone(), msg));
+    }
+
+    /// The single value of `name` if it is an RGB with three equal components.
+    fn uniform_rgb(&self, name: &str) -> Option<f32> {
+        let p = self.get(name, &["rgb"])?;
+        match p.floats[..] {
+            [r, g, b] if r == g && g == b => Some(r),
+            _ => None,
+        }
+    }
+
+    /// Drops spectrum or texture `name`; silent if it was the uniform RGB
+    /// `value` (pbrt-v4's implied value), a warning otherwise. Returns
+    /// whether it matched.
+    fn drop_if_constant(&mut self, name: &str, value: f32) -> bool {
+        let matches = self.uniform_rgb(name) == Some(value);
+        if !matches {
+            if let Some(p) = self
+                .get(name, &SPECTRUM_TYPES)
+                .or_else(|| self.get(name, &["texture"]))
+            {
+                let loc = p.loc.clone();
+                let msg = format!(
+                    "parameter \"{} {}\" is removed when converting to the \"{}\" material",
+                    p.ty, p.name, self.name
+                );
+                self.warn(Some(&loc), msg);
+            }
+        }
+        self.remove_all(name, &SPECTRUM_TYPES);
+        self.remove_all(name, &["texture"]);
+        matches
+    }
+
+    /// Folds a uniform RGB `name` into `scale`; false if it is not uniform.
+    fn rgb_into_scale(&mut self, name: &str, scale: &mut f32) -> bool {
+        if self.get(name, &SPECTRUM_TYPES).is_none() {
+            return true;
+        }
+        match self.uniform_rgb(name) {
+            Some(v) => {
+                *scale *= v;
+                self.remove_all(name, &SPECTRUM_TYPES);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// pbrt-v3 `blackbody [T scale]`: keep T and fold the scale.
+    fn upgrade_blackbody(&mut self, name: &str, scale: &mut f32) {
+        let mut errs = Vec::new();
+        for p in &mut self.params {
+            if p.name == name && p.canonical_type() == "blackbody" {
+                match p.floats.len() {
+                    1 => {}
+                    2 => {
+                        *scale *= p.floats[1];
+                        p.floats.truncate(1);
+                    }
+                    _ => errs.push(p.loc.clone()),
+                }
+            }
+        }
+        for l in errs {
+            self.error(
+                Some(&l),
+                "expected one (pbrt-v4) or two (pbrt-v3) values for \"blackbody\"".into(),
+            );
+        }
+    }
+}
+
+/// Upgrades a `Material` (or the `"string type"` of a `MakeNamedMaterial`).
+pub fn upgrade_material(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
+    let mut e = Edit::new(name, params, loc);
+    // "index" became "eta" for glass and uber.
+    if name == "glass" || name == "uber" {
+        if let Some(mut p) = e.remove("index", &["float", "texture"]) {
+            if e.get("eta", &["float", "texture", "spectrum"]).is_some() {
+                let l = p.loc.clone();
+                e.error(
+                    Some(&l),
+                    format!("material \"{name}\" has both \"index\" and \"eta\""),
+                );
+            } else {
+                p.name = "eta".into();
+                e.add_front(p);
+            }
+        }
+    }
+    e.rename("bumpmap", "displacement");
+    match name {
+        "uber" => {
+            e.name = "coateddiffuse".into();
+            if e.drop_if_constant("Ks", 0.0) {
+                e.name = "diffuse".into();
+                e.remove_all("eta", &["float", "texture"]);
+                e.remove_all("roughness", &["float", "texture"]);
+            }
+            e.drop_if_constant("Kr", 0.0);
+            e.drop_if_constant("Kt", 0.0);
+            e.rename("Kd", "reflectance");
+            if let Some(p) = e.get("opacity", &["texture"]) {
+                let l = p.loc.clone();
+                e.error(Some(&l), "an \"opacity\" texture on \"uber\" is not supported by pbrt-v4; edit the file manually".into());
+            } else if e.get("opacity", &SPECTRUM_TYPES).is_some() {
+                if e.uniform_rgb("opacity") == Some(1.0) {
+                    e.remove_all("opacity", &SPECTRUM_TYPES);
+                } else {
+                    let l = e.get("opacity", &SPECTRUM_TYPES).map(|p| p.loc.clone());
+                    e.error(l.as_ref(), "a non-opaque \"opacity\" on \"uber\" is not supported by pbrt-v4; edit the file manually".into());
+                }
+            }
+        }
+        "mix" => {
+            if let Some(p) = e.get("amount", &["rgb"]) {
+                let (l, f) = (p.loc.clone(), p.floats.clone());
+                if let [r, g, b] = f[..] {
+                    let v = if r == g && g == b {
+                        r
+                    } else {
+                        let avg = (r + g + b) / 3.0;
+                        e.warn(
+                            Some(&l),
+                            format!("RGB \"amount\" ({r}, {g}, {b}) becomes its average {avg}"),
+                        );
+                        avg
+                    };
+                    let p = e.float("amount", &[v]);
+                    e.add_front(p);
+                }
+            } else if let Some(p) = e.get("amount", &["spectrum", "blackbody"]) {
+                let l = p.loc.clone();
+                e.error(
+                    Some(&l),
+                    "cannot convert a non-RGB spectrum \"amount\" to a scalar".into(),
+                );
+            }
+            e.remove_all("amount", &SPECTRUM_TYPES);
+            let m1 = e
+                .remove("namedmaterial1", &["string"])
+                .and_then(|p| p.strings.first().cloned());
+            let m2 = e
+                .remove("namedmaterial2", &["string"])
+                .and_then(|p| p.strings.first().cloned());
+            match (m1, m2) {
+                (Some(m1), Some(m2)) => {
+                    // pbrt-v4 blends the other way round: amount weights the second.
+                    let p = e.string("string", "materials", &[&m2, &m1]);
+                    e.add_front(p);
+                }
+                _ => e.error(
+                    None,
+                    "\"mix\" material needs \"namedmaterial1\" and \"namedmaterial2\"".into(),
+                ),
+            }
+        }
+        "substrate" => {
+            e.name = "coateddiffuse".into();
+            e.drop_if_constant("Ks", 1.0);
+            e.rename("Kd", "reflectance");
+        }
+        "glass" => {
+            e.name = "dielectric".into();
+            e.drop_if_constant("Kr", 1.0);
+            e.drop_if_constant("Kt", 1.0);
+        }
+        "plastic" => {
+            e.name = "coateddiffuse".into();
+            if e.drop_if_constant("Ks", 0.0) {
+                e.name = "diffuse".into();
+                e.remove_all("roughness", &["float", "texture"]);
+                e.remove_all("eta", &["float", "texture"]);
+            }
+            e.rename("Kd", "reflectance");
+        }
+        "fourier" => e.warn(
+            None,
+            "the \"fourier\" material is not supported by pbrt-v4 (see \"measured\")".into(),
+        ),
+        "kdsubsurface" => {
+            e.name = "subsurface".into();
+            e.rename("Kd", "reflectance");
+        }
+        "matte" => {
+            e.name = "diffuse".into();
+            e.rename("Kd", "reflectance");
+        }
+        "metal" => {
+            e.name = "conductor".into();
+            e.drop_if_constant("Kr", 1.0);
+        }
+        "translucent" => {
+            e.name = "diffusetransmission".into();
+            e.rename("Kd", "transmittance");
+            e.drop_if_constant("reflect", 0.0);
+            e.drop_if_constant("transmit", 1.0);
+            e.drop_if_constant("Ks", 0.0);
+            e.remove_all("roughness", &["float", "texture"]);
+        }
+        "mirror" => {
+            // A perfect conductor tinted by pbrt-v3's Kr (default 0.9).
+            e.name = "conductor".into();
+            let p = e.float("roughness", &[0.0]);
+            e.add_front(p);
+            if e.get("Kr", &["rgb", "spectrum", "blackbody", "texture"])
+                .is_some()
+            {
+                e.rename("Kr", "reflectance");
+            } else {
+                let p =
+                    ParsedParameter::with_floats("rgb", "reflectance", e.loc.clone(), vec![0.9; 3]);
+                e.add_front(p);
+            }
+        }
+        "disney" => {
+            e.name = "diffuse".into();
+            e.rename("color", "reflectance");
+            e.warn(
+                None,
+                "the \"disney\" material is approximated by \"diffuse\"".into(),
+            );
+        }
+        "" | "none" => e.name = "interface".into(),
+        _ => {}
+    }
+    e.finish()
+}
+
+/// Upgrades a `LightSource`.
+pub fn upgrade_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
+    let mut e = Edit::new(name, params, loc);
+    let mut scale = 1.0f32;
+    if !e.rgb_into_scale("scale", &mut scale) {
+        let l = e.get("scale", &SPECTRUM_TYPES).map(|p| p.loc.clone());
+        e.error(l.as_ref(), "in pbrt-v4 a light's \"scale\" is a \"float\"; a non-uniform spectrum cannot be converted".into());
+        return e.finish();
+    }
+    e.remove_all("samples", &["integer"]);
+    let has_map = e.get("mapname", &["string"]).is_some();
+    if has_map && name == "infinite" && !e.rgb_into_scale("L", &mut scale) {
+        let l = e.get("L", &SPECTRUM_TYPES).map(|p| p.loc.clone());
+        e.error(l.as_ref(), "a non-uniform \"L\" with \"mapname\" on an \"infinite\" light is not supported by pbrt-v4".into());
+        return e.finish();
+    }
+    if has_map && name == "projection" && !e.rgb_into_scale("I", &mut scale) {
+        let l = e.get("I", &SPECTRUM_TYPES).map(|p| p.loc.clone());
+        e.error(
+            l.as_ref(),
+            "\"I\" with \"mapname\" on a \"projection\" light is not supported by pbrt-v4".into(),
+        );
+        return e.finish();
+    }
+    e.upgrade_blackbody("I", &mut scale);
+    e.upgrade_blackbody("L", &mut scale);
+    if let Some(mut p) = e.remove("mapname", &["string"]) {
+        p.name = "filename".into();
+        e.add_front(p);
+    }
+    if scale != 1.0 {
+        let old = e
+            .remove("scale", &["float"])
+            .and_then(|p| p.floats.first().copied())
+            .unwrap_or(1.0);
+        let p = e.float("scale", &[scale * old]);
+        e.front.insert(0, p);
+    }
+    if e.get("L", &SPECTRUM_TYPES).is_some() || e.get("I", &SPECTRUM_TYPES).is_some() {
+        e.warn(
+            None,
+            "pbrt-v4 normalizes light spectra to unit luminance; brightness may differ from pbrt-v3 (adjust \"scale\" or use \"power\")".into(),
+        );
+    }
+    e.finish()
+}
+
+/// Upgrades an `AreaLightSource` (`area` → `diffuse`).
+pub fn upgrade_area_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
+    let mut e = Edit::new(name, params, loc);
+    let mut scale = 1.0f32;
+    if !e.rgb_into_scale("scale", &mut scale) {
+        let l = e.get("scale", &SPECTRUM_TYPES).map(|p| p.loc.clone());
+        e.error(l.as_ref(), "in pbrt-v4 a light's \"scale\" is a \"float\"; a non-uniform spectrum cannot be converted".into());
+        return e.finish();
+    }
+    e.upgrade_blackbody("L", &mut scale);
+    if name == "area" {
+        e.name = "diffuse".into();
+    }
+    e.remove_all("nsamples", &["integer"]);
+    if scale != 1.0 {
+        let old = e
+            .remove("scale", &["float"])
+            .and_then(|p| p.floats.first().copied())
+            .unwrap_or(1.0);
+        let p = e.float("scale", &[scale * old]);
+        e.front.insert(0, p);
+    }
+    e.finish()
+}
+
+/// Upgrades a `Film` (`image` → `rgb`, `maxsampleluminance`, `scale` → `iso`).
+pub fn upgrade_film(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
+    let mut e = Edit::new(name, params, loc);
+    if let Some(mut p) = e.remove("maxsampleluminance", &["float"]) {
+        p.name = "maxcomponentvalue".into();
+        e.add_front(p);
+    }
+    if let Some(p) = e.remove("scale", &["float"]) {
+        if let Some(&s) = p.floats.first() {
+            let iso = e.float("iso", &[100.0 * s]);
+            e.add_front(iso);
+            e.warn(
+                Some(&p.loc),
+                "film \"scale\" is approximated by \"iso\" = 100 × scale".into(),
+            );
+        }
+    }
+    if name == "image" {
+        e.name = "rgb".into();
+    }
+    e.finish()
+}
+
+/// Upgrades a `Sampler` (`lowdiscrepancy`/`02sequence` → `paddedsobol`,
+/// `maxmindist` → `pmj02bn`).
+pub fn upgrade_sampler(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
+    let mut e = Edit::new(name, params, loc);
+    match name {
+        "lowdiscrepancy" | "02sequence" => e.name = "paddedsobol".into(),
+        "maxmindist" => e.name = "pmj02bn".into(),
+        _ => {}
+    }
+    e.finish()
+}
+
+/// Upgrades an `Integrator` (`directlighting` → `path` with depth 1, SPPM
+/// and light-sampling parameters).
+pub fn upgrade_integrator(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
+    let mut e = Edit::new(name, params, loc);
+    e.remove_all("rrthreshold", &["float"]);
+    if name == "sppm" {
+        e.remove_all("imagewritefrequency", &["integer"]);
+        if let Some(p) = e.remove("numiterations", &["integer"]) {
+            e.warn(
+                Some(&p.loc),
+                "the SPPM integrator no longer takes \"numiterations\"; the sampler's pixel sample count sets it".into(),
+            );
+        }
+    }
+    if e.get("lightsamplestrategy", &["string"])
+        .is_some_and(|p| p.strings == ["spatial"])
+    {
+        e.remove_all("lightsamplestrategy", &["string"]);
+        let p = e.string("string", "lightsamplestrategy", &["bvh"]);
+        e.add_front(p);
+    }
+    if name == "directlighting" {
+        e.name = "path".into();
+        let mut p = ParsedParameter::new("integer", "maxdepth", loc.clone());
+        p.ints = vec![1];
+        e.remove_all("maxdepth", &["integer"]);
+        e.add_front(p);
+        e.warn(
+            None,
+            "\"directlighting\" is approximated by \"path\" with \"maxdepth\" 1".into(),
+        );
+    }
+    e.finish()
+}
+
+/// Upgrades a `Camera` (`environment` → `spherical`, equirectangular).
+pub fn upgrade_camera(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
+    let mut e = Edit::new(name, params, loc);
+    if name == "environment" {
+        e.name = "spherical".into();
+        let p = e.string("string", "mapping", &["equirectangular"]);
+        e.add_front(p);
+    }
+    if name == "realistic" {
+        e.remove_all("simpleweighting", &["bool"]);
+    }
+    e.finish()
+}
+
+/// Upgrades a `PixelFilter` (widths → radii, gaussian `alpha` → `sigma`).
+pub fn upgrade_pixel_filter(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
+    let mut e = Edit::new(name, params, loc);
+    for (from, to) in [("xwidth", "xradius"), ("ywidth", "yradius")] {
+        if e.get(from, &["float"]).is_some_and(|p| p.floats.len() == 1) {
+            if let Some(mut p) = e.remove(from, &["float"]) {
+                p.name = to.into();
+                e.add_front(p);
+            }
+        }
+    }
+    if name == "gaussian" {
+        if let Some(p) = e.remove("alpha", &["float"]) {
+            if let [a] = p.floats[..] {
+                if a > 0.0 {
+                    let s = e.float("sigma", &[1.0 / (2.0 * a).sqrt()]);
+                    e.add_front(s);
+                } else {
+                    e.error(Some(&p.loc), "gaussian \"alpha\" must be positive".into());
+                }
+            }
+        }
+    }
+    e.finish()
+}
+
+/// Upgrades a `MakeNamedMedium` (`heterogeneous` → `uniformgrid`).
+pub fn upgrade_medium(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
+    let mut e = Edit::new(name, params, loc);
+    if name == "heterogeneous" {
+        e.name = "uniformgrid".into();
+    }
+    e.finish()
+}
+
+/// Upgrades a `Texture`; returns the pbrt-v4 texture type (`color` →
+/// `spectrum`) and the upgraded class and parameters.
+pub fn upgrade_texture(
+    ty: &str,
+    class: &str,
+    params: Vec<ParsedParameter>,
+    loc: &FileLoc,
+) -> (String, Upgraded) {
+    let mut e = Edit::new(class, params, loc);
+    let ty = if ty == "color" { "spectrum" } else { ty }.to_string();
+    if class == "scale" {
+        if ty == "float" {
+            e.rename("tex1", "tex");
+            e.rename("tex2", "scale");
+        } else {
+            // One of tex1/tex2 must be a constant to become the float "scale".
+            let (mut found_rgb, mut found_tex) = (false, false);
+            let mut errs = Vec::new();
+            for p in &mut e.params {
+                if p.name != "tex1" && p.name != "tex2" {
+                    continue;
+                }
+                if p.canonical_type() == "rgb" {
+                    let uniform = matches!(p.floats[..], [r, g, b] if r == g && g == b);
+                    if found_rgb || !uniform {
+                        errs.push((p.loc.clone(), format!("cannot convert \"{}\" of a \"scale\" texture to a float scale; edit the file manually", p.name)));
+                        continue;
+                    }
+                    found_rgb = true;
+                    p.ty = "float".into();
+                    p.name = "scale".into();
+                    p.floats.truncate(1);
+                } else {
+                    if found_tex {
+                        errs.push((
+                            p.loc.clone(),
+                            "two textures in a \"scale\" texture; edit the file manually".into(),
+                        ));
+                        continue;
+                    }
+                    found_tex = true;
+                    p.name = "tex".into();
+                }
+            }
+            for (l, m) in errs {
+                e.error(Some(&l), m);
+            }
+        }
+    }
+    if class == "imagemap" {
+        if let Some(p) = e.remove("trilinear", &["bool"]) {
+            if let [t] = p.bools[..] {
+                let s = e.string(
+                    "string",
+                    "filter",
+                    &[if t { "trilinear" } else { "bilinear" }],
+                );
+                e.add_front(s);
+            }
+        }
+    }
+    if class == "imagemap" || class == "ptex" {
+        if let Some(p) = e.remove("gamma", &["float"]) {
+            if let [g] = p.floats[..] {
+                let s = e.string("string", "encoding", &[&format!("gamma {g}")]);
+                e.add_front(s);
+            }
+        } else if let Some(p) = e.remove("gamma", &["bool"]) {
+            if let [g] = p.bools[..] {
+                let s = e.string("string", "encoding", &[if g { "sRGB" } else { "linear" }]);
+                e.add_front(s);
+            }
+        }
+    }
+    (ty, e.finish())
+}
+
+/// Upgrades a `Shape` (implicit mesh indices, `loopsubdiv` levels, UVs,
+/// dropped pbrt-v3 parameters).
+pub fn upgrade_shape(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
+    let mut e = Edit::new(name, params, loc);
+    let n_p = e.get("P", &["point3"]).map_or(0, |p| p.floats.len() / 3);
+    let implicit = |ints: &[i32], n: usize| {
+        ints.len() == n && ints.iter().enumerate().all(|(i, &v)| v as usize == i)
+    };
+    if name == "trianglemesh"
+        && n_p == 3
+        && e.get("indices", &["integer"])
+            .is_some_and(|p| implicit(&p.ints, 3))
+    {
+        e.remove_all("indices", &["integer"]);
+    }
+    if name == "bilinearmesh"
+        && n_p == 4
+        && e.get("indices", &["integer"])
+            .is_some_and(|p| implicit(&p.ints, 4))
+    {
+        e.remove_all("indices", &["integer"]);
+    }
+    if name == "loopsubdiv" {
+        if let Some(mut p) = e.remove("nlevels", &["integer"]) {
+            p.name = "levels".into();
+            e.add_front(p);
+        }
+    }
+    if name == "trianglemesh" || name == "plymesh" {
+        e.remove_all("discarddegenerateUVs", &["bool"]);
+        e.remove_all("shadowalpha", &["texture"]);
+    }
+    if name == "trianglemesh" {
+        let uv = if let Some(mut p) = e.remove("st", &["point2"]) {
+            p.name = "uv".into();
+            Some(p)
+        } else {
+            let mut found = None;
+            for n in ["uv", "st"] {
+                if let Some(mut p) = e.remove(n, &["float"]) {
+                    p.ty = "point2".into();
+                    p.name = "uv".into();
+                    if p.floats.len() % 2 != 0 {
+                        let l = p.loc.clone();
+                        e.error(Some(&l), format!("\"{n}\" has an odd number of values"));
+                    }
+                    found = Some(p);
+                }
+            }
+            found
+        };
+        if let Some(p) = uv {
+            e.add_front(p);
+        }
+    }
+    e.rename("Kd", "reflectance");
+    e.finish()
+}
+
+#[cfg(test)]
+#[path = "upgrade_tests.rs"]
+mod tests;
