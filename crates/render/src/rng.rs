@@ -17,7 +17,10 @@ pub struct Rng {
 
 impl Default for Rng {
     fn default() -> Self {
-        Rng { state: PCG32_DEFAULT_STATE, inc: PCG32_DEFAULT_STREAM }
+        Rng {
+            state: PCG32_DEFAULT_STATE,
+            inc: PCG32_DEFAULT_STREAM,
+        }
     }
 }
 

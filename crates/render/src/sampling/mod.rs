@@ -14,7 +14,11 @@ pub fn sample_uniform_disk_concentric(u: Point2f) -> Point2f {
     if uo.x == 0.0 && uo.y == 0.0 {
         return Point2f::new(0.0, 0.0);
     }
-    let (r, theta) = if uo.x.abs() > uo.y.abs() { (uo.x, PI_OVER_4 * (uo.y / uo.x)) } else { (uo.y, PI_OVER_2 - PI_OVER_4 * (uo.x / uo.y)) };
+    let (r, theta) = if uo.x.abs() > uo.y.abs() {
+        (uo.x, PI_OVER_4 * (uo.y / uo.x))
+    } else {
+        (uo.y, PI_OVER_2 - PI_OVER_4 * (uo.x / uo.y))
+    };
     Point2f::new(r * theta.cos(), r * theta.sin())
 }
 
@@ -139,7 +143,10 @@ pub fn bilinear_pdf(p: Point2f, w: [Float; 4]) -> Float {
     if w[0] + w[1] + w[2] + w[3] == 0.0 {
         return 1.0;
     }
-    4.0 * ((1.0 - p.x) * (1.0 - p.y) * w[0] + p.x * (1.0 - p.y) * w[1] + (1.0 - p.x) * p.y * w[2] + p.x * p.y * w[3])
+    4.0 * ((1.0 - p.x) * (1.0 - p.y) * w[0]
+        + p.x * (1.0 - p.y) * w[1]
+        + (1.0 - p.x) * p.y * w[2]
+        + p.x * p.y * w[3])
         / (w[0] + w[1] + w[2] + w[3])
 }
 

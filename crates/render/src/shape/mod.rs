@@ -77,7 +77,12 @@ pub struct ShapeSampleContext {
 impl ShapeSampleContext {
     /// A context at a point in space (no surface).
     pub fn from_point(p: Point3f, time: Float) -> Self {
-        ShapeSampleContext { pi: Point3fi::from(p), n: Normal3f::default(), ns: Normal3f::default(), time }
+        ShapeSampleContext {
+            pi: Point3fi::from(p),
+            n: Normal3f::default(),
+            ns: Normal3f::default(),
+            time,
+        }
     }
     /// The reference point.
     #[inline]
@@ -136,7 +141,10 @@ pub trait ShapeMethods {
 /// Converts an area-density sample into a solid-angle density sample from
 /// `ctx` (the generic `Shape::Sample(ctx, u)` of pbrt-v4); `None` when the
 /// density is infinite.
-pub fn area_sample_to_solid_angle(ctx: &ShapeSampleContext, mut ss: ShapeSample) -> Option<ShapeSample> {
+pub fn area_sample_to_solid_angle(
+    ctx: &ShapeSampleContext,
+    mut ss: ShapeSample,
+) -> Option<ShapeSample> {
     let wi = ss.p() - ctx.p();
     let d2 = wi.length_squared();
     if d2 == 0.0 {
@@ -152,13 +160,18 @@ pub fn area_sample_to_solid_angle(ctx: &ShapeSampleContext, mut ss: ShapeSample)
 
 /// The generic solid-angle pdf of pbrt-v4: intersect the ray from `ctx`
 /// toward `wi` with the shape and convert 1/area to solid angle.
-pub fn pdf_by_intersection<S: ShapeMethods + ?Sized>(shape: &S, ctx: &ShapeSampleContext, wi: Vector3f) -> Float {
+pub fn pdf_by_intersection<S: ShapeMethods + ?Sized>(
+    shape: &S,
+    ctx: &ShapeSampleContext,
+    wi: Vector3f,
+) -> Float {
     let ray = ctx.spawn_ray(wi);
     let isect = match shape.intersect(&ray, Float::INFINITY) {
         Some(i) => i,
         None => return 0.0,
     };
-    let pdf = (1.0 / shape.area()) / (abs_dot(isect.intr.n, -wi) / ctx.p().distance_squared(isect.intr.p()));
+    let pdf = (1.0 / shape.area())
+        / (abs_dot(isect.intr.n, -wi) / ctx.p().distance_squared(isect.intr.p()));
     if pdf.is_infinite() {
         0.0
     } else {

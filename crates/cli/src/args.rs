@@ -1,0 +1,304 @@
+//! Command-line options, spelled as pbrt-v4 spells them. Flag names ignore
+//! case, '-' and '_' (`--outfile`, `--out-file` and `--OUTFILE` are one
+//! flag), and a value may follow as the next argument or after '='.
+
+use std::fmt;
+
+/// What the user asked for.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Options {
+    /// Scene files, in order.
+    pub files: Vec<String>,
+    /// `--outfile`: overrides the film's filename.
+    pub outfile: Option<String>,
+    /// `--spp`: overrides the sampler's pixel sample count.
+    pub spp: Option<i32>,
+    /// `--seed`.
+    pub seed: Option<i32>,
+    /// `--nthreads` (0: all cores).
+    pub nthreads: Option<usize>,
+    /// `--cropwindow x0 x1 y0 y1` (NDC).
+    pub crop_window: Option<[f32; 4]>,
+    /// `--pixelbounds x0 x1 y0 y1`.
+    pub pixel_bounds: Option<[i32; 4]>,
+    /// `--quick`: a fast, reduced-quality render.
+    pub quick: bool,
+    /// `--quiet`: no progress bar or statistics.
+    pub quiet: bool,
+    /// `--stats`: print statistics after rendering.
+    pub stats: bool,
+    /// `--write-partial-images`.
+    pub write_partial_images: bool,
+    /// `--disable-pixel-jitter`.
+    pub disable_pixel_jitter: bool,
+    /// `--disable-wavelength-jitter`.
+    pub disable_wavelength_jitter: bool,
+    /// `--disable-texture-filtering`.
+    pub disable_texture_filtering: bool,
+    /// `--force-diffuse`.
+    pub force_diffuse: bool,
+    /// `--render-coord-sys camera|cameraworld|world`.
+    pub render_coord_sys: Option<String>,
+    /// `--mse-reference-image`.
+    pub mse_reference_image: Option<String>,
+    /// `--mse-reference-out`.
+    pub mse_reference_out: Option<String>,
+    /// `--format`: print the scene back as canonical pbrt-v4 text.
+    pub format: bool,
+    /// `--upgrade`: print a pbrt-v3 scene as pbrt-v4 text.
+    pub upgrade: bool,
+    /// `--toply`: with --format/--upgrade, write large meshes to PLY files.
+    pub toply: bool,
+    /// `--help`.
+    pub help: bool,
+    /// `--version`.
+    pub version: bool,
+}
+
+/// A command-line mistake.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ArgError(pub String);
+
+impl fmt::Display for ArgError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+/// The usage text printed by `--help`.
+pub const USAGE: &str = "\
+usage: rpbrt [<options>] <filename.pbrt...>
+
+Renders pbrt-v4 (and pbrt-v3) scene files. Flag names ignore case, '-' and '_'.
+
+Rendering options:
+  --cropwindow <x0,x1,y0,y1>   Render only this part of the image (NDC, [0,1]).
+  --disable-pixel-jitter       Always sample pixels at their centres.
+  --disable-texture-filtering  Point-sample all textures.
+  --disable-wavelength-jitter  Always sample the same four wavelengths of light.
+  --force-diffuse              Replace every material with a diffuse one.
+  --mse-reference-image <file> Compute the MSE against this image while rendering.
+  --mse-reference-out <file>   Write the MSE per sample count to this file.
+  --nthreads <n>               Use n threads (default: all cores).
+  --outfile <file>             Write the image here (overrides the Film's filename).
+  --pixelbounds <x0,x1,y0,y1>  Render only these pixels.
+  --quick                      Reduced quality for a fast preview.
+  --quiet                      No progress bar or informational messages.
+  --render-coord-sys <name>    Rendering space: camera, cameraworld (default), world.
+  --seed <n>                   Seed for the random number generators.
+  --spp <n>                    Samples per pixel (overrides the Sampler).
+  --stats                      Print statistics after rendering.
+  --write-partial-images       Write the image periodically while rendering.
+
+Scene file tools:
+  --format                     Print the scene back as canonical pbrt-v4 text.
+  --toply                      With --format/--upgrade: write large meshes to PLY files.
+  --upgrade                    Print a pbrt-v3 scene as pbrt-v4 text.
+
+  --help                       Print this help.
+  --version                    Print the version.
+";
+
+/// Lower-case and drop '-' and '_' so flag spellings compare equal.
+fn normalize(flag: &str) -> String {
+    flag.chars()
+        .filter(|c| *c != '-' && *c != '_')
+        .flat_map(char::to_lowercase)
+        .collect()
+}
+
+fn parse_num<T: std::str::FromStr>(flag: &str, v: &str) -> Result<T, ArgError> {
+    v.trim()
+        .parse::<T>()
+        .map_err(|_| ArgError(format!("--{flag}: \"{v}\" is not a valid number")))
+}
+
+fn parse_four<T: std::str::FromStr + Copy + Default>(
+    flag: &str,
+    vals: &[String],
+) -> Result<[T; 4], ArgError> {
+    let joined = vals.join(",");
+    let parts: Vec<&str> = joined
+        .split(|c: char| c == ',' || c.is_whitespace())
+        .filter(|s| !s.is_empty())
+        .collect();
+    if parts.len() != 4 {
+        return Err(ArgError(format!(
+            "--{flag} expects four values, got {}",
+            parts.len()
+        )));
+    }
+    let mut out = [T::default(); 4];
+    for (o, p) in out.iter_mut().zip(parts) {
+        *o = parse_num(flag, p)?;
+    }
+    Ok(out)
+}
+
+/// Parses the arguments after the program name.
+pub fn parse_args(args: &[String]) -> Result<Options, ArgError> {
+    let mut o = Options::default();
+    let mut i = 0;
+    while i < args.len() {
+        let arg = &args[i];
+        i += 1;
+        if !arg.starts_with('-') || arg == "-" {
+            o.files.push(arg.clone());
+            continue;
+        }
+        let body = arg.trim_start_matches('-');
+        let (name, inline) = match body.split_once('=') {
+            Some((n, v)) => (n, Some(v.to_string())),
+            None => (body, None),
+        };
+        let key = normalize(name);
+        // Fetches the flag's value: inline after '=' or the next argument.
+        let value = |i: &mut usize| -> Result<String, ArgError> {
+            if let Some(v) = &inline {
+                return Ok(v.clone());
+            }
+            match args.get(*i) {
+                Some(v) => {
+                    *i += 1;
+                    Ok(v.clone())
+                }
+                None => Err(ArgError(format!("--{name} needs a value"))),
+            }
+        };
+        match key.as_str() {
+            "outfile" => o.outfile = Some(value(&mut i)?),
+            "spp" => {
+                let n: i32 = parse_num(name, &value(&mut i)?)?;
+                if n <= 0 {
+                    return Err(ArgError(format!("--spp must be positive, got {n}")));
+                }
+                o.spp = Some(n);
+            }
+            "seed" => o.seed = Some(parse_num(name, &value(&mut i)?)?),
+            "nthreads" => {
+                let n: i64 = parse_num(name, &value(&mut i)?)?;
+                if n < 0 {
+                    return Err(ArgError(format!(
+                        "--nthreads must not be negative, got {n}"
+                    )));
+                }
+                o.nthreads = Some(n as usize);
+            }
+            "cropwindow" | "pixelbounds" => {
+                // Four values: "a,b,c,d" in one argument, or four arguments.
+                let first = value(&mut i)?;
+                let mut vals = vec![first];
+                let count = |v: &Vec<String>| {
+                    v.join(",")
+                        .split(|c: char| c == ',' || c.is_whitespace())
+                        .filter(|s| !s.is_empty())
+                        .count()
+                };
+                while count(&vals) < 4 && i < args.len() && !args[i].starts_with("--") {
+                    vals.push(args[i].clone());
+                    i += 1;
+                }
+                if key == "cropwindow" {
+                    let c: [f32; 4] = parse_four(name, &vals)?;
+                    if c.iter().any(|v| !(0.0..=1.0).contains(v)) || c[0] >= c[1] || c[2] >= c[3] {
+                        return Err(ArgError(format!(
+                            "--cropwindow {c:?}: values must be in [0,1] with x0 < x1 and y0 < y1"
+                        )));
+                    }
+                    o.crop_window = Some(c);
+                } else {
+                    let b: [i32; 4] = parse_four(name, &vals)?;
+                    if b[0] >= b[1] || b[2] >= b[3] || b.iter().any(|v| *v < 0) {
+                        return Err(ArgError(format!(
+                            "--pixelbounds {b:?}: need 0 <= x0 < x1 and 0 <= y0 < y1"
+                        )));
+                    }
+                    o.pixel_bounds = Some(b);
+                }
+            }
+            "quick" => o.quick = true,
+            "quiet" => o.quiet = true,
+            "stats" => o.stats = true,
+            "writepartialimages" => o.write_partial_images = true,
+            "disablepixeljitter" => o.disable_pixel_jitter = true,
+            "disablewavelengthjitter" => o.disable_wavelength_jitter = true,
+            "disabletexturefiltering" => o.disable_texture_filtering = true,
+            "forcediffuse" => o.force_diffuse = true,
+            "rendercoordsys" => {
+                let v = value(&mut i)?;
+                if !["camera", "cameraworld", "world"].contains(&v.as_str()) {
+                    return Err(ArgError(format!(
+                        "--render-coord-sys: \"{v}\" is not one of camera, cameraworld, world"
+                    )));
+                }
+                o.render_coord_sys = Some(v);
+            }
+            "msereferenceimage" => o.mse_reference_image = Some(value(&mut i)?),
+            "msereferenceout" => o.mse_reference_out = Some(value(&mut i)?),
+            "format" => o.format = true,
+            "upgrade" => o.upgrade = true,
+            "toply" => o.toply = true,
+            "help" | "h" => o.help = true,
+            "version" => o.version = true,
+            _ => return Err(ArgError(format!("unknown option \"{arg}\" (see --help)"))),
+        }
+    }
+    Ok(o)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn p(args: &[&str]) -> Result<Options, ArgError> {
+        parse_args(&args.iter().map(|s| s.to_string()).collect::<Vec<_>>())
+    }
+
+    #[test]
+    fn spellings_are_equivalent() {
+        for flag in [
+            "--outfile",
+            "--out-file",
+            "--OUTFILE",
+            "--out_file",
+            "-outfile",
+        ] {
+            let o = p(&[flag, "x.exr", "scene.pbrt"]).unwrap();
+            assert_eq!(o.outfile.as_deref(), Some("x.exr"));
+            assert_eq!(o.files, vec!["scene.pbrt"]);
+        }
+        let o = p(&["--spp=16", "--Disable_Pixel-Jitter", "a.pbrt"]).unwrap();
+        assert_eq!(o.spp, Some(16));
+        assert!(o.disable_pixel_jitter);
+    }
+
+    #[test]
+    fn four_value_flags() {
+        assert_eq!(
+            p(&["--cropwindow", "0,0.5,0.25,1"]).unwrap().crop_window,
+            Some([0.0, 0.5, 0.25, 1.0])
+        );
+        assert_eq!(
+            p(&["--cropwindow", "0", "0.5", "0.25", "1", "s.pbrt"])
+                .unwrap()
+                .crop_window,
+            Some([0.0, 0.5, 0.25, 1.0])
+        );
+        assert_eq!(
+            p(&["--pixelbounds", "0,16,8,24"]).unwrap().pixel_bounds,
+            Some([0, 16, 8, 24])
+        );
+        assert!(p(&["--cropwindow", "0,2,0,1"]).is_err());
+        assert!(p(&["--pixelbounds", "5,1,0,1"]).is_err());
+    }
+
+    #[test]
+    fn bad_values_are_errors() {
+        assert!(p(&["--spp", "-4"]).is_err());
+        assert!(p(&["--spp", "lots"]).is_err());
+        assert!(p(&["--nthreads", "-1"]).is_err());
+        assert!(p(&["--spp"]).is_err());
+        assert!(p(&["--render-coord-sys", "object"]).is_err());
+        assert!(p(&["--no-such-flag"]).is_err());
+    }
+}
