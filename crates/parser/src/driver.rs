@@ -642,6 +642,12 @@ impl<'a> Run<'a> {
             match first.kind {
                 TokenKind::LBracket => {
                     let open = self.loc(&first);
+                    if matches!(kind, Some(ValueKind::Float | ValueKind::Int))
+                        && self.fast_numbers(&mut p)?
+                    {
+                        out.push(p);
+                        continue;
+                    }
                     loop {
                         let Some(v) = self.next()? else {
                             self.report(Diagnostic::error(
@@ -680,6 +686,63 @@ impl<'a> Run<'a> {
         }
     }
 
+    /// The hot path for long numeric arrays: reads numbers straight from
+    /// the tokenizer. Returns `true` after the closing `]`; `false` when it
+    /// met anything else, which is left for the general loop (and its
+    /// error reporting) to handle.
+    fn fast_numbers(&mut self, p: &mut ParsedParameter) -> P<bool> {
+        if self.unget.is_some() {
+            return Ok(false);
+        }
+        let Some(src) = self.stack.last_mut() else {
+            return Ok(false);
+        };
+        let tk = &mut src.tok;
+        let ints = p.canonical_type() == "integer";
+        let max = self.opts.max_values;
+        loop {
+            let t = match tk.next_token() {
+                Ok(Some(t)) => t,
+                Ok(None) => return Ok(false),
+                Err(d) => {
+                    self.report(d);
+                    return Err(Abort);
+                }
+            };
+            match t.kind {
+                TokenKind::Word => {
+                    let raw = tk.raw(&t);
+                    let ok = if ints {
+                        crate::tokenizer::parse_i32(raw)
+                            .map(|v| p.ints.push(v))
+                            .is_ok()
+                    } else {
+                        match crate::tokenizer::parse_f32(raw) {
+                            Some(v) if v.is_finite() => {
+                                p.floats.push(v);
+                                true
+                            }
+                            _ => false,
+                        }
+                    };
+                    if !ok || p.floats.len() + p.ints.len() > max {
+                        if ok {
+                            p.floats.pop();
+                            p.ints.pop();
+                        }
+                        self.unget = Some(t);
+                        return Ok(false);
+                    }
+                }
+                TokenKind::RBracket => return Ok(true),
+                _ => {
+                    self.unget = Some(t);
+                    return Ok(false);
+                }
+            }
+        }
+    }
+
     fn add_value(
         &mut self,
         p: &mut ParsedParameter,
@@ -701,8 +764,14 @@ impl<'a> Run<'a> {
             }
             (ValueKind::Int, TokenKind::Word) => tk.parse_int(&t).map(|v| p.ints.push(v)),
             (ValueKind::Bool, _) => match tk.raw(&t) {
-                b"true" => Ok(p.bools.push(true)),
-                b"false" => Ok(p.bools.push(false)),
+                b"true" => {
+                    p.bools.push(true);
+                    Ok(())
+                }
+                b"false" => {
+                    p.bools.push(false);
+                    Ok(())
+                }
                 _ => Err(Diagnostic::error(
                     tk.loc(&t),
                     format!("{}: expected true or false for \"{decl}\"", tk.display(&t)),

@@ -1,1 +1,189 @@
+//! Tests of the formatter: canonical layout, float round trips, idempotence
+//! and the pbrt-v3 upgrade of a small scene.
 use super::*;
+use crate::driver::parse_string;
+use crate::tokenizer::parse_f32;
+
+fn format(text: &str, upgrade: bool) -> (String, crate::diag::Diagnostics) {
+    let mut f = FormattingTarget::new(upgrade);
+    let d = match parse_string(text, &mut f) {
+        Ok(d) | Err(d) => d,
+    };
+    (f.into_output(), d)
+}
+
+const EVERY_DIRECTIVE: &str = r#"# a comment
+Option "bool disablepixeljitter" true
+Option "string seed" "x \"y\""
+ColorSpace "srgb"
+LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" 45.000
+Film "rgb" "integer xresolution" [ 64 ] "string filename" "out\t.exr"
+Sampler "halton" "integer pixelsamples" 16
+PixelFilter "gaussian" "float sigma" 0.1
+Accelerator "bvh"
+Integrator "volpath" "integer maxdepth" 5 "bool regularize" "false"
+TransformTimes 0 1
+ActiveTransform EndTime Translate 1 2 3 ActiveTransform StartTime Scale 2 2 2
+ActiveTransform All
+Rotate 90 0 0 1
+Identity
+ConcatTransform [ 1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1 ]
+Transform [ 2 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1 ]
+CoordinateSystem "cam"
+CoordSysTransform "cam"
+MakeNamedMedium "fog" "string type" "homogeneous" "spectrum sigma_a" [ 300 .1 800 .2 ]
+WorldBegin
+MediumInterface "fog"
+Attribute "shape" "float radius" 2
+Texture "checks" "spectrum" "checkerboard" "rgb tex1" [1 1 1] "float uscale" 1e-7
+MakeNamedMaterial "red" "string type" "diffuse" "rgb reflectance" [ 1 0 0 ]
+NamedMaterial "red"
+Material "conductor" "spectrum eta" "metal-Cu-eta" "spectrum k" "metal-Cu-k"
+AttributeBegin
+  ReverseOrientation
+  AreaLightSource "diffuse" "blackbody L" 6500 "float scale" 3.4028235e38
+  Shape "sphere" "float radius" 0.30000001192092896
+  AttributeBegin
+    Shape "disk" "normal N" [0 0 1] "normal3 M" [0 1 0]
+  AttributeEnd
+AttributeEnd
+TransformBegin
+  Translate 0 0 1
+TransformEnd
+LightSource "point" "point3 from" [0 1 0]
+ObjectBegin "thing"
+  Shape "trianglemesh" "point3 P" [0 0 0 1 0 0 0 1 0 1 1 0 2 2 2]
+    "integer indices" [0 1 2 2 1 3 0 1 2 3 3 3 1 1 1]
+    "string names" ["a" "b" "c" "d" "e"]
+ObjectEnd
+ObjectInstance "thing"
+Include "other.pbrt"
+Import "geometry.pbrt"
+WorldEnd
+"#;
+
+#[test]
+fn format_is_canonical_and_idempotent() {
+    let (f1, d1) = format(EVERY_DIRECTIVE, false);
+    assert!(!d1.has_errors(), "{d1}");
+    let (f2, d2) = format(&f1, false);
+    assert!(!d2.has_errors(), "{d2}");
+    assert_eq!(f1, f2);
+    let expected_fragments = [
+        "Option \"bool disablepixeljitter\" true\n",
+        "Option \"string seed\" \"x \\\"y\\\"\"\n",
+        "LookAt 0 0 5\n       0 0 0\n       0 1 0\n",
+        "Camera \"perspective\"\n    \"float fov\" [ 45 ]\n",
+        "    \"string filename\" [ \"out\\t.exr\" ]\n",
+        "    \"bool regularize\" [ false ]\n",
+        "ActiveTransform EndTime\nTranslate 1 2 3\n",
+        "\nWorldBegin\n\n",
+        "    \"float uscale\" [ 1e-7 ]\n",
+        "AttributeBegin\n    ReverseOrientation\n",
+        "        \"float scale\" [ 3.4028235e38 ]\n",
+        "        \"float radius\" [ 0.3 ]\n",
+        "    AttributeBegin\n        Shape \"disk\"\n            \"normal N\" [ 0 0 1 ]\n            \"normal3 M\" [ 0 1 0 ]\n    AttributeEnd\nAttributeEnd\n",
+        "TransformBegin\n    Translate 0 0 1\nTransformEnd\n",
+        "ObjectBegin \"thing\"\n    Shape \"trianglemesh\"\n        \"point3 P\" [\n            0 0 0 1 0 0 0 1 0 1 1 0\n            2 2 2\n        ]\n",
+        "        \"string names\" [\n            \"a\" \"b\" \"c\" \"d\"\n            \"e\"\n        ]\nObjectEnd\n",
+        "Include \"other.pbrt\"\nImport \"geometry.pbrt\"\n",
+    ];
+    for frag in expected_fragments {
+        assert!(f1.contains(frag), "missing {frag:?} in\n{f1}");
+    }
+    assert!(!f1.contains("WorldEnd"));
+}
+
+#[test]
+fn floats_print_shortest_and_round_trip() {
+    assert_eq!(format_float(1.0), "1");
+    assert_eq!(format_float(-0.0), "-0");
+    assert_eq!(format_float(0.1), "0.1");
+    assert_eq!(format_float(1e-7), "1e-7");
+    assert_eq!(format_float(1e30), "1e30");
+    let mut x: u32 = 0x1234_5679;
+    for _ in 0..100_000 {
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        let v = f32::from_bits(x);
+        if !v.is_finite() {
+            continue;
+        }
+        let s = format_float(v);
+        assert_eq!(
+            parse_f32(s.as_bytes()).map(f32::to_bits),
+            Some(v.to_bits()),
+            "{s}"
+        );
+    }
+}
+
+const V3_SCENE: &str = r#"Film "image" "string filename" "v3.exr" "float scale" 2
+Sampler "lowdiscrepancy" "integer pixelsamples" 8
+Integrator "directlighting"
+PixelFilter "gaussian" "float xwidth" 2 "float alpha" 2
+Camera "environment"
+WorldBegin
+LightSource "infinite" "string mapname" "sky.exr" "color L" [2 2 2] "color scale" [0.5 0.5 0.5]
+TransformBegin
+  Translate 0 1 0
+  LightSource "point" "blackbody I" [5500 10]
+TransformEnd
+Texture "grid" "color" "imagemap" "string filename" "g.png" "bool trilinear" "true" "float gamma" 2.2
+Material "matte" "color Kd" [0.5 0.5 0.5] "texture bumpmap" "bumps"
+Material "plastic" "color Kd" [0.5 0.5 0.5] "color Ks" [0 0 0] "float roughness" 0.1
+Material "mirror"
+Material "glass" "float index" 1.5
+MakeNamedMaterial "a" "string type" "metal"
+MakeNamedMaterial "m" "string type" "mix" "string namedmaterial1" "a" "string namedmaterial2" "b" "color amount" [0.2 0.4 0.6]
+AttributeBegin
+  AreaLightSource "area" "color L" [4 4 4] "integer nsamples" 4
+  Shape "trianglemesh" "point P" [0 0 0 1 0 0 0 1 0] "integer indices" [0 1 2] "float uv" [0 0 1 0 0 1] "vector S" [1 0 0 1 0 0 1 0 0]
+AttributeEnd
+WorldEnd
+"#;
+
+#[test]
+fn upgrades_a_small_v3_scene() {
+    let (out, diags) = format(V3_SCENE, true);
+    assert!(!diags.has_errors(), "{diags}");
+    for frag in [
+        "Film \"rgb\"\n    \"float iso\" [ 200 ]\n    \"string filename\" [ \"v3.exr\" ]\n",
+        "Sampler \"paddedsobol\"\n",
+        "Integrator \"path\"\n    \"integer maxdepth\" [ 1 ]\n",
+        "PixelFilter \"gaussian\"\n    \"float xradius\" [ 2 ]\n    \"float sigma\" [ 0.5 ]\n",
+        "Camera \"spherical\"\n    \"string mapping\" [ \"equirectangular\" ]\n",
+        "LightSource \"infinite\"\n    \"string filename\" [ \"sky.exr\" ]\n",
+        "AttributeBegin\n    Translate 0 1 0\n    LightSource \"point\"\n        \"float scale\" [ 10 ]\n        \"blackbody I\" [ 5500 ]\nAttributeEnd\n",
+        "Texture \"grid\" \"spectrum\" \"imagemap\"\n    \"string filter\" [ \"trilinear\" ]\n    \"string encoding\" [ \"gamma 2.2\" ]\n",
+        "Material \"diffuse\"\n    \"rgb reflectance\" [ 0.5 0.5 0.5 ]\n    \"texture displacement\" [ \"bumps\" ]\n",
+        "Material \"diffuse\"\n    \"rgb reflectance\" [ 0.5 0.5 0.5 ]\n",
+        "Material \"conductor\"\n    \"float roughness\" [ 0 ]\n    \"rgb reflectance\" [ 0.9 0.9 0.9 ]\n",
+        "Material \"dielectric\"\n    \"float eta\" [ 1.5 ]\n",
+        "MakeNamedMaterial \"a\"\n    \"string type\" [ \"conductor\" ]\n",
+        "    \"string type\" [ \"mix\" ]\n    \"float amount\" [ 0.4 ]\n    \"string materials\" [ \"b\" \"a\" ]\n",
+        "AreaLightSource \"diffuse\"\n        \"rgb L\" [ 4 4 4 ]\n    Shape",
+        "        \"point2 uv\" [ 0 0 1 0 0 1 ]\n        \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ]\n        \"vector3 S\"",
+    ] {
+        assert!(out.contains(frag), "missing {frag:?} in\n{out}");
+    }
+    assert!(
+        !out.contains("TransformBegin") && !out.contains("nsamples") && !out.contains("indices")
+    );
+    assert!(!out.contains("\"color") && !out.contains("\"point P"));
+    // Approximations are reported, located.
+    let msgs: Vec<String> = diags.iter().map(|d| d.to_string()).collect();
+    assert!(
+        msgs.iter()
+            .any(|m| m.contains(":4:1: warning:") || m.contains("directlighting")),
+        "{msgs:?}"
+    );
+    assert!(msgs.iter().any(|m| m.contains("average 0.4")), "{msgs:?}");
+    // The upgraded text is valid pbrt-v4 and formats stably.
+    let (again, d) = format(&out, false);
+    assert!(!d.has_errors(), "{d}");
+    let (again2, _) = format(&again, false);
+    assert_eq!(again, again2);
+}

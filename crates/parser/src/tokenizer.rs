@@ -63,9 +63,22 @@ pub struct Tokenizer {
     line_start: usize,
 }
 
+/// Bytes that end a bare word, as a table so the hot scan is one load.
+static ENDS_WORD: [bool; 256] = {
+    let mut t = [false; 256];
+    t[b' ' as usize] = true;
+    t[b'\n' as usize] = true;
+    t[b'\t' as usize] = true;
+    t[b'\r' as usize] = true;
+    t[b'"' as usize] = true;
+    t[b'[' as usize] = true;
+    t[b']' as usize] = true;
+    t
+};
+
 #[inline]
 fn ends_word(b: u8) -> bool {
-    matches!(b, b' ' | b'\n' | b'\t' | b'\r' | b'"' | b'[' | b']')
+    ENDS_WORD[b as usize]
 }
 
 fn saturating_u32(v: usize) -> u32 {
