@@ -41,11 +41,13 @@ fn main() -> ExitCode {
 
 /// `--format` / `--upgrade`: print the scene back as pbrt-v4 text.
 fn format_scene(opts: &args::Options) -> ExitCode {
-    if opts.toply {
-        eprintln!("rpbrt: error: --toply is not supported yet");
-        return ExitCode::FAILURE;
-    }
     let mut target = FormattingTarget::new(opts.upgrade);
+    if opts.toply {
+        // As pbrt-v4: PLY files go to the current directory, named
+        // $PLY_PREFIX_NNNNN.ply ("mesh" by default).
+        let prefix = std::env::var("PLY_PREFIX").unwrap_or_else(|_| "mesh".to_string());
+        target = target.with_toply(".", prefix);
+    }
     let result = parse_files(&opts.files, &mut target);
     let (diags, ok) = match result {
         Ok(d) => (d, true),

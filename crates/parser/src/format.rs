@@ -24,7 +24,20 @@ pub struct FormattingTarget {
     depth: usize,
     upgrade: bool,
     diags: Vec<Diagnostic>,
+    toply: Option<ToPly>,
 }
+
+/// Where `--toply` writes meshes, and how many it has written.
+#[derive(Clone, Debug, Default)]
+struct ToPly {
+    dir: std::path::PathBuf,
+    prefix: String,
+    count: usize,
+}
+
+/// Meshes with fewer vertex indices than this stay inline under `--toply`
+/// (as in pbrt-v4).
+pub const TOPLY_MIN_INDICES: usize = 500;
 
 /// Formats `v` in the shortest decimal form that parses back to `v`.
 pub fn format_float(v: f32) -> String {
@@ -42,6 +55,98 @@ impl FormattingTarget {
             upgrade,
             ..Self::default()
         }
+    }
+
+    /// Makes the formatter write every `trianglemesh` with at least
+    /// [`TOPLY_MIN_INDICES`] indices to `dir/<prefix>_NNNNN.ply` (object
+    /// space, binary) and print a `plymesh` shape referring to it instead
+    /// (`pbrt --toply`).
+    pub fn with_toply(
+        mut self,
+        dir: impl Into<std::path::PathBuf>,
+        prefix: impl Into<String>,
+    ) -> Self {
+        self.toply = Some(ToPly {
+            dir: dir.into(),
+            prefix: prefix.into(),
+            count: 0,
+        });
+        self
+    }
+
+    /// Writes an inline triangle mesh to a PLY file; returns the file name
+    /// to reference, or `None` when the mesh is small enough to stay inline.
+    fn mesh_to_ply(
+        &mut self,
+        params: &mut ParamList,
+        loc: &FileLoc,
+    ) -> Result<Option<String>, Diagnostic> {
+        if self.toply.is_none() {
+            return Ok(None);
+        }
+        let dict = crate::params::ParameterDictionary::new(params.clone());
+        let idx = dict.get_int_array("indices").map_err(Diagnostic::from)?;
+        if idx.len() < TOPLY_MIN_INDICES {
+            return Ok(None);
+        }
+        let positions = dict.get_point3_array("P").map_err(Diagnostic::from)?;
+        let normals = dict.get_normal3_array("N").map_err(Diagnostic::from)?;
+        let uvs = dict.get_point2_array("uv").map_err(Diagnostic::from)?;
+        let face_indices = dict
+            .get_int_array("faceIndices")
+            .map_err(Diagnostic::from)?;
+        if !dict
+            .get_vector3_array("S")
+            .map_err(Diagnostic::from)?
+            .is_empty()
+        {
+            self.diags.push(Diagnostic::warning(
+                loc.clone(),
+                "--toply: per-vertex tangents \"S\" cannot be stored in PLY and are dropped",
+            ));
+        }
+        let mut tri_indices = Vec::with_capacity(idx.len());
+        for &i in &idx {
+            if i < 0 || i as usize >= positions.len() {
+                return Err(Diagnostic::error(
+                    loc.clone(),
+                    format!(
+                        "--toply: vertex index {i} is out of range (the mesh has {} vertices)",
+                        positions.len()
+                    ),
+                ));
+            }
+            tri_indices.push(i as u32);
+        }
+        if tri_indices.len() % 3 != 0 {
+            return Err(Diagnostic::error(
+                loc.clone(),
+                "--toply: the number of indices is not a multiple of 3",
+            ));
+        }
+        let Some(tp) = self.toply.as_mut() else {
+            return Ok(None);
+        };
+        tp.count += 1;
+        let file = format!("{}_{:05}.ply", tp.prefix, tp.count);
+        let mesh = crate::ply::PlyMesh {
+            positions,
+            normals,
+            uvs,
+            tri_indices,
+            quad_indices: Vec::new(),
+            face_indices,
+            warnings: Vec::new(),
+        };
+        crate::ply::write_ply(&tp.dir.join(&file), &mesh)
+            .map_err(|e| Diagnostic::error(loc.clone(), format!("--toply: {e}")))?;
+        params.retain(|p| {
+            !matches!(
+                p.name.as_str(),
+                "indices" | "P" | "N" | "S" | "uv" | "faceIndices"
+            )
+        });
+        Ok(Some(file))
     }
 
     /// The text printed so far.
@@ -420,7 +525,19 @@ impl ParserTarget for FormattingTarget {
             upgrade::upgrade_area_light,
         )
     }
-    fn shape(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+    fn shape(&mut self, name: &str, mut params: ParamList, loc: FileLoc) -> DirectiveResult {
+        if name == "trianglemesh" {
+            if let Some(file) = self.mesh_to_ply(&mut params, &loc)? {
+                let mut all = vec![ParsedParameter::with_strings(
+                    "string",
+                    "filename",
+                    loc.clone(),
+                    vec![file],
+                )];
+                all.extend(params);
+                return self.simple("Shape", "plymesh", all, &loc, upgrade::upgrade_shape);
+            }
+        }
         self.simple("Shape", name, params, &loc, upgrade::upgrade_shape)
     }
     fn object_begin(&mut self, name: &str, _loc: FileLoc) -> DirectiveResult {

@@ -187,3 +187,48 @@ fn upgrades_a_small_v3_scene() {
     let (again2, _) = format(&again, false);
     assert_eq!(again, again2);
 }
+
+#[test]
+fn toply_writes_large_meshes_and_references_them() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-toply-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // A grid of 20x20 quads = 800 triangles = 2400 indices.
+    let n = 21;
+    let mut p = String::new();
+    for y in 0..n {
+        for x in 0..n {
+            p.push_str(&format!("{x} {y} 0 "));
+        }
+    }
+    let mut idx = String::new();
+    for y in 0..n - 1 {
+        for x in 0..n - 1 {
+            let v = y * n + x;
+            idx.push_str(&format!(
+                "{} {} {} {} {} {} ",
+                v,
+                v + 1,
+                v + n,
+                v + 1,
+                v + n + 1,
+                v + n
+            ));
+        }
+    }
+    let scene = format!(
+        "WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ {p} ] \"integer indices\" [ {idx} ] \"float alpha\" 0.5\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ] \"integer indices\" [ 0 1 2 ]\n"
+    );
+    let mut t = FormattingTarget::new(false).with_toply(&dir, "mesh");
+    crate::parse_string(&scene, &mut t).unwrap();
+    let out = t.into_output();
+    assert!(out.contains("Shape \"plymesh\""), "{out}");
+    assert!(out.contains("\"mesh_00001.ply\""), "{out}");
+    assert!(out.contains("\"float alpha\" [ 0.5 ]"), "{out}");
+    // The small mesh stays inline.
+    assert!(out.contains("Shape \"trianglemesh\""), "{out}");
+    let mesh = crate::ply::read_ply(&dir.join("mesh_00001.ply")).unwrap();
+    assert_eq!(mesh.positions.len(), n * n);
+    assert_eq!(mesh.tri_indices.len(), 2400);
+    assert_eq!(mesh.positions[n + 2], [2.0, 1.0, 0.0]);
+    std::fs::remove_dir_all(&dir).ok();
+}
