@@ -24,6 +24,9 @@ use rpbrt_parser::{
 use super::entities::*;
 use super::names::*;
 
+/// A pbrt-v3 → pbrt-v4 mapping of the parser crate.
+type UpgradeFn = fn(&str, Vec<ParsedParameter>, &FileLoc) -> Upgraded;
+
 /// Bit of [`GraphicsState::active`] for the start-time transformation.
 const START_BIT: u8 = 1;
 /// Bit of [`GraphicsState::active`] for the end-time transformation.
@@ -103,7 +106,7 @@ enum Pushed {
         opened: bool,
     },
     /// `TransformBegin` (pbrt-v3): only the transformation.
-    Transform(TransformSet, u8, FileLoc),
+    Transform(Box<TransformSet>, u8, FileLoc),
 }
 
 impl Pushed {
@@ -290,7 +293,7 @@ impl SceneBuilder {
     /// that changed nothing reports only errors.
     fn upgraded(
         &mut self,
-        f: fn(&str, Vec<ParsedParameter>, &FileLoc) -> Upgraded,
+        f: UpgradeFn,
         name: &str,
         params: ParamList,
         loc: &FileLoc,
@@ -334,7 +337,7 @@ impl SceneBuilder {
         &mut self,
         directive: &str,
         kind: EntityKind,
-        f: Option<fn(&str, Vec<ParsedParameter>, &FileLoc) -> Upgraded>,
+        f: Option<UpgradeFn>,
         name: &str,
         params: ParamList,
         loc: FileLoc,
@@ -398,7 +401,7 @@ impl SceneBuilder {
         match top {
             Pushed::Attribute(state, _) => self.state = *state,
             Pushed::Transform(ctm, active, _) => {
-                self.state.ctm = ctm;
+                self.state.ctm = *ctm;
                 self.state.active = active;
             }
             Pushed::Object { state, opened, .. } => {
@@ -713,8 +716,11 @@ impl ParserTarget for SceneBuilder {
     }
 
     fn transform_begin(&mut self, loc: FileLoc) -> DirectiveResult {
-        self.pushed
-            .push(Pushed::Transform(self.state.ctm, self.state.active, loc));
+        self.pushed.push(Pushed::Transform(
+            Box::new(self.state.ctm),
+            self.state.active,
+            loc,
+        ));
         Ok(())
     }
 
@@ -988,12 +994,12 @@ impl ParserTarget for SceneBuilder {
         }
         let world_from_render = self.render_from_world.inverse();
         let render_from_instance = if self.ctm_is_animated() {
-            InstanceTransform::Animated(AnimatedTransform::new(
+            InstanceTransform::Animated(Box::new(AnimatedTransform::new(
                 self.render_from_object_at(0) * world_from_render,
                 self.state.start_time,
                 self.render_from_object_at(1) * world_from_render,
                 self.state.end_time,
-            ))
+            )))
         } else {
             InstanceTransform::Fixed(self.render_from_object_at(0) * world_from_render)
         };

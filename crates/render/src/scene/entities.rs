@@ -241,12 +241,12 @@ pub struct InstanceDefinitionSceneEntity {
 }
 
 /// How an instance is placed.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum InstanceTransform {
     /// A fixed transformation.
     Fixed(Transform),
-    /// A transformation that changes over time.
-    Animated(AnimatedTransform),
+    /// A transformation that changes over time (boxed: it is large).
+    Animated(Box<AnimatedTransform>),
 }
 
 /// An `ObjectInstance`.
