@@ -13,7 +13,7 @@ use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
 use rpbrt_geometry::{
-    AnimatedTransform, Float, Point3f, SquareMatrix4, Transform, TransformError, Vector3f,
+    AnimatedTransform, Point3f, SquareMatrix4, Transform, TransformError, Vector3f,
 };
 use rpbrt_parser::upgrade::{self, Upgraded};
 use rpbrt_parser::Diagnostic;
@@ -23,130 +23,10 @@ use rpbrt_parser::{
 
 use super::entities::*;
 use super::names::*;
+use super::state::*;
 
 /// A pbrt-v3 → pbrt-v4 mapping of the parser crate.
 type UpgradeFn = fn(&str, Vec<ParsedParameter>, &FileLoc) -> Upgraded;
-
-/// Bit of [`GraphicsState::active`] for the start-time transformation.
-const START_BIT: u8 = 1;
-/// Bit of [`GraphicsState::active`] for the end-time transformation.
-const END_BIT: u8 = 2;
-/// Both transformations.
-const ALL_BITS: u8 = START_BIT | END_BIT;
-
-/// The current transformation at the start and at the end of the
-/// transformation times (pbrt-v4 `TransformSet`).
-type TransformSet = [Transform; 2];
-
-/// What `AttributeBegin` saves and `AttributeEnd` restores (pbrt-v4
-/// `BasicSceneBuilder::GraphicsState`).
-#[derive(Clone, Debug)]
-struct GraphicsState {
-    inside_medium: String,
-    outside_medium: String,
-    material: MaterialRef,
-    /// The active `AreaLightSource`, shared between saved states.
-    area_light: Option<Arc<SceneEntity>>,
-    shape_attributes: Arc<Vec<ParsedParameter>>,
-    light_attributes: Arc<Vec<ParsedParameter>>,
-    material_attributes: Arc<Vec<ParsedParameter>>,
-    medium_attributes: Arc<Vec<ParsedParameter>>,
-    texture_attributes: Arc<Vec<ParsedParameter>>,
-    reverse_orientation: bool,
-    color_space: &'static str,
-    ctm: TransformSet,
-    active: u8,
-    start_time: Float,
-    end_time: Float,
-}
-
-impl Default for GraphicsState {
-    fn default() -> Self {
-        GraphicsState {
-            inside_medium: String::new(),
-            outside_medium: String::new(),
-            material: MaterialRef::Index(0),
-            area_light: None,
-            shape_attributes: Arc::default(),
-            light_attributes: Arc::default(),
-            material_attributes: Arc::default(),
-            medium_attributes: Arc::default(),
-            texture_attributes: Arc::default(),
-            reverse_orientation: false,
-            color_space: COLOR_SPACES[0],
-            ctm: [Transform::identity(); 2],
-            active: ALL_BITS,
-            start_time: 0.0,
-            end_time: 1.0,
-        }
-    }
-}
-
-impl GraphicsState {
-    /// Applies `f` to each active transformation.
-    fn for_active(&mut self, f: impl Fn(&Transform) -> Transform) {
-        for (i, t) in self.ctm.iter_mut().enumerate() {
-            if self.active & (1 << i) != 0 {
-                *t = f(t);
-            }
-        }
-    }
-}
-
-/// One entry of the push stack.
-#[derive(Debug)]
-enum Pushed {
-    /// `AttributeBegin`: the whole state.
-    Attribute(Box<GraphicsState>, FileLoc),
-    /// `ObjectBegin`: the whole state; `opened` is false when the
-    /// `ObjectBegin` was in error and started no definition.
-    Object {
-        state: Box<GraphicsState>,
-        loc: FileLoc,
-        opened: bool,
-    },
-    /// `TransformBegin` (pbrt-v3): only the transformation.
-    Transform(Box<TransformSet>, u8, FileLoc),
-}
-
-impl Pushed {
-    fn describe(&self) -> &'static str {
-        match self {
-            Pushed::Attribute(..) => "AttributeBegin",
-            Pushed::Object { .. } => "ObjectBegin",
-            Pushed::Transform(..) => "TransformBegin",
-        }
-    }
-
-    fn loc(&self) -> &FileLoc {
-        match self {
-            Pushed::Attribute(_, l) | Pushed::Transform(_, _, l) => l,
-            Pushed::Object { loc, .. } => loc,
-        }
-    }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Block {
-    Options,
-    World,
-}
-
-/// A cheap summary of a parameter list: enough to tell whether an upgrade
-/// mapping changed anything (it renames, retypes, adds and removes
-/// parameters or changes their value counts; it never edits a value in place).
-fn fingerprint(params: &[ParsedParameter]) -> Vec<(String, String, [usize; 4])> {
-    params
-        .iter()
-        .map(|p| {
-            (
-                p.name.clone(),
-                p.ty.clone(),
-                [p.floats.len(), p.ints.len(), p.strings.len(), p.bools.len()],
-            )
-        })
-        .collect()
-}
 
 /// Builds a [`SceneDescription`] from parser callbacks (pbrt-v4
 /// `BasicSceneBuilder`).

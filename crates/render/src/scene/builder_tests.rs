@@ -574,6 +574,7 @@ fn shared_scenes_build_without_errors() {
         }
     }
     files.sort();
+    let mut built = 0;
     for f in &files {
         // Only top-level scene files (those with a WorldBegin) are scenes.
         let text = std::fs::read_to_string(f).unwrap_or_default();
@@ -583,5 +584,7 @@ fn shared_scenes_build_without_errors() {
         if let Err(d) = build_scene(std::slice::from_ref(f), &BuildOptions::default()) {
             panic!("{}:\n{}", f.display(), d);
         }
+        built += 1;
     }
+    assert!(built > 0, "no scene under {}", root.display());
 }

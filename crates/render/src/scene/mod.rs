@@ -11,6 +11,7 @@ pub mod builder;
 pub mod entities;
 pub mod names;
 pub mod options;
+mod state;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
