@@ -3,6 +3,7 @@
 
 pub mod rng;
 pub mod sampling;
+pub mod scene;
 pub mod shape;
 
 pub use rpbrt_geometry as geometry;

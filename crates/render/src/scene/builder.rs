@@ -1,0 +1,956 @@
+//! The scene builder: a [`ParserTarget`] that follows pbrt-v4's
+//! `BasicSceneBuilder` (`scene.h`/`scene.cpp`, book section C.2.3). It keeps
+//! the graphics state (current transformation for the start and end of the
+//! shutter interval, material, area light, media, color space, `Attribute`
+//! defaults) on an explicit stack and turns every directive into a plain
+//! entity of a [`SceneDescription`].
+//!
+//! pbrt-v3 input is read directly: each typed directive first goes through
+//! the parser crate's `upgrade_*` mappings, whose warnings are reported at
+//! the directive. A directive the mapping leaves alone produces no message.
+
+use std::collections::{HashMap, HashSet};
+use std::sync::Arc;
+
+use rpbrt_geometry::{
+    AnimatedTransform, Point3f, SquareMatrix4, Transform, TransformError, Vector3f,
+};
+use rpbrt_parser::upgrade::{self, Upgraded};
+use rpbrt_parser::Diagnostic;
+use rpbrt_parser::{
+    DirectiveResult, FileLoc, ParamList, ParameterDictionary, ParsedParameter, ParserTarget,
+};
+
+use super::entities::*;
+use super::names::*;
+use super::state::*;
+
+/// A pbrt-v3 → pbrt-v4 mapping of the parser crate.
+type UpgradeFn = fn(&str, Vec<ParsedParameter>, &FileLoc) -> Upgraded;
+
+/// Builds a [`SceneDescription`] from parser callbacks (pbrt-v4
+/// `BasicSceneBuilder`).
+#[derive(Debug)]
+pub struct SceneBuilder {
+    scene: SceneDescription,
+    block: Block,
+    state: GraphicsState,
+    pushed: Vec<Pushed>,
+    named_coordinate_systems: HashMap<String, TransformSet>,
+    render_from_world: Transform,
+    camera_defined: bool,
+    active_definition: Option<InstanceDefinitionSceneEntity>,
+    instance_names: HashSet<String>,
+    named_material_names: HashSet<String>,
+    medium_names: HashSet<String>,
+    float_texture_names: HashSet<String>,
+    spectrum_texture_names: HashSet<String>,
+    /// `NamedMaterial` directives, checked once all files are read.
+    named_material_uses: Vec<(String, FileLoc)>,
+    /// Media named by `MediumInterface`, checked once all files are read.
+    medium_uses: Vec<(String, FileLoc)>,
+    /// Messages waiting for [`ParserTarget::take_diagnostics`].
+    pending: Vec<Diagnostic>,
+}
+
+impl Default for SceneBuilder {
+    fn default() -> Self {
+        SceneBuilder::new(RenderingCoordinateSystem::default())
+    }
+}
+
+impl SceneBuilder {
+    /// A builder rendering in `render_coord_sys` unless the scene's
+    /// `Option "rendercoordsys"` says otherwise.
+    pub fn new(render_coord_sys: RenderingCoordinateSystem) -> Self {
+        let scene = SceneDescription {
+            render_coord_sys,
+            ..SceneDescription::default()
+        };
+        SceneBuilder {
+            scene,
+            block: Block::Options,
+            state: GraphicsState::default(),
+            pushed: Vec::new(),
+            named_coordinate_systems: HashMap::new(),
+            render_from_world: Transform::identity(),
+            camera_defined: false,
+            active_definition: None,
+            instance_names: HashSet::new(),
+            named_material_names: HashSet::new(),
+            medium_names: HashSet::new(),
+            float_texture_names: HashSet::new(),
+            spectrum_texture_names: HashSet::new(),
+            named_material_uses: Vec::new(),
+            medium_uses: Vec::new(),
+            pending: Vec::new(),
+        }
+    }
+
+    /// The description built so far (complete after `end_of_files`).
+    pub fn scene(&self) -> &SceneDescription {
+        &self.scene
+    }
+
+    /// Hands over the description.
+    pub fn finish(self) -> SceneDescription {
+        self.scene
+    }
+
+    /// Depth of the `AttributeBegin`/`ObjectBegin`/`TransformBegin` stack.
+    pub fn nesting_depth(&self) -> usize {
+        self.pushed.len()
+    }
+
+    // ---- state checks ---------------------------------------------------
+
+    fn verify_options(&self, directive: &str, loc: &FileLoc) -> DirectiveResult {
+        if self.block == Block::World {
+            return Err(Diagnostic::error(
+                loc.clone(),
+                format!("{directive} not allowed after WorldBegin"),
+            ));
+        }
+        Ok(())
+    }
+
+    fn verify_world(&self, directive: &str, loc: &FileLoc) -> DirectiveResult {
+        if self.block == Block::Options {
+            return Err(Diagnostic::error(
+                loc.clone(),
+                format!("{directive} not allowed before WorldBegin"),
+            ));
+        }
+        Ok(())
+    }
+
+    // ---- transformations --------------------------------------------------
+
+    fn render_from_object_at(&self, i: usize) -> Transform {
+        self.render_from_world * self.state.ctm[i]
+    }
+
+    fn render_from_object(&self) -> AnimatedTransform {
+        AnimatedTransform::new(
+            self.render_from_object_at(0),
+            self.state.start_time,
+            self.render_from_object_at(1),
+            self.state.end_time,
+        )
+    }
+
+    fn ctm_is_animated(&self) -> bool {
+        self.state.ctm[0] != self.state.ctm[1]
+    }
+
+    fn transform_error(e: TransformError, loc: FileLoc, directive: &str) -> Diagnostic {
+        Diagnostic::error(
+            loc,
+            format!("{directive}: {e}; the current transformation is unchanged"),
+        )
+    }
+
+    /// The matrix of `Transform`/`ConcatTransform`: the 16 values are the
+    /// matrix's columns, one after the other (pbrt transposes them).
+    fn matrix_from_values(
+        m: &[f32; 16],
+        loc: &FileLoc,
+        directive: &str,
+    ) -> Result<Transform, Diagnostic> {
+        let mut rows = [[0.0; 4]; 4];
+        for (i, row) in rows.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = m[j * 4 + i];
+            }
+        }
+        Transform::from_matrix(SquareMatrix4::new(rows))
+            .map_err(|e| Self::transform_error(e, loc.clone(), directive))
+    }
+
+    // ---- entities ---------------------------------------------------------
+
+    /// Runs a pbrt-v3 → pbrt-v4 mapping and queues its messages; a mapping
+    /// that changed nothing reports only errors.
+    fn upgraded(
+        &mut self,
+        f: UpgradeFn,
+        name: &str,
+        params: ParamList,
+        loc: &FileLoc,
+    ) -> (String, ParamList) {
+        let before = fingerprint(&params);
+        let u = f(name, params, loc);
+        self.keep_upgrade_messages(
+            name == u.name && before == fingerprint(&u.params),
+            u.diagnostics,
+        );
+        (u.name, u.params)
+    }
+
+    fn keep_upgrade_messages(&mut self, unchanged: bool, diags: Vec<Diagnostic>) {
+        self.pending
+            .extend(diags.into_iter().filter(|d| !unchanged || d.is_error()));
+    }
+
+    fn entity(&self, name: String, params: ParamList, loc: FileLoc) -> SceneEntity {
+        SceneEntity::new(
+            name,
+            ParameterDictionary::new(params),
+            loc,
+            self.state.color_space,
+        )
+    }
+
+    fn entity_with(
+        &self,
+        name: String,
+        params: ParamList,
+        inherited: &Arc<Vec<ParsedParameter>>,
+        loc: FileLoc,
+    ) -> SceneEntity {
+        let dict = ParameterDictionary::with_inherited(params, inherited.as_ref().clone());
+        SceneEntity::new(name, dict, loc, self.state.color_space)
+    }
+
+    /// Film, Sampler, PixelFilter, Integrator and Accelerator.
+    fn option_entity(
+        &mut self,
+        directive: &str,
+        kind: EntityKind,
+        f: Option<UpgradeFn>,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> Result<SceneEntity, Diagnostic> {
+        self.verify_options(directive, &loc)?;
+        let (name, params) = match f {
+            Some(f) => self.upgraded(f, name, params, &loc),
+            None => {
+                let mut params = params;
+                upgrade::upgrade_param_types(&mut params);
+                (name.to_string(), params)
+            }
+        };
+        kind.check(&name, &loc)?;
+        Ok(self.entity(name, params, loc))
+    }
+
+    /// Removes the last `"string type"` parameter and returns its value and
+    /// location.
+    fn take_type_param(params: &mut ParamList) -> Option<(String, FileLoc)> {
+        let i = params
+            .iter()
+            .rposition(|p| p.name == "type" && p.ty == "string")?;
+        let p = params.remove(i);
+        let value = p.strings.first().cloned().unwrap_or_default();
+        Some((value, p.loc))
+    }
+
+    fn shape_attributes(&self, light_index: Option<usize>) -> ShapeAttributes {
+        ShapeAttributes {
+            reverse_orientation: self.state.reverse_orientation,
+            material: self.state.material.clone(),
+            light_index,
+            inside_medium: self.state.inside_medium.clone(),
+            outside_medium: self.state.outside_medium.clone(),
+        }
+    }
+
+    // ---- the push stack ---------------------------------------------------
+
+    /// Pops one entry for the directive `closing`, which expects an entry
+    /// made by `opening`; a mismatch is an error, but the entry is popped
+    /// and restored anyway (as pbrt-v4 does).
+    fn pop(&mut self, closing: &str, opening: &str, loc: &FileLoc) -> DirectiveResult {
+        let Some(top) = self.pushed.pop() else {
+            return Err(Diagnostic::error(
+                loc.clone(),
+                format!("unmatched {closing} encountered; ignoring it"),
+            ));
+        };
+        let mismatch = (top.describe() != opening).then(|| {
+            Diagnostic::error(
+                loc.clone(),
+                format!(
+                    "mismatched nesting: open {} from {} at {closing}",
+                    top.describe(),
+                    top.loc()
+                ),
+            )
+        });
+        match top {
+            Pushed::Attribute(state, _) => self.state = *state,
+            Pushed::Transform(ctm, active, _) => {
+                self.state.ctm = *ctm;
+                self.state.active = active;
+            }
+            Pushed::Object { state, opened, .. } => {
+                self.state = *state;
+                if opened {
+                    if let Some(def) = self.active_definition.take() {
+                        self.scene.instance_definitions.push(def);
+                    }
+                }
+            }
+        }
+        match mismatch {
+            Some(d) => Err(d),
+            None => Ok(()),
+        }
+    }
+}
+
+impl ParserTarget for SceneBuilder {
+    fn identity(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.state.for_active(|_| Transform::identity());
+        Ok(())
+    }
+
+    fn translate(&mut self, d: [f32; 3], _loc: FileLoc) -> DirectiveResult {
+        let t = Transform::translate(Vector3f::new(d[0], d[1], d[2]));
+        self.state.for_active(|c| *c * t);
+        Ok(())
+    }
+
+    fn scale(&mut self, s: [f32; 3], _loc: FileLoc) -> DirectiveResult {
+        let t = Transform::scale(s[0], s[1], s[2]);
+        self.state.for_active(|c| *c * t);
+        Ok(())
+    }
+
+    fn rotate(&mut self, angle: f32, axis: [f32; 3], loc: FileLoc) -> DirectiveResult {
+        let t = Transform::try_rotate(angle, Vector3f::new(axis[0], axis[1], axis[2]))
+            .map_err(|e| Self::transform_error(e, loc, "Rotate"))?;
+        self.state.for_active(|c| *c * t);
+        Ok(())
+    }
+
+    fn look_at(
+        &mut self,
+        eye: [f32; 3],
+        look: [f32; 3],
+        up: [f32; 3],
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        let t = Transform::look_at(
+            Point3f::new(eye[0], eye[1], eye[2]),
+            Point3f::new(look[0], look[1], look[2]),
+            Vector3f::new(up[0], up[1], up[2]),
+        )
+        .map_err(|e| Self::transform_error(e, loc, "LookAt"))?;
+        self.state.for_active(|c| *c * t);
+        Ok(())
+    }
+
+    fn concat_transform(&mut self, m: [f32; 16], loc: FileLoc) -> DirectiveResult {
+        let t = Self::matrix_from_values(&m, &loc, "ConcatTransform")?;
+        self.state.for_active(|c| *c * t);
+        Ok(())
+    }
+
+    fn transform(&mut self, m: [f32; 16], loc: FileLoc) -> DirectiveResult {
+        let t = Self::matrix_from_values(&m, &loc, "Transform")?;
+        self.state.for_active(|_| t);
+        Ok(())
+    }
+
+    fn coordinate_system(&mut self, name: &str, _loc: FileLoc) -> DirectiveResult {
+        self.named_coordinate_systems
+            .insert(name.to_string(), self.state.ctm);
+        Ok(())
+    }
+
+    fn coord_sys_transform(&mut self, name: &str, loc: FileLoc) -> DirectiveResult {
+        match self.named_coordinate_systems.get(name) {
+            Some(ctm) => {
+                self.state.ctm = *ctm;
+                Ok(())
+            }
+            None => Err(Diagnostic::warning(
+                loc,
+                format!("couldn't find named coordinate system \"{name}\""),
+            )),
+        }
+    }
+
+    fn active_transform_all(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.state.active = ALL_BITS;
+        Ok(())
+    }
+
+    fn active_transform_end_time(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.state.active = END_BIT;
+        Ok(())
+    }
+
+    fn active_transform_start_time(&mut self, _loc: FileLoc) -> DirectiveResult {
+        self.state.active = START_BIT;
+        Ok(())
+    }
+
+    fn transform_times(&mut self, start: f32, end: f32, loc: FileLoc) -> DirectiveResult {
+        self.verify_options("TransformTimes", &loc)?;
+        if !(start.is_finite() && end.is_finite() && start <= end) {
+            return Err(Diagnostic::error(
+                loc,
+                format!("TransformTimes: start time {start} must not exceed end time {end}"),
+            ));
+        }
+        self.state.start_time = start;
+        self.state.end_time = end;
+        Ok(())
+    }
+
+    fn reverse_orientation(&mut self, loc: FileLoc) -> DirectiveResult {
+        self.verify_world("ReverseOrientation", &loc)?;
+        self.state.reverse_orientation = !self.state.reverse_orientation;
+        Ok(())
+    }
+
+    fn color_space(&mut self, name: &str, loc: FileLoc) -> DirectiveResult {
+        let lower = name.to_ascii_lowercase();
+        match COLOR_SPACES.iter().find(|&&c| c == lower) {
+            Some(c) => {
+                self.state.color_space = c;
+                Ok(())
+            }
+            None => Err(Diagnostic::error(
+                loc,
+                format!(
+                    "\"{name}\": unknown color space; expected one of {}",
+                    COLOR_SPACES
+                        .iter()
+                        .map(|c| format!("\"{c}\""))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            )),
+        }
+    }
+
+    fn pixel_filter(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        let f = upgrade::upgrade_pixel_filter;
+        self.scene.filter = self.option_entity(
+            "PixelFilter",
+            EntityKind::Filter,
+            Some(f),
+            name,
+            params,
+            loc,
+        )?;
+        Ok(())
+    }
+
+    fn film(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        let f = upgrade::upgrade_film;
+        self.scene.film =
+            self.option_entity("Film", EntityKind::Film, Some(f), name, params, loc)?;
+        Ok(())
+    }
+
+    fn sampler(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        let f = upgrade::upgrade_sampler;
+        self.scene.sampler =
+            self.option_entity("Sampler", EntityKind::Sampler, Some(f), name, params, loc)?;
+        Ok(())
+    }
+
+    fn accelerator(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.scene.accelerator = self.option_entity(
+            "Accelerator",
+            EntityKind::Accelerator,
+            None,
+            name,
+            params,
+            loc,
+        )?;
+        Ok(())
+    }
+
+    fn integrator(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        let f = upgrade::upgrade_integrator;
+        self.scene.integrator = self.option_entity(
+            "Integrator",
+            EntityKind::Integrator,
+            Some(f),
+            name,
+            params,
+            loc,
+        )?;
+        Ok(())
+    }
+
+    fn camera(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        let f = upgrade::upgrade_camera;
+        let base = self.option_entity("Camera", EntityKind::Camera, Some(f), name, params, loc)?;
+        let camera_from_world = self.state.ctm;
+        let world_from_camera = [
+            camera_from_world[0].inverse(),
+            camera_from_world[1].inverse(),
+        ];
+        self.named_coordinate_systems
+            .insert("camera".to_string(), world_from_camera);
+        let animated = AnimatedTransform::new(
+            world_from_camera[0],
+            self.state.start_time,
+            world_from_camera[1],
+            self.state.end_time,
+        );
+        let camera_transform = CameraTransform::new(&animated, self.scene.render_coord_sys);
+        self.render_from_world = camera_transform.render_from_world();
+        self.scene.camera = CameraSceneEntity {
+            base,
+            camera_transform,
+            medium: self.state.outside_medium.clone(),
+        };
+        self.camera_defined = true;
+        Ok(())
+    }
+
+    fn make_named_medium(
+        &mut self,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        let mut params = params;
+        let Some((ty, ty_loc)) = Self::take_type_param(&mut params) else {
+            return Err(Diagnostic::error(
+                loc,
+                format!("no parameter \"string type\" found for medium \"{name}\""),
+            ));
+        };
+        let (ty, mut params) = self.upgraded(upgrade::upgrade_medium, &ty, params, &loc);
+        EntityKind::Medium.check(&ty, &ty_loc)?;
+        if !self.medium_names.insert(name.to_string()) {
+            return Err(Diagnostic::error(
+                loc,
+                format!("named medium \"{name}\" redefined"),
+            ));
+        }
+        params.insert(
+            0,
+            ParsedParameter::with_strings("string", "type", ty_loc, vec![ty.clone()]),
+        );
+        let attrs = self.state.medium_attributes.clone();
+        let base = self.entity_with(ty, params, &attrs, loc);
+        let render_from_object = self.render_from_object();
+        self.scene.media.push(MediumSceneEntity {
+            name: name.to_string(),
+            base,
+            render_from_object,
+        });
+        Ok(())
+    }
+
+    fn medium_interface(&mut self, inside: &str, outside: &str, loc: FileLoc) -> DirectiveResult {
+        for n in [inside, outside] {
+            if !n.is_empty() {
+                self.medium_uses.push((n.to_string(), loc.clone()));
+            }
+        }
+        self.state.inside_medium = inside.to_string();
+        self.state.outside_medium = outside.to_string();
+        Ok(())
+    }
+
+    fn option(&mut self, name: &str, value: &str, loc: FileLoc) -> DirectiveResult {
+        let value = super::options::parse_option(name, value, &loc)?;
+        if value.name == "rendercoordsys" {
+            if self.camera_defined {
+                return Err(Diagnostic::error(
+                    loc,
+                    "the \"rendercoordsys\" option must come before Camera",
+                ));
+            }
+            if let OptionValue::String(s) = &value.value {
+                if let Some(sys) = RenderingCoordinateSystem::from_name(s) {
+                    self.scene.render_coord_sys = sys;
+                }
+            }
+        }
+        self.scene.options.push(value);
+        Ok(())
+    }
+
+    fn world_begin(&mut self, loc: FileLoc) -> DirectiveResult {
+        self.verify_options("WorldBegin", &loc)?;
+        self.block = Block::World;
+        self.state.ctm = [Transform::identity(); 2];
+        self.state.active = ALL_BITS;
+        self.named_coordinate_systems
+            .insert("world".to_string(), self.state.ctm);
+        Ok(())
+    }
+
+    fn attribute_begin(&mut self, loc: FileLoc) -> DirectiveResult {
+        self.verify_world("AttributeBegin", &loc)?;
+        self.pushed
+            .push(Pushed::Attribute(Box::new(self.state.clone()), loc));
+        Ok(())
+    }
+
+    fn attribute_end(&mut self, loc: FileLoc) -> DirectiveResult {
+        self.verify_world("AttributeEnd", &loc)?;
+        self.pop("AttributeEnd", "AttributeBegin", &loc)
+    }
+
+    fn transform_begin(&mut self, loc: FileLoc) -> DirectiveResult {
+        self.pushed.push(Pushed::Transform(
+            Box::new(self.state.ctm),
+            self.state.active,
+            loc,
+        ));
+        Ok(())
+    }
+
+    fn transform_end(&mut self, loc: FileLoc) -> DirectiveResult {
+        self.pop("TransformEnd", "TransformBegin", &loc)
+    }
+
+    fn attribute(&mut self, target: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        let attrs = match target {
+            "shape" => &mut self.state.shape_attributes,
+            "light" => &mut self.state.light_attributes,
+            "material" => &mut self.state.material_attributes,
+            "medium" => &mut self.state.medium_attributes,
+            "texture" => &mut self.state.texture_attributes,
+            _ => {
+                return Err(Diagnostic::error(
+                    loc,
+                    format!(
+                        "unknown attribute target \"{target}\"; must be \"shape\", \"light\", \"material\", \"medium\" or \"texture\""
+                    ),
+                ))
+            }
+        };
+        let mut params = params;
+        upgrade::upgrade_param_types(&mut params);
+        Arc::make_mut(attrs).extend(params);
+        Ok(())
+    }
+
+    fn texture(
+        &mut self,
+        name: &str,
+        ty: &str,
+        texname: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        self.verify_world("Texture", &loc)?;
+        let before = fingerprint(&params);
+        let (new_ty, u) = upgrade::upgrade_texture(ty, texname, params, &loc);
+        let unchanged = new_ty == ty && u.name == texname && before == fingerprint(&u.params);
+        self.keep_upgrade_messages(unchanged, u.diagnostics);
+        let kind = match new_ty.as_str() {
+            "float" => TextureKind::Float,
+            "spectrum" => TextureKind::Spectrum,
+            _ => {
+                return Err(Diagnostic::error(
+                    loc,
+                    format!("\"{ty}\": texture type unknown; must be \"float\" or \"spectrum\""),
+                ))
+            }
+        };
+        EntityKind::Texture.check(&u.name, &loc)?;
+        let names = match kind {
+            TextureKind::Float => &mut self.float_texture_names,
+            TextureKind::Spectrum => &mut self.spectrum_texture_names,
+        };
+        if !names.insert(name.to_string()) {
+            return Err(Diagnostic::error(
+                loc,
+                format!("redefining texture \"{name}\""),
+            ));
+        }
+        let attrs = self.state.texture_attributes.clone();
+        let base = self.entity_with(u.name, u.params, &attrs, loc);
+        let entity = TextureSceneEntity {
+            name: name.to_string(),
+            kind,
+            base,
+            render_from_object: self.render_from_object(),
+        };
+        match kind {
+            TextureKind::Float => self.scene.float_textures.push(entity),
+            TextureKind::Spectrum => self.scene.spectrum_textures.push(entity),
+        }
+        Ok(())
+    }
+
+    fn material(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.verify_world("Material", &loc)?;
+        let (name, params) = self.upgraded(upgrade::upgrade_material, name, params, &loc);
+        EntityKind::Material.check(&name, &loc)?;
+        let attrs = self.state.material_attributes.clone();
+        let entity = self.entity_with(name, params, &attrs, loc);
+        self.scene.materials.push(entity);
+        self.state.material = MaterialRef::Index(self.scene.materials.len() - 1);
+        Ok(())
+    }
+
+    fn make_named_material(
+        &mut self,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        self.verify_world("MakeNamedMaterial", &loc)?;
+        let mut params = params;
+        let Some((ty, ty_loc)) = Self::take_type_param(&mut params) else {
+            return Err(Diagnostic::error(
+                loc,
+                format!("no parameter \"string type\" found for named material \"{name}\""),
+            ));
+        };
+        let (ty, mut params) = self.upgraded(upgrade::upgrade_material, &ty, params, &loc);
+        EntityKind::Material.check(&ty, &ty_loc)?;
+        if !self.named_material_names.insert(name.to_string()) {
+            return Err(Diagnostic::error(
+                loc,
+                format!("\"{name}\": named material redefined"),
+            ));
+        }
+        params.insert(
+            0,
+            ParsedParameter::with_strings("string", "type", ty_loc, vec![ty.clone()]),
+        );
+        let attrs = self.state.material_attributes.clone();
+        let entity = self.entity_with(ty, params, &attrs, loc);
+        self.scene.named_materials.push((name.to_string(), entity));
+        Ok(())
+    }
+
+    fn named_material(&mut self, name: &str, loc: FileLoc) -> DirectiveResult {
+        self.verify_world("NamedMaterial", &loc)?;
+        self.named_material_uses.push((name.to_string(), loc));
+        self.state.material = MaterialRef::Named(name.to_string());
+        Ok(())
+    }
+
+    fn light_source(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.verify_world("LightSource", &loc)?;
+        let (name, params) = self.upgraded(upgrade::upgrade_light, name, params, &loc);
+        EntityKind::Light.check(&name, &loc)?;
+        let attrs = self.state.light_attributes.clone();
+        let base = self.entity_with(name, params, &attrs, loc);
+        let light = LightSceneEntity {
+            base,
+            render_from_object: self.render_from_object(),
+            medium: self.state.outside_medium.clone(),
+        };
+        self.scene.lights.push(light);
+        Ok(())
+    }
+
+    fn area_light_source(
+        &mut self,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        self.verify_world("AreaLightSource", &loc)?;
+        let (name, params) = self.upgraded(upgrade::upgrade_area_light, name, params, &loc);
+        EntityKind::AreaLight.check(&name, &loc)?;
+        let attrs = self.state.light_attributes.clone();
+        let entity = self.entity_with(name, params, &attrs, loc);
+        self.state.area_light = Some(Arc::new(entity));
+        Ok(())
+    }
+
+    fn shape(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.verify_world("Shape", &loc)?;
+        // pbrt-v3 meshes may spell out the implicit indices of a single
+        // triangle or quad; the mapping drops them, but a pbrt-v4 file must
+        // pass through unchanged, so they are kept.
+        let indices = params
+            .iter()
+            .find(|p| p.name == "indices" && p.ty == "integer")
+            .cloned();
+        let (name, mut params) = self.upgraded(upgrade::upgrade_shape, name, params, &loc);
+        if let Some(ix) = indices {
+            if !params.iter().any(|p| p.name == "indices") {
+                params.push(ix);
+            }
+        }
+        EntityKind::Shape.check(&name, &loc)?;
+        let light_index = match &self.state.area_light {
+            Some(al) => {
+                if self.active_definition.is_some() {
+                    self.pending.push(Diagnostic::warning(
+                        loc.clone(),
+                        "area lights not supported with object instancing",
+                    ));
+                }
+                self.scene.area_lights.push(al.as_ref().clone());
+                Some(self.scene.area_lights.len() - 1)
+            }
+            None => None,
+        };
+        let attrs = self.state.shape_attributes.clone();
+        let base = self.entity_with(name, params, &attrs, loc);
+        let attributes = self.shape_attributes(light_index);
+        if self.ctm_is_animated() {
+            let shape = AnimatedShapeSceneEntity {
+                base,
+                render_from_object: self.render_from_object(),
+                attributes,
+            };
+            match &mut self.active_definition {
+                Some(def) => def.animated_shapes.push(shape),
+                None => self.scene.animated_shapes.push(shape),
+            }
+        } else {
+            let render_from_object = self.render_from_object_at(0);
+            let shape = ShapeSceneEntity {
+                base,
+                render_from_object,
+                object_from_render: render_from_object.inverse(),
+                attributes,
+            };
+            match &mut self.active_definition {
+                Some(def) => def.shapes.push(shape),
+                None => self.scene.shapes.push(shape),
+            }
+        }
+        Ok(())
+    }
+
+    fn object_begin(&mut self, name: &str, loc: FileLoc) -> DirectiveResult {
+        self.verify_world("ObjectBegin", &loc)?;
+        let state = Box::new(self.state.clone());
+        let error = if self.active_definition.is_some() {
+            Some(Diagnostic::error(
+                loc.clone(),
+                "ObjectBegin called inside of instance definition",
+            ))
+        } else if !self.instance_names.insert(name.to_string()) {
+            Some(Diagnostic::error(
+                loc.clone(),
+                format!("\"{name}\": trying to redefine an object instance"),
+            ))
+        } else {
+            None
+        };
+        let opened = error.is_none();
+        if opened {
+            self.active_definition = Some(InstanceDefinitionSceneEntity {
+                name: name.to_string(),
+                loc: loc.clone(),
+                shapes: Vec::new(),
+                animated_shapes: Vec::new(),
+            });
+        }
+        self.pushed.push(Pushed::Object { state, loc, opened });
+        match error {
+            Some(e) => Err(e),
+            None => Ok(()),
+        }
+    }
+
+    fn object_end(&mut self, loc: FileLoc) -> DirectiveResult {
+        self.verify_world("ObjectEnd", &loc)?;
+        let inside = self
+            .pushed
+            .iter()
+            .any(|p| matches!(p, Pushed::Object { .. }));
+        if !inside {
+            return Err(Diagnostic::error(
+                loc,
+                "ObjectEnd called outside of instance definition",
+            ));
+        }
+        self.pop("ObjectEnd", "ObjectBegin", &loc)
+    }
+
+    fn object_instance(&mut self, name: &str, loc: FileLoc) -> DirectiveResult {
+        self.verify_world("ObjectInstance", &loc)?;
+        if self.active_definition.is_some() {
+            return Err(Diagnostic::error(
+                loc,
+                "ObjectInstance can't be called inside instance definition",
+            ));
+        }
+        let world_from_render = self.render_from_world.inverse();
+        let render_from_instance = if self.ctm_is_animated() {
+            InstanceTransform::Animated(Box::new(AnimatedTransform::new(
+                self.render_from_object_at(0) * world_from_render,
+                self.state.start_time,
+                self.render_from_object_at(1) * world_from_render,
+                self.state.end_time,
+            )))
+        } else {
+            InstanceTransform::Fixed(self.render_from_object_at(0) * world_from_render)
+        };
+        self.scene.instances.push(InstanceSceneEntity {
+            name: name.to_string(),
+            loc,
+            render_from_instance,
+        });
+        Ok(())
+    }
+
+    fn end_of_files(&mut self) -> DirectiveResult {
+        if self.block != Block::World {
+            self.pending.push(Diagnostic::unlocated_error(
+                "end of files before \"WorldBegin\"",
+            ));
+        }
+        if let Some(first) = self.pushed.first() {
+            let n = self.pushed.len();
+            let msg = if n == 1 {
+                format!("missing end to {}", first.describe())
+            } else {
+                format!(
+                    "missing end to {}; {n} blocks are still open, the outermost here",
+                    first.describe()
+                )
+            };
+            self.pending
+                .push(Diagnostic::error(first.loc().clone(), msg));
+            // Unwind so that an open object definition is kept.
+            while let Some(p) = self.pushed.pop() {
+                if let Pushed::Object { opened: true, .. } = p {
+                    if let Some(def) = self.active_definition.take() {
+                        self.scene.instance_definitions.push(def);
+                    }
+                }
+            }
+        }
+        for inst in &self.scene.instances {
+            if !self.instance_names.contains(&inst.name) {
+                self.pending.push(Diagnostic::error(
+                    inst.loc.clone(),
+                    format!("\"{}\": object instance not defined", inst.name),
+                ));
+            }
+        }
+        for (name, loc) in &self.named_material_uses {
+            if !self.named_material_names.contains(name) {
+                self.pending.push(Diagnostic::error(
+                    loc.clone(),
+                    format!("\"{name}\": named material not defined"),
+                ));
+            }
+        }
+        let mut reported = HashSet::new();
+        for (name, loc) in &self.medium_uses {
+            if !self.medium_names.contains(name) && reported.insert((name, loc)) {
+                self.pending.push(Diagnostic::error(
+                    loc.clone(),
+                    format!("\"{name}\": medium not defined"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn take_diagnostics(&mut self) -> Vec<Diagnostic> {
+        std::mem::take(&mut self.pending)
+    }
+}
+
+#[cfg(test)]
+#[path = "builder_tests.rs"]
+mod tests;

@@ -1,0 +1,590 @@
+use super::*;
+use crate::scene::{build_scene, build_scene_from_str, BuildOptions};
+use rpbrt_parser::{parse_string, FormattingTarget, Severity};
+use std::path::PathBuf;
+
+fn opts(sys: RenderingCoordinateSystem) -> BuildOptions {
+    BuildOptions {
+        render_coord_sys: sys,
+        ..BuildOptions::default()
+    }
+}
+
+fn build_with(text: &str, sys: RenderingCoordinateSystem) -> SceneDescription {
+    match build_scene_from_str(text, &opts(sys)) {
+        Ok((scene, _)) => scene,
+        Err(d) => panic!("unexpected errors:\n{d}"),
+    }
+}
+
+fn build(text: &str) -> SceneDescription {
+    build_with(text, RenderingCoordinateSystem::World)
+}
+
+/// The errors of a scene that must fail, as `file:line:col: error: message`.
+fn errors(text: &str) -> Vec<String> {
+    match build_scene_from_str(text, &opts(RenderingCoordinateSystem::World)) {
+        Ok(_) => panic!("expected errors in:\n{text}"),
+        Err(d) => d
+            .iter()
+            .filter(|d| d.severity == Severity::Error)
+            .map(|d| d.to_string())
+            .collect(),
+    }
+}
+
+fn assert_error(text: &str, prefix: &str, fragment: &str) {
+    let errs = errors(text);
+    assert!(
+        errs.iter()
+            .any(|e| e.starts_with(prefix) && e.contains(fragment)),
+        "no error at {prefix} containing {fragment:?}: {errs:#?}"
+    );
+}
+
+fn close(p: Point3f, x: f32, y: f32, z: f32) -> bool {
+    (Vector3f::from(p) - Vector3f::new(x, y, z)).length() < 1e-4
+}
+
+fn origin() -> Point3f {
+    Point3f::new(0.0, 0.0, 0.0)
+}
+
+#[test]
+fn transforms_compose_in_pbrt_order() {
+    let s = build("WorldBegin\nTranslate 1 0 0\nScale 2 2 2\nShape \"sphere\"\n");
+    let t = &s.shapes[0].render_from_object;
+    // Scale applies first: (1,0,0) -> (2,0,0) -> (3,0,0).
+    assert!(close(
+        t.apply_point(Point3f::new(1.0, 0.0, 0.0)),
+        3.0,
+        0.0,
+        0.0
+    ));
+    let back = s.shapes[0]
+        .object_from_render
+        .apply_point(Point3f::new(3.0, 0.0, 0.0));
+    assert!(close(back, 1.0, 0.0, 0.0));
+}
+
+#[test]
+fn transform_and_concat_read_columns() {
+    let s = build(
+        "WorldBegin\nTransform [1 0 0 0  0 1 0 0  0 0 1 0  5 6 7 1]\nShape \"sphere\"\n\
+         ConcatTransform [2 0 0 0  0 2 0 0  0 0 2 0  0 0 0 1]\nShape \"sphere\"\n",
+    );
+    assert!(close(
+        s.shapes[0].render_from_object.apply_point(origin()),
+        5.0,
+        6.0,
+        7.0
+    ));
+    let p = s.shapes[1]
+        .render_from_object
+        .apply_point(Point3f::new(1.0, 0.0, 0.0));
+    assert!(close(p, 7.0, 6.0, 7.0));
+}
+
+#[test]
+fn look_at_and_camera_define_camera_space() {
+    let text = "LookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 45\n\
+                WorldBegin\nAttributeBegin\nCoordSysTransform \"camera\"\nShape \"sphere\"\nAttributeEnd\n\
+                Shape \"sphere\"\n";
+    let s = build(text);
+    assert_eq!(s.camera.base.name, "perspective");
+    let rfc = &s.camera.camera_transform.render_from_camera;
+    assert!(close(
+        rfc.start_transform.apply_point(origin()),
+        0.0,
+        0.0,
+        -5.0
+    ));
+    // Camera looks down +z in camera space; towards the world origin here.
+    let ahead = rfc.start_transform.apply_point(Point3f::new(0.0, 0.0, 1.0));
+    assert!(close(ahead, 0.0, 0.0, -4.0));
+    // "camera" coordinate system: objects placed at the camera.
+    assert!(close(
+        s.shapes[0].render_from_object.apply_point(origin()),
+        0.0,
+        0.0,
+        -5.0
+    ));
+    // WorldBegin reset the CTM.
+    assert!(s.shapes[1].render_from_object.is_identity());
+}
+
+#[test]
+fn rendering_coordinate_systems() {
+    let text = "LookAt 1 2 3  1 2 4  0 1 0\nCamera \"perspective\"\nWorldBegin\nShape \"sphere\"\n";
+    // cameraworld (default): world translated so that the camera is at the origin.
+    let s = build_with(text, RenderingCoordinateSystem::CameraWorld);
+    assert_eq!(s.render_coord_sys, RenderingCoordinateSystem::CameraWorld);
+    let wfr = &s.camera.camera_transform.world_from_render;
+    assert!(close(wfr.apply_point(origin()), 1.0, 2.0, 3.0));
+    assert!(close(
+        s.shapes[0].render_from_object.apply_point(origin()),
+        -1.0,
+        -2.0,
+        -3.0
+    ));
+    // camera: render space is camera space.
+    let s = build_with(text, RenderingCoordinateSystem::Camera);
+    let rfc = s.camera.camera_transform.render_from_camera.start_transform;
+    assert!(close(
+        rfc.apply_point(Point3f::new(0.5, 0.25, 2.0)),
+        0.5,
+        0.25,
+        2.0
+    ));
+    let p = s.shapes[0]
+        .render_from_object
+        .apply_point(Point3f::new(1.0, 2.0, 5.0));
+    assert!(close(p, 0.0, 0.0, 2.0));
+    // world: identity.
+    let s = build_with(text, RenderingCoordinateSystem::World);
+    assert!(s.camera.camera_transform.world_from_render.is_identity());
+    assert!(s.shapes[0].render_from_object.is_identity());
+    // The Option overrides the builder option.
+    let s = build_with(
+        &format!("Option \"string rendercoordsys\" \"world\"\n{text}"),
+        RenderingCoordinateSystem::Camera,
+    );
+    assert_eq!(s.render_coord_sys, RenderingCoordinateSystem::World);
+    assert!(s.shapes[0].render_from_object.is_identity());
+    assert_eq!(
+        s.option("rendercoordsys"),
+        Some(&OptionValue::String("world".into()))
+    );
+    assert_error(
+        &format!("{text}Option \"rendercoordsys\" \"camera\"\n"),
+        "<string>:5:1:",
+        "before Camera",
+    );
+}
+
+#[test]
+fn active_transform_makes_animated_shapes() {
+    let s = build(
+        "TransformTimes 0 2\nWorldBegin\nActiveTransform EndTime\nTranslate 1 0 0\n\
+         ActiveTransform All\nShape \"sphere\"\nTranslate 0 1 0\nShape \"disk\"\n\
+         ActiveTransform StartTime\nTranslate 1 0 0\nShape \"cylinder\"\n",
+    );
+    assert_eq!(s.animated_shapes.len(), 2);
+    let a = &s.animated_shapes[0].render_from_object;
+    assert_eq!((a.start_time, a.end_time), (0.0, 2.0));
+    assert!(close(
+        a.start_transform.apply_point(origin()),
+        0.0,
+        0.0,
+        0.0
+    ));
+    assert!(close(a.end_transform.apply_point(origin()), 1.0, 0.0, 0.0));
+    assert!(close(a.apply_point(origin(), 1.0), 0.5, 0.0, 0.0));
+    let b = &s.animated_shapes[1].render_from_object;
+    assert!(close(b.end_transform.apply_point(origin()), 1.0, 1.0, 0.0));
+    // Only the start moved: both keyframes now agree.
+    assert_eq!(s.shapes.len(), 1);
+    assert_eq!(s.shapes[0].base.name, "cylinder");
+    assert!(close(
+        s.shapes[0].render_from_object.apply_point(origin()),
+        1.0,
+        1.0,
+        0.0
+    ));
+}
+
+#[test]
+fn attribute_begin_end_restore_state() {
+    let s = build(
+        "WorldBegin\nMaterial \"conductor\"\nAttributeBegin\nTranslate 1 0 0\n\
+         Material \"dielectric\"\nReverseOrientation\nAreaLightSource \"diffuse\"\n\
+         MediumInterface \"fog\" \"\"\nColorSpace \"rec2020\"\nShape \"sphere\"\nAttributeEnd\n\
+         Shape \"sphere\"\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\n",
+    );
+    let (inner, outer) = (&s.shapes[0], &s.shapes[1]);
+    assert_eq!(s.materials[1].name, "conductor");
+    assert_eq!(s.materials[2].name, "dielectric");
+    assert_eq!(inner.attributes.material, MaterialRef::Index(2));
+    assert!(inner.attributes.reverse_orientation);
+    assert_eq!(inner.attributes.light_index, Some(0));
+    assert_eq!(inner.attributes.inside_medium, "fog");
+    assert_eq!(inner.base.color_space, "rec2020");
+    assert_eq!(outer.attributes.material, MaterialRef::Index(1));
+    assert!(!outer.attributes.reverse_orientation);
+    assert_eq!(outer.attributes.light_index, None);
+    assert_eq!(outer.attributes.inside_medium, "");
+    assert_eq!(outer.base.color_space, "srgb");
+    assert!(outer.render_from_object.is_identity());
+    assert_eq!(s.area_lights.len(), 1);
+}
+
+#[test]
+fn transform_begin_end_restore_only_the_transform() {
+    let s = build(
+        "WorldBegin\nTransformBegin\nTranslate 0 0 3\nMaterial \"conductor\"\n\
+         Shape \"sphere\"\nTransformEnd\nShape \"sphere\"\n",
+    );
+    assert!(close(
+        s.shapes[0].render_from_object.apply_point(origin()),
+        0.0,
+        0.0,
+        3.0
+    ));
+    assert!(s.shapes[1].render_from_object.is_identity());
+    assert_eq!(s.shapes[1].attributes.material, MaterialRef::Index(1));
+    // Mismatched nesting is an error.
+    assert_error(
+        "WorldBegin\nAttributeBegin\nTransformEnd\n",
+        "<string>:3:1:",
+        "mismatched nesting: open AttributeBegin from <string>:2:1",
+    );
+}
+
+#[test]
+fn named_materials_textures_and_media() {
+    let s = build(
+        "WorldBegin\nTexture \"checks\" \"spectrum\" \"checkerboard\" \"float uscale\" 4\n\
+         Texture \"bump\" \"float\" \"fbm\"\n\
+         MakeNamedMaterial \"gold\" \"string type\" \"conductor\" \"spectrum eta\" \"metal-Au-eta\"\n\
+         MakeNamedMedium \"smoke\" \"string type\" \"homogeneous\"\n\
+         NamedMaterial \"gold\"\nShape \"sphere\"\n",
+    );
+    let gold = s.named_material("gold").expect("gold");
+    assert_eq!(gold.name, "conductor");
+    assert_eq!(gold.loc.line, 4);
+    assert_eq!(
+        s.shapes[0].attributes.material,
+        MaterialRef::Named("gold".into())
+    );
+    assert_eq!(
+        s.spectrum_texture("checks").map(|t| t.base.name.as_str()),
+        Some("checkerboard")
+    );
+    assert_eq!(
+        s.float_texture("bump").map(|t| t.kind),
+        Some(TextureKind::Float)
+    );
+    assert!(s.float_texture("checks").is_none());
+    assert_eq!(
+        s.medium("smoke").map(|m| m.base.name.as_str()),
+        Some("homogeneous")
+    );
+
+    assert_error(
+        "WorldBegin\nNamedMaterial \"nope\"\nShape \"sphere\"\n",
+        "<string>:2:1:",
+        "\"nope\": named material not defined",
+    );
+    assert_error(
+        "WorldBegin\nMakeNamedMaterial \"a\" \"string type\" \"diffuse\"\n\
+         MakeNamedMaterial \"a\" \"string type\" \"diffuse\"\n",
+        "<string>:3:1:",
+        "named material redefined",
+    );
+    assert_error(
+        "WorldBegin\nTexture \"t\" \"float\" \"fbm\"\n  Texture \"t\" \"float\" \"fbm\"\n",
+        "<string>:3:3:",
+        "redefining texture \"t\"",
+    );
+    assert_error(
+        "WorldBegin\nTexture \"t\" \"vector\" \"fbm\"\n",
+        "<string>:2:1:",
+        "texture type unknown",
+    );
+    assert_error(
+        "MakeNamedMedium \"m\" \"string type\" \"homogeneous\"\n\
+         MakeNamedMedium \"m\" \"string type\" \"homogeneous\"\nWorldBegin\n",
+        "<string>:2:1:",
+        "named medium \"m\" redefined",
+    );
+    assert_error(
+        "WorldBegin\nMediumInterface \"nothere\" \"\"\n",
+        "<string>:2:1:",
+        "\"nothere\": medium not defined",
+    );
+    assert_error(
+        "WorldBegin\nMakeNamedMaterial \"a\" \"rgb reflectance\" [1 1 1]\n",
+        "<string>:2:1:",
+        "no parameter \"string type\"",
+    );
+}
+
+#[test]
+fn attribute_defaults_are_inherited() {
+    let s = build(
+        "WorldBegin\nAttributeBegin\nAttribute \"shape\" \"float radius\" 2\n\
+         Shape \"sphere\"\nShape \"sphere\" \"float radius\" 3\nAttributeEnd\nShape \"sphere\"\n\
+         Attribute \"light\" \"float scale\" 5\nLightSource \"point\"\n",
+    );
+    let r = |i: usize| {
+        s.shapes[i]
+            .base
+            .params
+            .get_one_float("radius", 1.0)
+            .unwrap()
+    };
+    assert_eq!((r(0), r(1), r(2)), (2.0, 3.0, 1.0));
+    let scale = s.lights[0].base.params.get_one_float("scale", 1.0).unwrap();
+    assert_eq!(scale, 5.0);
+    // Inherited parameters are not the entity's own, so never "unused".
+    assert!(s.shapes[0].base.params.report_unused().is_empty());
+    assert_error(
+        "WorldBegin\nAttribute \"camera\" \"float fov\" 3\n",
+        "<string>:2:1:",
+        "unknown attribute target \"camera\"",
+    );
+}
+
+#[test]
+fn object_instances() {
+    let s = build(
+        "WorldBegin\nObjectBegin \"thing\"\nTranslate 1 0 0\nShape \"sphere\"\nObjectEnd\n\
+         Shape \"disk\"\nTranslate 0 5 0\nObjectInstance \"thing\"\n",
+    );
+    let def = s.instance_definition("thing").expect("definition");
+    assert_eq!(def.shapes.len(), 1);
+    assert_eq!(def.loc.line, 2);
+    // Transform directives inside ObjectBegin apply; ObjectEnd restores.
+    assert!(close(
+        def.shapes[0].render_from_object.apply_point(origin()),
+        1.0,
+        0.0,
+        0.0
+    ));
+    assert_eq!(s.shapes.len(), 1);
+    assert!(s.shapes[0].render_from_object.is_identity());
+    match s.instances[0].render_from_instance {
+        InstanceTransform::Fixed(t) => assert!(close(t.apply_point(origin()), 0.0, 5.0, 0.0)),
+        InstanceTransform::Animated(_) => panic!("not animated"),
+    }
+
+    assert_error(
+        "WorldBegin\nObjectInstance \"ghost\"\n",
+        "<string>:2:1:",
+        "\"ghost\": object instance not defined",
+    );
+    assert_error(
+        "WorldBegin\nObjectBegin \"a\"\nObjectBegin \"b\"\nObjectEnd\nObjectEnd\n",
+        "<string>:3:1:",
+        "ObjectBegin called inside of instance definition",
+    );
+    assert_error(
+        "WorldBegin\nObjectBegin \"a\"\nObjectEnd\nObjectBegin \"b\"\nObjectInstance \"a\"\nObjectEnd\n",
+        "<string>:5:1:",
+        "ObjectInstance can't be called inside instance definition",
+    );
+    assert_error(
+        "WorldBegin\nObjectEnd\n",
+        "<string>:2:1:",
+        "ObjectEnd called outside of instance definition",
+    );
+}
+
+#[test]
+fn pbrt_v3_matte_becomes_diffuse() {
+    let (s, diags) = build_scene_from_str(
+        "WorldBegin\nMaterial \"matte\" \"color Kd\" [0.5 0.25 0.125]\nShape \"sphere\"\n",
+        &BuildOptions::default(),
+    )
+    .expect("builds");
+    let m = &s.materials[1];
+    assert_eq!(m.name, "diffuse");
+    let p = &m.params.params()[0];
+    assert_eq!((p.ty.as_str(), p.name.as_str()), ("rgb", "reflectance"));
+    assert_eq!(p.floats, vec![0.5, 0.25, 0.125]);
+    assert!(diags.iter().all(|d| !d.is_error()));
+}
+
+#[test]
+fn located_errors() {
+    let cases: &[(&str, &str, &str)] = &[
+        ("Shape \"sphere\"\nWorldBegin\n", "<string>:1:1:", "Shape not allowed before WorldBegin"),
+        ("WorldBegin\n  Camera \"perspective\"\n", "<string>:2:3:", "Camera not allowed after WorldBegin"),
+        ("WorldBegin\nFilm \"rgb\"\n", "<string>:2:1:", "Film not allowed after WorldBegin"),
+        ("WorldBegin\nWorldBegin\n", "<string>:2:1:", "WorldBegin not allowed after WorldBegin"),
+        ("Material \"diffuse\"\nWorldBegin\n", "<string>:1:1:", "Material not allowed before WorldBegin"),
+        ("WorldBegin\nShape \"sphre\"\n", "<string>:2:1:", "\"sphre\": unknown shape type; expected one of \"bilinearmesh\""),
+        ("WorldBegin\nMaterial \"plasticky\"\n", "<string>:2:1:", "unknown material type"),
+        ("WorldBegin\nLightSource \"sun\"\n", "<string>:2:1:", "unknown light type"),
+        ("WorldBegin\nAreaLightSource \"glow\"\n", "<string>:2:1:", "unknown area light type"),
+        ("WorldBegin\nTexture \"t\" \"float\" \"noise\"\n", "<string>:2:1:", "unknown texture class type"),
+        ("Film \"png\"\nWorldBegin\n", "<string>:1:1:", "unknown film type"),
+        ("Sampler \"random\"\nWorldBegin\n", "<string>:1:1:", "unknown sampler type"),
+        ("PixelFilter \"lanczos\"\nWorldBegin\n", "<string>:1:1:", "unknown pixel filter type"),
+        ("Integrator \"whitted\"\nWorldBegin\n", "<string>:1:1:", "unknown integrator type"),
+        ("Accelerator \"octree\"\nWorldBegin\n", "<string>:1:1:", "unknown accelerator type; expected one of \"bvh\", \"grid\", \"kdtree\""),
+        ("Camera \"pinhole\"\nWorldBegin\n", "<string>:1:1:", "unknown camera type"),
+        ("MakeNamedMedium \"m\" \"string type\" \"fog\"\nWorldBegin\n", "<string>:1:21:", "unknown medium type"),
+        ("ColorSpace \"adobe\"\nWorldBegin\n", "<string>:1:1:", "\"adobe\": unknown color space; expected one of \"srgb\", \"rec2020\", \"aces2065-1\", \"dci-p3\""),
+        ("Option \"bogus\" true\nWorldBegin\n", "<string>:1:1:", "unknown option"),
+        ("Option \"seed\" \"x\"\nWorldBegin\n", "<string>:1:1:", "expected an integer"),
+        ("WorldBegin\nAttributeEnd\n", "<string>:2:1:", "unmatched AttributeEnd"),
+        ("WorldBegin\nAttributeBegin\n", "<string>:2:1:", "missing end to AttributeBegin"),
+        ("LookAt 0 0 0  0 1 0  0 1 0\nWorldBegin\n", "<string>:1:1:", "LookAt"),
+        ("WorldBegin\nTransform [0 0 0 0  0 0 0 0  0 0 0 0  0 0 0 0]\n", "<string>:2:1:", "singular"),
+        ("WorldBegin\nConcatTransform [1 0 0 0  1 0 0 0  0 0 1 0  0 0 0 1]\n", "<string>:2:1:", "singular"),
+        ("WorldBegin\nRotate 30 0 0 0\n", "<string>:2:1:", "zero length"),
+        ("TransformTimes 2 1\nWorldBegin\n", "<string>:1:1:", "TransformTimes"),
+    ];
+    for (text, at, what) in cases {
+        assert_error(text, at, what);
+    }
+    let errs = errors("Camera \"perspective\"\n");
+    assert!(
+        errs.iter()
+            .any(|e| e == "error: end of files before \"WorldBegin\""),
+        "{errs:?}"
+    );
+}
+
+#[test]
+fn bad_transforms_leave_ctm_unchanged() {
+    let text = "WorldBegin\nTranslate 1 0 0\nLookAt 0 0 0  0 1 0  0 1 0\n\
+                Transform [0 0 0 0  0 0 0 0  0 0 0 0  0 0 0 0]\nShape \"sphere\"\n";
+    let mut b = SceneBuilder::new(RenderingCoordinateSystem::World);
+    let r = parse_string(text, &mut b);
+    assert!(r.is_err());
+    let s = b.finish();
+    assert!(close(
+        s.shapes[0].render_from_object.apply_point(origin()),
+        1.0,
+        0.0,
+        0.0
+    ));
+}
+
+#[test]
+fn deep_attribute_nesting() {
+    const N: usize = 100_000;
+    let mut text = String::with_capacity(N * 30);
+    text.push_str("WorldBegin\n");
+    for _ in 0..N {
+        text.push_str("AttributeBegin\n");
+    }
+    text.push_str("Material \"conductor\"\nShape \"sphere\"\n");
+    for _ in 0..N {
+        text.push_str("AttributeEnd\n");
+    }
+    text.push_str("Shape \"sphere\"\n");
+    let mut b = SceneBuilder::new(RenderingCoordinateSystem::World);
+    parse_string(&text, &mut b).expect("parses");
+    assert_eq!(b.nesting_depth(), 0);
+    let s = b.finish();
+    assert_eq!(s.shapes[0].attributes.material, MaterialRef::Index(1));
+    assert_eq!(s.shapes[1].attributes.material, MaterialRef::Index(0));
+}
+
+const V3_SCENE: &str = r#"
+LookAt 0 5 -10  0 0 0  0 1 0
+Camera "perspective" "float fov" [ 40 ]
+Film "image" "integer xresolution" [ 64 ] "integer yresolution" [ 48 ] "string filename" "out.exr"
+Sampler "lowdiscrepancy" "integer pixelsamples" [ 16 ]
+PixelFilter "gaussian" "float xwidth" [ 2 ] "float ywidth" [ 2 ]
+Integrator "directlighting"
+WorldBegin
+LightSource "point" "color I" [ 10 10 10 ] "point from" [ 0 4 0 ]
+AttributeBegin
+  AreaLightSource "area" "color L" [ 4 4 4 ] "integer nsamples" [ 4 ]
+  Translate 0 3 0
+  Shape "disk" "float radius" [ 0.5 ]
+AttributeEnd
+Texture "checks" "color" "checkerboard" "color tex1" [ 1 1 1 ] "color tex2" [ 0 0 0 ]
+Material "matte" "texture Kd" "checks"
+Shape "trianglemesh" "point P" [ -1 0 -1  1 0 -1  1 0 1  -1 0 1 ] "integer indices" [ 0 1 2  0 2 3 ] "float uv" [ 0 0 1 0 1 1 0 1 ]
+MakeNamedMaterial "glassy" "string type" "glass" "float index" [ 1.5 ]
+NamedMaterial "glassy"
+TransformBegin
+  Translate 0 1 0
+  Shape "sphere" "float radius" [ 1 ]
+TransformEnd
+Material "plastic" "color Kd" [ 0.2 0.3 0.4 ] "color Ks" [ 0.5 0.5 0.5 ] "float roughness" [ 0.1 ]
+Shape "sphere" "float radius" [ 0.25 ]
+WorldEnd
+"#;
+
+#[test]
+fn pbrt_v3_file_and_its_upgrade_agree() {
+    let mut fmt = FormattingTarget::new(true);
+    parse_string(V3_SCENE, &mut fmt).expect("formats");
+    let v4 = fmt.into_output();
+    let (a, _) = build_scene_from_str(V3_SCENE, &BuildOptions::default()).expect("v3 builds");
+    let (b, warnings) = build_scene_from_str(&v4, &BuildOptions::default()).expect("v4 builds");
+    assert_eq!(
+        a.normalized_dump(),
+        b.normalized_dump(),
+        "upgraded text:\n{v4}"
+    );
+    assert_eq!(a.film.name, "rgb");
+    assert_eq!(a.sampler.name, "paddedsobol");
+    assert_eq!(a.integrator.name, "path");
+    assert_eq!(
+        a.named_material("glassy").map(|m| m.name.as_str()),
+        Some("dielectric")
+    );
+    assert_eq!(a.area_lights[0].name, "diffuse");
+    // The pbrt-v4 text passes through without upgrade messages.
+    let upgrade_msgs: Vec<_> = warnings
+        .iter()
+        .filter(|d| !d.message.contains("deprecated"))
+        .collect();
+    assert!(upgrade_msgs.is_empty(), "{upgrade_msgs:?}");
+}
+
+#[test]
+fn v4_input_is_unchanged() {
+    let text = "WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \
+                \"integer indices\" [0 1 2]\nLightSource \"point\" \"rgb I\" [1 1 1]\n";
+    let (s, diags) = build_scene_from_str(text, &BuildOptions::default()).expect("builds");
+    assert!(diags.is_empty(), "{diags}");
+    let names: Vec<&str> = s.shapes[0]
+        .base
+        .params
+        .params()
+        .iter()
+        .map(|p| p.name.as_str())
+        .collect();
+    assert_eq!(names, ["P", "indices"]);
+}
+
+fn pbrt_files(dir: &std::path::Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.extension().is_some_and(|x| x == "pbrt") {
+            out.push(p);
+        }
+    }
+}
+
+#[test]
+fn shared_scenes_build_without_errors() {
+    let mut roots = vec![PathBuf::from("/work/shared/scenes")];
+    let manifest = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    roots.push(manifest.join("../../../shared/scenes"));
+    let Some(root) = roots.into_iter().find(|r| r.is_dir()) else {
+        eprintln!("no shared scenes; skipping");
+        return;
+    };
+    let mut files = Vec::new();
+    if let Ok(dirs) = std::fs::read_dir(&root) {
+        for d in dirs.flatten() {
+            pbrt_files(&d.path(), &mut files);
+        }
+    }
+    files.sort();
+    let mut built = 0;
+    for f in &files {
+        // Only top-level scene files (those with a WorldBegin) are scenes.
+        let text = std::fs::read_to_string(f).unwrap_or_default();
+        if !text.contains("WorldBegin") {
+            continue;
+        }
+        if let Err(d) = build_scene(std::slice::from_ref(f), &BuildOptions::default()) {
+            panic!("{}:\n{}", f.display(), d);
+        }
+        built += 1;
+    }
+    assert!(built > 0, "no scene under {}", root.display());
+}
