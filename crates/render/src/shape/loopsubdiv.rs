@@ -406,7 +406,7 @@ fn build_topology(indices: &[u32], p: &[Point3f]) -> Result<Topology, ShapeError
     if indices.is_empty() {
         return err("loopsubdiv: no triangles given (\"indices\" is empty)".into());
     }
-    if indices.len() % 3 != 0 {
+    if !indices.len().is_multiple_of(3) {
         return err(format!(
             "loopsubdiv: number of vertex indices {} is not a multiple of 3",
             indices.len()
