@@ -4,6 +4,8 @@
 //! reference point, with the inverse mappings that let the sampling density
 //! be warped by a bilinear cos θ approximation, and the areas of spherical
 //! polygons.
+// `!(x > 0.0)` is deliberate throughout: it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::frame::Frame;
