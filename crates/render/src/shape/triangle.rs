@@ -1,1 +1,1344 @@
-//! (in progress)
+//! Triangle meshes (book section 6.5; pbrt-v4 `util/mesh.h`, `shapes.h`,
+//! `shapes.cpp`): a [`TriangleMesh`] holds rendering-space vertices shared by
+//! its [`Triangle`]s, which are intersected with the watertight algorithm of
+//! Woop et al. and sampled by solid angle with spherical triangles.
+// `!(x > 0.0)` is deliberate throughout: it also rejects NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use super::{
+    area_sample_to_solid_angle, pdf_by_intersection, ShapeError, ShapeIntersection, ShapeMethods,
+    ShapeSample, ShapeSampleContext,
+};
+use crate::sampling::spherical::{
+    invert_spherical_triangle_sample, sample_spherical_triangle, spherical_triangle_area,
+};
+use crate::sampling::{bilinear_pdf, sample_bilinear, sample_uniform_triangle};
+use rpbrt_geometry::float::*;
+use rpbrt_geometry::interaction::SurfaceInteraction;
+use rpbrt_geometry::ray::Ray;
+use rpbrt_geometry::spherical::DirectionCone;
+use rpbrt_geometry::transform::Transform;
+use rpbrt_geometry::tuple::*;
+use rpbrt_geometry::Bounds3f;
+use std::sync::Arc;
+
+/// Below this solid angle (steradians) a triangle is sampled by area:
+/// spherical sampling is inaccurate and the triangle contributes little.
+pub const MIN_SPHERICAL_SAMPLE_AREA: Float = 3e-4;
+/// Above this solid angle (nearly a hemisphere) a triangle is sampled by
+/// area: spherical sampling breaks down and BSDF sampling does better.
+pub const MAX_SPHERICAL_SAMPLE_AREA: Float = 6.22;
+
+/// A triangle mesh in rendering space (pbrt-v4's `TriangleMesh`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TriangleMesh {
+    /// Three vertex indices per triangle.
+    pub indices: Vec<u32>,
+    /// Vertex positions in rendering space.
+    pub p: Vec<Point3f>,
+    /// Per-vertex shading normals in rendering space (already flipped when
+    /// the orientation is reversed).
+    pub n: Option<Vec<Normal3f>>,
+    /// Per-vertex shading tangents in rendering space.
+    pub s: Option<Vec<Vector3f>>,
+    /// Per-vertex texture coordinates.
+    pub uv: Option<Vec<Point2f>>,
+    /// One face index per triangle (for ptex lookups).
+    pub face_indices: Option<Vec<i32>>,
+    /// Whether the surface normals are reversed (`ReverseOrientation`).
+    pub reverse_orientation: bool,
+    /// Whether the object-to-render transformation changes handedness.
+    pub transform_swaps_handedness: bool,
+}
+
+impl TriangleMesh {
+    /// Validates the mesh parameters, transforms positions, normals and
+    /// tangents to rendering space and returns the mesh with warnings
+    /// (non-finite positions, triangles that will be skipped).
+    ///
+    /// Empty `s`, `n`, `uv` or `face_indices` mean "not given"; empty
+    /// `indices` is allowed only for exactly three vertices (one triangle).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        render_from_object: &Transform,
+        reverse_orientation: bool,
+        indices: Vec<u32>,
+        p: Vec<Point3f>,
+        s: Vec<Vector3f>,
+        n: Vec<Normal3f>,
+        uv: Vec<Point2f>,
+        face_indices: Vec<i32>,
+    ) -> Result<(Arc<TriangleMesh>, Vec<String>), ShapeError> {
+        let err = |m: String| Err(ShapeError(format!("trianglemesh: {m}")));
+        if p.len() < 3 {
+            return err(format!(
+                "at least 3 vertex positions \"P\" are required, {} given",
+                p.len()
+            ));
+        }
+        if p.len() > u32::MAX as usize {
+            return err(format!("too many vertices ({})", p.len()));
+        }
+        let indices = if indices.is_empty() {
+            if p.len() == 3 {
+                vec![0, 1, 2]
+            } else {
+                return err(format!("vertex indices \"indices\" must be given with {} vertices (only 3 vertices imply one triangle)", p.len()));
+            }
+        } else {
+            indices
+        };
+        if indices.len() % 3 != 0 {
+            return err(format!(
+                "number of vertex indices {} is not a multiple of 3",
+                indices.len()
+            ));
+        }
+        if let Some((i, &v)) = indices
+            .iter()
+            .enumerate()
+            .find(|(_, &v)| v as usize >= p.len())
+        {
+            return err(format!(
+                "vertex index {v} (at position {i}) is out of range: {} \"P\" values were given",
+                p.len()
+            ));
+        }
+        let counts = [
+            ("\"S\" tangents", s.len()),
+            ("\"N\" normals", n.len()),
+            ("\"uv\" coordinates", uv.len()),
+        ];
+        for (what, len) in counts {
+            if len != 0 && len != p.len() {
+                return err(format!(
+                    "number of {what} ({len}) does not match the number of \"P\" values ({})",
+                    p.len()
+                ));
+            }
+        }
+        let n_tris = indices.len() / 3;
+        if !face_indices.is_empty() && face_indices.len() != n_tris {
+            return err(format!(
+                "number of face indices ({}) does not match the number of triangles ({n_tris})",
+                face_indices.len()
+            ));
+        }
+        if let Some(i) = n.iter().position(|v| !v.is_finite()) {
+            return err(format!("normal \"N\" {i} is not finite"));
+        }
+        if let Some(i) = s.iter().position(|v| !v.is_finite()) {
+            return err(format!("tangent \"S\" {i} is not finite"));
+        }
+        if let Some(i) = uv
+            .iter()
+            .position(|v| !(v.x.is_finite() && v.y.is_finite()))
+        {
+            return err(format!("texture coordinate \"uv\" {i} is not finite"));
+        }
+
+        let mut warnings = Vec::new();
+        let bad_p = p.iter().filter(|q| !q.is_finite()).count();
+        if bad_p > 0 {
+            warnings.push(format!(
+                "trianglemesh: {bad_p} vertex positions are not finite"
+            ));
+        }
+        let p: Vec<Point3f> = p
+            .into_iter()
+            .map(|q| render_from_object.apply_point(q))
+            .collect();
+        let n = (!n.is_empty()).then(|| {
+            n.into_iter()
+                .map(|v| {
+                    let v = render_from_object.apply_normal(v);
+                    if reverse_orientation {
+                        -v
+                    } else {
+                        v
+                    }
+                })
+                .collect()
+        });
+        let s = (!s.is_empty()).then(|| {
+            s.into_iter()
+                .map(|v| render_from_object.apply_vector(v))
+                .collect()
+        });
+        let mesh = TriangleMesh {
+            indices,
+            p,
+            n,
+            s,
+            uv: (!uv.is_empty()).then_some(uv),
+            face_indices: (!face_indices.is_empty()).then_some(face_indices),
+            reverse_orientation,
+            transform_swaps_handedness: render_from_object.swaps_handedness(),
+        };
+        let skipped = (0..n_tris).filter(|&i| !mesh.is_valid_triangle(i)).count();
+        if skipped > 0 {
+            warnings.push(format!("trianglemesh: skipping {skipped} of {n_tris} triangles that are degenerate (zero area) or have non-finite vertices"));
+        }
+        Ok((Arc::new(mesh), warnings))
+    }
+
+    /// Number of triangles (including degenerate ones).
+    #[inline]
+    pub fn n_triangles(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    /// The vertex indices of triangle `i`.
+    #[inline]
+    fn vertex_indices(&self, i: usize) -> [usize; 3] {
+        [
+            self.indices[3 * i] as usize,
+            self.indices[3 * i + 1] as usize,
+            self.indices[3 * i + 2] as usize,
+        ]
+    }
+
+    /// The rendering-space vertices of triangle `i`.
+    #[inline]
+    pub fn vertices(&self, i: usize) -> [Point3f; 3] {
+        let v = self.vertex_indices(i);
+        [self.p[v[0]], self.p[v[1]], self.p[v[2]]]
+    }
+
+    /// True when triangle `i` has finite vertices and a finite, nonzero
+    /// area, so that it can be intersected and sampled.
+    pub fn is_valid_triangle(&self, i: usize) -> bool {
+        let [p0, p1, p2] = self.vertices(i);
+        if !(p0.is_finite() && p1.is_finite() && p2.is_finite()) {
+            return false;
+        }
+        let c = cross(p2 - p0, p1 - p0);
+        let a2 = c.length_squared();
+        a2 > 0.0 && a2.is_finite()
+    }
+}
+
+/// The usable triangles of `mesh`: degenerate ones (zero area, non-finite
+/// vertices) are left out, as [`TriangleMesh::new`] warned.
+pub fn triangles(mesh: &Arc<TriangleMesh>) -> Vec<Triangle> {
+    (0..mesh.n_triangles())
+        .filter(|&i| mesh.is_valid_triangle(i))
+        .map(|i| Triangle::new(mesh.clone(), i as u32))
+        .collect()
+}
+
+/// The watertight ray–triangle intersection of pbrt-v4 (Woop, Benthin and
+/// Wald 2013): returns the barycentric coordinates `(b0, b1, b2)` of the
+/// closest hit with `0 < t < t_max` and its `t`, which is conservatively
+/// positive given floating-point error. Rays through a shared edge or
+/// vertex hit at least one of the triangles that share it.
+pub fn intersect_triangle(
+    ray: &Ray,
+    t_max: Float,
+    p0: Point3f,
+    p1: Point3f,
+    p2: Point3f,
+) -> Option<(Float, Float, Float, Float)> {
+    // Degenerate triangles (and NaN vertices) never hit.
+    if !(cross(p2 - p0, p1 - p0).length_squared() > 0.0) {
+        return None;
+    }
+    // Translate to the ray origin, permute so the ray's largest direction
+    // component is z, and shear so the ray becomes the +z axis.
+    let o = Vector3f::from(ray.o);
+    let kz = ray.d.abs().max_dimension();
+    let kx = (kz + 1) % 3;
+    let ky = (kx + 1) % 3;
+    let perm = [kx, ky, kz];
+    let d = ray.d.permute(perm);
+    let mut p0t = (p0 - o).permute(perm);
+    let mut p1t = (p1 - o).permute(perm);
+    let mut p2t = (p2 - o).permute(perm);
+    let sx = -d.x / d.z;
+    let sy = -d.y / d.z;
+    let sz = 1.0 / d.z;
+    for q in [&mut p0t, &mut p1t, &mut p2t] {
+        q.x += sx * q.z;
+        q.y += sy * q.z;
+    }
+
+    // Edge functions; on an exact zero, redo them in double precision so
+    // that the sign test is exact for rays through edges.
+    let mut e0 = difference_of_products(p1t.x, p2t.y, p1t.y, p2t.x);
+    let mut e1 = difference_of_products(p2t.x, p0t.y, p2t.y, p0t.x);
+    let mut e2 = difference_of_products(p0t.x, p1t.y, p0t.y, p1t.x);
+    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
+        let f = |a: Float, b: Float, c: Float, dd: Float| {
+            (a as f64 * b as f64 - c as f64 * dd as f64) as Float
+        };
+        e0 = f(p1t.x, p2t.y, p1t.y, p2t.x);
+        e1 = f(p2t.x, p0t.y, p2t.y, p0t.x);
+        e2 = f(p0t.x, p1t.y, p0t.y, p1t.x);
+    }
+    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
+        return None;
+    }
+    let det = e0 + e1 + e2;
+    if det == 0.0 || det.is_nan() {
+        return None;
+    }
+
+    // Scaled hit distance, tested against (0, t_max) without dividing.
+    p0t.z *= sz;
+    p1t.z *= sz;
+    p2t.z *= sz;
+    let t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
+    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
+        return None;
+    }
+    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+        return None;
+    }
+    let inv_det = 1.0 / det;
+    let (b0, b1, b2) = (e0 * inv_det, e1 * inv_det, e2 * inv_det);
+    let t = t_scaled * inv_det;
+    if t.is_nan() {
+        return None;
+    }
+
+    // Conservative error bound on t (book section 6.8.7): reject hits too
+    // close to the origin to be sure they are in front of it.
+    let max_zt = Vector3f::new(p0t.z, p1t.z, p2t.z)
+        .abs()
+        .max_component_value();
+    let delta_z = gamma(3) * max_zt;
+    let max_xt = Vector3f::new(p0t.x, p1t.x, p2t.x)
+        .abs()
+        .max_component_value();
+    let max_yt = Vector3f::new(p0t.y, p1t.y, p2t.y)
+        .abs()
+        .max_component_value();
+    let delta_x = gamma(5) * (max_xt + max_zt);
+    let delta_y = gamma(5) * (max_yt + max_zt);
+    let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    let max_e = Vector3f::new(e0, e1, e2).abs().max_component_value();
+    let delta_t =
+        3.0 * (gamma(3) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    if t <= delta_t {
+        return None;
+    }
+    Some((b0, b1, b2, t))
+}
+
+/// One triangle of a [`TriangleMesh`].
+#[derive(Clone, Debug)]
+pub struct Triangle {
+    /// The mesh holding the vertices.
+    pub mesh: Arc<TriangleMesh>,
+    /// Which triangle of the mesh.
+    pub tri_index: u32,
+}
+
+impl Triangle {
+    /// Triangle `tri_index` of `mesh` (which must be in range; use
+    /// [`triangles`] to get only the valid ones).
+    pub fn new(mesh: Arc<TriangleMesh>, tri_index: u32) -> Self {
+        debug_assert!((tri_index as usize) < mesh.n_triangles());
+        Triangle { mesh, tri_index }
+    }
+
+    #[inline]
+    fn vertices(&self) -> [Point3f; 3] {
+        self.mesh.vertices(self.tri_index as usize)
+    }
+
+    #[inline]
+    fn vertex_indices(&self) -> [usize; 3] {
+        self.mesh.vertex_indices(self.tri_index as usize)
+    }
+
+    /// The texture coordinates of the vertices, (0,0), (1,0), (1,1) when
+    /// the mesh has none.
+    fn uvs(&self) -> [Point2f; 3] {
+        match &self.mesh.uv {
+            Some(uv) => {
+                let v = self.vertex_indices();
+                [uv[v[0]], uv[v[1]], uv[v[2]]]
+            }
+            None => [
+                Point2f::new(0.0, 0.0),
+                Point2f::new(1.0, 0.0),
+                Point2f::new(1.0, 1.0),
+            ],
+        }
+    }
+
+    /// The solid angle the triangle subtends from `p`.
+    pub fn solid_angle(&self, p: Point3f) -> Float {
+        let [p0, p1, p2] = self.vertices();
+        spherical_triangle_area(
+            (p0 - p).normalize(),
+            (p1 - p).normalize(),
+            (p2 - p).normalize(),
+        )
+    }
+
+    /// The geometric normal at barycentrics `b`, oriented as intersections
+    /// orient it: toward the interpolated shading normal when there are
+    /// per-vertex normals, else flipped by reverse orientation XOR a
+    /// handedness change.
+    fn oriented_normal(&self, b: [Float; 3]) -> Normal3f {
+        let [p0, p1, p2] = self.vertices();
+        let n = Normal3f::from(cross(p1 - p0, p2 - p0).normalize());
+        if let Some(ns) = &self.mesh.n {
+            let v = self.vertex_indices();
+            n.face_forward(ns[v[0]] * b[0] + ns[v[1]] * b[1] + ns[v[2]] * b[2])
+        } else if self.mesh.reverse_orientation ^ self.mesh.transform_swaps_handedness {
+            -n
+        } else {
+            n
+        }
+    }
+
+    /// The sample at barycentrics `b` with density `pdf`.
+    fn sample_at(&self, b: [Float; 3], pdf: Float, time: Float) -> ShapeSample {
+        let [p0, p1, p2] = self.vertices();
+        let p = p0 * b[0] + p1 * b[1] + p2 * b[2];
+        let abs_sum = (p0 * b[0]).abs() + (p1 * b[1]).abs() + (p2 * b[2]).abs();
+        let p_error = Vector3f::from(abs_sum) * gamma(6);
+        let uv = self.uvs();
+        let uv = Point2f::new(
+            b[0] * uv[0].x + b[1] * uv[1].x + b[2] * uv[2].x,
+            b[0] * uv[0].y + b[1] * uv[1].y + b[2] * uv[2].y,
+        );
+        ShapeSample {
+            pi: Point3fi::from_value_and_error(p, p_error),
+            n: self.oriented_normal(b),
+            uv,
+            time,
+            pdf,
+        }
+    }
+
+    /// The weights of the bilinear cos θ warp for spherical sampling from
+    /// `ctx`: corner (0,0) and (1,0) map to vertex 1, (0,1) to vertex 0 and
+    /// (1,1) to vertex 2, as the spherical triangle sampler lays them out.
+    fn cos_weights(&self, ctx: &ShapeSampleContext) -> [Float; 4] {
+        let [p0, p1, p2] = self.vertices();
+        let rp = ctx.p();
+        let w = |q: Point3f| abs_dot(ctx.ns, (q - rp).normalize()).max(0.01);
+        let (w0, w1, w2) = (w(p0), w(p1), w(p2));
+        [w1, w1, w0, w2]
+    }
+
+    /// The full surface interaction at barycentrics (b0, b1, b2).
+    fn interaction(
+        &self,
+        b0: Float,
+        b1: Float,
+        b2: Float,
+        time: Float,
+        wo: Vector3f,
+    ) -> SurfaceInteraction {
+        let mesh = &*self.mesh;
+        let v = self.vertex_indices();
+        let [p0, p1, p2] = self.vertices();
+        let uv = self.uvs();
+
+        // dp/du and dp/dv from the uv parameterization, or any tangent
+        // frame when the uv mapping is degenerate.
+        let duv02 = uv[0] - uv[2];
+        let duv12 = uv[1] - uv[2];
+        let dp02 = p0 - p2;
+        let dp12 = p1 - p2;
+        let determinant = difference_of_products(duv02.x, duv12.y, duv02.y, duv12.x);
+        let degenerate_uv = determinant.abs() < 1e-9;
+        let (mut dpdu, mut dpdv) = (Vector3f::default(), Vector3f::default());
+        if !degenerate_uv {
+            let inv = 1.0 / determinant;
+            dpdu = (dp02 * duv12.y - dp12 * duv02.y) * inv;
+            dpdv = (dp12 * duv02.x - dp02 * duv12.x) * inv;
+        }
+        if degenerate_uv || !(cross(dpdu, dpdv).length_squared() > 0.0) {
+            let mut ng = cross(p2 - p0, p1 - p0);
+            if ng.length_squared() == 0.0 {
+                // The f32 cross product underflowed; redo it in double.
+                let (a, c) = (p2 - p0, p1 - p0);
+                let f = |x: Float, y: Float, z: Float, w: Float| {
+                    (x as f64 * y as f64 - z as f64 * w as f64) as Float
+                };
+                ng = Vector3f::new(
+                    f(a.y, c.z, a.z, c.y),
+                    f(a.z, c.x, a.x, c.z),
+                    f(a.x, c.y, a.y, c.x),
+                );
+            }
+            let (s, t) = ng
+                .try_normalize()
+                .unwrap_or(Vector3f::new(0.0, 0.0, 1.0))
+                .coordinate_system();
+            dpdu = s;
+            dpdv = t;
+        }
+
+        let p_hit = p0 * b0 + p1 * b1 + p2 * b2;
+        let uv_hit = Point2f::new(
+            b0 * uv[0].x + b1 * uv[1].x + b2 * uv[2].x,
+            b0 * uv[0].y + b1 * uv[1].y + b2 * uv[2].y,
+        );
+        let abs_sum = (p0 * b0).abs() + (p1 * b1).abs() + (p2 * b2).abs();
+        let p_error = Vector3f::from(abs_sum) * gamma(7);
+
+        let flip = mesh.reverse_orientation ^ mesh.transform_swaps_handedness;
+        let mut isect = SurfaceInteraction::new(
+            Point3fi::from_value_and_error(p_hit, p_error),
+            uv_hit,
+            wo,
+            dpdu,
+            dpdv,
+            Normal3f::default(),
+            Normal3f::default(),
+            time,
+            flip,
+        );
+        // The geometric normal follows the vertex order, not dpdu × dpdv.
+        let mut n = Normal3f::from(cross(dp02, dp12).normalize());
+        if flip {
+            n = -n;
+        }
+        isect.n = n;
+        isect.shading.n = n;
+        isect.face_index = mesh
+            .face_indices
+            .as_ref()
+            .map_or(0, |f| f[self.tri_index as usize]);
+
+        if mesh.n.is_some() || mesh.s.is_some() {
+            // Shading normal: interpolated vertex normals when usable.
+            let ns = match &mesh.n {
+                Some(nn) => {
+                    let ns = nn[v[0]] * b0 + nn[v[1]] * b1 + nn[v[2]] * b2;
+                    if ns.length_squared() > 0.0 {
+                        ns.normalize()
+                    } else {
+                        isect.n
+                    }
+                }
+                None => isect.n,
+            };
+            // Shading tangent: interpolated tangents or dp/du.
+            let mut ss = match &mesh.s {
+                Some(s) => {
+                    let ss = s[v[0]] * b0 + s[v[1]] * b1 + s[v[2]] * b2;
+                    if ss.length_squared() == 0.0 {
+                        isect.dpdu
+                    } else {
+                        ss
+                    }
+                }
+                None => isect.dpdu,
+            };
+            let mut ts = cross(ns, ss);
+            if ts.length_squared() > 0.0 {
+                ss = cross(ts, ns);
+            } else {
+                let (a, c) = Vector3f::from(ns).coordinate_system();
+                ss = a;
+                ts = c;
+            }
+            // dn/du and dn/dv from the vertex normals.
+            let (dndu, dndv) = match &mesh.n {
+                Some(nn) => {
+                    let dn1 = nn[v[0]] - nn[v[2]];
+                    let dn2 = nn[v[1]] - nn[v[2]];
+                    if degenerate_uv {
+                        // Derivatives with respect to the same arbitrary
+                        // frame used for dp/du, so that reflected ray
+                        // differentials stay reasonable.
+                        let dn = cross(
+                            Vector3f::from(nn[v[2]] - nn[v[0]]),
+                            Vector3f::from(nn[v[1]] - nn[v[0]]),
+                        );
+                        match dn.try_normalize() {
+                            Some(dn) => {
+                                let (a, c) = dn.coordinate_system();
+                                (Normal3f::from(a), Normal3f::from(c))
+                            }
+                            None => (Normal3f::default(), Normal3f::default()),
+                        }
+                    } else {
+                        let inv = 1.0 / determinant;
+                        (
+                            (dn1 * duv12.y - dn2 * duv02.y) * inv,
+                            (dn2 * duv02.x - dn1 * duv12.x) * inv,
+                        )
+                    }
+                }
+                None => (Normal3f::default(), Normal3f::default()),
+            };
+            isect.set_shading_geometry(ns, ss, ts, dndu, dndv, true);
+        }
+        isect
+    }
+}
+
+impl ShapeMethods for Triangle {
+    fn bounds(&self) -> Bounds3f {
+        let [p0, p1, p2] = self.vertices();
+        Bounds3f::new(p0, p1).union_point(p2)
+    }
+
+    fn normal_bounds(&self) -> DirectionCone {
+        let [p0, p1, p2] = self.vertices();
+        let n = Normal3f::from(cross(p1 - p0, p2 - p0).normalize());
+        let n = if let Some(ns) = &self.mesh.n {
+            let v = self.vertex_indices();
+            n.face_forward(ns[v[0]] + ns[v[1]] + ns[v[2]])
+        } else if self.mesh.reverse_orientation ^ self.mesh.transform_swaps_handedness {
+            -n
+        } else {
+            n
+        };
+        DirectionCone::from_direction(Vector3f::from(n))
+    }
+
+    fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
+        let [p0, p1, p2] = self.vertices();
+        let (b0, b1, b2, t) = intersect_triangle(ray, t_max, p0, p1, p2)?;
+        let wo = (-ray.d).try_normalize().unwrap_or_default();
+        Some(ShapeIntersection {
+            intr: self.interaction(b0, b1, b2, ray.time, wo),
+            t_hit: t,
+        })
+    }
+
+    fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
+        let [p0, p1, p2] = self.vertices();
+        intersect_triangle(ray, t_max, p0, p1, p2).is_some()
+    }
+
+    fn area(&self) -> Float {
+        let [p0, p1, p2] = self.vertices();
+        0.5 * cross(p1 - p0, p2 - p0).length()
+    }
+
+    fn sample_area(&self, u: Point2f) -> Option<ShapeSample> {
+        let b = sample_uniform_triangle(u);
+        let pdf = 1.0 / self.area();
+        pdf.is_finite().then(|| self.sample_at(b, pdf, 0.0))
+    }
+
+    fn sample(&self, ctx: &ShapeSampleContext, u: Point2f) -> Option<ShapeSample> {
+        let sa = self.solid_angle(ctx.p());
+        if !(MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA).contains(&sa) {
+            let mut ss = self.sample_area(u)?;
+            ss.time = ctx.time;
+            return area_sample_to_solid_angle(ctx, ss);
+        }
+        // Warp u by an approximation of the cos θ factor at the reference
+        // point, then sample the spherical triangle uniformly.
+        let mut pdf = 1.0;
+        let mut u = u;
+        if ctx.ns != Normal3f::default() {
+            let w = self.cos_weights(ctx);
+            u = sample_bilinear(u, w);
+            pdf *= bilinear_pdf(u, w);
+        }
+        let (b, tri_pdf) = sample_spherical_triangle(self.vertices(), ctx.p(), u)?;
+        if !(tri_pdf > 0.0) {
+            return None;
+        }
+        Some(self.sample_at(b, pdf * tri_pdf, ctx.time))
+    }
+
+    fn pdf(&self, ctx: &ShapeSampleContext, wi: Vector3f) -> Float {
+        let sa = self.solid_angle(ctx.p());
+        if !(MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA).contains(&sa) {
+            return pdf_by_intersection(self, ctx, wi);
+        }
+        if !self.intersect_p(&ctx.spawn_ray(wi), Float::INFINITY) {
+            return 0.0;
+        }
+        let mut pdf = 1.0 / sa;
+        if ctx.ns != Normal3f::default() {
+            let w = self.cos_weights(ctx);
+            let u = invert_spherical_triangle_sample(self.vertices(), ctx.p(), wi.normalize());
+            pdf *= bilinear_pdf(u, w);
+        }
+        pdf
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Rng;
+    use crate::sampling::{sample_uniform_cone, sample_uniform_sphere, uniform_cone_pdf};
+    use rpbrt_geometry::frame::Frame;
+    use std::collections::HashMap;
+
+    fn ru(r: &mut Rng) -> Point2f {
+        Point2f::new(r.uniform_float(), r.uniform_float())
+    }
+    fn rp(r: &mut Rng, s: Float) -> Point3f {
+        Point3f::new(
+            s * (2.0 * r.uniform_float() - 1.0),
+            s * (2.0 * r.uniform_float() - 1.0),
+            s * (2.0 * r.uniform_float() - 1.0),
+        )
+    }
+    fn mesh(p: Vec<Point3f>, indices: Vec<u32>) -> Arc<TriangleMesh> {
+        TriangleMesh::new(
+            &Transform::default(),
+            false,
+            indices,
+            p,
+            vec![],
+            vec![],
+            vec![],
+            vec![],
+        )
+        .expect("valid mesh")
+        .0
+    }
+    fn single(p0: Point3f, p1: Point3f, p2: Point3f) -> Triangle {
+        Triangle::new(mesh(vec![p0, p1, p2], vec![]), 0)
+    }
+    fn random_triangle(r: &mut Rng) -> Triangle {
+        loop {
+            let t = single(rp(r, 1.0), rp(r, 1.0), rp(r, 1.0));
+            if t.area() > 0.05 {
+                return t;
+            }
+        }
+    }
+    fn hit_any(tris: &[Triangle], ray: &Ray) -> bool {
+        tris.iter().any(|t| t.intersect_p(ray, Float::INFINITY))
+    }
+
+    /// A sphere-like closed mesh: an octahedron subdivided `levels` times,
+    /// vertices shared between neighbouring triangles.
+    fn subdivided_octahedron(levels: u32) -> Arc<TriangleMesh> {
+        let mut p = vec![
+            Point3f::new(1.0, 0.0, 0.0),
+            Point3f::new(-1.0, 0.0, 0.0),
+            Point3f::new(0.0, 1.0, 0.0),
+            Point3f::new(0.0, -1.0, 0.0),
+            Point3f::new(0.0, 0.0, 1.0),
+            Point3f::new(0.0, 0.0, -1.0),
+        ];
+        let mut tris: Vec<[u32; 3]> = vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        for _ in 0..levels {
+            let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
+            let mut next = Vec::new();
+            for t in &tris {
+                let mut m = [0u32; 3];
+                for k in 0..3 {
+                    let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+                    m[k] = *mid.entry((a, b)).or_insert_with(|| {
+                        let q = p[a as usize] + p[b as usize];
+                        p.push(Point3f::from(Vector3f::from(q).normalize()));
+                        (p.len() - 1) as u32
+                    });
+                }
+                next.extend([
+                    [t[0], m[0], m[2]],
+                    [m[0], t[1], m[1]],
+                    [m[2], m[1], t[2]],
+                    [m[0], m[1], m[2]],
+                ]);
+            }
+            tris = next;
+        }
+        // Move it off the origin so that coordinates are not symmetric.
+        let p = p
+            .into_iter()
+            .map(|q| q * 3.7 + Vector3f::new(0.3, -1.1, 2.9))
+            .collect();
+        mesh(p, tris.into_iter().flatten().collect())
+    }
+
+    #[test]
+    fn watertight_closed_mesh() {
+        let m = subdivided_octahedron(3);
+        let tris = triangles(&m);
+        assert_eq!(tris.len(), m.n_triangles());
+        let mut r = Rng::new(10, 0);
+        let center = Point3f::new(0.3, -1.1, 2.9);
+        for i in 0..4000 {
+            let o = center + Vector3f::from(rp(&mut r, 1.0));
+            // Aim at vertices, at points on edges, or anywhere.
+            let d = match i % 3 {
+                0 => m.p[r.uniform_bounded(m.p.len() as u32) as usize] - o,
+                1 => {
+                    let t = r.uniform_bounded(m.n_triangles() as u32) as usize;
+                    let v = m.vertices(t);
+                    let k = r.uniform_bounded(3) as usize;
+                    v[k] + (v[(k + 1) % 3] - v[k]) * r.uniform_float() - o
+                }
+                _ => sample_uniform_sphere(ru(&mut r)),
+            };
+            let ray = Ray::new(o, d);
+            assert!(hit_any(&tris, &ray), "ray {ray:?} escaped the closed mesh");
+        }
+    }
+
+    #[test]
+    fn watertight_grid_edges_and_vertices() {
+        // A bumpy n×n grid; rays through its shared edges and vertices.
+        let n = 8;
+        let mut r = Rng::new(11, 0);
+        let mut p = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                p.push(Point3f::new(
+                    i as Float * 0.37,
+                    j as Float * 0.41,
+                    0.2 * r.uniform_float(),
+                ));
+            }
+        }
+        let mut idx = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let a = j * (n + 1) + i;
+                idx.extend([a, a + 1, a + n + 2, a, a + n + 2, a + n + 1]);
+            }
+        }
+        let m = mesh(p, idx.into_iter().map(|x| x as u32).collect());
+        let tris = triangles(&m);
+        for _ in 0..4000 {
+            let (i, j) = (
+                1 + r.uniform_bounded(n as u32 - 1) as usize,
+                1 + r.uniform_bounded(n as u32 - 1) as usize,
+            );
+            let a = m.p[j * (n + 1) + i];
+            let neighbours = [
+                m.p[j * (n + 1) + i + 1],
+                m.p[(j + 1) * (n + 1) + i],
+                m.p[(j + 1) * (n + 1) + i + 1],
+            ];
+            let b = neighbours[r.uniform_bounded(3) as usize];
+            let target = if r.uniform_float() < 0.3 {
+                a
+            } else {
+                a + (b - a) * r.uniform_float()
+            };
+            let o = Point3f::new(
+                target.x + rp(&mut r, 2.0).x,
+                target.y + rp(&mut r, 2.0).y,
+                if r.uniform_float() < 0.5 { 3.0 } else { -3.0 },
+            );
+            let ray = Ray::new(o, target - o);
+            assert!(
+                hit_any(&tris, &ray),
+                "ray {ray:?} slipped through the grid at {target:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn spawned_rays_do_not_reintersect() {
+        let mut r = Rng::new(12, 0);
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let tri = random_triangle(&mut r);
+            let [p0, p1, p2] = tri.vertices();
+            let b = sample_uniform_triangle(ru(&mut r));
+            let target = p0 * b[0] + p1 * b[1] + p2 * b[2];
+            let o = rp(&mut r, 8.0);
+            let Some(si) = tri.intersect(&Ray::new(o, target - o), Float::INFINITY) else {
+                continue;
+            };
+            hits += 1;
+            for _ in 0..5 {
+                let d = sample_uniform_sphere(ru(&mut r));
+                let spawned = si.intr.spawn_ray(d);
+                assert!(
+                    !tri.intersect_p(&spawned, Float::INFINITY),
+                    "re-hit from {:?} toward {d:?}",
+                    si.intr.p()
+                );
+            }
+        }
+        assert!(hits > 1900, "{hits}");
+    }
+
+    /// Double-precision Möller–Trumbore: (b0, b1, b2, t).
+    fn brute_force(ray: &Ray, v: [Point3f; 3]) -> Option<(f64, f64, f64, f64)> {
+        let f = |p: Point3f| [p.x as f64, p.y as f64, p.z as f64];
+        let (p0, p1, p2, o) = (f(v[0]), f(v[1]), f(v[2]), f(ray.o));
+        let d = [ray.d.x as f64, ray.d.y as f64, ray.d.z as f64];
+        let sub = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+        let cr = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let dt = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        let (e1, e2) = (sub(p1, p0), sub(p2, p0));
+        let pv = cr(d, e2);
+        let det = dt(e1, pv);
+        if det == 0.0 {
+            return None;
+        }
+        let tv = sub(o, p0);
+        let b1 = dt(tv, pv) / det;
+        let q = cr(tv, e1);
+        let b2 = dt(d, q) / det;
+        Some((1.0 - b1 - b2, b1, b2, dt(e2, q) / det))
+    }
+
+    #[test]
+    fn agrees_with_double_precision_brute_force() {
+        let mut r = Rng::new(13, 0);
+        let (mut hits, mut misses) = (0, 0);
+        for _ in 0..20_000 {
+            let tri = random_triangle(&mut r);
+            let o = rp(&mut r, 4.0);
+            let ray = Ray::new(o, rp(&mut r, 1.0) - o);
+            let got = tri.intersect(&ray, Float::INFINITY);
+            assert_eq!(got.is_some(), tri.intersect_p(&ray, Float::INFINITY));
+            let Some((b0, b1, b2, t)) = brute_force(&ray, tri.vertices()) else {
+                continue;
+            };
+            let margin = b0.min(b1).min(b2);
+            if margin > 1e-4 && t > 1e-4 {
+                let si = got.expect("brute force hit missed");
+                assert!(
+                    ((si.t_hit as f64 - t) / t).abs() < 1e-4,
+                    "t {} vs {t}",
+                    si.t_hit
+                );
+                let e = si.intr.p() - ray.at(t as Float);
+                assert!(e.length() < 1e-4 * (1.0 + Vector3f::from(si.intr.p()).length()));
+                hits += 1;
+            } else if margin < -1e-4 || t < -1e-4 {
+                assert!(got.is_none(), "brute force miss hit");
+                misses += 1;
+            }
+            // Limiting t_max below the hit must remove it.
+            if let Some(si) = got {
+                assert!(tri.intersect(&ray, si.t_hit * 0.999).is_none());
+            }
+        }
+        assert!(hits > 1000 && misses > 1000, "{hits} {misses}");
+    }
+
+    #[test]
+    fn bad_triangles_are_skipped_and_never_hit() {
+        let nan = Float::NAN;
+        let p = vec![
+            Point3f::new(0.0, 0.0, 0.0),
+            Point3f::new(1.0, 0.0, 0.0),
+            Point3f::new(2.0, 0.0, 0.0),
+            Point3f::new(0.0, 1.0, 0.0),
+            Point3f::new(nan, 0.0, 0.0),
+            Point3f::new(Float::INFINITY, 1.0, 0.0),
+        ];
+        // good, collinear, repeated vertex, NaN vertex, infinite vertex.
+        let idx = vec![0, 1, 3, 0, 1, 2, 0, 0, 3, 4, 1, 3, 5, 1, 3];
+        let (m, warnings) = TriangleMesh::new(
+            &Transform::default(),
+            false,
+            idx,
+            p,
+            vec![],
+            vec![],
+            vec![],
+            vec![],
+        )
+        .expect("mesh");
+        assert!(
+            warnings.iter().any(|w| w.contains("skipping 4 of 5")),
+            "{warnings:?}"
+        );
+        assert!(
+            warnings.iter().any(|w| w.contains("not finite")),
+            "{warnings:?}"
+        );
+        let good = triangles(&m);
+        assert_eq!(good.len(), 1);
+        assert_eq!(good[0].tri_index, 0);
+        let mut r = Rng::new(14, 0);
+        let ctx = ShapeSampleContext::from_point(Point3f::new(0.2, 0.2, 1.0), 0.0);
+        for i in 1..5 {
+            let t = Triangle::new(m.clone(), i);
+            for _ in 0..200 {
+                let o = rp(&mut r, 2.0);
+                let ray = Ray::new(o, rp(&mut r, 1.0) - o);
+                assert!(t.intersect(&ray, Float::INFINITY).is_none());
+                assert!(!t.intersect_p(&ray, Float::INFINITY));
+                let u = ru(&mut r);
+                if let Some(s) = t.sample_area(u) {
+                    assert!(s.pdf.is_finite());
+                }
+                if let Some(s) = t.sample(&ctx, u) {
+                    assert!(s.pdf.is_finite() && !s.p().has_nan());
+                }
+                let pdf = t.pdf(&ctx, sample_uniform_sphere(u));
+                assert!(pdf.is_finite() && pdf >= 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn validation_errors() {
+        let id = Transform::default();
+        let p3 = vec![
+            Point3f::new(0.0, 0.0, 0.0),
+            Point3f::new(1.0, 0.0, 0.0),
+            Point3f::new(0.0, 1.0, 0.0),
+        ];
+        let p4 = [p3.clone(), vec![Point3f::new(1.0, 1.0, 0.0)]].concat();
+        let new =
+            |idx: Vec<u32>,
+             p: Vec<Point3f>,
+             s: Vec<Vector3f>,
+             n: Vec<Normal3f>,
+             uv: Vec<Point2f>,
+             f: Vec<i32>| TriangleMesh::new(&id, false, idx, p, s, n, uv, f);
+        let msg = |r: Result<(Arc<TriangleMesh>, Vec<String>), ShapeError>| {
+            r.err().map(|e| e.0).unwrap_or_default()
+        };
+        assert!(msg(new(
+            vec![0, 1, 5],
+            p3.clone(),
+            vec![],
+            vec![],
+            vec![],
+            vec![]
+        ))
+        .contains("out of range"));
+        assert!(msg(new(
+            vec![0, 1, 2, 3],
+            p4.clone(),
+            vec![],
+            vec![],
+            vec![],
+            vec![]
+        ))
+        .contains("multiple of 3"));
+        assert!(msg(new(
+            vec![0, 1],
+            p3[..2].to_vec(),
+            vec![],
+            vec![],
+            vec![],
+            vec![]
+        ))
+        .contains("at least 3"));
+        assert!(msg(new(vec![], p4.clone(), vec![], vec![], vec![], vec![])).contains("indices"));
+        assert!(msg(new(
+            vec![],
+            p3.clone(),
+            vec![],
+            vec![Normal3f::new(0.0, 0.0, 1.0)],
+            vec![],
+            vec![]
+        ))
+        .contains("\"N\""));
+        assert!(msg(new(
+            vec![],
+            p3.clone(),
+            vec![Vector3f::default(); 2],
+            vec![],
+            vec![],
+            vec![]
+        ))
+        .contains("\"S\""));
+        assert!(msg(new(
+            vec![],
+            p3.clone(),
+            vec![],
+            vec![],
+            vec![Point2f::default(); 4],
+            vec![]
+        ))
+        .contains("\"uv\""));
+        assert!(
+            msg(new(vec![], p3.clone(), vec![], vec![], vec![], vec![1, 2]))
+                .contains("face indices")
+        );
+        assert!(msg(new(
+            vec![],
+            p3.clone(),
+            vec![],
+            vec![Normal3f::new(Float::NAN, 0.0, 1.0); 3],
+            vec![],
+            vec![]
+        ))
+        .contains("not finite"));
+        let (m, w) = new(vec![], p3, vec![], vec![], vec![], vec![7]).expect("one triangle");
+        assert!(w.is_empty());
+        assert_eq!(m.indices, vec![0, 1, 2]);
+        assert_eq!(m.face_indices, Some(vec![7]));
+    }
+
+    #[test]
+    fn interaction_geometry_and_orientation() {
+        let p = vec![
+            Point3f::new(0.0, 0.0, 0.0),
+            Point3f::new(1.0, 0.0, 0.0),
+            Point3f::new(1.0, 1.0, 0.0),
+        ];
+        let ray = Ray::new(Point3f::new(0.7, 0.2, 2.0), Vector3f::new(0.0, 0.0, -1.0));
+        let id = Transform::default();
+        let hit = |m: Arc<TriangleMesh>| {
+            Triangle::new(m, 0)
+                .intersect(&ray, Float::INFINITY)
+                .expect("hit")
+                .intr
+        };
+
+        let (m, _) = TriangleMesh::new(
+            &id,
+            false,
+            vec![],
+            p.clone(),
+            vec![],
+            vec![],
+            vec![],
+            vec![5],
+        )
+        .expect("mesh");
+        let si = hit(m.clone());
+        // Default uvs make (u, v) = (x, y) here.
+        assert!((si.uv - Point2f::new(0.7, 0.2)).length() < 1e-5);
+        assert!((si.dpdu - Vector3f::new(1.0, 0.0, 0.0)).length() < 1e-5);
+        assert!((si.dpdv - Vector3f::new(0.0, 1.0, 0.0)).length() < 1e-5);
+        assert!((Vector3f::from(si.n) - Vector3f::new(0.0, 0.0, 1.0)).length() < 1e-6);
+        assert_eq!(si.face_index, 5);
+        assert!((si.wo - Vector3f::new(0.0, 0.0, 1.0)).length() < 1e-6);
+        assert!(si.p_error().length() > 0.0 && si.p_error().length() < 1e-5);
+        assert!((Triangle::new(m, 0).normal_bounds().w - Vector3f::from(si.n)).length() < 1e-6);
+
+        let (m, _) =
+            TriangleMesh::new(&id, true, vec![], p.clone(), vec![], vec![], vec![], vec![])
+                .expect("mesh");
+        assert!(hit(m.clone()).n.z < 0.0);
+        assert!(Triangle::new(m, 0).normal_bounds().w.z < 0.0);
+
+        // Per-vertex normals decide the side, reversed by ReverseOrientation.
+        let down = vec![Normal3f::new(0.0, 0.0, -1.0); 3];
+        let (m, _) = TriangleMesh::new(
+            &id,
+            false,
+            vec![],
+            p.clone(),
+            vec![],
+            down.clone(),
+            vec![],
+            vec![],
+        )
+        .expect("mesh");
+        let si = hit(m);
+        assert!(si.n.z < 0.0 && si.shading.n.z < 0.0);
+        let (m, _) = TriangleMesh::new(&id, true, vec![], p.clone(), vec![], down, vec![], vec![])
+            .expect("mesh");
+        let si = hit(m);
+        assert!(si.n.z > 0.0 && si.shading.n.z > 0.0);
+
+        // Interpolated shading normals and their derivatives.
+        let tilted = vec![
+            Normal3f::new(0.0, 0.0, 1.0),
+            Normal3f::new(1.0, 0.0, 1.0).normalize(),
+            Normal3f::new(0.0, 1.0, 1.0).normalize(),
+        ];
+        let (m, _) = TriangleMesh::new(
+            &id,
+            false,
+            vec![],
+            p.clone(),
+            vec![],
+            tilted,
+            vec![],
+            vec![],
+        )
+        .expect("mesh");
+        let si = hit(m);
+        assert!(
+            si.shading.n.x > 0.0
+                && si.shading.n.y > 0.0
+                && (si.shading.n.length() - 1.0).abs() < 1e-5
+        );
+        assert!(si.shading.dndu.length() > 0.0);
+        assert!(dot(si.shading.dpdu, si.shading.n).abs() < 1e-5);
+
+        // A mirroring transformation swaps handedness; normals stay outward.
+        let (m, _) = TriangleMesh::new(
+            &Transform::scale(-1.0, 1.0, 1.0),
+            false,
+            vec![],
+            p,
+            vec![],
+            vec![],
+            vec![],
+            vec![],
+        )
+        .expect("mesh");
+        assert!(m.transform_swaps_handedness);
+        let mirrored = Ray::new(Point3f::new(-0.7, 0.2, 2.0), Vector3f::new(0.0, 0.0, -1.0));
+        let si = Triangle::new(m, 0)
+            .intersect(&mirrored, Float::INFINITY)
+            .expect("hit")
+            .intr;
+        assert!(si.n.z > 0.0);
+
+        // Degenerate uvs fall back to a frame around the normal.
+        let (m, _) = TriangleMesh::new(
+            &id,
+            false,
+            vec![],
+            vec![
+                Point3f::new(0.0, 0.0, 0.0),
+                Point3f::new(1.0, 0.0, 0.0),
+                Point3f::new(1.0, 1.0, 0.0),
+            ],
+            vec![],
+            vec![],
+            vec![Point2f::new(0.5, 0.5); 3],
+            vec![],
+        )
+        .expect("mesh");
+        let si = hit(m);
+        assert!(si.dpdu.length() > 0.0 && si.dpdv.length() > 0.0 && !si.dpdu.has_nan());
+        assert!(dot(si.dpdu, si.n).abs() < 1e-5);
+    }
+
+    #[test]
+    fn solid_angle_matches_monte_carlo() {
+        let mut r = Rng::new(15, 0);
+        for _ in 0..4 {
+            let tri = random_triangle(&mut r);
+            let p = rp(&mut r, 1.5);
+            let sa = tri.solid_angle(p);
+            let n = 100_000;
+            let hits = (0..n)
+                .filter(|_| {
+                    tri.intersect_p(
+                        &Ray::new(p, sample_uniform_sphere(ru(&mut r))),
+                        Float::INFINITY,
+                    )
+                })
+                .count();
+            let frac = hits as Float / n as Float;
+            let sigma = 4.0 * PI * (frac * (1.0 - frac) / n as Float).sqrt();
+            assert!(
+                (4.0 * PI * frac - sa).abs() < 4.0 * sigma + 1e-3,
+                "mc {} sa {sa}",
+                4.0 * PI * frac
+            );
+        }
+    }
+
+    fn contexts(r: &mut Rng, tri: &Triangle) -> Vec<ShapeSampleContext> {
+        let mut v = Vec::new();
+        for k in 0..4 {
+            let scale = if k < 2 { 2.0 } else { 60.0 };
+            let mut ctx = ShapeSampleContext::from_point(
+                Point3f::from(Vector3f::from(rp(r, 1.0)).normalize() * scale)
+                    + Vector3f::from(tri.vertices()[0]),
+                0.0,
+            );
+            if k % 2 == 1 {
+                let n = Normal3f::from(sample_uniform_sphere(ru(r)));
+                ctx.n = n;
+                ctx.ns = n;
+            }
+            v.push(ctx);
+        }
+        v
+    }
+
+    #[test]
+    fn sample_pdf_matches_pdf_and_integrates_to_one() {
+        let mut r = Rng::new(16, 0);
+        let (mut spherical, mut by_area) = (0, 0);
+        for _ in 0..6 {
+            let tri = random_triangle(&mut r);
+            for ctx in contexts(&mut r, &tri) {
+                let sa = tri.solid_angle(ctx.p());
+                if sa < MIN_SPHERICAL_SAMPLE_AREA {
+                    by_area += 1;
+                } else {
+                    spherical += 1;
+                }
+                let n = 4000;
+                let (mut bad, mut inv_pdf_sum) = (0, 0.0f64);
+                for _ in 0..n {
+                    let Some(ss) = tri.sample(&ctx, ru(&mut r)) else {
+                        continue;
+                    };
+                    assert!(ss.pdf > 0.0 && ss.pdf.is_finite());
+                    let wi = (ss.p() - ctx.p()).normalize();
+                    let pdf = tri.pdf(&ctx, wi);
+                    if (pdf - ss.pdf).abs() > 1e-2 * ss.pdf {
+                        bad += 1;
+                    }
+                    inv_pdf_sum += 1.0 / ss.pdf as f64;
+                }
+                assert!(
+                    bad < n / 100,
+                    "{bad} of {n} sample pdfs disagree with pdf() (solid angle {sa})"
+                );
+                // E[1/pdf] is the solid angle.
+                let est = inv_pdf_sum / n as f64;
+                assert!(
+                    (est - sa as f64).abs() < 0.05 * sa as f64,
+                    "E[1/pdf] {est} vs {sa}"
+                );
+
+                // ∫ pdf dω = 1, by uniform directions in a cone around the
+                // triangle.
+                let cone = DirectionCone::bound_subtended_directions(&tri.bounds(), ctx.p());
+                let frame = Frame::from_z(cone.w);
+                let m = 50_000;
+                let total: f64 = (0..m)
+                    .map(|_| {
+                        let w = frame.from_local(sample_uniform_cone(ru(&mut r), cone.cos_theta));
+                        tri.pdf(&ctx, w) as f64
+                    })
+                    .sum::<f64>()
+                    / (m as f64 * uniform_cone_pdf(cone.cos_theta) as f64);
+                assert!(
+                    (total - 1.0).abs() < 0.04,
+                    "∫pdf = {total} (solid angle {sa})"
+                );
+            }
+        }
+        assert!(spherical > 0 && by_area > 0, "{spherical} {by_area}");
+    }
+
+    #[test]
+    fn area_sampling() {
+        let mut r = Rng::new(17, 0);
+        for _ in 0..10 {
+            let tri = random_triangle(&mut r);
+            let [p0, p1, p2] = tri.vertices();
+            let n = 2000;
+            let mut inv = 0.0f64;
+            for _ in 0..n {
+                let ss = tri.sample_area(ru(&mut r)).expect("sample");
+                inv += 1.0 / ss.pdf as f64;
+                // The point lies in the triangle's plane, inside it.
+                let q = ss.p();
+                let nn = cross(p1 - p0, p2 - p0).normalize();
+                assert!(dot(q - p0, nn).abs() < 1e-5);
+                let a = cross(p1 - q, p2 - q).length()
+                    + cross(p2 - q, p0 - q).length()
+                    + cross(p0 - q, p1 - q).length();
+                assert!((0.5 * a - tri.area()).abs() < 1e-4 * (1.0 + tri.area()));
+                assert!((ss.n.length() - 1.0).abs() < 1e-5);
+                assert!((Vector3f::from(ss.n) - tri.normal_bounds().w).length() < 1e-5);
+            }
+            assert!((inv / n as f64 - tri.area() as f64).abs() < 1e-4 * tri.area() as f64);
+        }
+    }
+}
