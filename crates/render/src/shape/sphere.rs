@@ -619,7 +619,7 @@ pub(super) mod testing {
                 }
             }
         }
-        assert!(hits > n / 20, "too few hits ({hits} of {n}) for the test to mean much");
+        assert!(hits > n / 50, "too few hits ({hits} of {n}) for the test to mean much");
     }
 
     /// The hit of `ray` found independently in double precision: `f` is
