@@ -3,8 +3,8 @@
 //! the plane z = 0, swept to `φ_max`.
 
 use super::sphere::{
-    nearest_hit, object_ray, object_wo, phi_max_radians, positive_atan2, ray_point_fi, render_normal, require_finite,
-    solve_quadratic, transforms, weingarten,
+    nearest_hit, object_ray, object_wo, phi_max_radians, positive_atan2, ray_point_fi,
+    render_normal, require_finite, solve_quadratic, transforms, weingarten,
 };
 use super::{area_sample_to_solid_angle, pdf_by_intersection, ShapeError, ShapeIntersection};
 use super::{ShapeMethods, ShapeSample, ShapeSampleContext};
@@ -48,10 +48,14 @@ impl Cone {
         require_finite(S, "height", height)?;
         require_finite(S, "radius", radius)?;
         if height <= 0.0 {
-            return Err(ShapeError(format!("cone: \"height\" must be positive, got {height}")));
+            return Err(ShapeError(format!(
+                "cone: \"height\" must be positive, got {height}"
+            )));
         }
         if radius <= 0.0 {
-            return Err(ShapeError(format!("cone: \"radius\" must be positive, got {radius}")));
+            return Err(ShapeError(format!(
+                "cone: \"radius\" must be positive, got {radius}"
+            )));
         }
         let phi_max = phi_max_radians(S, phi_max)?;
         let (render_from_object, object_from_render, swaps) = transforms(S, render_from_object)?;
@@ -70,7 +74,11 @@ impl Cone {
         self.reverse_orientation ^ self.transform_swaps_handedness
     }
 
-    fn basic_intersect(&self, r: &Ray, t_max: Float) -> Option<(Interval, Point3f, Float, Point3fi)> {
+    fn basic_intersect(
+        &self,
+        r: &Ray,
+        t_max: Float,
+    ) -> Option<(Interval, Point3f, Float, Point3fi)> {
         let (oi, di) = object_ray(&self.object_from_render, r);
         // x² + y² = k (z − h)², k = (r/h)².
         let k = (Interval::new(self.radius) / Interval::new(self.height)).sqr();
@@ -88,7 +96,14 @@ impl Cone {
         Some((t, p, phi, ray_point_fi(oi, di, t)))
     }
 
-    fn interaction(&self, p: Point3f, phi: Float, p_fi: Point3fi, wo: Vector3f, time: Float) -> SurfaceInteraction {
+    fn interaction(
+        &self,
+        p: Point3f,
+        phi: Float,
+        p_fi: Point3fi,
+        wo: Vector3f,
+        time: Float,
+    ) -> SurfaceInteraction {
         let v = p.z / self.height;
         let uv = Point2f::new(phi / self.phi_max, v);
         let (c, s) = (phi.cos(), phi.sin());
@@ -117,8 +132,10 @@ impl Cone {
 impl ShapeMethods for Cone {
     fn bounds(&self) -> Bounds3f {
         let r = self.radius;
-        self.render_from_object
-            .apply_bounds(&Bounds3f::new(Point3f::new(-r, -r, 0.0), Point3f::new(r, r, self.height)))
+        self.render_from_object.apply_bounds(&Bounds3f::new(
+            Point3f::new(-r, -r, 0.0),
+            Point3f::new(r, r, self.height),
+        ))
     }
 
     fn normal_bounds(&self) -> DirectionCone {
@@ -128,7 +145,10 @@ impl ShapeMethods for Cone {
     fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
         let (t, p, phi, p_fi) = self.basic_intersect(ray, t_max)?;
         let wo = object_wo(&self.object_from_render, ray);
-        Some(ShapeIntersection { intr: self.interaction(p, phi, p_fi, wo, ray.time), t_hit: t.midpoint() })
+        Some(ShapeIntersection {
+            intr: self.interaction(p, phi, p_fi, wo, ray.time),
+            t_hit: t.midpoint(),
+        })
     }
 
     fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
@@ -151,9 +171,15 @@ impl ShapeMethods for Cone {
         let (c, sn) = (phi.cos(), phi.sin());
         let p = Point3f::new(rho * c, rho * sn, v * self.height);
         let p_error = Vector3f::from(p).abs() * gamma(5);
-        let n = render_normal(&self.render_from_object, Normal3f::new(self.height * c, self.height * sn, self.radius), self.flip())?;
+        let n = render_normal(
+            &self.render_from_object,
+            Normal3f::new(self.height * c, self.height * sn, self.radius),
+            self.flip(),
+        )?;
         Some(ShapeSample {
-            pi: self.render_from_object.apply_point_fi(Point3fi::from_value_and_error(p, p_error)),
+            pi: self
+                .render_from_object
+                .apply_point_fi(Point3fi::from_value_and_error(p, p_error)),
             n,
             uv: Point2f::new(u.y, v),
             time: 0.0,
@@ -207,10 +233,26 @@ mod tests {
             let t = rigid(&mut rng);
             let h = 0.2 + 2.0 * uf(&mut rng);
             let r = 0.2 + 2.0 * uf(&mut rng);
-            let ph = if i % 2 == 0 { 360.0 } else { 60.0 + 300.0 * uf(&mut rng) };
+            let ph = if i % 2 == 0 {
+                360.0
+            } else {
+                60.0 + 300.0 * uf(&mut rng)
+            };
             let c = Cone::new(t, i % 3 == 0, h, r, ph).unwrap();
-            check_reintersect(&c, &mut rng, 300, Leaving::Outward(if i % 3 == 0 { -1.0 } else { 1.0 }));
-            check_reference(&c, &t, &mut rng, 500, &implicit(h as f64, r as f64), &clip(h as f64, ph as f64));
+            check_reintersect(
+                &c,
+                &mut rng,
+                300,
+                Leaving::Outward(if i % 3 == 0 { -1.0 } else { 1.0 }),
+            );
+            check_reference(
+                &c,
+                &t,
+                &mut rng,
+                500,
+                &implicit(h as f64, r as f64),
+                &clip(h as f64, ph as f64),
+            );
         }
     }
 
@@ -221,25 +263,45 @@ mod tests {
         // Above the apex, outside the sweep.
         assert!(!c.intersect_p(&Ray::new(Point3f::new(-5.0, 0.0, 1.5), x), Float::INFINITY));
         assert!(!c.intersect_p(&Ray::new(Point3f::new(-5.0, -0.2, 0.5), x), Float::INFINITY));
-        let h = c.intersect(&Ray::new(Point3f::new(-5.0, 0.2, 0.5), x), Float::INFINITY).unwrap();
+        let h = c
+            .intersect(&Ray::new(Point3f::new(-5.0, 0.2, 0.5), x), Float::INFINITY)
+            .unwrap();
         assert!((h.intr.p().x - (0.25f32 - 0.04).sqrt()).abs() < 1e-4);
         assert!(h.intr.n.x > 0.0 && h.intr.n.z > 0.0);
         let flip = Transform::scale(1.0, 1.0, -1.0);
         let ray = Ray::new(Point3f::new(5.0, 0.0, -0.5), Vector3f::new(-1.0, 0.0, 0.0));
-        let n = Cone::new(flip, false, 1.0, 1.0, 360.0).unwrap().intersect(&ray, Float::INFINITY).unwrap().intr.n;
+        let n = Cone::new(flip, false, 1.0, 1.0, 360.0)
+            .unwrap()
+            .intersect(&ray, Float::INFINITY)
+            .unwrap()
+            .intr
+            .n;
         assert!(n.x < -0.5);
-        let n = Cone::new(flip, true, 1.0, 1.0, 360.0).unwrap().intersect(&ray, Float::INFINITY).unwrap().intr.n;
+        let n = Cone::new(flip, true, 1.0, 1.0, 360.0)
+            .unwrap()
+            .intersect(&ray, Float::INFINITY)
+            .unwrap()
+            .intr
+            .n;
         assert!(n.x > 0.5);
     }
 
     #[test]
     fn area_and_sampling() {
         let mut rng = Rng::with_sequence(32);
-        for (i, &(h, r, ph)) in [(1.0, 1.0, 360.0), (2.0, 0.5, 360.0), (0.5, 1.5, 120.0)].iter().enumerate() {
+        for (i, &(h, r, ph)) in [(1.0, 1.0, 360.0), (2.0, 0.5, 360.0), (0.5, 1.5, 120.0)]
+            .iter()
+            .enumerate()
+        {
             let t = rigid(&mut rng);
             let c = Cone::new(t, i == 1, h, r, ph).unwrap();
             check_area_sampling(&c, &mut rng, 3000);
-            check_solid_angle(&c, t.apply_point(Point3f::new(0.0, 0.0, -0.5 * h)), &mut rng, 20000);
+            check_solid_angle(
+                &c,
+                t.apply_point(Point3f::new(0.0, 0.0, -0.5 * h)),
+                &mut rng,
+                20000,
+            );
         }
     }
 }

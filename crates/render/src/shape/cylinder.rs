@@ -3,8 +3,8 @@
 //! swept to `φ_max`.
 
 use super::sphere::{
-    nearest_hit, object_ray, object_wo, phi_max_radians, positive_atan2, render_normal, require_finite,
-    roots_from_discriminant, transforms, weingarten,
+    nearest_hit, object_ray, object_wo, phi_max_radians, positive_atan2, render_normal,
+    require_finite, roots_from_discriminant, transforms, weingarten,
 };
 use super::{area_sample_to_solid_angle, pdf_by_intersection, ShapeError, ShapeIntersection};
 use super::{ShapeMethods, ShapeSample, ShapeSampleContext};
@@ -52,10 +52,14 @@ impl Cylinder {
         require_finite(S, "zmin", z_min)?;
         require_finite(S, "zmax", z_max)?;
         if radius <= 0.0 {
-            return Err(ShapeError(format!("cylinder: \"radius\" must be positive, got {radius}")));
+            return Err(ShapeError(format!(
+                "cylinder: \"radius\" must be positive, got {radius}"
+            )));
         }
         if z_min == z_max {
-            return Err(ShapeError(format!("cylinder: \"zmin\" and \"zmax\" are both {z_min}")));
+            return Err(ShapeError(format!(
+                "cylinder: \"zmin\" and \"zmax\" are both {z_min}"
+            )));
         }
         let phi_max = phi_max_radians(S, phi_max)?;
         let (render_from_object, object_from_render, swaps) = transforms(S, render_from_object)?;
@@ -99,7 +103,7 @@ impl Cylinder {
         let fy = oi.y - f * di.y;
         let rho = (fx.sqr() + fy.sqr()).sqrt();
         let discrim = Interval::new(4.0) * a * (rad + rho) * (rad - rho);
-        if !(discrim.low >= 0.0) {
+        if discrim.low.is_nan() || discrim.low < 0.0 {
             return None;
         }
         let (t0, t1) = roots_from_discriminant(a, b, c, discrim);
@@ -112,7 +116,10 @@ impl Cylinder {
     }
 
     fn interaction(&self, p: Point3f, phi: Float, wo: Vector3f, time: Float) -> SurfaceInteraction {
-        let uv = Point2f::new(phi / self.phi_max, (p.z - self.z_min) / (self.z_max - self.z_min));
+        let uv = Point2f::new(
+            phi / self.phi_max,
+            (p.z - self.z_min) / (self.z_max - self.z_min),
+        );
         let dpdu = Vector3f::new(-self.phi_max * p.y, self.phi_max * p.x, 0.0);
         let dpdv = Vector3f::new(0.0, 0.0, self.z_max - self.z_min);
         let d2pduu = Vector3f::new(p.x, p.y, 0.0) * (-self.phi_max * self.phi_max);
@@ -136,8 +143,10 @@ impl Cylinder {
 impl ShapeMethods for Cylinder {
     fn bounds(&self) -> Bounds3f {
         let r = self.radius;
-        self.render_from_object
-            .apply_bounds(&Bounds3f::new(Point3f::new(-r, -r, self.z_min), Point3f::new(r, r, self.z_max)))
+        self.render_from_object.apply_bounds(&Bounds3f::new(
+            Point3f::new(-r, -r, self.z_min),
+            Point3f::new(r, r, self.z_max),
+        ))
     }
 
     fn normal_bounds(&self) -> DirectionCone {
@@ -147,7 +156,10 @@ impl ShapeMethods for Cylinder {
     fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
         let (t_hit, p, phi) = self.basic_intersect(ray, t_max)?;
         let wo = object_wo(&self.object_from_render, ray);
-        Some(ShapeIntersection { intr: self.interaction(p, phi, wo, ray.time), t_hit })
+        Some(ShapeIntersection {
+            intr: self.interaction(p, phi, wo, ray.time),
+            t_hit,
+        })
     }
 
     fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
@@ -163,11 +175,21 @@ impl ShapeMethods for Cylinder {
     fn sample_area(&self, u: Point2f) -> Option<ShapeSample> {
         let z = lerp(u.x, self.z_min, self.z_max);
         let phi = u.y * self.phi_max;
-        let (p, _) = self.point_at(Point3f::new(self.radius * phi.cos(), self.radius * phi.sin(), z), Vector3f::default(), 0.0);
+        let (p, _) = self.point_at(
+            Point3f::new(self.radius * phi.cos(), self.radius * phi.sin(), z),
+            Vector3f::default(),
+            0.0,
+        );
         let p_error = Vector3f::new(p.x, p.y, 0.0).abs() * gamma(3);
-        let n = render_normal(&self.render_from_object, Normal3f::new(p.x, p.y, 0.0), self.flip())?;
+        let n = render_normal(
+            &self.render_from_object,
+            Normal3f::new(p.x, p.y, 0.0),
+            self.flip(),
+        )?;
         Some(ShapeSample {
-            pi: self.render_from_object.apply_point_fi(Point3fi::from_value_and_error(p, p_error)),
+            pi: self
+                .render_from_object
+                .apply_point_fi(Point3fi::from_value_and_error(p, p_error)),
             n,
             uv: Point2f::new(u.y, u.x),
             time: 0.0,
@@ -223,10 +245,26 @@ mod tests {
             let t = rigid(&mut rng);
             let r = 0.2 + 2.0 * uf(&mut rng);
             let (z0, z1) = (-2.0 * uf(&mut rng), 0.1 + 2.0 * uf(&mut rng));
-            let ph = if i % 2 == 0 { 360.0 } else { 60.0 + 300.0 * uf(&mut rng) };
+            let ph = if i % 2 == 0 {
+                360.0
+            } else {
+                60.0 + 300.0 * uf(&mut rng)
+            };
             let c = Cylinder::new(t, i % 3 == 0, r, z0, z1, ph).unwrap();
-            check_reintersect(&c, &mut rng, 300, Leaving::Outward(if i % 3 == 0 { -1.0 } else { 1.0 }));
-            check_reference(&c, &t, &mut rng, 500, &implicit(r as f64), &clip(z0 as f64, z1 as f64, ph as f64));
+            check_reintersect(
+                &c,
+                &mut rng,
+                300,
+                Leaving::Outward(if i % 3 == 0 { -1.0 } else { 1.0 }),
+            );
+            check_reference(
+                &c,
+                &t,
+                &mut rng,
+                500,
+                &implicit(r as f64),
+                &clip(z0 as f64, z1 as f64, ph as f64),
+            );
         }
     }
 
@@ -234,11 +272,22 @@ mod tests {
     fn misses_outside_clipping() {
         let c = Cylinder::new(Transform::identity(), false, 1.0, 0.0, 1.0, 90.0).unwrap();
         // Below the z range.
-        assert!(!c.intersect_p(&Ray::new(Point3f::new(-5.0, 0.5, -0.5), Vector3f::new(1.0, 0.0, 0.0)), Float::INFINITY));
+        assert!(!c.intersect_p(
+            &Ray::new(Point3f::new(-5.0, 0.5, -0.5), Vector3f::new(1.0, 0.0, 0.0)),
+            Float::INFINITY
+        ));
         // Outside the sweep (φ = 210° and 330°).
-        assert!(!c.intersect_p(&Ray::new(Point3f::new(-5.0, -0.5, 0.5), Vector3f::new(1.0, 0.0, 0.0)), Float::INFINITY));
+        assert!(!c.intersect_p(
+            &Ray::new(Point3f::new(-5.0, -0.5, 0.5), Vector3f::new(1.0, 0.0, 0.0)),
+            Float::INFINITY
+        ));
         // First root cut (φ = 150°), second kept (φ = 30°).
-        let h = c.intersect(&Ray::new(Point3f::new(-5.0, 0.5, 0.5), Vector3f::new(1.0, 0.0, 0.0)), Float::INFINITY).unwrap();
+        let h = c
+            .intersect(
+                &Ray::new(Point3f::new(-5.0, 0.5, 0.5), Vector3f::new(1.0, 0.0, 0.0)),
+                Float::INFINITY,
+            )
+            .unwrap();
         assert!((h.intr.p().x - 0.75f32.sqrt()).abs() < 1e-4);
         assert!(h.intr.n.x > 0.8);
     }
@@ -258,15 +307,24 @@ mod tests {
     #[test]
     fn area_and_sampling() {
         let mut rng = Rng::with_sequence(12);
-        for (i, &(z0, z1, ph)) in [(-1.0, 1.0, 360.0), (0.0, 0.5, 360.0), (-1.0, 2.0, 100.0)].iter().enumerate() {
+        for (i, &(z0, z1, ph)) in [(-1.0, 1.0, 360.0), (0.0, 0.5, 360.0), (-1.0, 2.0, 100.0)]
+            .iter()
+            .enumerate()
+        {
             let t = rigid(&mut rng);
             let c = Cylinder::new(t, i == 2, 0.7, z0, z1, ph).unwrap();
             check_area_sampling(&c, &mut rng, 3000);
             // From a point on the axis beyond the tube every ray meets it at
             // most once.
-            check_solid_angle(&c, t.apply_point(Point3f::new(0.0, 0.0, z1 + 0.7)), &mut rng, 20000);
+            check_solid_angle(
+                &c,
+                t.apply_point(Point3f::new(0.0, 0.0, z1 + 0.7)),
+                &mut rng,
+                20000,
+            );
         }
-        let c = Cylinder::new(Transform::scale(1.0, 1.0, -1.0), true, 1.0, 0.0, 1.0, 360.0).unwrap();
+        let c =
+            Cylinder::new(Transform::scale(1.0, 1.0, -1.0), true, 1.0, 0.0, 1.0, 360.0).unwrap();
         check_area_sampling(&c, &mut rng, 1000);
     }
 }

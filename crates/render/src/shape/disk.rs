@@ -1,7 +1,10 @@
 //! Disks (book section 6.4; pbrt-v4 `shapes.h` `Disk`): the annulus
 //! `inner_radius ≤ ρ ≤ radius` in the plane z = `height`, swept to `φ_max`.
 
-use super::sphere::{object_ray, object_wo, phi_max_radians, positive_atan2, render_normal, require_finite, transforms};
+use super::sphere::{
+    object_ray, object_wo, phi_max_radians, positive_atan2, render_normal, require_finite,
+    transforms,
+};
 use super::{area_sample_to_solid_angle, pdf_by_intersection, ShapeError, ShapeIntersection};
 use super::{ShapeMethods, ShapeSample, ShapeSampleContext};
 use rpbrt_geometry::float::*;
@@ -47,7 +50,9 @@ impl Disk {
         require_finite(S, "radius", radius)?;
         require_finite(S, "innerradius", inner_radius)?;
         if radius <= 0.0 {
-            return Err(ShapeError(format!("disk: \"radius\" must be positive, got {radius}")));
+            return Err(ShapeError(format!(
+                "disk: \"radius\" must be positive, got {radius}"
+            )));
         }
         if inner_radius < 0.0 || inner_radius >= radius {
             return Err(ShapeError(format!(
@@ -95,9 +100,18 @@ impl Disk {
         Some((t, p, phi))
     }
 
-    fn interaction(&self, mut p: Point3f, phi: Float, wo: Vector3f, time: Float) -> SurfaceInteraction {
+    fn interaction(
+        &self,
+        mut p: Point3f,
+        phi: Float,
+        wo: Vector3f,
+        time: Float,
+    ) -> SurfaceInteraction {
         let r_hit = (p.x * p.x + p.y * p.y).sqrt();
-        let uv = Point2f::new(phi / self.phi_max, (self.radius - r_hit) / (self.radius - self.inner_radius));
+        let uv = Point2f::new(
+            phi / self.phi_max,
+            (self.radius - r_hit) / (self.radius - self.inner_radius),
+        );
         // At the very centre ∂p/∂u vanishes; use a tiny radius there so
         // the normal stays defined.
         let rr = r_hit.max(1e-5 * self.radius);
@@ -124,13 +138,19 @@ impl Disk {
 impl ShapeMethods for Disk {
     fn bounds(&self) -> Bounds3f {
         let r = self.radius;
-        self.render_from_object
-            .apply_bounds(&Bounds3f::new(Point3f::new(-r, -r, self.height), Point3f::new(r, r, self.height)))
+        self.render_from_object.apply_bounds(&Bounds3f::new(
+            Point3f::new(-r, -r, self.height),
+            Point3f::new(r, r, self.height),
+        ))
     }
 
     /// The single direction of the disk's normal.
     fn normal_bounds(&self) -> DirectionCone {
-        match render_normal(&self.render_from_object, Normal3f::new(0.0, 0.0, 1.0), self.flip()) {
+        match render_normal(
+            &self.render_from_object,
+            Normal3f::new(0.0, 0.0, 1.0),
+            self.flip(),
+        ) {
             Some(n) => DirectionCone::from_direction(Vector3f::from(n)),
             None => DirectionCone::entire_sphere(),
         }
@@ -139,7 +159,10 @@ impl ShapeMethods for Disk {
     fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
         let (t_hit, p, phi) = self.basic_intersect(ray, t_max)?;
         let wo = object_wo(&self.object_from_render, ray);
-        Some(ShapeIntersection { intr: self.interaction(p, phi, wo, ray.time), t_hit })
+        Some(ShapeIntersection {
+            intr: self.interaction(p, phi, wo, ray.time),
+            t_hit,
+        })
     }
 
     fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
@@ -157,7 +180,11 @@ impl ShapeMethods for Disk {
         let rho = lerp(u.x, sqr(self.inner_radius), sqr(self.radius)).sqrt();
         let phi = u.y * self.phi_max;
         let p = Point3f::new(rho * phi.cos(), rho * phi.sin(), self.height);
-        let n = render_normal(&self.render_from_object, Normal3f::new(0.0, 0.0, 1.0), self.flip())?;
+        let n = render_normal(
+            &self.render_from_object,
+            Normal3f::new(0.0, 0.0, 1.0),
+            self.flip(),
+        )?;
         Some(ShapeSample {
             pi: self.render_from_object.apply_point_fi(Point3fi::from(p)),
             n,
@@ -211,12 +238,27 @@ mod tests {
             let t = rigid(&mut rng);
             let h = 2.0 * uf(&mut rng) - 1.0;
             let r = 0.2 + 2.0 * uf(&mut rng);
-            let ri = if i % 2 == 0 { 0.0 } else { 0.8 * r * uf(&mut rng) };
-            let ph = if i % 4 < 2 { 360.0 } else { 60.0 + 300.0 * uf(&mut rng) };
+            let ri = if i % 2 == 0 {
+                0.0
+            } else {
+                0.8 * r * uf(&mut rng)
+            };
+            let ph = if i % 4 < 2 {
+                360.0
+            } else {
+                60.0 + 300.0 * uf(&mut rng)
+            };
             let d = Disk::new(t, i % 3 == 0, h, r, ri, ph).unwrap();
             check_reintersect(&d, &mut rng, 300, Leaving::Never);
             let (hf, rf, rif) = (h as f64, r as f64, ri as f64);
-            check_reference(&d, &t, &mut rng, 500, &move |p| p[2] - hf, &clip(hf, rf, rif, ph as f64));
+            check_reference(
+                &d,
+                &t,
+                &mut rng,
+                500,
+                &move |p| p[2] - hf,
+                &clip(hf, rf, rif, ph as f64),
+            );
         }
     }
 
@@ -225,11 +267,28 @@ mod tests {
         let d = Disk::new(Transform::identity(), false, 1.0, 1.0, 0.5, 90.0).unwrap();
         let down = Vector3f::new(0.0, 0.0, -1.0);
         // In the hole, outside the radius, outside the sweep, parallel.
-        assert!(!d.intersect_p(&Ray::new(Point3f::new(0.2, 0.2, 5.0), down), Float::INFINITY));
-        assert!(!d.intersect_p(&Ray::new(Point3f::new(0.9, 0.9, 5.0), down), Float::INFINITY));
-        assert!(!d.intersect_p(&Ray::new(Point3f::new(-0.6, 0.3, 5.0), down), Float::INFINITY));
-        assert!(!d.intersect_p(&Ray::new(Point3f::new(0.6, 0.3, 1.0), Vector3f::new(1.0, 0.0, 0.0)), Float::INFINITY));
-        let h = d.intersect(&Ray::new(Point3f::new(0.6, 0.3, 5.0), down), Float::INFINITY).unwrap();
+        assert!(!d.intersect_p(
+            &Ray::new(Point3f::new(0.2, 0.2, 5.0), down),
+            Float::INFINITY
+        ));
+        assert!(!d.intersect_p(
+            &Ray::new(Point3f::new(0.9, 0.9, 5.0), down),
+            Float::INFINITY
+        ));
+        assert!(!d.intersect_p(
+            &Ray::new(Point3f::new(-0.6, 0.3, 5.0), down),
+            Float::INFINITY
+        ));
+        assert!(!d.intersect_p(
+            &Ray::new(Point3f::new(0.6, 0.3, 1.0), Vector3f::new(1.0, 0.0, 0.0)),
+            Float::INFINITY
+        ));
+        let h = d
+            .intersect(
+                &Ray::new(Point3f::new(0.6, 0.3, 5.0), down),
+                Float::INFINITY,
+            )
+            .unwrap();
         assert_eq!(h.intr.p().z, 1.0);
         assert!((h.t_hit - 4.0).abs() < 1e-6);
         assert!(h.intr.n.z > 0.99);
@@ -237,7 +296,14 @@ mod tests {
         let t = Transform::identity();
         let flip = Transform::scale(1.0, 1.0, -1.0);
         let nz = |d: Disk| {
-            let n = d.intersect(&Ray::new(Point3f::new(0.6, 0.3, 5.0), down), Float::INFINITY).unwrap().intr.n;
+            let n = d
+                .intersect(
+                    &Ray::new(Point3f::new(0.6, 0.3, 5.0), down),
+                    Float::INFINITY,
+                )
+                .unwrap()
+                .intr
+                .n;
             assert!((Vector3f::from(n) - d.normal_bounds().w).length() < 1e-6);
             n.z
         };
@@ -252,12 +318,25 @@ mod tests {
     #[test]
     fn area_and_sampling() {
         let mut rng = Rng::with_sequence(22);
-        for (i, &(ri, ph)) in [(0.0, 360.0), (0.4, 360.0), (0.3, 120.0)].iter().enumerate() {
+        for (i, &(ri, ph)) in [(0.0, 360.0), (0.4, 360.0), (0.3, 120.0)]
+            .iter()
+            .enumerate()
+        {
             let t = rigid(&mut rng);
             let d = Disk::new(t, i == 1, 0.5, 1.2, ri, ph).unwrap();
             check_area_sampling(&d, &mut rng, 3000);
-            check_solid_angle(&d, t.apply_point(Point3f::new(0.3, -0.2, 1.5)), &mut rng, 20000);
-            check_solid_angle(&d, t.apply_point(Point3f::new(3.0, 1.0, -0.5)), &mut rng, 20000);
+            check_solid_angle(
+                &d,
+                t.apply_point(Point3f::new(0.3, -0.2, 1.5)),
+                &mut rng,
+                20000,
+            );
+            check_solid_angle(
+                &d,
+                t.apply_point(Point3f::new(3.0, 1.0, -0.5)),
+                &mut rng,
+                20000,
+            );
         }
     }
 }

@@ -14,8 +14,8 @@
 //! and the derivatives are pbrt-v3's.
 
 use super::sphere::{
-    nearest_hit, object_ray, object_wo, phi_max_radians, positive_atan2, ray_point_fi, render_normal,
-    solve_quadratic, transforms, weingarten,
+    nearest_hit, object_ray, object_wo, phi_max_radians, positive_atan2, ray_point_fi,
+    render_normal, solve_quadratic, transforms, weingarten,
 };
 use super::{area_sample_to_solid_angle, pdf_by_intersection, ShapeError, ShapeIntersection};
 use super::{ShapeMethods, ShapeSample, ShapeSampleContext};
@@ -70,14 +70,20 @@ impl Hyperboloid {
         const S: &str = "hyperboloid";
         for (name, p) in [("p1", p1), ("p2", p2)] {
             if !p.is_finite() {
-                return Err(ShapeError(format!("hyperboloid: \"{name}\" must be finite, got {p:?}")));
+                return Err(ShapeError(format!(
+                    "hyperboloid: \"{name}\" must be finite, got {p:?}"
+                )));
             }
         }
         if p1 == p2 {
-            return Err(ShapeError("hyperboloid: \"p1\" and \"p2\" are the same point".into()));
+            return Err(ShapeError(
+                "hyperboloid: \"p1\" and \"p2\" are the same point".into(),
+            ));
         }
         if p1.x == 0.0 && p1.y == 0.0 && p2.x == 0.0 && p2.y == 0.0 {
-            return Err(ShapeError("hyperboloid: \"p1\" and \"p2\" both lie on the z axis".into()));
+            return Err(ShapeError(
+                "hyperboloid: \"p1\" and \"p2\" both lie on the z axis".into(),
+            ));
         }
         if p1.z == p2.z {
             return Err(ShapeError(format!(
@@ -87,16 +93,26 @@ impl Hyperboloid {
         }
         let phi_max = phi_max_radians(S, phi_max)?;
         let (render_from_object, object_from_render, swaps) = transforms(S, render_from_object)?;
-        let (dx, dy, dz) = ((p2.x - p1.x) as f64, (p2.y - p1.y) as f64, (p2.z - p1.z) as f64);
+        let (dx, dy, dz) = (
+            (p2.x - p1.x) as f64,
+            (p2.y - p1.y) as f64,
+            (p2.z - p1.z) as f64,
+        );
         let alpha = dx * dx + dy * dy;
         let beta = 2.0 * (p1.x as f64 * dx + p1.y as f64 * dy);
         let gamma = (p1.x as f64).powi(2) + (p1.y as f64).powi(2);
         // |∂p/∂u × ∂p/∂v|² = φ_max²(ρ² Δz² + (p·∂p/∂v)²_xy), and the latter
         // dot product is dρ²/dv / 2 = αv + β/2.
-        let q = [gamma * dz * dz + beta * beta / 4.0, beta * dz * dz + alpha * beta, alpha * dz * dz + alpha * alpha];
+        let q = [
+            gamma * dz * dz + beta * beta / 4.0,
+            beta * dz * dz + alpha * beta,
+            alpha * dz * dz + alpha * alpha,
+        ];
         let area = (phi_max as f64 * (antiderivative(q, 1.0) - antiderivative(q, 0.0))) as Float;
         if !(area > 0.0 && area.is_finite()) {
-            return Err(ShapeError(format!("hyperboloid: no surface area for p1 = {p1:?}, p2 = {p2:?}")));
+            return Err(ShapeError(format!(
+                "hyperboloid: no surface area for p1 = {p1:?}, p2 = {p2:?}"
+            )));
         }
         let r1 = (p1.x * p1.x + p1.y * p1.y).sqrt();
         let r2 = (p2.x * p2.x + p2.y * p2.y).sqrt();
@@ -129,10 +145,17 @@ impl Hyperboloid {
     fn phi_v(&self, p: Point3f) -> (Float, Float) {
         let v = (p.z - self.p1.z) / (self.p2.z - self.p1.z);
         let pr = Point3f::lerp(v, self.p1, self.p2);
-        (positive_atan2(pr.x * p.y - p.x * pr.y, p.x * pr.x + p.y * pr.y), v)
+        (
+            positive_atan2(pr.x * p.y - p.x * pr.y, p.x * pr.x + p.y * pr.y),
+            v,
+        )
     }
 
-    fn basic_intersect(&self, r: &Ray, t_max: Float) -> Option<(Interval, Point3f, Float, Float, Point3fi)> {
+    fn basic_intersect(
+        &self,
+        r: &Ray,
+        t_max: Float,
+    ) -> Option<(Interval, Point3f, Float, Float, Point3fi)> {
         let (oi, di) = object_ray(&self.object_from_render, r);
         let dz = self.p2.z - self.p1.z;
         // v along the ray: v0 + t·vd.
@@ -140,7 +163,8 @@ impl Hyperboloid {
         let vd = di.z / dz;
         let a = di.x.sqr() + di.y.sqr() - vd.sqr() * self.alpha;
         let b = (di.x * oi.x + di.y * oi.y) * 2.0 - (v0 * vd * (2.0 * self.alpha) + vd * self.beta);
-        let c = oi.x.sqr() + oi.y.sqr() - (v0.sqr() * self.alpha + v0 * self.beta + Interval::new(self.gamma));
+        let c = oi.x.sqr() + oi.y.sqr()
+            - (v0.sqr() * self.alpha + v0 * self.beta + Interval::new(self.gamma));
         let (t0, t1) = solve_quadratic(a, b, c)?;
         let (o, d) = (oi.midpoint(), di.midpoint());
         let (t, (p, phi, v)) = nearest_hit(t0, t1, t_max, |t| {
@@ -159,7 +183,6 @@ impl Hyperboloid {
         (dpdu, dpdv)
     }
 
-    #[allow(clippy::too_many_arguments)]
     fn interaction(
         &self,
         p: Point3f,
@@ -204,9 +227,15 @@ impl Hyperboloid {
             } else {
                 lo = v;
             }
-            let df = (self.q[0] + v * (self.q[1] + v * self.q[2])).max(0.0).sqrt();
+            let df = (self.q[0] + v * (self.q[1] + v * self.q[2]))
+                .max(0.0)
+                .sqrt();
             let next = v - f / df;
-            v = if df > 0.0 && next > lo && next < hi { next } else { 0.5 * (lo + hi) };
+            v = if df > 0.0 && next > lo && next < hi {
+                next
+            } else {
+                0.5 * (lo + hi)
+            };
         }
         v.clamp(0.0, 1.0)
     }
@@ -223,15 +252,21 @@ fn antiderivative(q: [f64; 3], v: f64) -> f64 {
     let s = v + q1 / (2.0 * q2);
     let m = ((q0 - q1 * q1 / (4.0 * q2)) / q2).max(0.0);
     let root = (s * s + m).sqrt();
-    let log_term = if m > 0.0 { m * (s / m.sqrt()).asinh() } else { 0.0 };
+    let log_term = if m > 0.0 {
+        m * (s / m.sqrt()).asinh()
+    } else {
+        0.0
+    };
     0.5 * q2.sqrt() * (s * root + log_term)
 }
 
 impl ShapeMethods for Hyperboloid {
     fn bounds(&self) -> Bounds3f {
         let r = self.r_max;
-        self.render_from_object
-            .apply_bounds(&Bounds3f::new(Point3f::new(-r, -r, self.z_min), Point3f::new(r, r, self.z_max)))
+        self.render_from_object.apply_bounds(&Bounds3f::new(
+            Point3f::new(-r, -r, self.z_min),
+            Point3f::new(r, r, self.z_max),
+        ))
     }
 
     fn normal_bounds(&self) -> DirectionCone {
@@ -241,7 +276,10 @@ impl ShapeMethods for Hyperboloid {
     fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
         let (t, p, phi, v, p_fi) = self.basic_intersect(ray, t_max)?;
         let wo = object_wo(&self.object_from_render, ray);
-        Some(ShapeIntersection { intr: self.interaction(p, phi, v, p_fi, wo, ray.time), t_hit: t.midpoint() })
+        Some(ShapeIntersection {
+            intr: self.interaction(p, phi, v, p_fi, wo, ray.time),
+            t_hit: t.midpoint(),
+        })
     }
 
     fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
@@ -265,9 +303,15 @@ impl ShapeMethods for Hyperboloid {
         let p = Point3f::new(pr.x * c - pr.y * s, pr.x * s + pr.y * c, pr.z);
         let p_error = Vector3f::from(p).abs() * gamma(6);
         let (dpdu, dpdv) = self.derivatives(p, phi);
-        let n = render_normal(&self.render_from_object, Normal3f::from(cross(dpdu, dpdv)), self.flip())?;
+        let n = render_normal(
+            &self.render_from_object,
+            Normal3f::from(cross(dpdu, dpdv)),
+            self.flip(),
+        )?;
         Some(ShapeSample {
-            pi: self.render_from_object.apply_point_fi(Point3fi::from_value_and_error(p, p_error)),
+            pi: self
+                .render_from_object
+                .apply_point_fi(Point3fi::from_value_and_error(p, p_error)),
             n,
             uv: Point2f::new(u.y, v),
             time: 0.0,
@@ -294,7 +338,11 @@ mod tests {
 
     /// The implicit function and clipping test of the swept segment,
     /// written independently in double precision.
-    fn reference(p1: Point3f, p2: Point3f, phimax_deg: f64) -> (impl Fn([f64; 3]) -> f64, impl Fn([f64; 3]) -> bool) {
+    fn reference(
+        p1: Point3f,
+        p2: Point3f,
+        phimax_deg: f64,
+    ) -> (impl Fn([f64; 3]) -> f64, impl Fn([f64; 3]) -> bool) {
         let a = [p1.x as f64, p1.y as f64, p1.z as f64];
         let b = [p2.x as f64, p2.y as f64, p2.z as f64];
         let gen = move |z: f64| {
@@ -307,7 +355,9 @@ mod tests {
         };
         let on = move |p: [f64; 3]| {
             let (gx, gy) = gen(p[2]);
-            let phi = (gx * p[1] - p[0] * gy).atan2(p[0] * gx + p[1] * gy).rem_euclid(2.0 * std::f64::consts::PI);
+            let phi = (gx * p[1] - p[0] * gy)
+                .atan2(p[0] * gx + p[1] * gy)
+                .rem_euclid(2.0 * std::f64::consts::PI);
             p[2] >= a[2].min(b[2]) && p[2] <= a[2].max(b[2]) && phi <= phimax_deg.to_radians()
         };
         (f, on)
@@ -320,7 +370,9 @@ mod tests {
         assert!(Hyperboloid::new(t, false, p(1.0, 0.0, 0.0), p(1.0, 0.0, 0.0), 360.0).is_err());
         assert!(Hyperboloid::new(t, false, p(0.0, 0.0, 0.0), p(0.0, 0.0, 1.0), 360.0).is_err());
         assert!(Hyperboloid::new(t, false, p(1.0, 0.0, 0.0), p(0.0, 1.0, 0.0), 360.0).is_err());
-        assert!(Hyperboloid::new(t, false, p(Float::NAN, 0.0, 0.0), p(0.0, 1.0, 1.0), 360.0).is_err());
+        assert!(
+            Hyperboloid::new(t, false, p(Float::NAN, 0.0, 0.0), p(0.0, 1.0, 1.0), 360.0).is_err()
+        );
         assert!(Hyperboloid::new(t, false, p(1.0, 0.0, 0.0), p(0.0, 1.0, 1.0), 0.0).is_err());
         // pbrt-v3's default, a cone through the origin, on which its
         // fitting loop never ends.
@@ -340,7 +392,12 @@ mod tests {
         // Symmetric about z = 0: pbrt-v3's implicit fit a ρ² − c z² = 1 is
         // exact here (ρ² = (1 + z²)/2 for this segment).
         let h = Hyperboloid::new(t, false, p(1.0, 0.0, -1.0), p(0.0, 1.0, 1.0), 360.0).unwrap();
-        let hit = h.intersect(&Ray::new(p(5.0, 0.0, 0.5), Vector3f::new(-1.0, 0.0, 0.0)), Float::INFINITY).unwrap();
+        let hit = h
+            .intersect(
+                &Ray::new(p(5.0, 0.0, 0.5), Vector3f::new(-1.0, 0.0, 0.0)),
+                Float::INFINITY,
+            )
+            .unwrap();
         assert!((hit.intr.p().x - (1.25f32 / 2.0).sqrt()).abs() < 1e-4);
     }
 
@@ -349,14 +406,24 @@ mod tests {
         let mut rng = Rng::with_sequence(51);
         for i in 0..40 {
             let t = rigid(&mut rng);
-            let mut pt = || Point3f::new(2.0 * uf(&mut rng) - 1.0, 2.0 * uf(&mut rng) - 1.0, 2.0 * uf(&mut rng) - 1.0);
+            let mut pt = || {
+                Point3f::new(
+                    2.0 * uf(&mut rng) - 1.0,
+                    2.0 * uf(&mut rng) - 1.0,
+                    2.0 * uf(&mut rng) - 1.0,
+                )
+            };
             let (p1, mut p2) = (pt(), pt());
             // Keep the segment away from horizontal, where v = (z − z₁)/Δz
             // magnifies float error beyond the reference's tolerance.
             if (p2.z - p1.z).abs() < 0.3 {
                 p2.z = p1.z + 0.3;
             }
-            let ph = if i % 2 == 0 { 360.0 } else { 60.0 + 300.0 * uf(&mut rng) };
+            let ph = if i % 2 == 0 {
+                360.0
+            } else {
+                60.0 + 300.0 * uf(&mut rng)
+            };
             let h = Hyperboloid::new(t, i % 3 == 0, p1, p2, ph).unwrap();
             check_reintersect(&h, &mut rng, 300, Leaving::FarOnly);
             let (f, on) = reference(p1, p2, ph as f64);

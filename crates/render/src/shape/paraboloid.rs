@@ -3,8 +3,8 @@
 //! z = `z_max`, clipped to `z_min ≤ z ≤ z_max`, swept to `φ_max`.
 
 use super::sphere::{
-    nearest_hit, object_ray, object_wo, phi_max_radians, positive_atan2, ray_point_fi, render_normal, require_finite,
-    solve_quadratic, transforms, weingarten,
+    nearest_hit, object_ray, object_wo, phi_max_radians, positive_atan2, ray_point_fi,
+    render_normal, require_finite, solve_quadratic, transforms, weingarten,
 };
 use super::{area_sample_to_solid_angle, pdf_by_intersection, ShapeError, ShapeIntersection};
 use super::{ShapeMethods, ShapeSample, ShapeSampleContext};
@@ -53,7 +53,9 @@ impl Paraboloid {
         require_finite(S, "zmin", z_min)?;
         require_finite(S, "zmax", z_max)?;
         if radius <= 0.0 {
-            return Err(ShapeError(format!("paraboloid: \"radius\" must be positive, got {radius}")));
+            return Err(ShapeError(format!(
+                "paraboloid: \"radius\" must be positive, got {radius}"
+            )));
         }
         let zhi = z_min.max(z_max);
         let zlo = z_min.min(z_max).max(0.0);
@@ -85,7 +87,11 @@ impl Paraboloid {
         self.z_max / (self.radius * self.radius)
     }
 
-    fn basic_intersect(&self, r: &Ray, t_max: Float) -> Option<(Interval, Point3f, Float, Point3fi)> {
+    fn basic_intersect(
+        &self,
+        r: &Ray,
+        t_max: Float,
+    ) -> Option<(Interval, Point3f, Float, Point3fi)> {
         let (oi, di) = object_ray(&self.object_from_render, r);
         let k = Interval::new(self.z_max) / Interval::new(self.radius).sqr();
         let a = k * (di.x.sqr() + di.y.sqr());
@@ -101,7 +107,14 @@ impl Paraboloid {
         Some((t, p, phi, ray_point_fi(oi, di, t)))
     }
 
-    fn interaction(&self, p: Point3f, phi: Float, p_fi: Point3fi, wo: Vector3f, time: Float) -> SurfaceInteraction {
+    fn interaction(
+        &self,
+        p: Point3f,
+        phi: Float,
+        p_fi: Point3fi,
+        wo: Vector3f,
+        time: Float,
+    ) -> SurfaceInteraction {
         let dz = self.z_max - self.z_min;
         let uv = Point2f::new(phi / self.phi_max, (p.z - self.z_min) / dz);
         // The z parameterization is singular at the apex; keep it finite.
@@ -130,8 +143,10 @@ impl Paraboloid {
 impl ShapeMethods for Paraboloid {
     fn bounds(&self) -> Bounds3f {
         let r = self.radius;
-        self.render_from_object
-            .apply_bounds(&Bounds3f::new(Point3f::new(-r, -r, self.z_min), Point3f::new(r, r, self.z_max)))
+        self.render_from_object.apply_bounds(&Bounds3f::new(
+            Point3f::new(-r, -r, self.z_min),
+            Point3f::new(r, r, self.z_max),
+        ))
     }
 
     fn normal_bounds(&self) -> DirectionCone {
@@ -141,7 +156,10 @@ impl ShapeMethods for Paraboloid {
     fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
         let (t, p, phi, p_fi) = self.basic_intersect(ray, t_max)?;
         let wo = object_wo(&self.object_from_render, ray);
-        Some(ShapeIntersection { intr: self.interaction(p, phi, p_fi, wo, ray.time), t_hit: t.midpoint() })
+        Some(ShapeIntersection {
+            intr: self.interaction(p, phi, p_fi, wo, ray.time),
+            t_hit: t.midpoint(),
+        })
     }
 
     fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
@@ -172,7 +190,9 @@ impl ShapeMethods for Paraboloid {
         let n_obj = Normal3f::new(p.x, p.y, (-0.5 / k) as Float);
         let n = render_normal(&self.render_from_object, n_obj, self.flip())?;
         Some(ShapeSample {
-            pi: self.render_from_object.apply_point_fi(Point3fi::from_value_and_error(p, p_error)),
+            pi: self
+                .render_from_object
+                .apply_point_fi(Point3fi::from_value_and_error(p, p_error)),
             n,
             uv: Point2f::new(u.y, (p.z - self.z_min) / (self.z_max - self.z_min)),
             time: 0.0,
@@ -227,12 +247,32 @@ mod tests {
             let t = rigid(&mut rng);
             let r = 0.2 + 2.0 * uf(&mut rng);
             let z1 = 0.2 + 2.0 * uf(&mut rng);
-            let z0 = if i % 2 == 0 { 0.0 } else { 0.5 * z1 * uf(&mut rng) };
-            let ph = if i % 4 < 2 { 360.0 } else { 60.0 + 300.0 * uf(&mut rng) };
+            let z0 = if i % 2 == 0 {
+                0.0
+            } else {
+                0.5 * z1 * uf(&mut rng)
+            };
+            let ph = if i % 4 < 2 {
+                360.0
+            } else {
+                60.0 + 300.0 * uf(&mut rng)
+            };
             let p = Paraboloid::new(t, i % 3 == 0, r, z0, z1, ph).unwrap();
-            check_reintersect(&p, &mut rng, 300, Leaving::Outward(if i % 3 == 0 { -1.0 } else { 1.0 }));
+            check_reintersect(
+                &p,
+                &mut rng,
+                300,
+                Leaving::Outward(if i % 3 == 0 { -1.0 } else { 1.0 }),
+            );
             let k = z1 as f64 / (r as f64 * r as f64);
-            check_reference(&p, &t, &mut rng, 500, &implicit(k), &clip(z0 as f64, z1 as f64, ph as f64));
+            check_reference(
+                &p,
+                &t,
+                &mut rng,
+                500,
+                &implicit(k),
+                &clip(z0 as f64, z1 as f64, ph as f64),
+            );
         }
     }
 
@@ -244,27 +284,51 @@ mod tests {
         assert!(!p.intersect_p(&Ray::new(Point3f::new(-5.0, 0.1, 0.1), x), Float::INFINITY));
         assert!(!p.intersect_p(&Ray::new(Point3f::new(-5.0, 0.1, 1.5), x), Float::INFINITY));
         assert!(!p.intersect_p(&Ray::new(Point3f::new(-5.0, -0.1, 0.5), x), Float::INFINITY));
-        let h = p.intersect(&Ray::new(Point3f::new(-5.0, 0.1, 0.5), x), Float::INFINITY).unwrap();
+        let h = p
+            .intersect(&Ray::new(Point3f::new(-5.0, 0.1, 0.5), x), Float::INFINITY)
+            .unwrap();
         assert!((h.intr.p().x - (0.5f32 - 0.01).sqrt()).abs() < 1e-4);
         assert!(h.intr.n.x > 0.0 && h.intr.n.z < 0.0);
         let flip = Transform::scale(1.0, 1.0, -1.0);
         let ray = Ray::new(Point3f::new(5.0, 0.0, -0.5), Vector3f::new(-1.0, 0.0, 0.0));
-        let n = Paraboloid::new(flip, false, 1.0, 0.0, 1.0, 360.0).unwrap().intersect(&ray, Float::INFINITY).unwrap().intr.n;
+        let n = Paraboloid::new(flip, false, 1.0, 0.0, 1.0, 360.0)
+            .unwrap()
+            .intersect(&ray, Float::INFINITY)
+            .unwrap()
+            .intr
+            .n;
         assert!(n.x < -0.5);
-        let n = Paraboloid::new(flip, true, 1.0, 0.0, 1.0, 360.0).unwrap().intersect(&ray, Float::INFINITY).unwrap().intr.n;
+        let n = Paraboloid::new(flip, true, 1.0, 0.0, 1.0, 360.0)
+            .unwrap()
+            .intersect(&ray, Float::INFINITY)
+            .unwrap()
+            .intr
+            .n;
         assert!(n.x > 0.5);
     }
 
     #[test]
     fn area_and_sampling() {
         let mut rng = Rng::with_sequence(42);
-        for (i, &(r, z0, z1, ph)) in [(1.0, 0.0, 1.0, 360.0), (0.5, 0.3, 2.0, 360.0), (1.5, 0.0, 0.5, 120.0)].iter().enumerate() {
+        for (i, &(r, z0, z1, ph)) in [
+            (1.0, 0.0, 1.0, 360.0),
+            (0.5, 0.3, 2.0, 360.0),
+            (1.5, 0.0, 0.5, 120.0),
+        ]
+        .iter()
+        .enumerate()
+        {
             let t = rigid(&mut rng);
             let p = Paraboloid::new(t, i == 1, r, z0, z1, ph).unwrap();
             check_area_sampling(&p, &mut rng, 3000);
             // From inside the convex solid every ray meets the surface once
             // at most.
-            check_solid_angle(&p, t.apply_point(Point3f::new(0.0, 0.0, 0.5 * (z0 + z1))), &mut rng, 20000);
+            check_solid_angle(
+                &p,
+                t.apply_point(Point3f::new(0.0, 0.0, 0.5 * (z0 + z1))),
+                &mut rng,
+                20000,
+            );
         }
     }
 }

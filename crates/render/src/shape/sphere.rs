@@ -24,7 +24,9 @@ pub(super) fn require_finite(shape: &str, name: &str, v: Float) -> Result<(), Sh
     if v.is_finite() {
         Ok(())
     } else {
-        Err(ShapeError(format!("{shape}: \"{name}\" must be finite, got {v}")))
+        Err(ShapeError(format!(
+            "{shape}: \"{name}\" must be finite, got {v}"
+        )))
     }
 }
 
@@ -34,7 +36,9 @@ pub(super) fn phi_max_radians(shape: &str, degrees: Float) -> Result<Float, Shap
     require_finite(shape, "phimax", degrees)?;
     let d = clamp(degrees, 0.0, 360.0);
     if d <= 0.0 {
-        return Err(ShapeError(format!("{shape}: \"phimax\" must be positive, got {degrees}")));
+        return Err(ShapeError(format!(
+            "{shape}: \"phimax\" must be positive, got {degrees}"
+        )));
     }
     Ok(radians(d))
 }
@@ -67,7 +71,11 @@ pub(super) fn roots_from_discriminant(
     discrim: Interval,
 ) -> (Interval, Interval) {
     let root = discrim.sqrt();
-    let q = if b.midpoint() < 0.0 { (b - root) * -0.5 } else { (b + root) * -0.5 };
+    let q = if b.midpoint() < 0.0 {
+        (b - root) * -0.5
+    } else {
+        (b + root) * -0.5
+    };
     let mut t0 = q / a;
     let mut t1 = c / q;
     if t0.low > t1.low {
@@ -80,10 +88,18 @@ pub(super) fn roots_from_discriminant(
 /// used by the quadrics whose coefficients have no simpler discriminant:
 /// whether there are roots is decided in double precision from the
 /// coefficients' midpoints; the root intervals bound all their error.
-pub(super) fn solve_quadratic(a: Interval, b: Interval, c: Interval) -> Option<(Interval, Interval)> {
-    let (am, bm, cm) = (a.midpoint() as f64, b.midpoint() as f64, c.midpoint() as f64);
+pub(super) fn solve_quadratic(
+    a: Interval,
+    b: Interval,
+    c: Interval,
+) -> Option<(Interval, Interval)> {
+    let (am, bm, cm) = (
+        a.midpoint() as f64,
+        b.midpoint() as f64,
+        c.midpoint() as f64,
+    );
     let d = bm * bm - 4.0 * am * cm;
-    if !(d >= 0.0) {
+    if d.is_nan() || d < 0.0 {
         return None;
     }
     let mut discrim = b.sqr() - Interval::new(4.0) * a * c;
@@ -180,7 +196,11 @@ pub(super) fn ray_point_fi(o: Point3fi, d: Vector3fi, t: Interval) -> Point3fi {
 /// way intersections orient theirs (flipped by reverse orientation XOR a
 /// handedness swap), so sampled and intersected normals agree.
 #[inline]
-pub(super) fn render_normal(render_from_object: &Transform, n_obj: Normal3f, flip: bool) -> Option<Normal3f> {
+pub(super) fn render_normal(
+    render_from_object: &Transform,
+    n_obj: Normal3f,
+    flip: bool,
+) -> Option<Normal3f> {
     let n = render_from_object.apply_normal(n_obj).try_normalize()?;
     Some(if flip { -n } else { n })
 }
@@ -188,18 +208,34 @@ pub(super) fn render_normal(render_from_object: &Transform, n_obj: Normal3f, fli
 /// Direction toward the ray's origin, in object space, normalized.
 #[inline]
 pub(super) fn object_wo(object_from_render: &Transform, r: &Ray) -> Vector3f {
-    object_from_render.apply_vector(-r.d).try_normalize().unwrap_or_default()
+    object_from_render
+        .apply_vector(-r.d)
+        .try_normalize()
+        .unwrap_or_default()
 }
 
 /// Common constructor work: the transformation pair and handedness.
-pub(super) fn transforms(shape: &str, render_from_object: Transform) -> Result<(Transform, Transform, bool), ShapeError> {
+pub(super) fn transforms(
+    shape: &str,
+    render_from_object: Transform,
+) -> Result<(Transform, Transform, bool), ShapeError> {
     let m = render_from_object.matrix().m;
     if m.iter().flatten().any(|v| !v.is_finite()) {
-        return Err(ShapeError(format!("{shape}: the object-to-render transformation is not finite")));
+        return Err(ShapeError(format!(
+            "{shape}: the object-to-render transformation is not finite"
+        )));
     }
     let object_from_render = render_from_object.inverse();
-    if object_from_render.matrix().m.iter().flatten().any(|v| !v.is_finite()) {
-        return Err(ShapeError(format!("{shape}: the object-to-render transformation is singular")));
+    if object_from_render
+        .matrix()
+        .m
+        .iter()
+        .flatten()
+        .any(|v| !v.is_finite())
+    {
+        return Err(ShapeError(format!(
+            "{shape}: the object-to-render transformation is singular"
+        )));
     }
     let swaps = render_from_object.swaps_handedness();
     Ok((render_from_object, object_from_render, swaps))
@@ -248,7 +284,9 @@ impl Sphere {
         require_finite(S, "zmin", z_min)?;
         require_finite(S, "zmax", z_max)?;
         if radius <= 0.0 {
-            return Err(ShapeError(format!("sphere: \"radius\" must be positive, got {radius}")));
+            return Err(ShapeError(format!(
+                "sphere: \"radius\" must be positive, got {radius}"
+            )));
         }
         let zlo = clamp(z_min.min(z_max), -radius, radius);
         let zhi = clamp(z_min.max(z_max), -radius, radius);
@@ -260,7 +298,11 @@ impl Sphere {
         let phi_max = phi_max_radians(S, phi_max)?;
         let (render_from_object, object_from_render, swaps) = transforms(S, render_from_object)?;
         let full = zlo <= -radius && zhi >= radius && phi_max >= 2.0 * PI;
-        let cone_radius = if full { uniform_scale(&render_from_object).map(|s| s * radius) } else { None };
+        let cone_radius = if full {
+            uniform_scale(&render_from_object).map(|s| s * radius)
+        } else {
+            None
+        };
         Ok(Sphere {
             render_from_object,
             object_from_render,
@@ -296,7 +338,7 @@ impl Sphere {
         let mut p = o + d * t;
         let len = Vector3f::from(p).length();
         if len > 0.0 {
-            p = p * (self.radius / len);
+            p *= self.radius / len;
         }
         if p.x == 0.0 && p.y == 0.0 {
             p.x = 1e-5 * self.radius;
@@ -332,7 +374,10 @@ impl Sphere {
 
     fn uv_of(&self, p: Point3f, phi: Float) -> Point2f {
         let theta = safe_acos(p.z / self.radius);
-        Point2f::new(phi / self.phi_max, (theta - self.theta_z_min) / (self.theta_z_max - self.theta_z_min))
+        Point2f::new(
+            phi / self.phi_max,
+            (theta - self.theta_z_min) / (self.theta_z_max - self.theta_z_min),
+        )
     }
 
     fn interaction(&self, p: Point3f, phi: Float, wo: Vector3f, time: Float) -> SurfaceInteraction {
@@ -381,8 +426,18 @@ fn uniform_scale(t: &Transform) -> Option<Float> {
     let ex = Vector3f::new(1.0, 0.0, 0.0);
     let ey = Vector3f::new(0.0, 1.0, 0.0);
     let orthogonal = dot(t.apply_vector(ex), t.apply_vector(ey)).abs() <= 1e-4 * lx * ly
-        && dot(t.apply_vector(ex), t.apply_vector(Vector3f::new(0.0, 0.0, 1.0))).abs() <= 1e-4 * lx * lz
-        && dot(t.apply_vector(ey), t.apply_vector(Vector3f::new(0.0, 0.0, 1.0))).abs() <= 1e-4 * ly * lz;
+        && dot(
+            t.apply_vector(ex),
+            t.apply_vector(Vector3f::new(0.0, 0.0, 1.0)),
+        )
+        .abs()
+            <= 1e-4 * lx * lz
+        && dot(
+            t.apply_vector(ey),
+            t.apply_vector(Vector3f::new(0.0, 0.0, 1.0)),
+        )
+        .abs()
+            <= 1e-4 * ly * lz;
     let same = (lx - ly).abs() <= 1e-4 * lx && (lx - lz).abs() <= 1e-4 * lx;
     (orthogonal && same && lx > 0.0).then_some(lx)
 }
@@ -390,8 +445,10 @@ fn uniform_scale(t: &Transform) -> Option<Float> {
 impl ShapeMethods for Sphere {
     fn bounds(&self) -> Bounds3f {
         let r = self.radius;
-        self.render_from_object
-            .apply_bounds(&Bounds3f::new(Point3f::new(-r, -r, self.z_min), Point3f::new(r, r, self.z_max)))
+        self.render_from_object.apply_bounds(&Bounds3f::new(
+            Point3f::new(-r, -r, self.z_min),
+            Point3f::new(r, r, self.z_max),
+        ))
     }
 
     fn normal_bounds(&self) -> DirectionCone {
@@ -401,7 +458,10 @@ impl ShapeMethods for Sphere {
     fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
         let (t_hit, p, phi) = self.basic_intersect(ray, t_max)?;
         let wo = object_wo(&self.object_from_render, ray);
-        Some(ShapeIntersection { intr: self.interaction(p, phi, wo, ray.time), t_hit })
+        Some(ShapeIntersection {
+            intr: self.interaction(p, phi, wo, ray.time),
+            t_hit,
+        })
     }
 
     fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
@@ -422,13 +482,19 @@ impl ShapeMethods for Sphere {
         let mut p = Point3f::new(rho * phi.cos(), rho * phi.sin(), z);
         let len = Vector3f::from(p).length();
         if len > 0.0 {
-            p = p * (self.radius / len);
+            p *= self.radius / len;
         }
         let p_error = Vector3f::from(p).abs() * gamma(5);
-        let n = render_normal(&self.render_from_object, Normal3f::new(p.x, p.y, p.z), self.flip())?;
+        let n = render_normal(
+            &self.render_from_object,
+            Normal3f::new(p.x, p.y, p.z),
+            self.flip(),
+        )?;
         let uv = self.uv_of(p, positive_atan2(p.y, p.x).min(self.phi_max));
         Some(ShapeSample {
-            pi: self.render_from_object.apply_point_fi(Point3fi::from_value_and_error(p, p_error)),
+            pi: self
+                .render_from_object
+                .apply_point_fi(Point3fi::from_value_and_error(p, p_error)),
             n,
             uv,
             time: 0.0,
@@ -464,7 +530,8 @@ impl ShapeMethods for Sphere {
             one_minus_cos_theta_max = sin2_theta_max / 2.0;
         }
         // The angle α at the centre between the axis and the sampled point.
-        let cos_alpha = sin2_theta / sin_theta_max + cos_theta * safe_sqrt(1.0 - sin2_theta / sqr(sin_theta_max));
+        let cos_alpha = sin2_theta / sin_theta_max
+            + cos_theta * safe_sqrt(1.0 - sin2_theta / sqr(sin_theta_max));
         let sin_alpha = safe_sqrt(1.0 - cos_alpha * cos_alpha);
         let phi = u.y * 2.0 * PI;
         let w = spherical_direction(sin_alpha, cos_alpha, phi);
@@ -505,11 +572,17 @@ impl ShapeMethods for Sphere {
             Some(w) => w,
             None => return 0.0,
         };
-        if dot(w, to_center) <= 0.0 || cross(w, to_center).length_squared() > radius * radius * (1.0 + 1e-3) {
+        if dot(w, to_center) <= 0.0
+            || cross(w, to_center).length_squared() > radius * radius * (1.0 + 1e-3)
+        {
             return 0.0;
         }
         let cos_theta_max = safe_sqrt(1.0 - sin2_theta_max);
-        let one_minus = if sin2_theta_max < SIN2_SMALL_ANGLE { sin2_theta_max / 2.0 } else { 1.0 - cos_theta_max };
+        let one_minus = if sin2_theta_max < SIN2_SMALL_ANGLE {
+            sin2_theta_max / 2.0
+        } else {
+            1.0 - cos_theta_max
+        };
         1.0 / (2.0 * PI * one_minus)
     }
 }
@@ -527,13 +600,13 @@ pub(super) mod testing {
     use super::super::{ShapeMethods, ShapeSampleContext};
     use crate::rng::Rng;
     use crate::sampling::{sample_uniform_cone, sample_uniform_sphere, uniform_cone_pdf};
-    use rpbrt_geometry::spherical::DirectionCone;
-    use rpbrt_geometry::Frame;
     use rpbrt_geometry::float::*;
     use rpbrt_geometry::ray::Ray;
+    use rpbrt_geometry::spherical::DirectionCone;
     use rpbrt_geometry::transform::Transform;
     use rpbrt_geometry::tuple::*;
     use rpbrt_geometry::Bounds3f;
+    use rpbrt_geometry::Frame;
 
     /// A uniform float.
     pub fn uf(rng: &mut Rng) -> Float {
@@ -593,14 +666,24 @@ pub(super) mod testing {
             let target = point_in(&b, rng);
             let ray = Ray::new(o, target - o);
             let hit = s.intersect(&ray, Float::INFINITY);
-            assert_eq!(hit.is_some(), s.intersect_p(&ray, Float::INFINITY), "intersect vs intersect_p");
+            assert_eq!(
+                hit.is_some(),
+                s.intersect_p(&ray, Float::INFINITY),
+                "intersect vs intersect_p"
+            );
             let Some(h) = hit else { continue };
             hits += 1;
             assert!(h.t_hit > 0.0 && h.t_hit.is_finite());
             let p = h.intr.p();
-            assert!(p.distance(ray.at(h.t_hit)) < 1e-3 * r, "hit point off the ray");
+            assert!(
+                p.distance(ray.at(h.t_hit)) < 1e-3 * r,
+                "hit point off the ray"
+            );
             assert!(b.expand(1e-3 * r).inside(p), "hit point outside the bounds");
-            assert!(!s.intersect_p(&ray, h.t_hit * (1.0 - 1e-3)), "a hit before t_hit");
+            assert!(
+                !s.intersect_p(&ray, h.t_hit * (1.0 - 1e-3)),
+                "a hit before t_hit"
+            );
             assert!((h.intr.n.length() - 1.0).abs() < 1e-3, "normal not unit");
             for _ in 0..20 {
                 let w = dir(rng);
@@ -609,7 +692,10 @@ pub(super) mod testing {
                     Leaving::Never => assert!(!s.intersect_p(&out, Float::INFINITY), "re-hit"),
                     Leaving::Outward(sign) => {
                         if dot(w, h.intr.n) * sign > 0.0 {
-                            assert!(!s.intersect_p(&out, Float::INFINITY), "re-hit leaving outward");
+                            assert!(
+                                !s.intersect_p(&out, Float::INFINITY),
+                                "re-hit leaving outward"
+                            );
                         }
                     }
                     Leaving::FarOnly => {}
@@ -619,7 +705,10 @@ pub(super) mod testing {
                 }
             }
         }
-        assert!(hits > n / 50, "too few hits ({hits} of {n}) for the test to mean much");
+        assert!(
+            hits > n / 50,
+            "too few hits ({hits} of {n}) for the test to mean much"
+        );
     }
 
     /// The hit of `ray` found independently in double precision: `f` is
@@ -635,7 +724,10 @@ pub(super) mod testing {
         let ap = |p: [f64; 3], w: f64| -> [f64; 3] {
             let mut r = [0.0; 3];
             for (i, ri) in r.iter_mut().enumerate() {
-                *ri = mi[i][0] as f64 * p[0] + mi[i][1] as f64 * p[1] + mi[i][2] as f64 * p[2] + w * mi[i][3] as f64;
+                *ri = mi[i][0] as f64 * p[0]
+                    + mi[i][1] as f64 * p[1]
+                    + mi[i][2] as f64 * p[2]
+                    + w * mi[i][3] as f64;
             }
             r
         };
@@ -693,7 +785,10 @@ pub(super) mod testing {
             }
         }
         assert!(hits > n / 50, "too few hits: {hits}");
-        assert!(disagree * 250 <= n, "{disagree} of {n} rays disagree with the reference");
+        assert!(
+            disagree * 250 <= n,
+            "{disagree} of {n} rays disagree with the reference"
+        );
     }
 
     /// The area of the surface by Crofton's formula: a uniformly random
@@ -724,11 +819,16 @@ pub(super) mod testing {
     pub fn check_area_sampling<S: ShapeMethods>(s: &S, rng: &mut Rng, n: usize) {
         let area = s.area() as f64;
         let est = crofton_area(s, rng, 20 * n);
-        assert!((est - area).abs() < 0.03 * area, "area {area} vs Crofton estimate {est}");
+        assert!(
+            (est - area).abs() < 0.03 * area,
+            "area {area} vs Crofton estimate {est}"
+        );
         let (_, r) = big_sphere(&s.bounds());
         let mut inv_pdf = 0.0f64;
         for _ in 0..n {
-            let Some(ss) = s.sample_area(u2(rng)) else { continue };
+            let Some(ss) = s.sample_area(u2(rng)) else {
+                continue;
+            };
             inv_pdf += 1.0 / ss.pdf as f64;
             assert!((ss.pdf - s.pdf_area()).abs() <= 1e-5 * ss.pdf);
             let p = ss.p();
@@ -737,13 +837,30 @@ pub(super) mod testing {
             let Some(h) = s.intersect(&Ray::new(o, -nv), Float::INFINITY) else {
                 panic!("no hit aimed at sampled point {p:?}");
             };
-            assert!(h.intr.p().distance(p) < 2e-3 * r, "sampled point off the surface: {p:?} vs {:?}", h.intr.p());
-            assert!(dot(h.intr.n, ss.n) > 0.99, "sampled normal {:?} vs hit normal {:?}", ss.n, h.intr.n);
+            assert!(
+                h.intr.p().distance(p) < 2e-3 * r,
+                "sampled point off the surface: {p:?} vs {:?}",
+                h.intr.p()
+            );
+            assert!(
+                dot(h.intr.n, ss.n) > 0.99,
+                "sampled normal {:?} vs hit normal {:?}",
+                ss.n,
+                h.intr.n
+            );
             let du = (h.intr.uv.x - ss.uv.x).abs();
-            assert!(du.min(1.0 - du) < 1e-2 && (h.intr.uv.y - ss.uv.y).abs() < 1e-2, "uv {:?} vs {:?}", ss.uv, h.intr.uv);
+            assert!(
+                du.min(1.0 - du) < 1e-2 && (h.intr.uv.y - ss.uv.y).abs() < 1e-2,
+                "uv {:?} vs {:?}",
+                ss.uv,
+                h.intr.uv
+            );
         }
         let mean = inv_pdf / n as f64;
-        assert!((mean - area).abs() < 1e-3 * area, "E[1/pdf] = {mean}, area {area}");
+        assert!(
+            (mean - area).abs() < 1e-3 * area,
+            "E[1/pdf] = {mean}, area {area}"
+        );
     }
 
     /// Solid-angle sampling from `p`, where every direction meets the
@@ -756,7 +873,11 @@ pub(super) mod testing {
         // over the whole sphere from inside its bounds) so that small
         // shapes get enough of them.
         let cone = DirectionCone::bound_subtended_directions(&s.bounds(), p);
-        let cos_max = if cone.cos_theta > -1.0 + 1e-3 { cone.cos_theta } else { -1.0 };
+        let cos_max = if cone.cos_theta > -1.0 + 1e-3 {
+            cone.cos_theta
+        } else {
+            -1.0
+        };
         let frame = Frame::from_z(cone.w);
         let dir_pdf = uniform_cone_pdf(cos_max) as f64;
         let (mut integral, mut omega) = (0.0f64, 0.0f64);
@@ -774,16 +895,26 @@ pub(super) mod testing {
         let mut inv = 0.0f64;
         let mut count = 0;
         for _ in 0..n {
-            let Some(ss) = s.sample(&ctx, u2(rng)) else { continue };
+            let Some(ss) = s.sample(&ctx, u2(rng)) else {
+                continue;
+            };
             count += 1;
             inv += 1.0 / ss.pdf as f64;
             let wi = (ss.p() - p).normalize();
             let pdf = s.pdf(&ctx, wi);
-            assert!((pdf - ss.pdf).abs() <= 2e-2 * ss.pdf, "sample pdf {} vs pdf() {}", ss.pdf, pdf);
+            assert!(
+                (pdf - ss.pdf).abs() <= 2e-2 * ss.pdf,
+                "sample pdf {} vs pdf() {}",
+                ss.pdf,
+                pdf
+            );
         }
         assert!(count * 100 >= n * 99, "too many failed samples");
         let est = inv / n as f64;
-        assert!((est - omega).abs() < 0.03 * omega, "E[1/pdf] {est} vs solid angle {omega}");
+        assert!(
+            (est - omega).abs() < 0.03 * omega,
+            "E[1/pdf] {est} vs solid angle {omega}"
+        );
     }
 }
 
@@ -828,19 +959,48 @@ mod tests {
             let (z0, z1, ph) = if i % 2 == 0 {
                 (-r, r, 360.0)
             } else {
-                (-r + 2.0 * r * uf(&mut rng) * 0.5, r - r * uf(&mut rng) * 0.5, 60.0 + 300.0 * uf(&mut rng))
+                (
+                    -r + 2.0 * r * uf(&mut rng) * 0.5,
+                    r - r * uf(&mut rng) * 0.5,
+                    60.0 + 300.0 * uf(&mut rng),
+                )
             };
             let s = Sphere::new(t, i % 3 == 0, r, z0, z1, ph).unwrap();
-            check_reintersect(&s, &mut rng, 300, Leaving::Outward(if i % 3 == 0 { -1.0 } else { 1.0 }));
-            check_reference(&s, &t, &mut rng, 500, &implicit(r as f64), &clip(s.z_min as f64, s.z_max as f64, ph as f64));
+            check_reintersect(
+                &s,
+                &mut rng,
+                300,
+                Leaving::Outward(if i % 3 == 0 { -1.0 } else { 1.0 }),
+            );
+            check_reference(
+                &s,
+                &t,
+                &mut rng,
+                500,
+                &implicit(r as f64),
+                &clip(s.z_min as f64, s.z_max as f64, ph as f64),
+            );
         }
     }
 
     #[test]
     fn tiny_and_distant_spheres_are_hit() {
         // pbrt-v4's accurate discriminant: rays from far away still hit.
-        let s = Sphere::new(Transform::translate(Vector3f::new(0.0, 0.0, 1e3)), false, 5e-2, -1.0, 1.0, 360.0).unwrap();
-        let h = s.intersect(&Ray::new(Point3f::default(), Vector3f::new(0.0, 0.0, 1.0)), Float::INFINITY).unwrap();
+        let s = Sphere::new(
+            Transform::translate(Vector3f::new(0.0, 0.0, 1e3)),
+            false,
+            5e-2,
+            -1.0,
+            1.0,
+            360.0,
+        )
+        .unwrap();
+        let h = s
+            .intersect(
+                &Ray::new(Point3f::default(), Vector3f::new(0.0, 0.0, 1.0)),
+                Float::INFINITY,
+            )
+            .unwrap();
         assert!((h.t_hit - (1e3 - 5e-2)).abs() < 1e-3);
     }
 
@@ -848,15 +1008,29 @@ mod tests {
     fn misses_outside_clipping() {
         let s = Sphere::new(Transform::identity(), false, 1.0, -0.5, 0.5, 90.0).unwrap();
         // Through the polar cap, cut away.
-        assert!(!s.intersect_p(&Ray::new(Point3f::new(0.1, 0.1, 5.0), Vector3f::new(0.0, 0.0, -1.0)), Float::INFINITY));
+        assert!(!s.intersect_p(
+            &Ray::new(Point3f::new(0.1, 0.1, 5.0), Vector3f::new(0.0, 0.0, -1.0)),
+            Float::INFINITY
+        ));
         // Outside the φ sweep (third quadrant).
         // Outside the φ sweep: enters at φ = 210°, leaves at φ = 330°.
-        assert!(!s.intersect_p(&Ray::new(Point3f::new(-5.0, -0.5, 0.0), Vector3f::new(1.0, 0.0, 0.0)), Float::INFINITY));
+        assert!(!s.intersect_p(
+            &Ray::new(Point3f::new(-5.0, -0.5, 0.0), Vector3f::new(1.0, 0.0, 0.0)),
+            Float::INFINITY
+        ));
         // Inside the sweep it hits; the second root is used when the first is cut.
-        let h = s.intersect(&Ray::new(Point3f::new(-5.0, 0.5, 0.0), Vector3f::new(1.0, 0.0, 0.0)), Float::INFINITY).unwrap();
+        let h = s
+            .intersect(
+                &Ray::new(Point3f::new(-5.0, 0.5, 0.0), Vector3f::new(1.0, 0.0, 0.0)),
+                Float::INFINITY,
+            )
+            .unwrap();
         assert!((h.intr.p().x - 0.75f32.sqrt()).abs() < 1e-4);
         // t_max before the hit.
-        assert!(!s.intersect_p(&Ray::new(Point3f::new(5.0, 0.5, 0.0), Vector3f::new(-1.0, 0.0, 0.0)), 1.0));
+        assert!(!s.intersect_p(
+            &Ray::new(Point3f::new(5.0, 0.5, 0.0), Vector3f::new(-1.0, 0.0, 0.0)),
+            1.0
+        ));
     }
 
     #[test]
@@ -874,12 +1048,23 @@ mod tests {
     #[test]
     fn area_and_area_sampling() {
         let mut rng = Rng::with_sequence(2);
-        for (i, &(z0, z1, ph)) in [(-1.0, 1.0, 360.0), (-0.3, 0.8, 360.0), (-1.0, 0.2, 125.0)].iter().enumerate() {
+        for (i, &(z0, z1, ph)) in [(-1.0, 1.0, 360.0), (-0.3, 0.8, 360.0), (-1.0, 0.2, 125.0)]
+            .iter()
+            .enumerate()
+        {
             let t = rigid(&mut rng);
             let s = Sphere::new(t, i == 1, 1.5, 1.5 * z0, 1.5 * z1, ph).unwrap();
             check_area_sampling(&s, &mut rng, 3000);
         }
-        let s = Sphere::new(Transform::scale(1.0, 1.0, -1.0), true, 1.0, -1.0, 1.0, 360.0).unwrap();
+        let s = Sphere::new(
+            Transform::scale(1.0, 1.0, -1.0),
+            true,
+            1.0,
+            -1.0,
+            1.0,
+            360.0,
+        )
+        .unwrap();
         check_area_sampling(&s, &mut rng, 1000);
     }
 
@@ -905,13 +1090,26 @@ mod tests {
 
     #[test]
     fn bounds_and_derivatives() {
-        let s = Sphere::new(Transform::translate(Vector3f::new(1.0, 2.0, 3.0)), false, 2.0, -1.0, 2.0, 360.0).unwrap();
+        let s = Sphere::new(
+            Transform::translate(Vector3f::new(1.0, 2.0, 3.0)),
+            false,
+            2.0,
+            -1.0,
+            2.0,
+            360.0,
+        )
+        .unwrap();
         let b = s.bounds();
         assert_eq!(b.p_min, Point3f::new(-1.0, 0.0, 2.0));
         assert_eq!(b.p_max, Point3f::new(3.0, 4.0, 5.0));
         assert_eq!(s.normal_bounds().cos_theta, -1.0);
         // dn/du on a sphere is dp/du / r.
-        let h = s.intersect(&Ray::new(Point3f::new(5.0, 2.5, 3.2), Vector3f::new(-1.0, 0.0, 0.0)), Float::INFINITY).unwrap();
+        let h = s
+            .intersect(
+                &Ray::new(Point3f::new(5.0, 2.5, 3.2), Vector3f::new(-1.0, 0.0, 0.0)),
+                Float::INFINITY,
+            )
+            .unwrap();
         let i = h.intr;
         let want = i.dpdu / 2.0;
         assert!((Vector3f::from(i.dndu) - want).length() < 1e-4 * want.length().max(1.0));
