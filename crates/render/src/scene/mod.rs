@@ -11,6 +11,7 @@ pub mod builder;
 pub mod entities;
 pub mod names;
 pub mod options;
+pub mod shapes;
 mod state;
 
 use std::path::{Path, PathBuf};

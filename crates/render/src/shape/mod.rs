@@ -15,8 +15,19 @@ use rpbrt_geometry::tuple::*;
 use rpbrt_geometry::Bounds3f;
 use std::fmt;
 
+pub use bilinear::{BilinearPatch, BilinearPatchMesh};
+pub use cone::Cone;
+pub use curve::Curve;
+pub use cylinder::Cylinder;
+pub use disk::Disk;
+pub use hyperboloid::Hyperboloid;
+pub use paraboloid::Paraboloid;
+pub use sphere::Sphere;
+pub use triangle::{Triangle, TriangleMesh};
+
 pub mod bilinear;
 pub mod cone;
+pub mod create;
 pub mod curve;
 pub mod cylinder;
 pub mod disk;
@@ -176,5 +187,102 @@ pub fn pdf_by_intersection<S: ShapeMethods + ?Sized>(
         0.0
     } else {
         pdf
+    }
+}
+
+/// Every shape rpbrt renders: a closed set, each method a one-line
+/// delegation. The quadrics carry two transformations and are boxed so that
+/// the common variants (triangles, patches, curve pieces) keep the enum
+/// small.
+#[derive(Clone, Debug)]
+pub enum Shape {
+    /// A sphere, possibly partial.
+    Sphere(Box<Sphere>),
+    /// A cylinder, possibly partial.
+    Cylinder(Box<Cylinder>),
+    /// A disk or annulus, possibly partial.
+    Disk(Box<Disk>),
+    /// A cone (pbrt-v3).
+    Cone(Box<Cone>),
+    /// A paraboloid (pbrt-v3).
+    Paraboloid(Box<Paraboloid>),
+    /// A hyperboloid (pbrt-v3).
+    Hyperboloid(Box<Hyperboloid>),
+    /// One triangle of a mesh.
+    Triangle(Triangle),
+    /// One bilinear patch of a mesh.
+    BilinearPatch(BilinearPatch),
+    /// One piece of a curve.
+    Curve(Curve),
+}
+
+macro_rules! delegate {
+    ($self:ident, $s:ident => $e:expr) => {
+        match $self {
+            Shape::Sphere($s) => $e,
+            Shape::Cylinder($s) => $e,
+            Shape::Disk($s) => $e,
+            Shape::Cone($s) => $e,
+            Shape::Paraboloid($s) => $e,
+            Shape::Hyperboloid($s) => $e,
+            Shape::Triangle($s) => $e,
+            Shape::BilinearPatch($s) => $e,
+            Shape::Curve($s) => $e,
+        }
+    };
+}
+
+impl ShapeMethods for Shape {
+    #[inline]
+    fn bounds(&self) -> Bounds3f {
+        delegate!(self, s => s.bounds())
+    }
+    #[inline]
+    fn normal_bounds(&self) -> DirectionCone {
+        delegate!(self, s => s.normal_bounds())
+    }
+    #[inline]
+    fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
+        delegate!(self, s => s.intersect(ray, t_max))
+    }
+    #[inline]
+    fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
+        delegate!(self, s => s.intersect_p(ray, t_max))
+    }
+    #[inline]
+    fn area(&self) -> Float {
+        delegate!(self, s => s.area())
+    }
+    #[inline]
+    fn sample_area(&self, u: Point2f) -> Option<ShapeSample> {
+        delegate!(self, s => s.sample_area(u))
+    }
+    #[inline]
+    fn pdf_area(&self) -> Float {
+        delegate!(self, s => s.pdf_area())
+    }
+    #[inline]
+    fn sample(&self, ctx: &ShapeSampleContext, u: Point2f) -> Option<ShapeSample> {
+        delegate!(self, s => s.sample(ctx, u))
+    }
+    #[inline]
+    fn pdf(&self, ctx: &ShapeSampleContext, wi: Vector3f) -> Float {
+        delegate!(self, s => s.pdf(ctx, wi))
+    }
+}
+
+#[cfg(test)]
+mod enum_tests {
+    use super::*;
+
+    #[test]
+    fn shape_enum_stays_small() {
+        // Triangles dominate real scenes: keep the enum at two words plus
+        // the tag.
+        assert!(
+            std::mem::size_of::<Shape>() <= 24,
+            "Shape is {} bytes",
+            std::mem::size_of::<Shape>()
+        );
     }
 }
