@@ -32,9 +32,7 @@ pub use params::{
     AccelKind, AccelParams, BvhParams, GridParams, KdTreeParams, ParamValue, SplitMethod,
 };
 
-use rpbrt_geometry::{
-    gamma, next_float_down, next_float_up, Bounds3f, Float, Point3f, Ray, Vector3f,
-};
+use rpbrt_geometry::{gamma, next_float_down, next_float_up, Bounds3f, Float, Point3f, Ray};
 
 /// The interface shared by every acceleration structure.
 ///
@@ -249,13 +247,6 @@ impl RayPrecomp {
             inv_dir,
             dir_is_neg: inv_dir.map(|c| (c < 0.0) as usize),
         }
-    }
-
-    /// The reciprocal direction as a vector.
-    #[inline]
-    #[allow(dead_code)]
-    pub fn inv_dir_vector(&self) -> Vector3f {
-        Vector3f::new(self.inv_dir[0], self.inv_dir[1], self.inv_dir[2])
     }
 
     /// The parametric range `[t0, t1]` of the ray inside the box `lo..hi`,

@@ -548,7 +548,11 @@ fn bvh_leaves_cover_every_primitive_once() {
 #[test]
 #[ignore]
 fn accel_throughput() {
-    let n = 200_000;
+    // RPBRT_BENCH_N sets the triangle count (default 200 000).
+    let n = std::env::var("RPBRT_BENCH_N")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(200_000);
     let tris = random_tris(19, n, 0.01);
     let bounds: Vec<Bounds3f> = tris.iter().map(tri_bounds).collect();
     let rays = random_rays(20, 1_000_000);
@@ -579,11 +583,19 @@ fn accel_throughput() {
                 a.intersect_p(r, *t, |p, r, t| tri_hit(&tris[p as usize], r, t).is_some()) as usize;
         }
         let secs_p = t0.elapsed().as_secs_f64();
+        let mut tests = 0usize;
+        for (r, t) in rays.iter().take(10000) {
+            a.intersect(r, *t, |p, r, t| {
+                tests += 1;
+                tri_hit(&tris[p as usize], r, t)
+            });
+        }
         println!(
-            "{name:10} build {build:6.3} s  {:5.2} Mrays/s closest  {:5.2} Mrays/s any  {hits} hits {occl} occluded  {:.1} B/prim",
+            "{name:10} build {build:6.3} s  {:5.2} Mrays/s closest  {:5.2} Mrays/s any  {hits} hits {occl} occluded  {:.1} B/prim  {:.1} tests/ray",
             rays.len() as f64 / secs / 1e6,
             rays.len() as f64 / secs_p / 1e6,
-            a.memory_bytes() as f64 / n as f64
+            a.memory_bytes() as f64 / n as f64,
+            tests as f64 / 10000.0
         );
     }
 }
