@@ -1,6 +1,7 @@
 //! rpbrt's renderer: shapes, accelerators, scene building and integrators.
 #![deny(missing_docs)]
 
+pub mod accel;
 pub mod rng;
 pub mod sampling;
 pub mod scene;
