@@ -1,0 +1,254 @@
+//! Primitives (pbrt-v4 `primitive.h/.cpp`; book section 7.1): shapes bound
+//! to their material, area light, media and alpha mask; object instances
+//! placed by a fixed or animated transformation; and aggregates that put an
+//! acceleration structure over a set of primitives.
+
+use crate::accel::{AccelParams, Accelerator, Aggregate};
+use crate::shape::{Shape, ShapeMethods};
+use rpbrt_geometry::animated::AnimatedTransform;
+use rpbrt_geometry::float::Float;
+use rpbrt_geometry::interaction::SurfaceInteraction;
+use rpbrt_geometry::ray::{MediumId, Ray};
+use rpbrt_geometry::transform::Transform;
+use rpbrt_geometry::tuple::*;
+use rpbrt_geometry::Bounds3f;
+use std::sync::Arc;
+
+/// The media on the two sides of a surface (pbrt-v4 `MediumInterface`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MediumInterface {
+    /// The medium on the side the normal points away from.
+    pub inside: Option<MediumId>,
+    /// The medium on the side the normal points to.
+    pub outside: Option<MediumId>,
+}
+
+impl MediumInterface {
+    /// True when both sides have the same medium.
+    #[inline]
+    pub fn is_transition(&self) -> bool {
+        self.inside != self.outside
+    }
+}
+
+/// How a primitive's alpha mask cuts it out. pbrt-v4 tests alpha
+/// stochastically: a hit with alpha `a` is kept with probability `a`,
+/// decided by a hash of the ray so that the result is deterministic.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Alpha {
+    /// Fully opaque.
+    Opaque,
+    /// A constant alpha in (0, 1); zero alpha primitives are never built.
+    Constant(Float),
+}
+
+/// What a ray hit: the surface geometry plus the primitive's properties.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PrimitiveIntersection {
+    /// The surface interaction, in rendering space.
+    pub si: SurfaceInteraction,
+    /// The ray parameter of the hit.
+    pub t_hit: Float,
+    /// The material index (`None`: an interface between media, no surface).
+    pub material: Option<u32>,
+    /// The area light index, if the surface emits.
+    pub area_light: Option<u32>,
+    /// The media on both sides, when the primitive separates media; `None`
+    /// means the ray's medium continues on both sides.
+    pub medium_interface: Option<MediumInterface>,
+}
+
+/// A shape with its material, area light, media and alpha.
+#[derive(Clone, Debug)]
+pub struct GeometricPrimitive {
+    /// The shape.
+    pub shape: Shape,
+    /// Material index (`None`: interface).
+    pub material: Option<u32>,
+    /// Area light index.
+    pub area_light: Option<u32>,
+    /// Media on either side.
+    pub medium_interface: Option<MediumInterface>,
+    /// Alpha mask.
+    pub alpha: Alpha,
+}
+
+/// A deterministic uniform value in [0, 1) from a ray, for the stochastic
+/// alpha test (pbrt-v4 hashes the ray's origin and direction).
+#[inline]
+fn hash_float_ray(r: &Ray) -> Float {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for v in [r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z] {
+        h ^= v.to_bits() as u64;
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    let h = crate::rng::mix_bits(h);
+    ((h >> 40) as Float) / (1u64 << 24) as Float
+}
+
+impl GeometricPrimitive {
+    /// Keeps a hit or lets the ray pass according to the alpha mask.
+    #[inline]
+    fn alpha_passes(&self, ray: &Ray) -> bool {
+        match self.alpha {
+            Alpha::Opaque => true,
+            Alpha::Constant(a) => a >= 1.0 || (a > 0.0 && hash_float_ray(ray) <= a),
+        }
+    }
+
+    /// The closest hit in (0, t_max).
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
+        let isect = self.shape.intersect(ray, t_max)?;
+        if !self.alpha_passes(ray) {
+            return None;
+        }
+        Some(PrimitiveIntersection {
+            si: isect.intr,
+            t_hit: isect.t_hit,
+            material: self.material,
+            area_light: self.area_light,
+            medium_interface: self.medium_interface,
+        })
+    }
+
+    /// Whether anything is hit in (0, t_max).
+    #[inline]
+    pub fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
+        match self.alpha {
+            Alpha::Opaque => self.shape.intersect_p(ray, t_max),
+            _ => self.intersect(ray, t_max).is_some(),
+        }
+    }
+}
+
+/// An object instance: a shared aggregate placed by a fixed transformation.
+#[derive(Clone, Debug)]
+pub struct TransformedPrimitive {
+    /// The instanced aggregate, in its own space.
+    pub primitive: Arc<PrimitiveAggregate>,
+    /// From the instance's space to rendering space.
+    pub render_from_primitive: Transform,
+}
+
+/// Primitives whose transformation changes over the shutter interval.
+#[derive(Clone, Debug)]
+pub struct AnimatedPrimitive {
+    /// The animated aggregate, in its own space.
+    pub primitive: Arc<PrimitiveAggregate>,
+    /// From the primitive's space to rendering space, over time.
+    pub render_from_primitive: AnimatedTransform,
+}
+
+fn transform_hit(mut pi: PrimitiveIntersection, render_from_primitive: &Transform) -> PrimitiveIntersection {
+    pi.si = pi.si.transform(render_from_primitive);
+    pi
+}
+
+/// The closed set of primitives.
+#[derive(Clone, Debug)]
+pub enum Primitive {
+    /// A shape with its properties.
+    Geometric(GeometricPrimitive),
+    /// An object instance.
+    Transformed(TransformedPrimitive),
+    /// Motion-blurred primitives.
+    Animated(AnimatedPrimitive),
+}
+
+impl Primitive {
+    /// Bounds in rendering space (over the whole shutter for animated ones).
+    pub fn bounds(&self) -> Bounds3f {
+        match self {
+            Primitive::Geometric(p) => p.shape.bounds(),
+            Primitive::Transformed(p) => p.render_from_primitive.apply_bounds(&p.primitive.bounds()),
+            Primitive::Animated(p) => p.render_from_primitive.motion_bounds(&p.primitive.bounds()),
+        }
+    }
+
+    /// The closest hit in (0, t_max).
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
+        match self {
+            Primitive::Geometric(p) => p.intersect(ray, t_max),
+            Primitive::Transformed(p) => {
+                let (r, t) = p.render_from_primitive.apply_inverse_ray(ray, t_max);
+                let pi = p.primitive.intersect(&r, t)?;
+                Some(transform_hit(pi, &p.render_from_primitive))
+            }
+            Primitive::Animated(p) => {
+                let xf = p.render_from_primitive.interpolate(ray.time);
+                let (r, t) = xf.apply_inverse_ray(ray, t_max);
+                let pi = p.primitive.intersect(&r, t)?;
+                Some(transform_hit(pi, &xf))
+            }
+        }
+    }
+
+    /// Whether anything is hit in (0, t_max).
+    #[inline]
+    pub fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
+        match self {
+            Primitive::Geometric(p) => p.intersect_p(ray, t_max),
+            Primitive::Transformed(p) => {
+                let (r, t) = p.render_from_primitive.apply_inverse_ray(ray, t_max);
+                p.primitive.intersect_p(&r, t)
+            }
+            Primitive::Animated(p) => {
+                let (r, t) = p.render_from_primitive.interpolate(ray.time).apply_inverse_ray(ray, t_max);
+                p.primitive.intersect_p(&r, t)
+            }
+        }
+    }
+}
+
+/// Primitives under an acceleration structure (pbrt-v4's aggregates).
+#[derive(Clone, Debug)]
+pub struct PrimitiveAggregate {
+    prims: Vec<Primitive>,
+    accel: Accelerator,
+}
+
+impl PrimitiveAggregate {
+    /// Builds the structure chosen by `params` over `prims`.
+    pub fn new(prims: Vec<Primitive>, params: &AccelParams) -> Self {
+        let bounds: Vec<Bounds3f> = prims.iter().map(Primitive::bounds).collect();
+        let accel = Accelerator::build(&bounds, params);
+        PrimitiveAggregate { prims, accel }
+    }
+
+    /// The primitives.
+    pub fn primitives(&self) -> &[Primitive] {
+        &self.prims
+    }
+
+    /// The acceleration structure.
+    pub fn accelerator(&self) -> &Accelerator {
+        &self.accel
+    }
+
+    /// Bounds of everything.
+    pub fn bounds(&self) -> Bounds3f {
+        self.accel.bounds()
+    }
+
+    /// The closest hit in (0, t_max).
+    pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
+        let mut best: Option<PrimitiveIntersection> = None;
+        self.accel.intersect(ray, t_max, |i, r, t| {
+            let pi = self.prims[i as usize].intersect(r, t)?;
+            let th = pi.t_hit;
+            best = Some(pi);
+            Some(th)
+        });
+        best
+    }
+
+    /// Whether anything is hit in (0, t_max).
+    pub fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
+        self.accel.intersect_p(ray, t_max, |i, r, t| self.prims[i as usize].intersect_p(r, t))
+    }
+}
+
+#[cfg(test)]
+mod tests;
