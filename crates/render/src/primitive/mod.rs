@@ -10,7 +10,6 @@ use rpbrt_geometry::float::Float;
 use rpbrt_geometry::interaction::SurfaceInteraction;
 use rpbrt_geometry::ray::{MediumId, Ray};
 use rpbrt_geometry::transform::Transform;
-use rpbrt_geometry::tuple::*;
 use rpbrt_geometry::Bounds3f;
 use std::sync::Arc;
 
@@ -140,7 +139,10 @@ pub struct AnimatedPrimitive {
     pub render_from_primitive: AnimatedTransform,
 }
 
-fn transform_hit(mut pi: PrimitiveIntersection, render_from_primitive: &Transform) -> PrimitiveIntersection {
+fn transform_hit(
+    mut pi: PrimitiveIntersection,
+    render_from_primitive: &Transform,
+) -> PrimitiveIntersection {
     pi.si = pi.si.transform(render_from_primitive);
     pi
 }
@@ -161,7 +163,9 @@ impl Primitive {
     pub fn bounds(&self) -> Bounds3f {
         match self {
             Primitive::Geometric(p) => p.shape.bounds(),
-            Primitive::Transformed(p) => p.render_from_primitive.apply_bounds(&p.primitive.bounds()),
+            Primitive::Transformed(p) => {
+                p.render_from_primitive.apply_bounds(&p.primitive.bounds())
+            }
             Primitive::Animated(p) => p.render_from_primitive.motion_bounds(&p.primitive.bounds()),
         }
     }
@@ -195,7 +199,10 @@ impl Primitive {
                 p.primitive.intersect_p(&r, t)
             }
             Primitive::Animated(p) => {
-                let (r, t) = p.render_from_primitive.interpolate(ray.time).apply_inverse_ray(ray, t_max);
+                let (r, t) = p
+                    .render_from_primitive
+                    .interpolate(ray.time)
+                    .apply_inverse_ray(ray, t_max);
                 p.primitive.intersect_p(&r, t)
             }
         }
@@ -246,7 +253,9 @@ impl PrimitiveAggregate {
 
     /// Whether anything is hit in (0, t_max).
     pub fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
-        self.accel.intersect_p(ray, t_max, |i, r, t| self.prims[i as usize].intersect_p(r, t))
+        self.accel.intersect_p(ray, t_max, |i, r, t| {
+            self.prims[i as usize].intersect_p(r, t)
+        })
     }
 }
 

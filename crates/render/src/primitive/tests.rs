@@ -4,36 +4,76 @@ use crate::shape::{triangle, Sphere, TriangleMesh};
 
 fn sphere_prim(xf: Transform, r: Float) -> Primitive {
     let s = Sphere::new(xf, false, r, -r, r, 360.0).unwrap();
-    Primitive::Geometric(GeometricPrimitive { shape: Shape::Sphere(Box::new(s)), material: Some(0), area_light: None, medium_interface: None, alpha: Alpha::Opaque })
+    Primitive::Geometric(GeometricPrimitive {
+        shape: Shape::Sphere(Box::new(s)),
+        material: Some(0),
+        area_light: None,
+        medium_interface: None,
+        alpha: Alpha::Opaque,
+    })
 }
 
 fn random_triangles(rng: &mut Rng, n: usize, xf: &Transform) -> Vec<Primitive> {
     let mut p = Vec::new();
     for _ in 0..n * 3 {
-        p.push(Point3f::new(rng.uniform_float() * 4.0 - 2.0, rng.uniform_float() * 4.0 - 2.0, rng.uniform_float() * 4.0 - 2.0));
+        p.push(Point3f::new(
+            rng.uniform_float() * 4.0 - 2.0,
+            rng.uniform_float() * 4.0 - 2.0,
+            rng.uniform_float() * 4.0 - 2.0,
+        ));
     }
     let idx: Vec<u32> = (0..(n * 3) as u32).collect();
     let (mesh, _) = TriangleMesh::new(xf, false, idx, p, vec![], vec![], vec![], vec![]).unwrap();
     triangle::triangles(&mesh)
         .into_iter()
-        .map(|t| Primitive::Geometric(GeometricPrimitive { shape: Shape::Triangle(t), material: Some(1), area_light: None, medium_interface: None, alpha: Alpha::Opaque }))
+        .map(|t| {
+            Primitive::Geometric(GeometricPrimitive {
+                shape: Shape::Triangle(t),
+                material: Some(1),
+                area_light: None,
+                medium_interface: None,
+                alpha: Alpha::Opaque,
+            })
+        })
         .collect()
 }
 
 fn random_ray(rng: &mut Rng) -> Ray {
-    let o = Point3f::new(rng.uniform_float() * 20.0 - 10.0, rng.uniform_float() * 20.0 - 10.0, -12.0);
-    let target = Point3f::new(rng.uniform_float() * 6.0 - 3.0, rng.uniform_float() * 6.0 - 3.0, rng.uniform_float() * 6.0 - 3.0);
+    let o = Point3f::new(
+        rng.uniform_float() * 20.0 - 10.0,
+        rng.uniform_float() * 20.0 - 10.0,
+        -12.0,
+    );
+    let target = Point3f::new(
+        rng.uniform_float() * 6.0 - 3.0,
+        rng.uniform_float() * 6.0 - 3.0,
+        rng.uniform_float() * 6.0 - 3.0,
+    );
     Ray::with_time(o, target - o, rng.uniform_float(), None)
 }
 
 #[test]
 fn instances_match_direct_geometry() {
-    let xf = Transform::translate(Vector3f::new(0.5, -0.3, 1.0)) * Transform::rotate(35.0, Vector3f::new(1.0, 2.0, 0.5)) * Transform::scale(1.2, 0.8, 1.0);
+    let xf = Transform::translate(Vector3f::new(0.5, -0.3, 1.0))
+        * Transform::rotate(35.0, Vector3f::new(1.0, 2.0, 0.5))
+        * Transform::scale(1.2, 0.8, 1.0);
     let mut rng = Rng::new(1, 0);
-    let direct = PrimitiveAggregate::new(random_triangles(&mut rng, 200, &xf), &AccelParams::default());
+    let direct = PrimitiveAggregate::new(
+        random_triangles(&mut rng, 200, &xf),
+        &AccelParams::default(),
+    );
     let mut rng = Rng::new(1, 0);
-    let inner = Arc::new(PrimitiveAggregate::new(random_triangles(&mut rng, 200, &Transform::identity()), &AccelParams::default()));
-    let inst = PrimitiveAggregate::new(vec![Primitive::Transformed(TransformedPrimitive { primitive: inner, render_from_primitive: xf })], &AccelParams::default());
+    let inner = Arc::new(PrimitiveAggregate::new(
+        random_triangles(&mut rng, 200, &Transform::identity()),
+        &AccelParams::default(),
+    ));
+    let inst = PrimitiveAggregate::new(
+        vec![Primitive::Transformed(TransformedPrimitive {
+            primitive: inner,
+            render_from_primitive: xf,
+        })],
+        &AccelParams::default(),
+    );
     let mut rng = Rng::new(2, 0);
     let mut hits = 0;
     for _ in 0..3000 {
@@ -41,10 +81,18 @@ fn instances_match_direct_geometry() {
         let a = direct.intersect(&r, Float::INFINITY);
         let b = inst.intersect(&r, Float::INFINITY);
         assert_eq!(a.is_some(), b.is_some());
-        assert_eq!(direct.intersect_p(&r, Float::INFINITY), inst.intersect_p(&r, Float::INFINITY));
+        assert_eq!(
+            direct.intersect_p(&r, Float::INFINITY),
+            inst.intersect_p(&r, Float::INFINITY)
+        );
         if let (Some(a), Some(b)) = (a, b) {
             hits += 1;
-            assert!((a.t_hit - b.t_hit).abs() < 1e-3 * a.t_hit.max(1.0), "{} {}", a.t_hit, b.t_hit);
+            assert!(
+                (a.t_hit - b.t_hit).abs() < 1e-3 * a.t_hit.max(1.0),
+                "{} {}",
+                a.t_hit,
+                b.t_hit
+            );
             assert!((a.si.p() - b.si.p()).length() < 1e-3);
             assert!(dot(a.si.n, b.si.n) > 0.999);
             assert_eq!(b.material, Some(1));
@@ -58,18 +106,39 @@ fn animated_primitive_follows_its_motion() {
     let start = Transform::translate(Vector3f::new(-2.0, 0.0, 0.0));
     let end = Transform::translate(Vector3f::new(2.0, 0.0, 0.0));
     let at = AnimatedTransform::new(start, 0.0, end, 1.0);
-    let inner = Arc::new(PrimitiveAggregate::new(vec![sphere_prim(Transform::identity(), 0.5)], &AccelParams::default()));
-    let agg = PrimitiveAggregate::new(vec![Primitive::Animated(AnimatedPrimitive { primitive: inner, render_from_primitive: at })], &AccelParams::default());
+    let inner = Arc::new(PrimitiveAggregate::new(
+        vec![sphere_prim(Transform::identity(), 0.5)],
+        &AccelParams::default(),
+    ));
+    let agg = PrimitiveAggregate::new(
+        vec![Primitive::Animated(AnimatedPrimitive {
+            primitive: inner,
+            render_from_primitive: at,
+        })],
+        &AccelParams::default(),
+    );
     // The bounds cover the whole motion.
     let b = agg.bounds();
     assert!(b.p_min.x <= -2.5 && b.p_max.x >= 2.5);
     for (time, x) in [(0.0, -2.0), (0.25, -1.0), (0.5, 0.0), (1.0, 2.0)] {
-        let r = Ray::with_time(Point3f::new(x, 0.0, -10.0), Vector3f::new(0.0, 0.0, 1.0), time, None);
-        let hit = agg.intersect(&r, Float::INFINITY).expect("moving sphere hit");
+        let r = Ray::with_time(
+            Point3f::new(x, 0.0, -10.0),
+            Vector3f::new(0.0, 0.0, 1.0),
+            time,
+            None,
+        );
+        let hit = agg
+            .intersect(&r, Float::INFINITY)
+            .expect("moving sphere hit");
         assert!((hit.t_hit - 9.5).abs() < 1e-3, "t={time}: {}", hit.t_hit);
         assert!((hit.si.p().x - x).abs() < 1e-3);
         // At the same time, a ray through where the sphere is not misses.
-        let miss = Ray::with_time(Point3f::new(x + 1.0, 0.0, -10.0), Vector3f::new(0.0, 0.0, 1.0), time, None);
+        let miss = Ray::with_time(
+            Point3f::new(x + 1.0, 0.0, -10.0),
+            Vector3f::new(0.0, 0.0, 1.0),
+            time,
+            None,
+        );
         assert!(agg.intersect(&miss, Float::INFINITY).is_none());
         assert!(!agg.intersect_p(&miss, Float::INFINITY));
     }
@@ -78,12 +147,22 @@ fn animated_primitive_follows_its_motion() {
 #[test]
 fn constant_alpha_is_stochastic_and_deterministic() {
     let s = Sphere::new(Transform::identity(), false, 1.0, -1.0, 1.0, 360.0).unwrap();
-    let prim = GeometricPrimitive { shape: Shape::Sphere(Box::new(s)), material: Some(0), area_light: None, medium_interface: None, alpha: Alpha::Constant(0.3) };
+    let prim = GeometricPrimitive {
+        shape: Shape::Sphere(Box::new(s)),
+        material: Some(0),
+        area_light: None,
+        medium_interface: None,
+        alpha: Alpha::Constant(0.3),
+    };
     let mut rng = Rng::new(5, 0);
     let mut kept = 0;
     let n = 20000;
     for _ in 0..n {
-        let o = Point3f::new(rng.uniform_float() * 0.2 - 0.1, rng.uniform_float() * 0.2 - 0.1, -5.0);
+        let o = Point3f::new(
+            rng.uniform_float() * 0.2 - 0.1,
+            rng.uniform_float() * 0.2 - 0.1,
+            -5.0,
+        );
         let r = Ray::new(o, Vector3f::new(0.0, 0.0, 1.0));
         let a = prim.intersect(&r, Float::INFINITY).is_some();
         assert_eq!(a, prim.intersect(&r, Float::INFINITY).is_some());

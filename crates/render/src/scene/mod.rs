@@ -75,3 +75,18 @@ pub fn build_scene_from_str(
     );
     finish(builder, result)
 }
+
+/// Builds the description of scene bytes held in memory as if they were
+/// the file `name` in directory `dir` (against which `Include`, `Import`
+/// and file parameters resolve).
+pub fn build_scene_from_bytes(
+    name: &str,
+    bytes: &[u8],
+    dir: &Path,
+    options: &BuildOptions,
+) -> Result<(SceneDescription, Diagnostics), Diagnostics> {
+    let mut builder = SceneBuilder::new(options.render_coord_sys);
+    let result =
+        Parser::new(options.parse.clone()).parse_bytes(name, Arc::from(bytes), dir, &mut builder);
+    finish(builder, result)
+}

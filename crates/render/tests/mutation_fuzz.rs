@@ -1,0 +1,186 @@
+//! A stable, seeded mutation fuzzer over the shared pbrt-v4 scenes (the
+//! issue allows this in place of `cargo fuzz`, which needs nightly): each
+//! scene file is mutated at the byte and token level and pushed through the
+//! whole front end (tokenizer, parser, scene builder, shape creation). The
+//! only requirement is that nothing panics or hangs: every outcome must be
+//! a scene or located diagnostics.
+//!
+//! Without `../shared` the test mutates a built-in scene only. The number
+//! of mutations per scene is `RPBRT_FUZZ_ITERS` (default 150).
+//! Crashes it ever finds are kept below as regression tests.
+
+use rpbrt_render::rng::Rng;
+use rpbrt_render::scene::shapes::create_scene_shapes;
+use rpbrt_render::scene::{build_scene_from_bytes, BuildOptions};
+use std::path::{Path, PathBuf};
+
+const BUILTIN: &str = r#"LookAt 0 0 -5  0 0 0  0 1 0
+Camera "perspective" "float fov" 45
+Film "rgb" "integer xresolution" 64 "integer yresolution" 64
+Sampler "zsobol" "integer pixelsamples" 4
+WorldBegin
+LightSource "point" "rgb I" [ 1 1 1 ]
+AttributeBegin
+  Material "diffuse" "rgb reflectance" [ 0.5 0.5 0.5 ]
+  Shape "sphere" "float radius" 1
+AttributeEnd
+AttributeBegin
+  Translate 0 -1 0
+  Shape "trianglemesh" "point3 P" [ -5 0 -5 5 0 -5 5 0 5 -5 0 5 ] "integer indices" [ 0 1 2 0 2 3 ]
+  Shape "bilinearmesh" "point3 P" [ 0 0 0 1 0 0 0 1 0 1 1 1 ]
+  Shape "curve" "point3 P" [ 0 0 0 1 1 0 2 -1 0 3 0 0 ] "float width" 0.1
+  Shape "loopsubdiv" "integer levels" 2 "point3 P" [ 0 0 0 1 0 0 0 1 0 0 0 1 ] "integer indices" [ 0 2 1 0 1 3 0 3 2 1 2 3 ]
+  Shape "disk" "float radius" 2
+  Shape "cylinder" "float zmax" 2
+ObjectBegin "thing"
+  Shape "sphere" "float radius" 0.3
+ObjectEnd
+ObjectInstance "thing"
+AttributeEnd
+"#;
+
+const TOKENS: &[&str] = &[
+    "AttributeBegin",
+    "AttributeEnd",
+    "Shape",
+    "\"sphere\"",
+    "[",
+    "]",
+    "\"float radius\"",
+    "-1e38",
+    "1e400",
+    "nan",
+    "\"integer indices\"",
+    "\"point3 P\"",
+    "ObjectBegin",
+    "ObjectInstance",
+    "\"x\"",
+    "Include",
+    "\"",
+    "#",
+    "WorldBegin",
+    "Transform",
+    "TransformBegin",
+    "ActiveTransform",
+    "EndTime",
+    "2147483647",
+    "-2147483648",
+    "0",
+];
+
+fn mutate(src: &[u8], rng: &mut Rng) -> Vec<u8> {
+    let mut v = src.to_vec();
+    let n = 1 + rng.uniform_bounded(4);
+    for _ in 0..n {
+        if v.is_empty() {
+            v.extend_from_slice(b"Shape");
+        }
+        let pos = rng.uniform_bounded(v.len() as u32) as usize;
+        match rng.uniform_bounded(6) {
+            0 => v[pos] = rng.uniform_u32() as u8,
+            1 => {
+                v.remove(pos);
+            }
+            2 => {
+                let t = TOKENS[rng.uniform_bounded(TOKENS.len() as u32) as usize];
+                let ins: Vec<u8> = format!(" {t} ").into_bytes();
+                v.splice(pos..pos, ins);
+            }
+            3 => v.truncate(pos),
+            4 => {
+                // Duplicate a chunk.
+                let end = (pos + 1 + rng.uniform_bounded(200) as usize).min(v.len());
+                let chunk = v[pos..end].to_vec();
+                let at = rng.uniform_bounded(v.len() as u32) as usize;
+                v.splice(at..at, chunk);
+            }
+            _ => {
+                // Delete a chunk.
+                let end = (pos + 1 + rng.uniform_bounded(200) as usize).min(v.len());
+                v.drain(pos..end);
+            }
+        }
+    }
+    v
+}
+
+fn run_one(name: &str, bytes: &[u8], dir: &Path) {
+    let opts = BuildOptions::default();
+    if let Ok((desc, _)) = build_scene_from_bytes(name, bytes, dir, &opts) {
+        // Skip shape creation for scenes whose meshes are huge (killeroos):
+        // the parse is the point there, and creating them each time is slow.
+        if desc.shapes.len() < 2000 {
+            let _ = create_scene_shapes(&desc);
+        }
+    }
+}
+
+fn scenes() -> Vec<(String, Vec<u8>, PathBuf)> {
+    let mut out = vec![(
+        "<builtin>".to_string(),
+        BUILTIN.as_bytes().to_vec(),
+        PathBuf::from("."),
+    )];
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
+    if let Ok(dirs) = std::fs::read_dir(&root) {
+        let mut files: Vec<PathBuf> = dirs
+            .flatten()
+            .filter(|d| d.path().is_dir())
+            .flat_map(|d| {
+                std::fs::read_dir(d.path())
+                    .into_iter()
+                    .flatten()
+                    .flatten()
+                    .map(|e| e.path())
+            })
+            .filter(|p| p.extension().is_some_and(|e| e == "pbrt"))
+            .filter(|p| {
+                std::fs::metadata(p)
+                    .map(|m| m.len() < 1 << 20)
+                    .unwrap_or(false)
+            })
+            .collect();
+        files.sort();
+        for f in files {
+            if let Ok(b) = std::fs::read(&f) {
+                let dir = f.parent().map(Path::to_path_buf).unwrap_or_default();
+                out.push((f.display().to_string(), b, dir));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn mutated_scenes_never_panic() {
+    let iters: u32 = std::env::var("RPBRT_FUZZ_ITERS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(150);
+    for (k, (name, bytes, dir)) in scenes().into_iter().enumerate() {
+        let mut rng = Rng::new(0x5eed + k as u64, 0);
+        for _ in 0..iters {
+            let m = mutate(&bytes, &mut rng);
+            run_one(&name, &m, &dir);
+        }
+    }
+}
+
+/// Inputs that once crashed or hung the front end.
+#[test]
+fn fuzz_regressions() {
+    let cases: &[&str] = &[
+        // Deep nesting must not overflow the stack.
+        &"AttributeBegin\n".repeat(100_000),
+        // A film of 2e9 x 2e9 pixels and negative sample counts parse; the
+        // renderer rejects them when it creates the film and sampler.
+        "Film \"rgb\" \"integer xresolution\" 2000000000 \"integer yresolution\" 2000000000\nSampler \"halton\" \"integer pixelsamples\" -5\nWorldBegin\n",
+        // Absurd numbers in shapes.
+        "WorldBegin\nShape \"sphere\" \"float radius\" 1e38 \"float zmin\" -1e38\nShape \"loopsubdiv\" \"integer levels\" 2147483647 \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 2]\n",
+        "WorldBegin\nShape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3] \"integer splitdepth\" 2147483647\n",
+        "WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 -7]\n",
+    ];
+    for c in cases {
+        run_one("<regression>", c.as_bytes(), Path::new("."));
+    }
+}
