@@ -1,4 +1,5 @@
 use super::*;
+use rpbrt_geometry::tuple::*;
 use crate::rng::Rng;
 use crate::shape::{triangle, Sphere, TriangleMesh};
 
