@@ -27,3 +27,18 @@ pub use ray::{offset_ray_origin, spawn_ray, spawn_ray_to, MediumId, Ray, RayDiff
 pub use spherical::*;
 pub use transform::{SquareMatrix4, Transform, TransformError};
 pub use tuple::*;
+
+/// A uniform-sphere warp, exposed only for the crate's integration tests
+/// (the renderer's sampling module has the real one).
+#[doc(hidden)]
+pub mod sampling_for_tests {
+    use crate::float::*;
+    use crate::tuple::*;
+    /// Uniform direction on the unit sphere.
+    pub fn uniform_sphere(u: Point2f) -> Vector3f {
+        let z = 1.0 - 2.0 * u.x;
+        let r = safe_sqrt(1.0 - z * z);
+        let phi = 2.0 * PI * u.y;
+        Vector3f::new(r * phi.cos(), r * phi.sin(), z)
+    }
+}

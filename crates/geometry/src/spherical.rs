@@ -174,6 +174,26 @@ pub fn wrap_equal_area_square(mut p: Point2i, resolution: Point2i) -> Point2i {
     p
 }
 
+/// Wraps a point outside [0,1]² back into the equal-area octahedral square,
+/// so that points just across an edge map to nearby directions.
+pub fn wrap_equal_area_square_f(mut uv: Point2f) -> Point2f {
+    if uv.x < 0.0 {
+        uv.x = -uv.x;
+        uv.y = 1.0 - uv.y;
+    } else if uv.x > 1.0 {
+        uv.x = 2.0 - uv.x;
+        uv.y = 1.0 - uv.y;
+    }
+    if uv.y < 0.0 {
+        uv.x = 1.0 - uv.x;
+        uv.y = -uv.y;
+    } else if uv.y > 1.0 {
+        uv.x = 1.0 - uv.x;
+        uv.y = 2.0 - uv.y;
+    }
+    uv
+}
+
 /// A unit vector stored in 32 bits (octahedral encoding, 16 bits a
 /// coordinate; book section 3.8.3).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -272,6 +292,25 @@ impl DirectionCone {
     #[inline]
     pub fn inside(&self, w: Vector3f) -> bool {
         !self.is_empty() && dot(self.w, w.normalize()) >= self.cos_theta
+    }
+
+    /// The direction inside the cone closest to `wp` (`wp` itself when it is
+    /// inside): `w` rotated toward `wp` by the cone's half-angle.
+    pub fn closest_vector_in_cone(&self, wp: Vector3f) -> Vector3f {
+        let wp = wp.normalize();
+        if dot(wp, self.w) > self.cos_theta {
+            return wp;
+        }
+        let perp = wp - self.w * dot(wp, self.w);
+        let sin_theta = safe_sqrt(1.0 - self.cos_theta * self.cos_theta);
+        match perp.try_normalize() {
+            Some(u) => self.w * self.cos_theta + u * sin_theta,
+            // wp is exactly opposite w: any boundary direction is closest.
+            None => {
+                let (u, _) = self.w.coordinate_system();
+                self.w * self.cos_theta + u * sin_theta
+            }
+        }
     }
 
     /// The cone of directions from points `p` toward the box `b`.

@@ -1038,6 +1038,72 @@ impl Add for Vector3fi {
     }
 }
 
+impl Vector3fi {
+    /// The interval dot product.
+    pub fn dot(self, o: Vector3fi) -> Interval {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+    /// The interval cross product.
+    pub fn cross(self, o: Vector3fi) -> Vector3fi {
+        Vector3fi::new(
+            self.y * o.z - self.z * o.y,
+            self.z * o.x - self.x * o.z,
+            self.x * o.y - self.y * o.x,
+        )
+    }
+}
+
+impl Point3fi {
+    /// Interval squared distance between two points.
+    pub fn distance_squared(self, o: Point3fi) -> Interval {
+        let d = self - o;
+        d.x.sqr() + d.y.sqr() + d.z.sqr()
+    }
+    /// Interval distance between two points.
+    pub fn distance(self, o: Point3fi) -> Interval {
+        self.distance_squared(o).sqrt()
+    }
+}
+
+/// The parametric coordinates (u, v) of `p` in the bilinear patch with
+/// corners `v = [v00, v10, v01, v11]` (so that `p = lerp(u, lerp(v, v00,
+/// v01), lerp(v, v10, v11))`), by Newton's method from the centre.
+pub fn invert_bilinear(p: Point2f, v: [Point2f; 4]) -> Point2f {
+    let mut u = 0.5f64;
+    let mut w = 0.5f64;
+    let c = |q: Point2f| (q.x as f64, q.y as f64);
+    let (p00, p10, p01, p11) = (c(v[0]), c(v[1]), c(v[2]), c(v[3]));
+    let (px, py) = c(p);
+    for _ in 0..32 {
+        let fx = (1.0 - u) * (1.0 - w) * p00.0
+            + u * (1.0 - w) * p10.0
+            + (1.0 - u) * w * p01.0
+            + u * w * p11.0
+            - px;
+        let fy = (1.0 - u) * (1.0 - w) * p00.1
+            + u * (1.0 - w) * p10.1
+            + (1.0 - u) * w * p01.1
+            + u * w * p11.1
+            - py;
+        let dxu = (1.0 - w) * (p10.0 - p00.0) + w * (p11.0 - p01.0);
+        let dyu = (1.0 - w) * (p10.1 - p00.1) + w * (p11.1 - p01.1);
+        let dxw = (1.0 - u) * (p01.0 - p00.0) + u * (p11.0 - p10.0);
+        let dyw = (1.0 - u) * (p01.1 - p00.1) + u * (p11.1 - p10.1);
+        let det = dxu * dyw - dxw * dyu;
+        if det == 0.0 || !det.is_finite() {
+            break;
+        }
+        let du = (fx * dyw - fy * dxw) / det;
+        let dw = (fy * dxu - fx * dyu) / det;
+        u -= du;
+        w -= dw;
+        if du.abs() < 1e-12 && dw.abs() < 1e-12 {
+            break;
+        }
+    }
+    Point2f::new(u as Float, w as Float)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

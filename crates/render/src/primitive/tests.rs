@@ -1,7 +1,7 @@
 use super::*;
-use rpbrt_geometry::tuple::*;
 use crate::rng::Rng;
 use crate::shape::{triangle, Sphere, TriangleMesh};
+use rpbrt_geometry::tuple::*;
 
 fn sphere_prim(xf: Transform, r: Float) -> Primitive {
     let s = Sphere::new(xf, false, r, -r, r, 360.0).unwrap();
