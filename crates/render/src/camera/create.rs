@@ -30,7 +30,10 @@ pub struct CreatedCamera {
 
 /// Creates the camera of a `Camera` directive for `film`, in no medium,
 /// discarding warnings (see [`create_camera_with`] to keep them).
-pub fn create_camera(entity: &CameraSceneEntity, film: &FilmGeometry) -> Result<Camera, Diagnostic> {
+pub fn create_camera(
+    entity: &CameraSceneEntity,
+    film: &FilmGeometry,
+) -> Result<Camera, Diagnostic> {
     create_camera_with(entity, film, None).map(|c| c.camera)
 }
 
@@ -62,7 +65,10 @@ pub fn create_camera_with(
             format!("film resolution {}x{} is not positive", res.x, res.y),
         ));
     }
-    if !matches!(name, "perspective" | "orthographic" | "spherical" | "realistic") {
+    if !matches!(
+        name,
+        "perspective" | "orthographic" | "spherical" | "realistic"
+    ) {
         return Err(Diagnostic::error(
             loc.clone(),
             format!("\"{name}\": camera type unknown"),
@@ -135,7 +141,9 @@ pub fn create_camera_with(
                     Camera::Orthographic(c)
                 }
                 _ => {
-                    let m = params.get_one_string("mapping", "equalarea").map_err(perr)?;
+                    let m = params
+                        .get_one_string("mapping", "equalarea")
+                        .map_err(perr)?;
                     let mapping = match m.as_str() {
                         "equalarea" => SphericalMapping::EqualArea,
                         "equirectangular" => SphericalMapping::EquiRectangular,
@@ -199,7 +207,10 @@ fn screen_window(
         if sw.len() != 4 {
             return Err(Diagnostic::error(
                 at(params, "screenwindow", loc),
-                format!("\"screenwindow\" should have four values; it has {}", sw.len()),
+                format!(
+                    "\"screenwindow\" should have four values; it has {}",
+                    sw.len()
+                ),
             ));
         }
         if !(sw.iter().all(|v| v.is_finite()) && sw[0] != sw[1] && sw[2] != sw[3]) {
@@ -222,7 +233,9 @@ fn resolve(loc: &FileLoc, name: &str) -> PathBuf {
     if p.is_absolute() {
         return p.to_path_buf();
     }
-    let dir = Path::new(&*loc.file).parent().unwrap_or_else(|| Path::new("."));
+    let dir = Path::new(&*loc.file)
+        .parent()
+        .unwrap_or_else(|| Path::new("."));
     let joined = dir.join(p);
     if joined.exists() {
         joined
@@ -261,7 +274,9 @@ fn create_realistic(
     let params = &entity.base.params;
     let loc = &entity.base.loc;
     let lens_file = params.get_one_string("lensfile", "").map_err(perr)?;
-    let aperture_diameter = params.get_one_float("aperturediameter", 1.0).map_err(perr)?;
+    let aperture_diameter = params
+        .get_one_float("aperturediameter", 1.0)
+        .map_err(perr)?;
     let focus_distance = params.get_one_float("focusdistance", 10.0).map_err(perr)?;
     let aperture = params.get_one_string("aperture", "").map_err(perr)?;
 

@@ -327,7 +327,10 @@ impl Camera {
 
     /// The ray for a film sample with the rays one pixel over in x and y.
     #[inline]
-    pub fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
+    pub fn generate_ray_differential(
+        &self,
+        sample: &CameraSample,
+    ) -> Option<CameraRayDifferential> {
         match self {
             Camera::Perspective(c) => c.generate_ray_differential(sample),
             Camera::Orthographic(c) => c.generate_ray_differential(sample),

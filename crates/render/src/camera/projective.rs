@@ -89,9 +89,14 @@ impl OrthographicCamera {
         lens_radius: Float,
         focal_distance: Float,
     ) -> Result<Self, TransformError> {
-        let xf = ProjectiveTransforms::new(Transform::orthographic(0.0, 1.0)?, screen_window, &base);
-        let dx_camera = xf.camera_from_raster.apply_vector(Vector3f::new(1.0, 0.0, 0.0));
-        let dy_camera = xf.camera_from_raster.apply_vector(Vector3f::new(0.0, 1.0, 0.0));
+        let xf =
+            ProjectiveTransforms::new(Transform::orthographic(0.0, 1.0)?, screen_window, &base);
+        let dx_camera = xf
+            .camera_from_raster
+            .apply_vector(Vector3f::new(1.0, 0.0, 0.0));
+        let dy_camera = xf
+            .camera_from_raster
+            .apply_vector(Vector3f::new(0.0, 1.0, 0.0));
         base.min_dir_differential_x = Vector3f::default();
         base.min_dir_differential_y = Vector3f::default();
         base.min_pos_differential_x = dx_camera;
@@ -108,10 +113,11 @@ impl OrthographicCamera {
 
     #[inline]
     fn camera_ray(&self, sample: &CameraSample) -> (Ray, Point3f) {
-        let p_camera = self
-            .xf
-            .camera_from_raster
-            .apply_point(Point3f::new(sample.p_film.x, sample.p_film.y, 0.0));
+        let p_camera = self.xf.camera_from_raster.apply_point(Point3f::new(
+            sample.p_film.x,
+            sample.p_film.y,
+            0.0,
+        ));
         let mut ray = Ray::with_time(
             p_camera,
             Vector3f::new(0.0, 0.0, 1.0),
@@ -119,7 +125,12 @@ impl OrthographicCamera {
             self.base.medium,
         );
         if self.lens_radius > 0.0 {
-            apply_thin_lens(&mut ray, self.lens_radius, self.focal_distance, sample.p_lens);
+            apply_thin_lens(
+                &mut ray,
+                self.lens_radius,
+                self.focal_distance,
+                sample.p_lens,
+            );
         }
         (ray, p_camera)
     }
@@ -135,12 +146,19 @@ impl OrthographicCamera {
     }
 
     /// The ray through a film sample with its one-pixel neighbours.
-    pub fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
+    pub fn generate_ray_differential(
+        &self,
+        sample: &CameraSample,
+    ) -> Option<CameraRayDifferential> {
         let (ray, p_camera) = self.camera_ray(sample);
         let mut rd = RayDifferential::new(ray);
         if self.lens_radius > 0.0 {
             let p_lens = sample_uniform_disk_concentric(sample.p_lens);
-            let o = Point3f::new(self.lens_radius * p_lens.x, self.lens_radius * p_lens.y, 0.0);
+            let o = Point3f::new(
+                self.lens_radius * p_lens.x,
+                self.lens_radius * p_lens.y,
+                0.0,
+            );
             let ft = self.focal_distance; // the unperturbed direction is +z
             let z = Vector3f::new(0.0, 0.0, ft);
             rd.rx_origin = o;
@@ -219,10 +237,11 @@ impl PerspectiveCamera {
 
     #[inline]
     fn camera_ray(&self, base: &CameraBase, sample: &CameraSample) -> (Ray, Point3f) {
-        let p_camera = self
-            .xf
-            .camera_from_raster
-            .apply_point(Point3f::new(sample.p_film.x, sample.p_film.y, 0.0));
+        let p_camera = self.xf.camera_from_raster.apply_point(Point3f::new(
+            sample.p_film.x,
+            sample.p_film.y,
+            0.0,
+        ));
         let mut ray = Ray::with_time(
             Point3f::new(0.0, 0.0, 0.0),
             Vector3f::from(p_camera).normalize(),
@@ -230,7 +249,12 @@ impl PerspectiveCamera {
             base.medium,
         );
         if self.lens_radius > 0.0 {
-            apply_thin_lens(&mut ray, self.lens_radius, self.focal_distance, sample.p_lens);
+            apply_thin_lens(
+                &mut ray,
+                self.lens_radius,
+                self.focal_distance,
+                sample.p_lens,
+            );
         }
         (ray, p_camera)
     }
@@ -247,7 +271,10 @@ impl PerspectiveCamera {
 
     /// The ray through a film sample with its one-pixel neighbours.
     #[inline]
-    pub fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
+    pub fn generate_ray_differential(
+        &self,
+        sample: &CameraSample,
+    ) -> Option<CameraRayDifferential> {
         self.differential_with_base(&self.base, sample)
     }
 
@@ -261,7 +288,11 @@ impl PerspectiveCamera {
         let pc = Vector3f::from(p_camera);
         if self.lens_radius > 0.0 {
             let p_lens = sample_uniform_disk_concentric(sample.p_lens);
-            let o = Point3f::new(self.lens_radius * p_lens.x, self.lens_radius * p_lens.y, 0.0);
+            let o = Point3f::new(
+                self.lens_radius * p_lens.x,
+                self.lens_radius * p_lens.y,
+                0.0,
+            );
             let focus = |d: Vector3f| {
                 let d = d.normalize();
                 Point3f::from(d * (self.focal_distance / d.z))

@@ -7,8 +7,8 @@
 //! "lens space" flips z so the elements lie at z < 0, rear element first.
 
 use rpbrt_geometry::{
-    dot, lerp, quadratic, safe_sqrt, sqr, Bounds2f, Float, Normal3f, Point2f, Point3f, Ray, Vector3f,
-    ONE_MINUS_EPSILON, PI,
+    dot, lerp, quadratic, safe_sqrt, sqr, Bounds2f, Float, Normal3f, Point2f, Point3f, Ray,
+    Vector3f, ONE_MINUS_EPSILON, PI,
 };
 
 use super::{differential_by_offset, CameraBase, CameraRay, CameraRayDifferential, CameraSample};
@@ -212,7 +212,11 @@ fn refract(wi: Vector3f, n: Normal3f, eta: Float) -> Option<Vector3f> {
 
 /// Where a lens-space ray meets a spherical element of `radius` centred at
 /// `z_center` on the axis, with the normal facing the ray's origin.
-fn intersect_spherical_element(radius: Float, z_center: Float, ray: &Ray) -> Option<(Float, Normal3f)> {
+fn intersect_spherical_element(
+    radius: Float,
+    z_center: Float,
+    ray: &Ray,
+) -> Option<(Float, Normal3f)> {
     let o = ray.o - Vector3f::new(0.0, 0.0, z_center);
     let d = ray.d;
     let a = d.x * d.x + d.y * d.y + d.z * d.z;
@@ -285,8 +289,10 @@ impl RealisticCamera {
         let diagonal = base.film.diagonal_m;
         let x = (sqr(diagonal) / (1.0 + sqr(aspect))).sqrt();
         let y = aspect * x;
-        let physical_extent =
-            Bounds2f::new(Point2f::new(-x / 2.0, -y / 2.0), Point2f::new(x / 2.0, y / 2.0));
+        let physical_extent = Bounds2f::new(
+            Point2f::new(-x / 2.0, -y / 2.0),
+            Point2f::new(x / 2.0, y / 2.0),
+        );
 
         let mut set_aperture = aperture_diameter_mm;
         let mut elements = Vec::with_capacity(lens_params.len() / 4);
@@ -314,7 +320,9 @@ impl RealisticCamera {
                     diameter = set_aperture;
                 }
             } else if eta < 0.0 {
-                return Err(format!("lens element index of refraction {eta} is negative"));
+                return Err(format!(
+                    "lens element index of refraction {eta} is negative"
+                ));
             }
             elements.push(LensElementInterface {
                 curvature_radius,
@@ -489,9 +497,11 @@ impl RealisticCamera {
         let r_scene = match r_scene {
             Some(r) if w != 0.0 => r,
             _ => {
-                return Err("unable to trace a ray from the film to the scene for the thick \
+                return Err(
+                    "unable to trace a ray from the film to the scene for the thick \
                             lens approximation; is the aperture stop extremely small?"
-                    .to_string())
+                        .to_string(),
+                )
             }
         };
         let (pz1, fz1) = Self::cardinal_points(&r_film, &r_scene);
@@ -546,7 +556,10 @@ impl RealisticCamera {
             );
             let p2 = Point2f::new(p_rear.x, p_rear.y);
             if !pupil.inside(p2)
-                && self.trace_lenses_from_film(&Ray::new(p_film, p_rear - p_film)).0 != 0.0
+                && self
+                    .trace_lenses_from_film(&Ray::new(p_film, p_rear - p_film))
+                    .0
+                    != 0.0
             {
                 pupil = pupil.union_point(p2);
             }
@@ -624,7 +637,8 @@ impl RealisticCamera {
 
     fn ray_with_base(&self, base: &CameraBase, sample: &CameraSample) -> Option<CameraRay> {
         let p_film = self.film_point(sample.p_film);
-        let (p_pupil, pdf) = self.sample_exit_pupil(Point2f::new(p_film.x, p_film.y), sample.p_lens)?;
+        let (p_pupil, pdf) =
+            self.sample_exit_pupil(Point2f::new(p_film.x, p_film.y), sample.p_lens)?;
         let r_film = Ray::new(p_film, p_pupil - p_film);
         let (mut weight, ray) = self.trace_lenses_from_film(&r_film);
         let mut ray = ray?;
@@ -648,7 +662,10 @@ impl RealisticCamera {
     }
 
     /// The ray with its neighbours, found by offsetting the film sample.
-    pub fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
+    pub fn generate_ray_differential(
+        &self,
+        sample: &CameraSample,
+    ) -> Option<CameraRayDifferential> {
         differential_by_offset(sample, |s| self.generate_ray(s))
     }
 }

@@ -101,7 +101,10 @@ impl SphericalCamera {
     }
 
     /// The ray with its neighbours, found by offsetting the film sample.
-    pub fn generate_ray_differential(&self, sample: &CameraSample) -> Option<CameraRayDifferential> {
+    pub fn generate_ray_differential(
+        &self,
+        sample: &CameraSample,
+    ) -> Option<CameraRayDifferential> {
         differential_by_offset(sample, |s| self.generate_ray(s))
     }
 }
