@@ -307,7 +307,7 @@ fn create_realistic(
             format!("{}: the lens file holds no values", path.display()),
         ));
     }
-    if lens.len() % 4 != 0 {
+    if !lens.chunks_exact(4).remainder().is_empty() {
         return Err(Diagnostic::error(
             lens_loc,
             format!(

@@ -125,7 +125,7 @@ impl ApertureImage {
         ApertureImage::from_pixels(n, n, values)
     }
 
-    /// The bilinearly interpolated value at `uv` in [0,1]², zero outside.
+    /// The bilinearly interpolated value at `uv` in \[0,1\]², zero outside.
     pub fn bilerp(&self, uv: Point2f) -> Float {
         let x = uv.x * self.width as Float - 0.5;
         let y = uv.y * self.height as Float - 0.5;
@@ -278,7 +278,7 @@ impl RealisticCamera {
         pupil_samples: usize,
     ) -> Result<(Self, Vec<String>), String> {
         let mut warnings = Vec::new();
-        if lens_params.is_empty() || lens_params.len() % 4 != 0 {
+        if lens_params.is_empty() || !lens_params.chunks_exact(4).remainder().is_empty() {
             return Err(format!(
                 "lens description must have four values per element; got {}",
                 lens_params.len()
@@ -383,7 +383,7 @@ impl RealisticCamera {
             let is_stop = element.curvature_radius == 0.0;
             let (t, n) = if is_stop {
                 let t = (element_z - r.o.z) / r.d.z;
-                if !(t >= 0.0) {
+                if t.is_nan() || t < 0.0 {
                     return (0.0, None);
                 }
                 (t, Normal3f::default())
@@ -439,7 +439,7 @@ impl RealisticCamera {
             let is_stop = element.curvature_radius == 0.0;
             let (t, n) = if is_stop {
                 let t = (element_z - r.o.z) / r.d.z;
-                if !(t >= 0.0) {
+                if t.is_nan() || t < 0.0 {
                     return None;
                 }
                 (t, Normal3f::default())
@@ -515,7 +515,7 @@ impl RealisticCamera {
         let f = fz[0] - pz[0];
         let z = -focus_distance;
         let c = (pz[1] - z - pz[0]) * (pz[1] - z - 4.0 * f - pz[0]);
-        if !(c > 0.0) {
+        if c.is_nan() || c <= 0.0 {
             return Err(format!(
                 "focus distance {focus_distance} is too short for this lens system \
                  (thick-lens coefficient {c} is not positive)"

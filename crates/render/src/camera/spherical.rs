@@ -60,7 +60,7 @@ impl SphericalCamera {
         cam
     }
 
-    /// The camera-space direction for film position `uv` in [0,1]²
+    /// The camera-space direction for film position `uv` in \[0,1\]²
     /// (y of the mapping swapped with z, so +y is up and the equator is
     /// the xz plane).
     pub fn direction(&self, uv: Point2f) -> Vector3f {

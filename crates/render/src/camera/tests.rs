@@ -817,3 +817,26 @@ fn warnings_for_unused_parameters_and_clamped_apertures() {
         .unwrap();
     assert!((stop.aperture_radius - 0.0171 / 2.0).abs() < 1e-6);
 }
+
+/// Times the exit-pupil precomputation at pbrt-v4's sample count:
+/// `cargo test --release -p rpbrt-render --lib camera::tests::time_full -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn time_full_exit_pupil_precomputation() {
+    let lens = super::read_lens_file(std::path::Path::new(&write_temp("dgauss-time.dat", DGAUSS)))
+        .unwrap();
+    let base = CameraBase::new(
+        CameraTransform::default(),
+        0.0,
+        1.0,
+        FilmGeometry::new(64, 64),
+        None,
+    );
+    let t0 = std::time::Instant::now();
+    let (cam, _) = RealisticCamera::new(base, &lens, 10.0, 1.0, None, 1024 * 1024).unwrap();
+    eprintln!(
+        "dgauss exit pupil, 64 rings x 1024^2 samples: {:.2} s; centre bounds {:?}",
+        t0.elapsed().as_secs_f64(),
+        cam.exit_pupil_bounds[0]
+    );
+}
