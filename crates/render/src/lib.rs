@@ -2,6 +2,7 @@
 #![deny(missing_docs)]
 
 pub mod accel;
+pub mod camera;
 pub mod primitive;
 pub mod rng;
 pub mod sampling;

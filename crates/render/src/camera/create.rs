@@ -1,0 +1,365 @@
+//! Creating a [`Camera`] from the scene's `Camera` directive (pbrt-v4
+//! `Camera::Create` and the cameras' `Create` functions): parameter names
+//! and defaults as pbrt-v4, with located errors for values it cannot use.
+
+use std::path::{Path, PathBuf};
+
+use rpbrt_geometry::{Bounds2f, Float, MediumId, Point2f};
+use rpbrt_parser::{Diagnostic, FileLoc, ParamError, ParameterDictionary};
+
+use super::realistic::EXIT_PUPIL_RINGS;
+use super::{
+    ApertureImage, Camera, CameraBase, FilmGeometry, OrthographicCamera, PerspectiveCamera,
+    RealisticCamera, SphericalCamera, SphericalMapping,
+};
+use crate::scene::CameraSceneEntity;
+
+/// Rays traced per ring when bounding the exit pupil (pbrt-v4: 1024²);
+/// smaller in unit tests, which build many lens systems on few cores.
+const EXIT_PUPIL_SAMPLES: usize = if cfg!(test) { 128 * 128 } else { 1024 * 1024 };
+
+/// A camera and the warnings raised making it.
+#[derive(Debug)]
+pub struct CreatedCamera {
+    /// The camera.
+    pub camera: Camera,
+    /// Located warnings (reversed shutter, clamped aperture, unused
+    /// parameters...).
+    pub warnings: Vec<Diagnostic>,
+}
+
+/// Creates the camera of a `Camera` directive for `film`, in no medium,
+/// discarding warnings (see [`create_camera_with`] to keep them).
+pub fn create_camera(
+    entity: &CameraSceneEntity,
+    film: &FilmGeometry,
+) -> Result<Camera, Diagnostic> {
+    create_camera_with(entity, film, None).map(|c| c.camera)
+}
+
+fn perr(e: ParamError) -> Diagnostic {
+    Diagnostic::from(e)
+}
+
+/// The location of parameter `name`, or the directive's.
+fn at(params: &ParameterDictionary, name: &str, loc: &FileLoc) -> FileLoc {
+    params.loc(name).cloned().unwrap_or_else(|| loc.clone())
+}
+
+/// Creates the camera of a `Camera` directive for `film`, in `medium`,
+/// with its warnings.
+pub fn create_camera_with(
+    entity: &CameraSceneEntity,
+    film: &FilmGeometry,
+    medium: Option<MediumId>,
+) -> Result<CreatedCamera, Diagnostic> {
+    let params = &entity.base.params;
+    let loc = &entity.base.loc;
+    let name = entity.base.name.as_str();
+    let mut warnings = Vec::new();
+
+    let res = film.full_resolution;
+    if res.x <= 0 || res.y <= 0 {
+        return Err(Diagnostic::error(
+            loc.clone(),
+            format!("film resolution {}x{} is not positive", res.x, res.y),
+        ));
+    }
+    if !matches!(
+        name,
+        "perspective" | "orthographic" | "spherical" | "realistic"
+    ) {
+        return Err(Diagnostic::error(
+            loc.clone(),
+            format!("\"{name}\": camera type unknown"),
+        ));
+    }
+
+    let shutter_open = params.get_one_float("shutteropen", 0.0).map_err(perr)?;
+    let shutter_close = params.get_one_float("shutterclose", 1.0).map_err(perr)?;
+    if !(shutter_open.is_finite() && shutter_close.is_finite()) {
+        return Err(Diagnostic::error(
+            at(params, "shutteropen", loc),
+            "shutter times must be finite",
+        ));
+    }
+    if shutter_close < shutter_open {
+        warnings.push(Diagnostic::warning(
+            at(params, "shutterclose", loc),
+            format!(
+                "shutter close time {shutter_close} < shutter open {shutter_open}; swapping them"
+            ),
+        ));
+    }
+    let ct = entity.camera_transform;
+    let rfc = &ct.render_from_camera;
+    if rfc.start_transform.has_scale(1e-3) || rfc.end_transform.has_scale(1e-3) {
+        warnings.push(Diagnostic::warning(
+            loc.clone(),
+            "scaling detected in the camera-from-render transformation; the renderer \
+             assumes it has none, so the image may be wrong",
+        ));
+    }
+    let base = CameraBase::new(ct, shutter_open, shutter_close, *film, medium);
+
+    let camera = match name {
+        "perspective" | "orthographic" | "spherical" => {
+            let lens_radius = params.get_one_float("lensradius", 0.0).map_err(perr)?;
+            let default_focal = if name == "spherical" { 1e30 } else { 1e6 };
+            let focal_distance = params
+                .get_one_float("focaldistance", default_focal)
+                .map_err(perr)?;
+            let screen = screen_window(params, film, loc)?;
+            if !(lens_radius >= 0.0 && lens_radius.is_finite()) {
+                return Err(Diagnostic::error(
+                    at(params, "lensradius", loc),
+                    format!("lens radius {lens_radius} must be finite and non-negative"),
+                ));
+            }
+            if lens_radius > 0.0 && !(focal_distance > 0.0 && focal_distance.is_finite()) {
+                return Err(Diagnostic::error(
+                    at(params, "focaldistance", loc),
+                    format!("focal distance {focal_distance} must be positive"),
+                ));
+            }
+            match name {
+                "perspective" => {
+                    let fov = params.get_one_float("fov", 90.0).map_err(perr)?;
+                    if !(fov > 0.0 && fov < 180.0) {
+                        return Err(Diagnostic::error(
+                            at(params, "fov", loc),
+                            format!("field of view {fov} must be between 0 and 180 degrees"),
+                        ));
+                    }
+                    let c = PerspectiveCamera::new(base, fov, screen, lens_radius, focal_distance)
+                        .map_err(|e| Diagnostic::error(loc.clone(), format!("{e}")))?;
+                    Camera::Perspective(c)
+                }
+                "orthographic" => {
+                    let c = OrthographicCamera::new(base, screen, lens_radius, focal_distance)
+                        .map_err(|e| Diagnostic::error(loc.clone(), format!("{e}")))?;
+                    Camera::Orthographic(c)
+                }
+                _ => {
+                    let m = params
+                        .get_one_string("mapping", "equalarea")
+                        .map_err(perr)?;
+                    let mapping = match m.as_str() {
+                        "equalarea" => SphericalMapping::EqualArea,
+                        "equirectangular" => SphericalMapping::EquiRectangular,
+                        _ => {
+                            return Err(Diagnostic::error(
+                                at(params, "mapping", loc),
+                                format!(
+                                    "\"{m}\": unknown mapping for spherical camera (must be \
+                                     \"equalarea\" or \"equirectangular\")"
+                                ),
+                            ))
+                        }
+                    };
+                    if mapping == SphericalMapping::EqualArea && res.x != res.y {
+                        return Err(Diagnostic::error(
+                            at(params, "mapping", loc),
+                            format!(
+                                "the equal-area spherical mapping needs a square film; \
+                                 the resolution is {}x{}",
+                                res.x, res.y
+                            ),
+                        ));
+                    }
+                    Camera::Spherical(SphericalCamera::new(base, mapping))
+                }
+            }
+        }
+        _ => create_realistic(entity, base, &mut warnings)?,
+    };
+    warnings.extend(params.report_unused());
+    Ok(CreatedCamera { camera, warnings })
+}
+
+/// `screenwindow`, or the default from `frameaspectratio` (itself
+/// defaulting to the film's aspect): the shorter axis spans [−1, 1].
+fn screen_window(
+    params: &ParameterDictionary,
+    film: &FilmGeometry,
+    loc: &FileLoc,
+) -> Result<Bounds2f, Diagnostic> {
+    let res = film.full_resolution;
+    let frame = params
+        .get_one_float("frameaspectratio", res.x as Float / res.y as Float)
+        .map_err(perr)?;
+    if !(frame > 0.0 && frame.is_finite()) {
+        return Err(Diagnostic::error(
+            at(params, "frameaspectratio", loc),
+            format!("frame aspect ratio {frame} must be positive"),
+        ));
+    }
+    let mut screen = if frame > 1.0 {
+        Bounds2f::new(Point2f::new(-frame, -1.0), Point2f::new(frame, 1.0))
+    } else {
+        Bounds2f::new(
+            Point2f::new(-1.0, -1.0 / frame),
+            Point2f::new(1.0, 1.0 / frame),
+        )
+    };
+    let sw = params.get_float_array("screenwindow").map_err(perr)?;
+    if !sw.is_empty() {
+        if sw.len() != 4 {
+            return Err(Diagnostic::error(
+                at(params, "screenwindow", loc),
+                format!(
+                    "\"screenwindow\" should have four values; it has {}",
+                    sw.len()
+                ),
+            ));
+        }
+        if !(sw.iter().all(|v| v.is_finite()) && sw[0] != sw[1] && sw[2] != sw[3]) {
+            return Err(Diagnostic::error(
+                at(params, "screenwindow", loc),
+                "\"screenwindow\" must be finite with a nonzero extent in x and y",
+            ));
+        }
+        // Kept as written (not sorted): a reversed window mirrors the image.
+        screen.p_min = Point2f::new(sw[0], sw[2]);
+        screen.p_max = Point2f::new(sw[1], sw[3]);
+    }
+    Ok(screen)
+}
+
+/// Resolves a file name against the scene file's directory, as pbrt-v4's
+/// `ResolveFilename`: absolute names and names not found there are kept.
+fn resolve(loc: &FileLoc, name: &str) -> PathBuf {
+    let p = Path::new(name);
+    if p.is_absolute() {
+        return p.to_path_buf();
+    }
+    let dir = Path::new(&*loc.file)
+        .parent()
+        .unwrap_or_else(|| Path::new("."));
+    let joined = dir.join(p);
+    if joined.exists() {
+        joined
+    } else {
+        p.to_path_buf()
+    }
+}
+
+/// Reads a lens description: whitespace-separated numbers, `#` comments to
+/// the end of the line (pbrt-v4 `ReadFloatFile`). Errors name the line.
+pub fn read_lens_file(path: &Path) -> Result<Vec<Float>, String> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("{}: unable to read lens file: {e}", path.display()))?;
+    let mut values = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("");
+        for tok in line.split_whitespace() {
+            let v: Float = tok.parse().map_err(|_| {
+                format!(
+                    "{}:{}: \"{tok}\" is not a number in the lens file",
+                    path.display(),
+                    i + 1
+                )
+            })?;
+            values.push(v);
+        }
+    }
+    Ok(values)
+}
+
+fn create_realistic(
+    entity: &CameraSceneEntity,
+    base: CameraBase,
+    warnings: &mut Vec<Diagnostic>,
+) -> Result<Camera, Diagnostic> {
+    let params = &entity.base.params;
+    let loc = &entity.base.loc;
+    let lens_file = params.get_one_string("lensfile", "").map_err(perr)?;
+    let aperture_diameter = params
+        .get_one_float("aperturediameter", 1.0)
+        .map_err(perr)?;
+    let focus_distance = params.get_one_float("focusdistance", 10.0).map_err(perr)?;
+    let aperture = params.get_one_string("aperture", "").map_err(perr)?;
+
+    if lens_file.is_empty() {
+        return Err(Diagnostic::error(
+            loc.clone(),
+            "realistic camera: no lens description file supplied (\"string lensfile\")",
+        ));
+    }
+    let lens_loc = at(params, "lensfile", loc);
+    if !(aperture_diameter > 0.0 && aperture_diameter.is_finite()) {
+        return Err(Diagnostic::error(
+            at(params, "aperturediameter", loc),
+            format!("aperture diameter {aperture_diameter} must be positive"),
+        ));
+    }
+    if !(focus_distance > 0.0 && focus_distance.is_finite()) {
+        return Err(Diagnostic::error(
+            at(params, "focusdistance", loc),
+            format!("focus distance {focus_distance} must be positive"),
+        ));
+    }
+    let path = resolve(loc, &lens_file);
+    let lens = read_lens_file(&path).map_err(|m| Diagnostic::error(lens_loc.clone(), m))?;
+    if lens.is_empty() {
+        return Err(Diagnostic::error(
+            lens_loc,
+            format!("{}: the lens file holds no values", path.display()),
+        ));
+    }
+    if !lens.chunks_exact(4).remainder().is_empty() {
+        return Err(Diagnostic::error(
+            lens_loc,
+            format!(
+                "{}: excess values in lens specification file; must be multiple-of-four \
+                 values, read {}",
+                path.display(),
+                lens.len()
+            ),
+        ));
+    }
+    if !lens.chunks_exact(4).any(|r| r[0] == 0.0) {
+        warnings.push(Diagnostic::warning(
+            lens_loc.clone(),
+            format!(
+                "{}: the lens has no aperture stop (a row with curvature radius 0); \
+                 \"aperturediameter\" has no effect",
+                path.display()
+            ),
+        ));
+    }
+
+    let aperture_image = if aperture.is_empty() {
+        None
+    } else {
+        match ApertureImage::builtin(&aperture) {
+            Some(img) => Some(img),
+            None => {
+                return Err(Diagnostic::error(
+                    at(params, "aperture", loc),
+                    format!(
+                        "aperture \"{aperture}\": aperture images read from files are not \
+                         supported yet; use \"gaussian\", \"square\", \"pentagon\" or \"star\""
+                    ),
+                ))
+            }
+        }
+    };
+
+    let (cam, warns) = RealisticCamera::new(
+        base,
+        &lens,
+        focus_distance,
+        aperture_diameter,
+        aperture_image,
+        EXIT_PUPIL_SAMPLES,
+    )
+    .map_err(|m| Diagnostic::error(lens_loc.clone(), format!("{}: {m}", path.display())))?;
+    debug_assert_eq!(cam.exit_pupil_bounds.len(), EXIT_PUPIL_RINGS);
+    warnings.extend(
+        warns
+            .into_iter()
+            .map(|m| Diagnostic::warning(at(params, "aperturediameter", loc), m)),
+    );
+    Ok(Camera::Realistic(Box::new(cam)))
+}

@@ -1,0 +1,316 @@
+//! Projective cameras (book sections 5.2.1–5.2.3; pbrt-v4
+//! `ProjectiveCamera`, `OrthographicCamera`, `PerspectiveCamera`): a
+//! projection from camera to screen space, a screen window mapped to the
+//! raster, and an optional thin lens.
+
+use rpbrt_geometry::{
+    Bounds2f, Float, Point2f, Point3f, Ray, RayDifferential, Transform, TransformError, Vector3f,
+};
+
+use super::{CameraBase, CameraRay, CameraRayDifferential, CameraSample};
+use crate::sampling::sample_uniform_disk_concentric;
+
+/// The transformations between camera, screen and raster space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProjectiveTransforms {
+    /// The camera's projection.
+    pub screen_from_camera: Transform,
+    /// Raster (pixels, y down) to camera space.
+    pub camera_from_raster: Transform,
+    /// Screen to raster space.
+    pub raster_from_screen: Transform,
+    /// Raster to screen space.
+    pub screen_from_raster: Transform,
+}
+
+impl ProjectiveTransforms {
+    /// The transformations for a projection, screen window and film
+    /// resolution: the window's upper-left corner goes to raster (0, 0) and
+    /// its lower-right to the resolution.
+    pub fn new(
+        screen_from_camera: Transform,
+        screen_window: Bounds2f,
+        base: &CameraBase,
+    ) -> ProjectiveTransforms {
+        let res = base.film.full_resolution;
+        let ndc_from_screen = Transform::scale(
+            1.0 / (screen_window.p_max.x - screen_window.p_min.x),
+            1.0 / (screen_window.p_max.y - screen_window.p_min.y),
+            1.0,
+        ) * Transform::translate(Vector3f::new(
+            -screen_window.p_min.x,
+            -screen_window.p_max.y,
+            0.0,
+        ));
+        let raster_from_ndc = Transform::scale(res.x as Float, -(res.y as Float), 1.0);
+        let raster_from_screen = raster_from_ndc * ndc_from_screen;
+        let screen_from_raster = raster_from_screen.inverse();
+        let camera_from_raster = screen_from_camera.inverse() * screen_from_raster;
+        ProjectiveTransforms {
+            screen_from_camera,
+            camera_from_raster,
+            raster_from_screen,
+            screen_from_raster,
+        }
+    }
+}
+
+/// Moves a camera-space ray's origin to a point on the thin lens and aims
+/// it at where the original ray meets the plane of focus.
+#[inline]
+fn apply_thin_lens(ray: &mut Ray, lens_radius: Float, focal_distance: Float, u: Point2f) {
+    let p_lens = sample_uniform_disk_concentric(u);
+    let ft = focal_distance / ray.d.z;
+    let p_focus = ray.at(ft);
+    ray.o = Point3f::new(lens_radius * p_lens.x, lens_radius * p_lens.y, 0.0);
+    ray.d = (p_focus - ray.o).normalize();
+}
+
+/// Parallel projection along +z (pbrt-v4 `OrthographicCamera`).
+#[derive(Clone, Debug)]
+pub struct OrthographicCamera {
+    /// Shared camera state.
+    pub base: CameraBase,
+    /// Camera, screen and raster transformations.
+    pub xf: ProjectiveTransforms,
+    /// Radius of the thin lens (0: pinhole).
+    pub lens_radius: Float,
+    /// Distance to the plane in focus.
+    pub focal_distance: Float,
+    dx_camera: Vector3f,
+    dy_camera: Vector3f,
+}
+
+impl OrthographicCamera {
+    /// An orthographic camera looking through `screen_window`.
+    pub fn new(
+        mut base: CameraBase,
+        screen_window: Bounds2f,
+        lens_radius: Float,
+        focal_distance: Float,
+    ) -> Result<Self, TransformError> {
+        let xf =
+            ProjectiveTransforms::new(Transform::orthographic(0.0, 1.0)?, screen_window, &base);
+        let dx_camera = xf
+            .camera_from_raster
+            .apply_vector(Vector3f::new(1.0, 0.0, 0.0));
+        let dy_camera = xf
+            .camera_from_raster
+            .apply_vector(Vector3f::new(0.0, 1.0, 0.0));
+        base.min_dir_differential_x = Vector3f::default();
+        base.min_dir_differential_y = Vector3f::default();
+        base.min_pos_differential_x = dx_camera;
+        base.min_pos_differential_y = dy_camera;
+        Ok(OrthographicCamera {
+            base,
+            xf,
+            lens_radius,
+            focal_distance,
+            dx_camera,
+            dy_camera,
+        })
+    }
+
+    #[inline]
+    fn camera_ray(&self, sample: &CameraSample) -> (Ray, Point3f) {
+        let p_camera = self.xf.camera_from_raster.apply_point(Point3f::new(
+            sample.p_film.x,
+            sample.p_film.y,
+            0.0,
+        ));
+        let mut ray = Ray::with_time(
+            p_camera,
+            Vector3f::new(0.0, 0.0, 1.0),
+            self.base.sample_time(sample.time),
+            self.base.medium,
+        );
+        if self.lens_radius > 0.0 {
+            apply_thin_lens(
+                &mut ray,
+                self.lens_radius,
+                self.focal_distance,
+                sample.p_lens,
+            );
+        }
+        (ray, p_camera)
+    }
+
+    /// The ray through a film sample.
+    #[inline]
+    pub fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
+        let (ray, _) = self.camera_ray(sample);
+        Some(CameraRay {
+            ray: self.base.render_from_camera_ray(&ray),
+            weight: 1.0,
+        })
+    }
+
+    /// The ray through a film sample with its one-pixel neighbours.
+    pub fn generate_ray_differential(
+        &self,
+        sample: &CameraSample,
+    ) -> Option<CameraRayDifferential> {
+        let (ray, p_camera) = self.camera_ray(sample);
+        let mut rd = RayDifferential::new(ray);
+        if self.lens_radius > 0.0 {
+            let p_lens = sample_uniform_disk_concentric(sample.p_lens);
+            let o = Point3f::new(
+                self.lens_radius * p_lens.x,
+                self.lens_radius * p_lens.y,
+                0.0,
+            );
+            let ft = self.focal_distance; // the unperturbed direction is +z
+            let z = Vector3f::new(0.0, 0.0, ft);
+            rd.rx_origin = o;
+            rd.rx_direction = (p_camera + self.dx_camera + z - o).normalize();
+            rd.ry_origin = o;
+            rd.ry_direction = (p_camera + self.dy_camera + z - o).normalize();
+        } else {
+            rd.rx_origin = ray.o + self.dx_camera;
+            rd.ry_origin = ray.o + self.dy_camera;
+            rd.rx_direction = ray.d;
+            rd.ry_direction = ray.d;
+        }
+        rd.has_differentials = true;
+        Some(CameraRayDifferential {
+            ray: self.base.render_from_camera_ray_differential(&rd),
+            weight: 1.0,
+        })
+    }
+}
+
+/// Perspective projection from a pinhole or thin lens (pbrt-v4
+/// `PerspectiveCamera`).
+#[derive(Clone, Debug)]
+pub struct PerspectiveCamera {
+    /// Shared camera state.
+    pub base: CameraBase,
+    /// Camera, screen and raster transformations.
+    pub xf: ProjectiveTransforms,
+    /// Radius of the thin lens (0: pinhole).
+    pub lens_radius: Float,
+    /// Distance to the plane in focus.
+    pub focal_distance: Float,
+    /// Area of the image rectangle on the plane z = 1 (for importance).
+    pub image_plane_area: Float,
+    dx_camera: Vector3f,
+    dy_camera: Vector3f,
+}
+
+impl PerspectiveCamera {
+    /// A perspective camera with field of view `fov` degrees across the
+    /// screen window's [−1, 1] extent (pbrt's near 1e-2, far 1000).
+    pub fn new(
+        mut base: CameraBase,
+        fov: Float,
+        screen_window: Bounds2f,
+        lens_radius: Float,
+        focal_distance: Float,
+    ) -> Result<Self, TransformError> {
+        let xf = ProjectiveTransforms::new(
+            Transform::perspective(fov, 1e-2, 1000.0)?,
+            screen_window,
+            &base,
+        );
+        let c = &xf.camera_from_raster;
+        let origin = c.apply_point(Point3f::new(0.0, 0.0, 0.0));
+        let dx_camera = c.apply_point(Point3f::new(1.0, 0.0, 0.0)) - origin;
+        let dy_camera = c.apply_point(Point3f::new(0.0, 1.0, 0.0)) - origin;
+        let res = base.film.full_resolution;
+        let p_min = origin / origin.z;
+        let p_max = c.apply_point(Point3f::new(res.x as Float, res.y as Float, 0.0));
+        let p_max = p_max / p_max.z;
+        let image_plane_area = ((p_max.x - p_min.x) * (p_max.y - p_min.y)).abs();
+        let mut cam = PerspectiveCamera {
+            base: base.clone(),
+            xf,
+            lens_radius,
+            focal_distance,
+            image_plane_area,
+            dx_camera,
+            dy_camera,
+        };
+        base.find_minimum_differentials(|b, s| cam.differential_with_base(b, s));
+        cam.base = base;
+        Ok(cam)
+    }
+
+    #[inline]
+    fn camera_ray(&self, base: &CameraBase, sample: &CameraSample) -> (Ray, Point3f) {
+        let p_camera = self.xf.camera_from_raster.apply_point(Point3f::new(
+            sample.p_film.x,
+            sample.p_film.y,
+            0.0,
+        ));
+        let mut ray = Ray::with_time(
+            Point3f::new(0.0, 0.0, 0.0),
+            Vector3f::from(p_camera).normalize(),
+            base.sample_time(sample.time),
+            base.medium,
+        );
+        if self.lens_radius > 0.0 {
+            apply_thin_lens(
+                &mut ray,
+                self.lens_radius,
+                self.focal_distance,
+                sample.p_lens,
+            );
+        }
+        (ray, p_camera)
+    }
+
+    /// The ray through a film sample.
+    #[inline]
+    pub fn generate_ray(&self, sample: &CameraSample) -> Option<CameraRay> {
+        let (ray, _) = self.camera_ray(&self.base, sample);
+        Some(CameraRay {
+            ray: self.base.render_from_camera_ray(&ray),
+            weight: 1.0,
+        })
+    }
+
+    /// The ray through a film sample with its one-pixel neighbours.
+    #[inline]
+    pub fn generate_ray_differential(
+        &self,
+        sample: &CameraSample,
+    ) -> Option<CameraRayDifferential> {
+        self.differential_with_base(&self.base, sample)
+    }
+
+    fn differential_with_base(
+        &self,
+        base: &CameraBase,
+        sample: &CameraSample,
+    ) -> Option<CameraRayDifferential> {
+        let (ray, p_camera) = self.camera_ray(base, sample);
+        let mut rd = RayDifferential::new(ray);
+        let pc = Vector3f::from(p_camera);
+        if self.lens_radius > 0.0 {
+            let p_lens = sample_uniform_disk_concentric(sample.p_lens);
+            let o = Point3f::new(
+                self.lens_radius * p_lens.x,
+                self.lens_radius * p_lens.y,
+                0.0,
+            );
+            let focus = |d: Vector3f| {
+                let d = d.normalize();
+                Point3f::from(d * (self.focal_distance / d.z))
+            };
+            rd.rx_origin = o;
+            rd.rx_direction = (focus(pc + self.dx_camera) - o).normalize();
+            rd.ry_origin = o;
+            rd.ry_direction = (focus(pc + self.dy_camera) - o).normalize();
+        } else {
+            rd.rx_origin = ray.o;
+            rd.ry_origin = ray.o;
+            rd.rx_direction = (pc + self.dx_camera).normalize();
+            rd.ry_direction = (pc + self.dy_camera).normalize();
+        }
+        rd.has_differentials = true;
+        Some(CameraRayDifferential {
+            ray: base.render_from_camera_ray_differential(&rd),
+            weight: 1.0,
+        })
+    }
+}
