@@ -2,6 +2,7 @@
 #![deny(missing_docs)]
 
 pub mod accel;
+pub mod image;
 pub mod rng;
 pub mod sampling;
 pub mod scene;
