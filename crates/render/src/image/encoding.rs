@@ -8,20 +8,15 @@
 use std::sync::OnceLock;
 
 /// How 8-bit pixel values relate to linear values.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum ColorEncoding {
     /// Value / 255.
     Linear,
-    /// The sRGB transfer curve.
+    /// The sRGB transfer curve (the default).
+    #[default]
     SRGB,
     /// (value / 255) ^ gamma.
     Gamma(f32),
-}
-
-impl Default for ColorEncoding {
-    fn default() -> Self {
-        ColorEncoding::SRGB
-    }
 }
 
 /// Exact sRGB decoding of a value in [0, 1].

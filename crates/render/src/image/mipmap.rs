@@ -383,11 +383,14 @@ impl MIPMap {
 /// Key of a cached MIP map: file, filter, anisotropy (bits), wrap mode, encoding.
 type CacheKey = (PathBuf, FilterFunction, u32, WrapMode, (u8, u32));
 
+/// One cache entry, locked while its file loads so concurrent users wait for it.
+type CacheSlot = Arc<Mutex<Option<Arc<MIPMap>>>>;
+
 /// MIP maps shared by all textures that use the same file with the same settings
 /// (pbrt-v4's texture cache). Different files load in parallel; the same file once.
 #[derive(Debug, Default)]
 pub struct MIPMapCache {
-    map: Mutex<HashMap<CacheKey, Arc<Mutex<Option<Arc<MIPMap>>>>>>,
+    map: Mutex<HashMap<CacheKey, CacheSlot>>,
     files_read: AtomicUsize,
 }
 

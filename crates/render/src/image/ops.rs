@@ -36,7 +36,9 @@ pub struct DiffStats {
 pub const TRIM_FRACTION: f64 = 0.001;
 
 /// Both images' values over `a`'s channels, after checking they match.
-fn paired(a: &Image, b: &Image) -> Result<(Vec<String>, Vec<f32>, Vec<f32>), ImageError> {
+type Paired = (Vec<String>, Vec<f32>, Vec<f32>);
+
+fn paired(a: &Image, b: &Image) -> Result<Paired, ImageError> {
     if a.resolution() != b.resolution() {
         let (ra, rb) = (a.resolution(), b.resolution());
         return Err(ImageError::Invalid(format!(

@@ -460,7 +460,7 @@ fn garbage_and_truncated_files_are_errors() {
     files.push(("t.png", u.encode("t.png", &md).unwrap()));
     files.push(("t.qoi", u.encode("t.qoi", &md).unwrap()));
     let mut tga = tga_header(2, None, 9, 7, 24, 0);
-    tga.extend(std::iter::repeat(5).take(9 * 7 * 3));
+    tga.extend(std::iter::repeat_n(5, 9 * 7 * 3));
     files.push(("t.tga", tga));
     let mut hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 8\n".to_vec();
     for _ in 0..2 {
