@@ -3,6 +3,7 @@
 
 pub mod accel;
 pub mod camera;
+pub mod image;
 pub mod primitive;
 pub mod rng;
 pub mod sampling;

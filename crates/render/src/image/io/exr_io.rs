@@ -1,0 +1,279 @@
+//! OpenEXR through the `exr` crate: any channels, half or float, with pbrt-v4's
+//! metadata attributes (pbrt-v4 `ReadEXR`, `WriteEXR`). The first layer of a multi-layer
+//! file is read; channels of mixed sample types are read as float.
+
+use std::collections::HashMap;
+use std::io::Cursor;
+
+use exr::math::Vec2;
+use exr::meta::attribute::{AttributeValue, Chromaticities, IntegerBounds, Text};
+use exr::prelude::{
+    AnyChannel, AnyChannels, Encoding, FlatSamples, Layer, LayerAttributes, ReadChannels,
+    ReadLayers, SmallVec, WritableImage,
+};
+use half::f16;
+use rpbrt_geometry::{Bounds2i, Point2i};
+
+use super::{FmtResult, ImageAndMetadata, ImageMetadata};
+use crate::image::{Image, PixelFormat};
+
+/// Primaries and white point (x, y) of the colour spaces pbrt-v4 knows by name.
+const COLOR_SPACES: [(&str, [[f32; 2]; 4]); 4] = [
+    (
+        "srgb",
+        [[0.64, 0.33], [0.3, 0.6], [0.15, 0.06], [0.3127, 0.329]],
+    ),
+    (
+        "dci-p3",
+        [[0.68, 0.32], [0.265, 0.69], [0.15, 0.06], [0.3127, 0.329]],
+    ),
+    (
+        "rec2020",
+        [
+            [0.708, 0.292],
+            [0.17, 0.797],
+            [0.131, 0.046],
+            [0.3127, 0.329],
+        ],
+    ),
+    (
+        "aces2065-1",
+        [
+            [0.7347, 0.2653],
+            [0.0, 1.0],
+            [0.0001, -0.077],
+            [0.32168, 0.33767],
+        ],
+    ),
+];
+
+fn lookup_color_space(c: &Chromaticities) -> &'static str {
+    let got = [c.red, c.green, c.blue, c.white];
+    for (name, prim) in COLOR_SPACES {
+        let close = got
+            .iter()
+            .zip(prim)
+            .all(|(g, p)| (g.0 - p[0]).abs() < 1e-3 && (g.1 - p[1]).abs() < 1e-3);
+        if close {
+            return name;
+        }
+    }
+    // pbrt-v4 falls back to sRGB (with a warning) for unknown chromaticities.
+    "srgb"
+}
+
+fn to_matrix(m: &[f32; 16]) -> [[f32; 4]; 4] {
+    let mut r = [[0.0; 4]; 4];
+    for i in 0..4 {
+        for j in 0..4 {
+            r[i][j] = m[4 * i + j];
+        }
+    }
+    r
+}
+
+fn from_matrix(m: &[[f32; 4]; 4]) -> [f32; 16] {
+    let mut r = [0.0; 16];
+    for i in 0..4 {
+        for j in 0..4 {
+            r[4 * i + j] = m[i][j];
+        }
+    }
+    r
+}
+
+pub(super) fn read(data: &[u8]) -> FmtResult<ImageAndMetadata> {
+    // The exr crate is defensive, but a panic inside it must not escape to the caller.
+    let decoded = std::panic::catch_unwind(|| {
+        exr::prelude::read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .all_layers()
+            .all_attributes()
+            .non_parallel()
+            .from_buffered(Cursor::new(data))
+    })
+    .map_err(|_| "EXR decoder failed on malformed data".to_string())?
+    .map_err(|e| e.to_string())?;
+
+    let layer = decoded.layer_data.first().ok_or("EXR file has no layers")?;
+    let (w, h) = (layer.size.0, layer.size.1);
+    let res = super::check_resolution(w as i64, h as i64)?;
+    let channels = &layer.channel_data.list;
+    if channels.is_empty() {
+        return Err("EXR layer has no channels".into());
+    }
+    let names: Vec<String> = channels.iter().map(|c| c.name.to_string()).collect();
+    let nc = channels.len();
+    let npix = w * h;
+    let all_half = channels
+        .iter()
+        .all(|c| matches!(c.sample_data, FlatSamples::F16(_)));
+    for c in channels {
+        let len = match &c.sample_data {
+            FlatSamples::F16(v) => v.len(),
+            FlatSamples::F32(v) => v.len(),
+            FlatSamples::U32(v) => v.len(),
+        };
+        if len != npix {
+            return Err("EXR channel sizes do not match the data window".into());
+        }
+    }
+    let image = if all_half {
+        let mut px = vec![f16::ZERO; npix * nc];
+        for (ci, c) in channels.iter().enumerate() {
+            if let FlatSamples::F16(v) = &c.sample_data {
+                for (i, &s) in v.iter().enumerate() {
+                    px[i * nc + ci] = s;
+                }
+            }
+        }
+        Image::from_f16(px, res, &names)
+    } else {
+        let mut px = vec![0.0f32; npix * nc];
+        for (ci, c) in channels.iter().enumerate() {
+            for i in 0..npix {
+                px[i * nc + ci] = match &c.sample_data {
+                    FlatSamples::F16(v) => v[i].to_f32(),
+                    FlatSamples::F32(v) => v[i],
+                    FlatSamples::U32(v) => v[i] as f32,
+                };
+            }
+        }
+        Image::from_f32(px, res, &names)
+    }
+    .map_err(|e| e.to_string())?;
+
+    let la = &layer.attributes;
+    let ia = &decoded.attributes;
+    let get = |name: &str| -> Option<&AttributeValue> {
+        let key = Text::new_or_none(name)?;
+        la.other.get(&key).or_else(|| ia.other.get(&key))
+    };
+    let f32_attr = |name: &str| match get(name) {
+        Some(AttributeValue::F32(v)) => Some(*v),
+        _ => None,
+    };
+    let mut metadata = ImageMetadata {
+        render_time_seconds: f32_attr("renderTimeSeconds"),
+        camera_from_world: la.world_to_camera.as_ref().map(to_matrix),
+        ndc_from_world: la.world_to_normalized_device.as_ref().map(to_matrix),
+        pixel_bounds: Some(Bounds2i::new(
+            Point2i {
+                x: la.layer_position.0,
+                y: la.layer_position.1,
+            },
+            Point2i {
+                x: la.layer_position.0 + res.x,
+                y: la.layer_position.1 + res.y,
+            },
+        )),
+        full_resolution: Some(Point2i {
+            x: ia.display_window.size.0 as i32,
+            y: ia.display_window.size.1 as i32,
+        }),
+        samples_per_pixel: match get("samplesPerPixel") {
+            Some(AttributeValue::I32(v)) => Some(*v),
+            _ => None,
+        },
+        estimated_variance: f32_attr("estimatedVariance"),
+        mse: f32_attr("MSE"),
+        color_space: ia
+            .chromaticities
+            .as_ref()
+            .map(|c| lookup_color_space(c).to_string()),
+        strings: Default::default(),
+    };
+    for (k, v) in la.other.iter().chain(ia.other.iter()) {
+        if let AttributeValue::TextVector(list) = v {
+            metadata
+                .strings
+                .insert(k.to_string(), list.iter().map(|t| t.to_string()).collect());
+        }
+    }
+    Ok(ImageAndMetadata { image, metadata })
+}
+
+fn text(s: &str) -> FmtResult<Text> {
+    Text::new_or_none(s).ok_or_else(|| format!("\"{s}\" cannot be stored as EXR text"))
+}
+
+/// Writes all channels as half (8-bit and half images) or float, ZIP-compressed
+/// scanlines, with pbrt-v4's attributes.
+pub(super) fn write(image: &Image, md: &ImageMetadata) -> FmtResult<Vec<u8>> {
+    let res = image.resolution();
+    if res.x <= 0 || res.y <= 0 || image.n_channels() == 0 {
+        return Err("cannot write an empty image".into());
+    }
+    let nc = image.n_channels();
+    let npix = res.x as usize * res.y as usize;
+    let vals = image.to_f32_vec();
+    let half = image.format() != PixelFormat::Float;
+    let mut list: SmallVec<[AnyChannel<FlatSamples>; 4]> = SmallVec::new();
+    for (ci, name) in image.channel_names().iter().enumerate() {
+        let samples = (0..npix).map(|i| vals[i * nc + ci]);
+        let data = if half {
+            FlatSamples::F16(samples.map(f16::from_f32).collect())
+        } else {
+            FlatSamples::F32(samples.collect())
+        };
+        list.push(AnyChannel::new(text(name)?, data));
+    }
+    let mut attrs = LayerAttributes::default();
+    if let Some(b) = md.pixel_bounds {
+        attrs.layer_position = Vec2(b.p_min.x, b.p_min.y);
+    }
+    attrs.world_to_camera = md.camera_from_world.as_ref().map(from_matrix);
+    attrs.world_to_normalized_device = md.ndc_from_world.as_ref().map(from_matrix);
+    let mut other: HashMap<Text, AttributeValue> = HashMap::new();
+    if let Some(t) = md.render_time_seconds {
+        other.insert(text("renderTimeSeconds")?, AttributeValue::F32(t));
+    }
+    if let Some(s) = md.samples_per_pixel {
+        other.insert(text("samplesPerPixel")?, AttributeValue::I32(s));
+    }
+    if let Some(v) = md.estimated_variance {
+        other.insert(text("estimatedVariance")?, AttributeValue::F32(v));
+    }
+    if let Some(v) = md.mse {
+        other.insert(text("MSE")?, AttributeValue::F32(v));
+    }
+    for (k, v) in &md.strings {
+        let list = v.iter().map(|s| text(s)).collect::<FmtResult<Vec<_>>>()?;
+        other.insert(text(k)?, AttributeValue::TextVector(list));
+    }
+    attrs.other = other;
+    let layer = Layer::new(
+        Vec2(res.x as usize, res.y as usize),
+        attrs,
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(list),
+    );
+    let mut out = exr::image::Image::from_layer(layer);
+    let full = md.full_resolution.unwrap_or(res);
+    if full.x <= 0 || full.y <= 0 {
+        return Err("invalid full resolution in metadata".into());
+    }
+    out.attributes.display_window =
+        IntegerBounds::new(Vec2(0, 0), Vec2(full.x as usize, full.y as usize));
+    // As pbrt-v4, chromaticities are written only for colour spaces other than sRGB.
+    if let Some(name) = md.color_space.as_deref().filter(|n| *n != "srgb") {
+        let (_, p) = COLOR_SPACES
+            .iter()
+            .find(|(n, _)| *n == name)
+            .ok_or_else(|| format!("unknown colour space \"{name}\""))?;
+        out.attributes.chromaticities = Some(Chromaticities {
+            red: Vec2(p[0][0], p[0][1]),
+            green: Vec2(p[1][0], p[1][1]),
+            blue: Vec2(p[2][0], p[2][1]),
+            white: Vec2(p[3][0], p[3][1]),
+        });
+    }
+    let mut buf = Cursor::new(Vec::new());
+    out.write()
+        .non_parallel()
+        .to_buffered(&mut buf)
+        .map_err(|e| e.to_string())?;
+    Ok(buf.into_inner())
+}

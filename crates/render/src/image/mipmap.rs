@@ -1,0 +1,438 @@
+//! MIP maps and texture filtering: point, bilinear, trilinear and EWA lookups (pbrt-v4
+//! `util/mipmap.h`, `util/mipmap.cpp`; book section 10.4.3 "MIP Maps" and 10.4.4
+//! "Elliptically Weighted Averaging"), plus a cache so each texture file is read once.
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+
+use rpbrt_geometry::{Point2f, Point2i, Vector2f};
+
+use super::{ColorEncoding, Image, ImageError, WrapMode, WrapMode2D};
+
+/// How MIP-map lookups filter.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum FilterFunction {
+    /// Nearest texel at the chosen level.
+    Point,
+    /// Bilinear interpolation at the chosen level.
+    Bilinear,
+    /// Interpolation between bilinear lookups at two levels.
+    Trilinear,
+    /// Elliptically weighted average with a Gaussian.
+    EWA,
+}
+
+impl FilterFunction {
+    /// Parses pbrt-v4's names: "point", "bilinear", "trilinear", "ewa" / "EWA".
+    pub fn parse(s: &str) -> Option<FilterFunction> {
+        match s {
+            "point" => Some(FilterFunction::Point),
+            "bilinear" => Some(FilterFunction::Bilinear),
+            "trilinear" => Some(FilterFunction::Trilinear),
+            "ewa" | "EWA" => Some(FilterFunction::EWA),
+            _ => None,
+        }
+    }
+}
+
+/// Filter choice and the anisotropy limit for EWA.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MIPMapFilterOptions {
+    /// The filter.
+    pub filter: FilterFunction,
+    /// Largest ratio of the ellipse axes; longer ellipses are widened.
+    pub max_anisotropy: f32,
+}
+
+impl Default for MIPMapFilterOptions {
+    fn default() -> Self {
+        MIPMapFilterOptions {
+            filter: FilterFunction::EWA,
+            max_anisotropy: 8.0,
+        }
+    }
+}
+
+/// Gaussian weights exp(-2 r^2) - exp(-2) sampled at r^2 = i / 127 (pbrt-v4's
+/// `MIPFilterLUT`), computed once.
+fn ewa_weights() -> &'static [f32; 128] {
+    static LUT: std::sync::OnceLock<[f32; 128]> = std::sync::OnceLock::new();
+    LUT.get_or_init(|| {
+        let mut t = [0.0f32; 128];
+        for (i, w) in t.iter_mut().enumerate() {
+            let r2 = i as f64 / 127.0;
+            *w = ((-2.0 * r2).exp() - (-2.0f64).exp()) as f32;
+        }
+        t
+    })
+}
+
+/// Values a MIP map can return: a float or an RGB triple.
+trait MipValue: Copy {
+    fn zero() -> Self;
+    fn add(self, o: Self) -> Self;
+    fn scale(self, s: f32) -> Self;
+    fn texel(m: &MIPMap, level: usize, st: Point2i) -> Self;
+    fn bilerp(m: &MIPMap, level: usize, st: Point2f) -> Self;
+}
+
+impl MipValue for f32 {
+    fn zero() -> Self {
+        0.0
+    }
+    fn add(self, o: Self) -> Self {
+        self + o
+    }
+    fn scale(self, s: f32) -> Self {
+        self * s
+    }
+    fn texel(m: &MIPMap, level: usize, st: Point2i) -> Self {
+        m.pyramid[level].get_channel(st, 0, m.wrap2d())
+    }
+    fn bilerp(m: &MIPMap, level: usize, st: Point2f) -> Self {
+        let im = &m.pyramid[level];
+        let w = m.wrap2d();
+        match im.n_channels() {
+            3 => (0..3).map(|c| im.bilerp_channel(st, c, w)).sum::<f32>() / 3.0,
+            4 => im.bilerp_channel(st, 3, w),
+            _ => im.bilerp_channel(st, 0, w),
+        }
+    }
+}
+
+impl MipValue for [f32; 3] {
+    fn zero() -> Self {
+        [0.0; 3]
+    }
+    fn add(self, o: Self) -> Self {
+        [self[0] + o[0], self[1] + o[1], self[2] + o[2]]
+    }
+    fn scale(self, s: f32) -> Self {
+        [self[0] * s, self[1] * s, self[2] * s]
+    }
+    fn texel(m: &MIPMap, level: usize, st: Point2i) -> Self {
+        let im = &m.pyramid[level];
+        let w = m.wrap2d();
+        if im.n_channels() >= 3 {
+            [
+                im.get_channel(st, 0, w),
+                im.get_channel(st, 1, w),
+                im.get_channel(st, 2, w),
+            ]
+        } else {
+            let v = im.get_channel(st, 0, w);
+            [v; 3]
+        }
+    }
+    fn bilerp(m: &MIPMap, level: usize, st: Point2f) -> Self {
+        let im = &m.pyramid[level];
+        let w = m.wrap2d();
+        if im.n_channels() >= 3 {
+            [
+                im.bilerp_channel(st, 0, w),
+                im.bilerp_channel(st, 1, w),
+                im.bilerp_channel(st, 2, w),
+            ]
+        } else {
+            let v = im.bilerp_channel(st, 0, w);
+            [v; 3]
+        }
+    }
+}
+
+#[inline]
+fn lerp_v<T: MipValue>(t: f32, a: T, b: T) -> T {
+    a.scale(1.0 - t).add(b.scale(t))
+}
+
+/// An image pyramid with filtered lookups.
+#[derive(Clone, Debug)]
+pub struct MIPMap {
+    pyramid: Vec<Image>,
+    color_space: String,
+    wrap_mode: WrapMode,
+    options: MIPMapFilterOptions,
+}
+
+impl MIPMap {
+    /// Builds the pyramid of `image` (see [`Image::generate_pyramid`]).
+    pub fn new(
+        image: &Image,
+        color_space: &str,
+        wrap_mode: WrapMode,
+        options: MIPMapFilterOptions,
+    ) -> MIPMap {
+        MIPMap {
+            pyramid: Image::generate_pyramid(image, wrap_mode.into()),
+            color_space: color_space.to_string(),
+            wrap_mode,
+            options,
+        }
+    }
+
+    /// Reads an image file and builds its MIP map. Multi-channel images are reduced to
+    /// R, G, B (and A unless alpha is 1 everywhere), as pbrt-v4 does.
+    pub fn from_file(
+        path: impl AsRef<Path>,
+        options: MIPMapFilterOptions,
+        wrap_mode: WrapMode,
+        encoding: ColorEncoding,
+    ) -> Result<MIPMap, ImageError> {
+        let path = path.as_ref();
+        let read = Image::read(path, Some(encoding))?;
+        let mut image = read.image;
+        if image.n_channels() != 1 {
+            let rgba = image.get_channel_desc(&["R", "G", "B", "A"]);
+            let rgb = image.get_channel_desc(&["R", "G", "B"]);
+            image = match (rgba, rgb) {
+                (Some(rgba), Some(rgb)) => {
+                    let nc = image.n_channels();
+                    let a = rgba.offset[3];
+                    let vals = image.to_f32_vec();
+                    let all_one = vals.chunks_exact(nc).all(|p| p[a] == 1.0);
+                    image.select_channels(if all_one { &rgb } else { &rgba })
+                }
+                (None, Some(rgb)) => image.select_channels(&rgb),
+                _ => {
+                    return Err(ImageError::Format {
+                        path: path.display().to_string(),
+                        message: "image doesn't have R, G, and B channels".into(),
+                    })
+                }
+            };
+        }
+        Ok(MIPMap::new(
+            &image,
+            read.metadata.color_space_name(),
+            wrap_mode,
+            options,
+        ))
+    }
+
+    fn wrap2d(&self) -> WrapMode2D {
+        self.wrap_mode.into()
+    }
+    /// Number of levels (finest is 0).
+    pub fn levels(&self) -> usize {
+        self.pyramid.len()
+    }
+    /// Resolution of a level.
+    pub fn level_resolution(&self, level: usize) -> Point2i {
+        self.pyramid[level].resolution()
+    }
+    /// The image of a level.
+    pub fn level(&self, level: usize) -> &Image {
+        &self.pyramid[level]
+    }
+    /// Name of the RGB colour space of the texels.
+    pub fn color_space(&self) -> &str {
+        &self.color_space
+    }
+    /// The wrap mode.
+    pub fn wrap_mode(&self) -> WrapMode {
+        self.wrap_mode
+    }
+    /// The filter options.
+    pub fn options(&self) -> MIPMapFilterOptions {
+        self.options
+    }
+    /// Bytes of pixel storage over all levels.
+    pub fn total_bytes_used(&self) -> usize {
+        self.pyramid.iter().map(|i| i.bytes_used()).sum()
+    }
+
+    /// Float texel (first channel).
+    pub fn texel_float(&self, level: usize, st: Point2i) -> f32 {
+        f32::texel(self, level, st)
+    }
+    /// RGB texel (grey images replicated).
+    pub fn texel_rgb(&self, level: usize, st: Point2i) -> [f32; 3] {
+        <[f32; 3]>::texel(self, level, st)
+    }
+    /// Bilinear float lookup: one channel as is, RGB averaged, RGBA gives alpha.
+    pub fn bilerp_float(&self, level: usize, st: Point2f) -> f32 {
+        f32::bilerp(self, level, st)
+    }
+    /// Bilinear RGB lookup.
+    pub fn bilerp_rgb(&self, level: usize, st: Point2f) -> [f32; 3] {
+        <[f32; 3]>::bilerp(self, level, st)
+    }
+    /// Filtered float lookup over the footprint spanned by `dst0` and `dst1`.
+    pub fn filter_float(&self, st: Point2f, dst0: Vector2f, dst1: Vector2f) -> f32 {
+        self.filter::<f32>(st, dst0, dst1)
+    }
+    /// Filtered RGB lookup over the footprint spanned by `dst0` and `dst1`.
+    pub fn filter_rgb(&self, st: Point2f, dst0: Vector2f, dst1: Vector2f) -> [f32; 3] {
+        self.filter::<[f32; 3]>(st, dst0, dst1)
+    }
+
+    fn filter<T: MipValue>(&self, st: Point2f, mut dst0: Vector2f, mut dst1: Vector2f) -> T {
+        let n_levels = self.levels();
+        if self.options.filter != FilterFunction::EWA {
+            let width = 2.0
+                * dst0
+                    .x
+                    .abs()
+                    .max(dst0.y.abs())
+                    .max(dst1.x.abs())
+                    .max(dst1.y.abs());
+            // Level whose texel spacing matches the filter width; very wide filters use
+            // the single top texel.
+            let level = (n_levels - 1) as f32 + width.max(1e-8).log2();
+            if level >= (n_levels - 1) as f32 {
+                return T::texel(self, n_levels - 1, Point2i { x: 0, y: 0 });
+            }
+            let ilevel = level.floor().max(0.0) as usize;
+            return match self.options.filter {
+                FilterFunction::Point => {
+                    let r = self.level_resolution(ilevel);
+                    let sti = Point2i {
+                        x: (st.x * r.x as f32 - 0.5).round() as i32,
+                        y: (st.y * r.y as f32 - 0.5).round() as i32,
+                    };
+                    T::texel(self, ilevel, sti)
+                }
+                FilterFunction::Bilinear => T::bilerp(self, ilevel, st),
+                _ => {
+                    if ilevel == 0 {
+                        T::bilerp(self, 0, st)
+                    } else {
+                        lerp_v(
+                            level - ilevel as f32,
+                            T::bilerp(self, ilevel, st),
+                            T::bilerp(self, ilevel + 1, st),
+                        )
+                    }
+                }
+            };
+        }
+        // EWA: the longer axis first, then limit the eccentricity.
+        let len2 = |v: Vector2f| v.x * v.x + v.y * v.y;
+        if len2(dst0) < len2(dst1) {
+            std::mem::swap(&mut dst0, &mut dst1);
+        }
+        let longer = len2(dst0).sqrt();
+        let mut shorter = len2(dst1).sqrt();
+        if shorter * self.options.max_anisotropy < longer && shorter > 0.0 {
+            let scale = longer / (shorter * self.options.max_anisotropy);
+            dst1 = Vector2f {
+                x: dst1.x * scale,
+                y: dst1.y * scale,
+            };
+            shorter *= scale;
+        }
+        if shorter == 0.0 {
+            return T::bilerp(self, 0, st);
+        }
+        let lod = ((n_levels - 1) as f32 + shorter.log2()).max(0.0);
+        let ilod = lod.floor();
+        lerp_v(
+            lod - ilod,
+            self.ewa::<T>(ilod as usize, st, dst0, dst1),
+            self.ewa::<T>(ilod as usize + 1, st, dst0, dst1),
+        )
+    }
+
+    fn ewa<T: MipValue>(&self, level: usize, st: Point2f, dst0: Vector2f, dst1: Vector2f) -> T {
+        if level >= self.levels() {
+            return T::texel(self, self.levels() - 1, Point2i { x: 0, y: 0 });
+        }
+        let r = self.level_resolution(level);
+        let (rx, ry) = (r.x as f32, r.y as f32);
+        let s = st.x * rx - 0.5;
+        let t = st.y * ry - 0.5;
+        let (d0x, d0y, d1x, d1y) = (dst0.x * rx, dst0.y * ry, dst1.x * rx, dst1.y * ry);
+        // Implicit ellipse A s^2 + B s t + C t^2 = 1, widened by one texel.
+        let mut a = d0y * d0y + d1y * d1y + 1.0;
+        let mut b = -2.0 * (d0x * d0y + d1x * d1y);
+        let mut c = d0x * d0x + d1x * d1x + 1.0;
+        let inv_f = 1.0 / (a * c - b * b * 0.25);
+        a *= inv_f;
+        b *= inv_f;
+        c *= inv_f;
+        let det = -b * b + 4.0 * a * c;
+        let inv_det = 1.0 / det;
+        let u_sqrt = (det * c).max(0.0).sqrt();
+        let v_sqrt = (a * det).max(0.0).sqrt();
+        let s0 = (s - 2.0 * inv_det * u_sqrt).ceil() as i32;
+        let s1 = (s + 2.0 * inv_det * u_sqrt).floor() as i32;
+        let t0 = (t - 2.0 * inv_det * v_sqrt).ceil() as i32;
+        let t1 = (t + 2.0 * inv_det * v_sqrt).floor() as i32;
+        let lut = ewa_weights();
+        let mut sum = T::zero();
+        let mut sum_w = 0.0f32;
+        for it in t0..=t1 {
+            let tt = it as f32 - t;
+            for is in s0..=s1 {
+                let ss = is as f32 - s;
+                let r2 = a * ss * ss + b * ss * tt + c * tt * tt;
+                if r2 < 1.0 {
+                    let idx = ((r2 * 128.0) as usize).min(127);
+                    let w = lut[idx];
+                    sum = sum.add(T::texel(self, level, Point2i { x: is, y: it }).scale(w));
+                    sum_w += w;
+                }
+            }
+        }
+        sum.scale(1.0 / sum_w)
+    }
+}
+
+/// Key of a cached MIP map: file, filter, anisotropy (bits), wrap mode, encoding.
+type CacheKey = (PathBuf, FilterFunction, u32, WrapMode, (u8, u32));
+
+/// One cache entry, locked while its file loads so concurrent users wait for it.
+type CacheSlot = Arc<Mutex<Option<Arc<MIPMap>>>>;
+
+/// MIP maps shared by all textures that use the same file with the same settings
+/// (pbrt-v4's texture cache). Different files load in parallel; the same file once.
+#[derive(Debug, Default)]
+pub struct MIPMapCache {
+    map: Mutex<HashMap<CacheKey, CacheSlot>>,
+    files_read: AtomicUsize,
+}
+
+impl MIPMapCache {
+    /// An empty cache.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The MIP map for these settings, reading the file on first use. Failures are not
+    /// cached.
+    pub fn get_or_load(
+        &self,
+        path: impl AsRef<Path>,
+        options: MIPMapFilterOptions,
+        wrap_mode: WrapMode,
+        encoding: ColorEncoding,
+    ) -> Result<Arc<MIPMap>, ImageError> {
+        let path = path.as_ref();
+        let key = (
+            path.to_path_buf(),
+            options.filter,
+            options.max_anisotropy.to_bits(),
+            wrap_mode,
+            encoding.key(),
+        );
+        let slot = {
+            let mut map = self.map.lock().unwrap_or_else(|e| e.into_inner());
+            map.entry(key).or_default().clone()
+        };
+        let mut slot = slot.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(m) = slot.as_ref() {
+            return Ok(m.clone());
+        }
+        self.files_read.fetch_add(1, Ordering::Relaxed);
+        let m = Arc::new(MIPMap::from_file(path, options, wrap_mode, encoding)?);
+        *slot = Some(m.clone());
+        Ok(m)
+    }
+
+    /// How many times a file has been read (for tests and statistics).
+    pub fn files_read(&self) -> usize {
+        self.files_read.load(Ordering::Relaxed)
+    }
+}

@@ -1,0 +1,266 @@
+//! Image comparison, statistics and simple edits behind `rpbrt imgtool` (pbrt-v4
+//! `cmd/imgtool.cpp` diff/info/convert; `Image::MSE`, `Image::Average`). Functions
+//! return data; formatting for the terminal belongs to the CLI.
+
+use std::fmt;
+
+use rpbrt_geometry::Point2i;
+
+use super::{ColorEncoding, Image, ImageError, PixelFormat};
+
+/// Differences between two images of the same resolution and channels.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DiffStats {
+    /// Channels compared (those of the first image).
+    pub channels: Vec<String>,
+    /// Mean over pixels and channels of (a - b)^2.
+    pub mse: f64,
+    /// Mean over pixels and channels of (a - b)^2 / (b^2 + 0.01).
+    pub rel_mse: f64,
+    /// The relative MSE per pixel (averaged over channels), with the worst 0.1% of
+    /// pixels dropped before averaging.
+    pub rel_mse_trimmed: f64,
+    /// Mean of all channel values of `a`.
+    pub mean_a: f64,
+    /// Mean of all channel values of `b`.
+    pub mean_b: f64,
+    /// Largest |a - b| over pixels and channels.
+    pub max_abs_diff: f64,
+    /// Pixels where any channel differs.
+    pub differing_pixels: usize,
+    /// Channel values where a term was NaN or infinite (left out of the sums).
+    pub non_finite: usize,
+}
+
+/// Fraction of pixels dropped by the trimmed relative MSE.
+pub const TRIM_FRACTION: f64 = 0.001;
+
+/// Both images' values over `a`'s channels, after checking they match.
+type Paired = (Vec<String>, Vec<f32>, Vec<f32>);
+
+fn paired(a: &Image, b: &Image) -> Result<Paired, ImageError> {
+    if a.resolution() != b.resolution() {
+        let (ra, rb) = (a.resolution(), b.resolution());
+        return Err(ImageError::Invalid(format!(
+            "image resolutions differ: {}x{} vs {}x{}",
+            ra.x, ra.y, rb.x, rb.y
+        )));
+    }
+    let names = a.channel_names().to_vec();
+    let bdesc = b.get_channel_desc(&names).ok_or_else(|| {
+        ImageError::Invalid(format!(
+            "second image lacks some of the channels {:?} (it has {:?})",
+            names,
+            b.channel_names()
+        ))
+    })?;
+    let bsel = if bdesc.is_identity() && b.n_channels() == names.len() {
+        b.clone()
+    } else {
+        b.select_channels(&bdesc)
+    };
+    Ok((names, a.to_f32_vec(), bsel.to_f32_vec()))
+}
+
+/// Per-pixel relative squared error, averaged over channels: (a-b)^2 / (b^2 + 0.01).
+fn per_pixel_rel(va: &[f32], vb: &[f32], nc: usize) -> Vec<f64> {
+    va.chunks_exact(nc)
+        .zip(vb.chunks_exact(nc))
+        .map(|(pa, pb)| {
+            let s: f64 = pa
+                .iter()
+                .zip(pb)
+                .map(|(&x, &y)| {
+                    let (x, y) = (x as f64, y as f64);
+                    (x - y) * (x - y) / (y * y + 0.01)
+                })
+                .sum();
+            s / nc as f64
+        })
+        .collect()
+}
+
+/// Mean of per-pixel values after dropping the largest `fraction` of them (non-finite
+/// values count as largest).
+pub fn trimmed_mean(mut v: Vec<f64>, fraction: f64) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    let key = |x: &f64| if x.is_finite() { *x } else { f64::INFINITY };
+    v.sort_by(|x, y| key(x).total_cmp(&key(y)));
+    let drop = ((v.len() as f64) * fraction).floor() as usize;
+    let keep = &v[..v.len() - drop.min(v.len() - 1)];
+    keep.iter().sum::<f64>() / keep.len() as f64
+}
+
+/// Relative MSE of `a` against reference `b` with the worst `fraction` of pixels dropped.
+pub fn rel_mse_trimmed(a: &Image, b: &Image, fraction: f64) -> Result<f64, ImageError> {
+    let (names, va, vb) = paired(a, b)?;
+    Ok(trimmed_mean(
+        per_pixel_rel(&va, &vb, names.len().max(1)),
+        fraction,
+    ))
+}
+
+/// Compares `a` with the reference `b` over `a`'s channels.
+pub fn diff(a: &Image, b: &Image) -> Result<DiffStats, ImageError> {
+    let (names, va, vb) = paired(a, b)?;
+    let nc = names.len().max(1);
+    let (mut se, mut rse, mut sa, mut sb, mut maxd) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let mut non_finite = 0;
+    let mut differing = 0;
+    for (pa, pb) in va.chunks_exact(nc).zip(vb.chunks_exact(nc)) {
+        if pa != pb {
+            differing += 1;
+        }
+        for (&x, &y) in pa.iter().zip(pb) {
+            let (x, y) = (x as f64, y as f64);
+            let d = x - y;
+            let e = d * d;
+            let re = e / (y * y + 0.01);
+            if !e.is_finite() || !re.is_finite() {
+                non_finite += 1;
+                continue;
+            }
+            se += e;
+            rse += re;
+            sa += x;
+            sb += y;
+            maxd = maxd.max(d.abs());
+        }
+    }
+    let n = va.len().max(1) as f64;
+    Ok(DiffStats {
+        rel_mse_trimmed: trimmed_mean(per_pixel_rel(&va, &vb, nc), TRIM_FRACTION),
+        channels: names,
+        mse: se / n,
+        rel_mse: rse / n,
+        mean_a: sa / n,
+        mean_b: sb / n,
+        max_abs_diff: maxd,
+        differing_pixels: differing,
+        non_finite,
+    })
+}
+
+/// Statistics of one channel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChannelStats {
+    /// Channel name.
+    pub name: String,
+    /// Smallest finite value.
+    pub min: f32,
+    /// Largest finite value.
+    pub max: f32,
+    /// Mean of the finite values.
+    pub average: f64,
+    /// Count of NaN values.
+    pub nan_count: usize,
+    /// Count of infinite values.
+    pub inf_count: usize,
+}
+
+/// Summary of an image for `imgtool info`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageInfo {
+    /// Resolution.
+    pub resolution: Point2i,
+    /// Storage format.
+    pub format: PixelFormat,
+    /// Encoding (meaningful for 8-bit images).
+    pub encoding: ColorEncoding,
+    /// Per-channel statistics.
+    pub channels: Vec<ChannelStats>,
+}
+
+/// Resolution, format and per-channel min/max/average and NaN/Inf counts.
+pub fn info(image: &Image) -> ImageInfo {
+    let nc = image.n_channels();
+    let vals = image.to_f32_vec();
+    let channels = image
+        .channel_names()
+        .iter()
+        .enumerate()
+        .map(|(c, name)| {
+            let mut s = ChannelStats {
+                name: name.clone(),
+                min: f32::INFINITY,
+                max: f32::NEG_INFINITY,
+                average: 0.0,
+                nan_count: 0,
+                inf_count: 0,
+            };
+            let mut n = 0usize;
+            for &v in vals.iter().skip(c).step_by(nc.max(1)) {
+                if v.is_nan() {
+                    s.nan_count += 1;
+                } else if v.is_infinite() {
+                    s.inf_count += 1;
+                } else {
+                    s.min = s.min.min(v);
+                    s.max = s.max.max(v);
+                    s.average += v as f64;
+                    n += 1;
+                }
+            }
+            s.average /= n.max(1) as f64;
+            s
+        })
+        .collect();
+    ImageInfo {
+        resolution: image.resolution(),
+        format: image.format(),
+        encoding: image.encoding(),
+        channels,
+    }
+}
+
+impl fmt::Display for ImageInfo {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "resolution {}x{}, format {}",
+            self.resolution.x, self.resolution.y, self.format
+        )?;
+        if self.format == PixelFormat::U256 {
+            write!(f, " (encoding {})", self.encoding.name())?;
+        }
+        writeln!(f)?;
+        for c in &self.channels {
+            writeln!(
+                f,
+                "  {}: min {} max {} avg {} ({} NaN, {} Inf)",
+                c.name, c.min, c.max, c.average, c.nan_count, c.inf_count
+            )?;
+        }
+        Ok(())
+    }
+}
+
+impl Image {
+    /// A copy with `f` applied to every linear value, in the same format.
+    pub fn map_values(&self, f: impl Fn(f32) -> f32) -> Image {
+        let vals: Vec<f32> = self.to_f32_vec().into_iter().map(f).collect();
+        let mut out = Image::new(
+            self.format(),
+            self.resolution(),
+            self.channel_names(),
+            self.encoding(),
+        );
+        for (i, v) in vals.into_iter().enumerate() {
+            out.set_value_at(i, v);
+        }
+        out
+    }
+
+    /// Values scaled by 2^stops.
+    pub fn apply_exposure(&self, stops: f32) -> Image {
+        let s = stops.exp2();
+        self.map_values(|v| v * s)
+    }
+
+    /// Values clamped to [lo, hi] (NaN becomes `lo`).
+    pub fn clamp_values(&self, lo: f32, hi: f32) -> Image {
+        self.map_values(|v| if v.is_nan() { lo } else { v.clamp(lo, hi) })
+    }
+}
