@@ -97,6 +97,8 @@ Scene file tools:
 
   --help                       Print this help.
   --version                    Print the version.
+
+  rpbrt imgtool diff|info|convert ...   Image utilities (see: rpbrt imgtool help).
 ";
 
 /// Lower-case and drop '-' and '_' so flag spellings compare equal.

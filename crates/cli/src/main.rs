@@ -3,6 +3,7 @@
 //! (`file:line:col: error: ...`) and exiting non-zero on errors.
 
 mod args;
+mod imgtool;
 
 use rpbrt_parser::{parse_files, FormattingTarget};
 use rpbrt_render::scene::shapes::create_scene_shapes;
@@ -13,6 +14,9 @@ use std::process::ExitCode;
 
 fn main() -> ExitCode {
     let argv: Vec<String> = std::env::args().skip(1).collect();
+    if argv.first().map(String::as_str) == Some("imgtool") {
+        return imgtool::run(&argv[1..]);
+    }
     let opts = match args::parse_args(&argv) {
         Ok(o) => o,
         Err(e) => {

@@ -774,8 +774,7 @@ fn mutation_fuzz_never_panics() {
         rich_file(Format::BinaryBigEndian),
         encode_ply(&sample_mesh()).unwrap(),
         {
-            let mut enc =
-                flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+            let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
             enc.write_all(&rich_file(Format::BinaryLittleEndian))
                 .unwrap();
             enc.finish().unwrap()

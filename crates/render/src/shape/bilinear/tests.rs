@@ -74,8 +74,7 @@ fn planar_rectangle_hits_match_plane() {
     // Rays beside the rectangle miss it.
     let ray = Ray::new(Point3f::new(10.0, 10.0, 3.0), Vector3f::new(0.0, 0.0, -1.0));
     assert!(
-        blp.intersect(&ray, Float::INFINITY).is_none()
-            && !blp.intersect_p(&ray, Float::INFINITY)
+        blp.intersect(&ray, Float::INFINITY).is_none() && !blp.intersect_p(&ray, Float::INFINITY)
     );
 }
 
@@ -95,8 +94,8 @@ fn twisted_patch_hits_satisfy_bilinear_equation() {
             .intersect(&ray, Float::INFINITY)
             .unwrap_or_else(|| panic!("ray {ray:?} aimed at ({u}, {v}) missed"));
         assert!(blp.intersect_p(&ray, Float::INFINITY));
-        let (uv, t) = intersect_bilinear_patch(&ray, Float::INFINITY, p[0], p[1], p[2], p[3])
-            .expect("hit");
+        let (uv, t) =
+            intersect_bilinear_patch(&ray, Float::INFINITY, p[0], p[1], p[2], p[3]).expect("hit");
         // The hit lies on the ray and on the patch, no further than the
         // aimed-at point.
         let on_patch = bilerp(&p, uv.x, uv.y);
@@ -282,8 +281,7 @@ fn sample_pdf_matches_pdf_and_integrates_to_one() {
                 let m = 40_000;
                 let total: f64 = (0..m)
                     .map(|_| {
-                        let w =
-                            frame.from_local(sample_uniform_cone(ru(&mut r), cone.cos_theta));
+                        let w = frame.from_local(sample_uniform_cone(ru(&mut r), cone.cos_theta));
                         blp.pdf(&ctx, w) as f64
                     })
                     .sum::<f64>()
@@ -427,8 +425,8 @@ fn validation_errors() {
         vec![1, 2]
     ))
     .contains("face indices"));
-    let (m, w) = BilinearPatchMesh::new(&id, false, vec![], p4, vec![], vec![], vec![3])
-        .expect("one patch");
+    let (m, w) =
+        BilinearPatchMesh::new(&id, false, vec![], p4, vec![], vec![], vec![3]).expect("one patch");
     assert!(w.is_empty());
     assert_eq!(m.indices, vec![0, 1, 2, 3]);
 }
@@ -450,9 +448,8 @@ fn orientation_shading_and_texture_coordinates() {
             .intr
     };
 
-    let (m, _) =
-        BilinearPatchMesh::new(&id, false, vec![], p4.clone(), vec![], vec![], vec![4])
-            .expect("mesh");
+    let (m, _) = BilinearPatchMesh::new(&id, false, vec![], p4.clone(), vec![], vec![], vec![4])
+        .expect("mesh");
     let si = hit(m.clone());
     assert!(si.n.z > 0.99 && si.face_index == 4);
     assert!((si.uv - Point2f::new(0.25, 0.75)).length() < 1e-5);
@@ -465,8 +462,8 @@ fn orientation_shading_and_texture_coordinates() {
     // Tilted vertex normals become the shading normal; the geometric
     // normal follows their side.
     let ns = vec![Normal3f::new(0.3, 0.0, -1.0).normalize(); 4];
-    let (m, _) = BilinearPatchMesh::new(&id, false, vec![], p4.clone(), ns, vec![], vec![])
-        .expect("mesh");
+    let (m, _) =
+        BilinearPatchMesh::new(&id, false, vec![], p4.clone(), ns, vec![], vec![]).expect("mesh");
     let si = hit(m);
     assert!(si.n.z < -0.99);
     assert!((si.shading.n - Normal3f::new(0.3, 0.0, -1.0).normalize()).length() < 1e-4);
@@ -479,8 +476,7 @@ fn orientation_shading_and_texture_coordinates() {
         Point2f::new(0.0, 4.0),
         Point2f::new(2.0, 4.0),
     ];
-    let (m, _) =
-        BilinearPatchMesh::new(&id, false, vec![], p4, vec![], uv, vec![]).expect("mesh");
+    let (m, _) = BilinearPatchMesh::new(&id, false, vec![], p4, vec![], uv, vec![]).expect("mesh");
     let si = hit(m);
     assert!(
         (si.uv - Point2f::new(0.5, 3.0)).length() < 1e-4,

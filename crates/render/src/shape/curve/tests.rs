@@ -103,21 +103,18 @@ fn create_curves_counts_and_conversion() {
         assert!(approx(a, b, 1e-5));
     }
     // bezier degree 2: 5 points give 2 segments.
-    let (c, _) =
-        create_curves(&id, false, &p[..5], "bezier", 2, "flat", &[], 1.0, 2.0, 0).unwrap();
+    let (c, _) = create_curves(&id, false, &p[..5], "bezier", 2, "flat", &[], 1.0, 2.0, 0).unwrap();
     assert_eq!(c.len(), 2);
     assert_eq!(c[0].common.cp_obj[0], p[0]);
     assert_eq!(c[1].common.cp_obj[3], p[4]);
     assert!((c[0].common.width[1] - 1.5).abs() < 1e-6);
     // bezier degree 3 with 7 points: 2 segments.
-    let (c, _) =
-        create_curves(&id, false, &p[..4], "bezier", 3, "flat", &[], 1.0, 1.0, 1).unwrap();
+    let (c, _) = create_curves(&id, false, &p[..4], "bezier", 3, "flat", &[], 1.0, 1.0, 1).unwrap();
     assert_eq!(c.len(), 2);
     assert_eq!((c[0].u_min, c[0].u_max, c[1].u_max), (0.0, 0.5, 1.0));
     // normals on non-ribbon curves are ignored with a warning
     let n = [Normal3f::new(0.0, 1.0, 0.0); 2];
-    let (_, w) =
-        create_curves(&id, false, &p[..4], "bezier", 3, "flat", &n, 1.0, 1.0, 0).unwrap();
+    let (_, w) = create_curves(&id, false, &p[..4], "bezier", 3, "flat", &n, 1.0, 1.0, 0).unwrap();
     assert_eq!(w.len(), 1);
 }
 
@@ -225,8 +222,7 @@ fn cylinder_normal_faces_the_ray() {
     }
     // Through the middle the normal is straight back along the ray.
     let dir = Vector3f::new(1.0, 0.0, 0.0);
-    let h =
-        intersect_all(&curves, &Ray::new(pt(-4.0, 0.0, 1.5), dir), Float::INFINITY).unwrap();
+    let h = intersect_all(&curves, &Ray::new(pt(-4.0, 0.0, 1.5), dir), Float::INFINITY).unwrap();
     assert!(dot(h.intr.n, -dir) > 0.999);
     // Reversed orientation turns it away.
     let (rev, _) = create_curves(
@@ -389,8 +385,7 @@ fn equal_dir(rng: &mut Rng) -> Vector3f {
 
 #[test]
 fn transformed_curve_and_orientation() {
-    let t =
-        Transform::translate(Vector3f::new(1.0, 2.0, 3.0)) * Transform::scale(2.0, 2.0, 2.0);
+    let t = Transform::translate(Vector3f::new(1.0, 2.0, 3.0)) * Transform::scale(2.0, 2.0, 2.0);
     let (c, _) =
         create_curves(&t, false, &z_line(), "bezier", 3, "flat", &[], 0.1, 0.1, 1).unwrap();
     let b = c

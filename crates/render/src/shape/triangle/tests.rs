@@ -329,13 +329,12 @@ fn validation_errors() {
         Point3f::new(0.0, 1.0, 0.0),
     ];
     let p4 = [p3.clone(), vec![Point3f::new(1.0, 1.0, 0.0)]].concat();
-    let new =
-        |idx: Vec<u32>,
-         p: Vec<Point3f>,
-         s: Vec<Vector3f>,
-         n: Vec<Normal3f>,
-         uv: Vec<Point2f>,
-         f: Vec<i32>| TriangleMesh::new(&id, false, idx, p, s, n, uv, f);
+    let new = |idx: Vec<u32>,
+               p: Vec<Point3f>,
+               s: Vec<Vector3f>,
+               n: Vec<Normal3f>,
+               uv: Vec<Point2f>,
+               f: Vec<i32>| TriangleMesh::new(&id, false, idx, p, s, n, uv, f);
     let msg = |r: Result<(Arc<TriangleMesh>, Vec<String>), ShapeError>| {
         r.err().map(|e| e.0).unwrap_or_default()
     };
@@ -395,8 +394,7 @@ fn validation_errors() {
     ))
     .contains("\"uv\""));
     assert!(
-        msg(new(vec![], p3.clone(), vec![], vec![], vec![], vec![1, 2]))
-            .contains("face indices")
+        msg(new(vec![], p3.clone(), vec![], vec![], vec![], vec![1, 2])).contains("face indices")
     );
     assert!(msg(new(
         vec![],
@@ -451,9 +449,8 @@ fn interaction_geometry_and_orientation() {
     assert!(si.p_error().length() > 0.0 && si.p_error().length() < 1e-5);
     assert!((Triangle::new(m, 0).normal_bounds().w - Vector3f::from(si.n)).length() < 1e-6);
 
-    let (m, _) =
-        TriangleMesh::new(&id, true, vec![], p.clone(), vec![], vec![], vec![], vec![])
-            .expect("mesh");
+    let (m, _) = TriangleMesh::new(&id, true, vec![], p.clone(), vec![], vec![], vec![], vec![])
+        .expect("mesh");
     assert!(hit(m.clone()).n.z < 0.0);
     assert!(Triangle::new(m, 0).normal_bounds().w.z < 0.0);
 
@@ -496,9 +493,7 @@ fn interaction_geometry_and_orientation() {
     .expect("mesh");
     let si = hit(m);
     assert!(
-        si.shading.n.x > 0.0
-            && si.shading.n.y > 0.0
-            && (si.shading.n.length() - 1.0).abs() < 1e-5
+        si.shading.n.x > 0.0 && si.shading.n.y > 0.0 && (si.shading.n.length() - 1.0).abs() < 1e-5
     );
     assert!(si.shading.dndu.length() > 0.0);
     assert!(dot(si.shading.dpdu, si.shading.n).abs() < 1e-5);

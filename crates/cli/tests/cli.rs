@@ -1,0 +1,120 @@
+//! End-to-end tests of the `rpbrt` binary: exit codes and located messages.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn rpbrt() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_rpbrt"))
+}
+
+fn temp_scene(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("rpbrt-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn help_lists_flags() {
+    let out = rpbrt().arg("--help").output().unwrap();
+    assert!(out.status.success());
+    let s = String::from_utf8_lossy(&out.stdout);
+    for flag in [
+        "--outfile",
+        "--spp",
+        "--nthreads",
+        "--format",
+        "--upgrade",
+        "--toply",
+        "imgtool",
+    ] {
+        assert!(s.contains(flag), "{flag} missing from --help");
+    }
+}
+
+#[test]
+fn errors_are_located_with_a_caret_and_exit_1() {
+    let p = temp_scene(
+        "bad.pbrt",
+        "WorldBegin\nShape \"sphere\" \"float radius\" \"big\"\n",
+    );
+    let out = rpbrt().arg("--format").arg(&p).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("bad.pbrt:2:31: error:"), "{e}");
+    assert!(e.contains('^'), "{e}");
+}
+
+#[test]
+fn unknown_shape_type_lists_known_ones() {
+    let p = temp_scene("unknown.pbrt", "WorldBegin\nShape \"sphear\"\n");
+    let out = rpbrt().arg(&p).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("unknown.pbrt:2:") && e.contains("sphere"), "{e}");
+}
+
+#[test]
+fn degenerate_shape_is_a_located_error() {
+    let p = temp_scene(
+        "degenerate.pbrt",
+        "WorldBegin\nAttributeBegin\nShape \"sphere\" \"float radius\" -2\nAttributeEnd\n",
+    );
+    let out = rpbrt().arg(&p).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        e.contains("degenerate.pbrt:3:") && e.contains("error"),
+        "{e}"
+    );
+}
+
+#[test]
+fn bad_flags_are_errors() {
+    let out = rpbrt().args(["--spp", "-3", "x.pbrt"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let out = rpbrt().arg("--frobnicate").output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+}
+
+#[test]
+fn format_round_trip_is_stable() {
+    let scene = "LookAt 0 0 -5 0 0 0 0 1 0\nCamera \"perspective\" \"float fov\" 45\nWorldBegin\nAttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0.5 0.5 0.5]\nShape \"sphere\"\nAttributeEnd\n";
+    let p = temp_scene("rt.pbrt", scene);
+    let once = rpbrt().arg("--format").arg(&p).output().unwrap();
+    assert!(once.status.success());
+    let p2 = temp_scene("rt2.pbrt", &String::from_utf8_lossy(&once.stdout));
+    let twice = rpbrt().arg("--format").arg(&p2).output().unwrap();
+    assert_eq!(once.stdout, twice.stdout);
+}
+
+#[test]
+fn upgrade_maps_v3_materials() {
+    let p = temp_scene(
+        "v3.pbrt",
+        "WorldBegin\nMaterial \"matte\" \"color Kd\" [0.5 0.5 0.5]\nShape \"sphere\"\nWorldEnd\n",
+    );
+    let out = rpbrt().arg("--upgrade").arg(&p).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        s.contains("Material \"diffuse\"") && s.contains("\"rgb reflectance\""),
+        "{s}"
+    );
+}
+
+#[test]
+fn imgtool_reports_bad_files() {
+    let out = rpbrt()
+        .args(["imgtool", "info", "/nonexistent.exr"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let out = rpbrt().args(["imgtool", "frob"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+}
