@@ -2,7 +2,9 @@
 #![deny(missing_docs)]
 
 pub mod accel;
+pub mod filter;
 pub mod rng;
+pub mod sampler;
 pub mod sampling;
 pub mod scene;
 pub mod shape;
