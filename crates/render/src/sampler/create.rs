@@ -149,9 +149,8 @@ pub fn create_sampler(
                     "pmj02bn: results are best with power-of-4 samples per pixel (1, 4, 16, 64, ...)",
                 ));
             }
-            let s = Pmj02bnSampler::new(n, seed).map_err(|e| {
-                Diagnostic::error(param_loc(params, "pixelsamples", loc), e)
-            })?;
+            let s = Pmj02bnSampler::new(n, seed)
+                .map_err(|e| Diagnostic::error(param_loc(params, "pixelsamples", loc), e))?;
             Sampler::Pmj02bn(s)
         }
         "independent" => {

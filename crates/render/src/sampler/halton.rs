@@ -51,7 +51,11 @@ impl HaltonSampler {
         let mut base_exponents = [0u32; 2];
         for i in 0..2 {
             let base = if i == 0 { 2 } else { 3 };
-            let res = if i == 0 { full_resolution.x } else { full_resolution.y };
+            let res = if i == 0 {
+                full_resolution.x
+            } else {
+                full_resolution.y
+            };
             let (mut scale, mut exp) = (1i64, 0u32);
             while scale < res.min(MAX_HALTON_RESOLUTION) as i64 {
                 scale *= base;

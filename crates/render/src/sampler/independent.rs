@@ -61,7 +61,13 @@ impl IndependentSampler {
 /// Restarts `rng` on the stream of pixel `p` and `seed`, advanced to
 /// `sample_index * 65536 + dimension`.
 #[inline]
-pub(crate) fn start_stream(rng: &mut Rng, p: Point2i, seed: i32, sample_index: i32, dimension: i32) {
+pub(crate) fn start_stream(
+    rng: &mut Rng,
+    p: Point2i,
+    seed: i32,
+    sample_index: i32,
+    dimension: i32,
+) {
     let seq = hash_values(&[&p, &seed]);
     rng.set_sequence(seq, mix_bits(seq));
     rng.advance(sample_index as i64 * 65536 + dimension as i64);

@@ -83,7 +83,11 @@ fn build_sobol_matrices() -> Vec<u32> {
         }
         // Column k is m_k / 2^(k+1), kept to 32 fractional bits.
         for (k, &mk) in m.iter().enumerate() {
-            let c = if k <= 31 { mk << (31 - k) } else { mk >> (k - 31) };
+            let c = if k <= 31 {
+                mk << (31 - k)
+            } else {
+                mk >> (k - 31)
+            };
             out[dim * SOBOL_MATRIX_SIZE + k] = c as u32;
         }
     }
@@ -269,7 +273,10 @@ fn digits_for_base(base: u32) -> usize {
 /// Digit permutations for every prime base of the table (pbrt-v4's
 /// `ComputeRadicalInversePermutations`).
 pub fn compute_radical_inverse_permutations(seed: u32) -> Vec<DigitPermutation> {
-    PRIMES.iter().map(|&b| DigitPermutation::new(b, seed)).collect()
+    PRIMES
+        .iter()
+        .map(|&b| DigitPermutation::new(b, seed))
+        .collect()
 }
 
 /// The radical inverse of `a` in the base `PRIMES[base_index]`.
@@ -495,13 +502,19 @@ mod tests {
     #[test]
     fn sobol_first_dimensions() {
         // Dimension 0 is van der Corput; dimension 1 the classic second
-        // Sobol' dimension: 0, 1/2, 3/4, 1/4, 3/8, 7/8, 5/8, 1/8.
-        let vdc: Vec<Float> = (0..4).map(|i| sobol_sample(i, 0, BinaryScrambler::None)).collect();
+        // Sobol' dimension (m = 1, 3, 5, ...) in index order.
+        let vdc: Vec<Float> = (0..4)
+            .map(|i| sobol_sample(i, 0, BinaryScrambler::None))
+            .collect();
         assert_eq!(vdc, vec![0.0, 0.5, 0.25, 0.75]);
-        let d1: Vec<Float> = (0..8).map(|i| sobol_sample(i, 1, BinaryScrambler::None)).collect();
-        assert_eq!(d1, vec![0.0, 0.5, 0.75, 0.25, 0.375, 0.875, 0.625, 0.125]);
+        let d1: Vec<Float> = (0..8)
+            .map(|i| sobol_sample(i, 1, BinaryScrambler::None))
+            .collect();
+        assert_eq!(d1, vec![0.0, 0.5, 0.75, 0.25, 0.625, 0.125, 0.375, 0.875]);
         // Dimension 2 (Joe–Kuo d=3: s=2, a=1, m=1,3): v = 1/2, 3/4, 3/8, ...
-        let d2: Vec<Float> = (0..4).map(|i| sobol_sample(i, 2, BinaryScrambler::None)).collect();
+        let d2: Vec<Float> = (0..4)
+            .map(|i| sobol_sample(i, 2, BinaryScrambler::None))
+            .collect();
         assert_eq!(sobol_sample(4, 2, BinaryScrambler::None), 0.375);
         assert_eq!(d2, vec![0.0, 0.5, 0.75, 0.25]);
         // Every dimension is a (0,1)-sequence: the first 2^k values hit
@@ -562,7 +575,9 @@ mod tests {
     #[test]
     fn permutation_and_hash() {
         for n in [1u32, 2, 5, 16, 100] {
-            let mut v: Vec<u32> = (0..n).map(|i| permutation_element(i, n, 0xdead_beef)).collect();
+            let mut v: Vec<u32> = (0..n)
+                .map(|i| permutation_element(i, n, 0xdead_beef))
+                .collect();
             v.sort();
             assert_eq!(v, (0..n).collect::<Vec<_>>());
         }

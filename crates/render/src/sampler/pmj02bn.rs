@@ -10,8 +10,12 @@
 //! candidate x stratum the admissible y strata are found by a depth-first
 //! search over y bits (each bit decides one more shape). Among a few
 //! admissible jittered candidates the one farthest from the existing points
-//! (toroidal distance) is kept: Mitchell's best-candidate rule, which gives
-//! the blue-noise character. If a level cannot be completed (rare), it is
+//! (toroidal distance) is kept (Mitchell's best-candidate rule, after
+//! Christensen et al.). Measured: under the (0,2) constraints this barely
+//! changes the spacing (mean nearest-neighbour distance 0.649 vs 0.651 ×
+//! 1/sqrt(N) for 1024 points, 16 vs 1 candidates; uniform random ≈ 0.5),
+//! so the sets are pmj02 with only a nominal blue-noise step; a real
+//! blue-noise optimisation is not done. If a level cannot be completed (rare), it is
 //! restarted with fresh random choices. Every prefix of 2^K points is thus
 //! a (0,K,2)-net.
 //!
@@ -35,16 +39,21 @@ pub const LOG2_PMJ02BN_SAMPLES: u32 = 16;
 /// Points per set (pbrt-v4's `nPMJ02bnSamples`): the most samples per pixel.
 pub const N_PMJ02BN_SAMPLES: usize = 1 << LOG2_PMJ02BN_SAMPLES;
 
-/// Best-candidate tries per point.
+/// Best-candidate tries per point for the cached sets.
 const N_CANDIDATES: usize = 4;
 
 /// Point set `set` (mod [`N_PMJ02BN_SETS`]), generated on first use.
 pub fn pmj02bn_set(set: usize) -> &'static [Point2f] {
-    static SETS: [OnceLock<Vec<Point2f>>; N_PMJ02BN_SETS] =
-        [OnceLock::new(), OnceLock::new(), OnceLock::new(), OnceLock::new(), OnceLock::new()];
+    static SETS: [OnceLock<Vec<Point2f>>; N_PMJ02BN_SETS] = [
+        OnceLock::new(),
+        OnceLock::new(),
+        OnceLock::new(),
+        OnceLock::new(),
+        OnceLock::new(),
+    ];
     let set = set % N_PMJ02BN_SETS;
     SETS[set].get_or_init(|| {
-        generate_pmj02bn(LOG2_PMJ02BN_SAMPLES, set as u64)
+        generate_pmj02bn(LOG2_PMJ02BN_SAMPLES, set as u64, N_CANDIDATES)
             .into_iter()
             .map(|(x, y)| Point2f::new(truncate_f32(x), truncate_f32(y)))
             .collect()
@@ -180,8 +189,10 @@ impl Occupancy {
     }
 }
 
-/// Generates 2^`log2_n` pmj02bn points (in [0,1)², as f64) for `seed`.
-pub fn generate_pmj02bn(log2_n: u32, seed: u64) -> Vec<(f64, f64)> {
+/// Generates 2^`log2_n` pmj02bn points (in [0,1)², as f64) for `seed`,
+/// keeping the best of `candidates` admissible points each time (1 gives
+/// plain pmj02 without blue-noise selection).
+pub fn generate_pmj02bn(log2_n: u32, seed: u64, candidates: usize) -> Vec<(f64, f64)> {
     let n = 1usize << log2_n;
     let mut rng = Rng::new(mix_bits(seed ^ 0x706d_6a30_3262_6e00), seed);
     let mut pts: Vec<(f64, f64)> = Vec::with_capacity(n);
@@ -195,14 +206,16 @@ pub fn generate_pmj02bn(log2_n: u32, seed: u64) -> Vec<(f64, f64)> {
         let cell = 1.0 / (1u64 << k) as f64;
         'attempt: loop {
             let mut occ = Occupancy::new(k, &pts);
-            let mut free_x: Vec<u32> = (0..1u32 << k).filter(|&x| !occ.occ[k as usize][x as usize]).collect();
+            let mut free_x: Vec<u32> = (0..1u32 << k)
+                .filter(|&x| !occ.occ[k as usize][x as usize])
+                .collect();
             while pts.len() < end {
                 // Random order of the free x strata; take the first few
                 // admissible candidates.
                 let mut best: Option<((f64, f64), f64, usize)> = None;
                 let mut found = 0;
                 let mut remaining = free_x.len();
-                while remaining > 0 && found < N_CANDIDATES {
+                while remaining > 0 && found < candidates.max(1) {
                     let r = rng.uniform_bounded(remaining as u32) as usize;
                     free_x.swap(r, remaining - 1);
                     remaining -= 1;
@@ -270,7 +283,10 @@ impl Pmj02bnSampler {
         }
         let spp = samples_per_pixel as usize;
         let log4_n = LOG2_PMJ02BN_SAMPLES / 2;
-        let log4_spp = (spp as u32).next_power_of_two().trailing_zeros().div_ceil(2);
+        let log4_spp = (spp as u32)
+            .next_power_of_two()
+            .trailing_zeros()
+            .div_ceil(2);
         let tile = 1usize << (log4_n - log4_spp);
         let mut samples = vec![Point2f::new(0.0, 0.0); tile * tile * spp];
         let mut stored = vec![0usize; tile * tile];

@@ -14,8 +14,8 @@ use rpbrt_geometry::float::{Float, ONE_MINUS_EPSILON};
 use rpbrt_geometry::tuple::{Point2f, Point2i};
 
 use super::lowdiscrepancy::{
-    encode_morton2, mix_bits, permutation_element, sobol_matrices, sobol_sample,
-    BinaryScrambler, RandomizeStrategy, N_SOBOL_DIMENSIONS, PERMUTATIONS_4, SOBOL_MATRIX_SIZE,
+    encode_morton2, mix_bits, permutation_element, sobol_matrices, sobol_sample, BinaryScrambler,
+    RandomizeStrategy, N_SOBOL_DIMENSIONS, PERMUTATIONS_4, SOBOL_MATRIX_SIZE,
 };
 
 /// Largest supported log2 of the Sobol' sampler's pixel scale (so that
@@ -161,8 +161,12 @@ impl SobolSampler {
             sobol_sample(self.sobol_index, 0, BinaryScrambler::None),
             sobol_sample(self.sobol_index, 1, BinaryScrambler::None),
         ];
-        let p = [self.pixel.x & (self.scale - 1), self.pixel.y & (self.scale - 1)];
-        let f = |i: usize| (u[i] * self.scale as Float - p[i] as Float).clamp(0.0, ONE_MINUS_EPSILON);
+        let p = [
+            self.pixel.x & (self.scale - 1),
+            self.pixel.y & (self.scale - 1),
+        ];
+        let f =
+            |i: usize| (u[i] * self.scale as Float - p[i] as Float).clamp(0.0, ONE_MINUS_EPSILON);
         Point2f::new(f(0), f(1))
     }
 }
@@ -332,8 +336,8 @@ impl ZSobolSampler {
     #[inline]
     pub fn start_pixel_sample(&mut self, p: Point2i, index: i32, dimension: i32) {
         self.dimension = dimension;
-        self.morton_index = (encode_morton2(p.x as u32, p.y as u32) << self.log2_samples_per_pixel)
-            | index as u64;
+        self.morton_index =
+            (encode_morton2(p.x as u32, p.y as u32) << self.log2_samples_per_pixel) | index as u64;
     }
 
     /// The Sobol' index for the current pixel sample and dimension: the
