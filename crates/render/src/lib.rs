@@ -3,9 +3,11 @@
 
 pub mod accel;
 pub mod camera;
+pub mod filter;
 pub mod image;
 pub mod primitive;
 pub mod rng;
+pub mod sampler;
 pub mod sampling;
 pub mod scene;
 pub mod shape;

@@ -3,6 +3,7 @@
 //! their densities and, where pbrt has them, their inverses.
 
 pub mod spherical;
+pub mod tabulated;
 
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;

@@ -1,0 +1,199 @@
+//! Creating samplers from scene-file parameters (pbrt-v4
+//! `Sampler::Create` and each sampler's `Create`): parameter names,
+//! defaults and overrides as pbrt-v4, with located errors for bad values.
+
+use rpbrt_geometry::tuple::Point2i;
+use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary};
+
+use super::*;
+
+fn param_loc(params: &ParameterDictionary, name: &str, loc: &FileLoc) -> FileLoc {
+    params.loc(name).cloned().unwrap_or_else(|| loc.clone())
+}
+
+/// Reads `pixelsamples` (default `default`), applying the command-line
+/// override; counts ≤ 0 are errors.
+fn pixel_samples(
+    params: &ParameterDictionary,
+    default: i32,
+    spp_override: Option<i32>,
+    loc: &FileLoc,
+) -> Result<i32, Diagnostic> {
+    let mut n = params.get_one_int("pixelsamples", default)?;
+    if n <= 0 {
+        return Err(Diagnostic::error(
+            param_loc(params, "pixelsamples", loc),
+            format!("\"pixelsamples\" must be positive, not {n}"),
+        ));
+    }
+    if let Some(o) = spp_override {
+        if o <= 0 {
+            return Err(Diagnostic::error(
+                loc.clone(),
+                format!("samples-per-pixel override must be positive, not {o}"),
+            ));
+        }
+        n = o;
+    }
+    Ok(n)
+}
+
+fn randomization(
+    params: &ParameterDictionary,
+    default: &str,
+    sampler: &str,
+    loc: &FileLoc,
+) -> Result<RandomizeStrategy, Diagnostic> {
+    let s = params.get_one_string("randomization", default)?;
+    let err = |msg: String| Diagnostic::error(param_loc(params, "randomization", loc), msg);
+    match s.as_str() {
+        "none" => Ok(RandomizeStrategy::None),
+        "permutedigits" => Ok(RandomizeStrategy::PermuteDigits),
+        "fastowen" if sampler == "halton" => Err(err(
+            "\"fastowen\" randomization is not supported by the halton sampler".into(),
+        )),
+        "fastowen" => Ok(RandomizeStrategy::FastOwen),
+        "owen" => Ok(RandomizeStrategy::Owen),
+        _ => Err(err(format!(
+            "\"{s}\": unknown randomization strategy given to {sampler} sampler \
+             (expected none, permutedigits, fastowen or owen)"
+        ))),
+    }
+}
+
+fn warn_not_pow2(n: i32, name: &str, loc: &FileLoc, warnings: &mut Vec<Diagnostic>) {
+    if n & (n - 1) != 0 {
+        warnings.push(Diagnostic::warning(
+            loc.clone(),
+            format!("{name}: non power-of-two sample counts ({n}) are sub-optimal"),
+        ));
+    }
+}
+
+/// Creates the sampler `name` ("zsobol", "sobol", "paddedsobol", "halton",
+/// "pmj02bn", "independent", "stratified") for an image of
+/// `full_resolution` from its parameters. `spp_override` and
+/// `seed_override` are the command-line `--spp` and `--seed` (the seed
+/// default for the `seed` parameter; pbrt's default 0). Warnings (such as
+/// a non-power-of-two count for a Sobol' sampler) go to `warnings`.
+pub fn create_sampler(
+    name: &str,
+    params: &ParameterDictionary,
+    full_resolution: Point2i,
+    spp_override: Option<i32>,
+    seed_override: Option<i32>,
+    loc: &FileLoc,
+    warnings: &mut Vec<Diagnostic>,
+) -> Result<Sampler, Diagnostic> {
+    let options_seed = seed_override.unwrap_or(0);
+    let sampler = match name {
+        "zsobol" => {
+            let n = pixel_samples(params, 16, spp_override, loc)?;
+            let seed = params.get_one_int("seed", options_seed)?;
+            let r = randomization(params, "fastowen", name, loc)?;
+            if n & (n - 1) != 0 {
+                let used = 1 << (31 - (n as u32).leading_zeros());
+                warnings.push(Diagnostic::warning(
+                    loc.clone(),
+                    format!(
+                        "zsobol: non power-of-two sample counts are sub-optimal; \
+                         using {used} samples per pixel instead of {n}"
+                    ),
+                ));
+            }
+            Sampler::ZSobol(ZSobolSampler::new(n, full_resolution, r, seed))
+        }
+        "sobol" => {
+            let n = pixel_samples(params, 16, spp_override, loc)?;
+            let r = randomization(params, "fastowen", name, loc)?;
+            warn_not_pow2(n, name, loc, warnings);
+            let res = full_resolution.x.max(full_resolution.y).max(1) as u64;
+            let log2_scale = res.next_power_of_two().trailing_zeros();
+            let log2_spp = (n as u64).next_power_of_two().trailing_zeros();
+            if log2_scale > sobol::MAX_SOBOL_LOG2_SCALE
+                || 2 * log2_scale + log2_spp > lowdiscrepancy::SOBOL_MATRIX_SIZE as u32
+            {
+                return Err(Diagnostic::error(
+                    loc.clone(),
+                    format!(
+                        "sobol: image resolution {}x{} with {n} samples per pixel exceeds \
+                         the Sobol' sequence's 2^52 samples",
+                        full_resolution.x, full_resolution.y
+                    ),
+                ));
+            }
+            // pbrt-v4 randomises the global Sobol' sampler with the
+            // command-line seed only.
+            Sampler::Sobol(SobolSampler::new(n, full_resolution, r, options_seed))
+        }
+        "paddedsobol" => {
+            let n = pixel_samples(params, 16, spp_override, loc)?;
+            let seed = params.get_one_int("seed", options_seed)?;
+            let r = randomization(params, "fastowen", name, loc)?;
+            warn_not_pow2(n, name, loc, warnings);
+            Sampler::PaddedSobol(PaddedSobolSampler::new(n, r, seed))
+        }
+        "halton" => {
+            let n = pixel_samples(params, 16, spp_override, loc)?;
+            let seed = params.get_one_int("seed", options_seed)?;
+            let r = randomization(params, "permutedigits", name, loc)?;
+            Sampler::Halton(HaltonSampler::new(n, full_resolution, r, seed))
+        }
+        "pmj02bn" => {
+            let n = pixel_samples(params, 16, spp_override, loc)?;
+            let seed = params.get_one_int("seed", options_seed)?;
+            let log2 = 31 - (n as u32).leading_zeros();
+            if n & (n - 1) != 0 || log2 % 2 != 0 {
+                warnings.push(Diagnostic::warning(
+                    loc.clone(),
+                    "pmj02bn: results are best with power-of-4 samples per pixel (1, 4, 16, 64, ...)",
+                ));
+            }
+            let s = Pmj02bnSampler::new(n, seed)
+                .map_err(|e| Diagnostic::error(param_loc(params, "pixelsamples", loc), e))?;
+            Sampler::Pmj02bn(s)
+        }
+        "independent" => {
+            let n = pixel_samples(params, 4, spp_override, loc)?;
+            let seed = params.get_one_int("seed", options_seed)?;
+            Sampler::Independent(IndependentSampler::new(n, seed))
+        }
+        "stratified" => {
+            let jitter = params.get_one_bool("jitter", true)?;
+            let mut xs = params.get_one_int("xsamples", 4)?;
+            let mut ys = params.get_one_int("ysamples", 4)?;
+            for (v, pname) in [(xs, "xsamples"), (ys, "ysamples")] {
+                if v <= 0 {
+                    return Err(Diagnostic::error(
+                        param_loc(params, pname, loc),
+                        format!("\"{pname}\" must be positive, not {v}"),
+                    ));
+                }
+            }
+            if let Some(n) = spp_override {
+                if n <= 0 {
+                    return Err(Diagnostic::error(
+                        loc.clone(),
+                        format!("samples-per-pixel override must be positive, not {n}"),
+                    ));
+                }
+                // The most square factorisation, as pbrt-v4.
+                let mut div = (n as f64).sqrt() as i32;
+                while n % div != 0 {
+                    div -= 1;
+                }
+                xs = n / div;
+                ys = n / xs;
+            }
+            let seed = params.get_one_int("seed", options_seed)?;
+            Sampler::Stratified(StratifiedSampler::new(xs, ys, jitter, seed))
+        }
+        _ => {
+            return Err(Diagnostic::error(
+                loc.clone(),
+                format!("\"{name}\": sampler type unknown"),
+            ))
+        }
+    };
+    Ok(sampler)
+}

@@ -1,0 +1,3 @@
+//! Generated data tables for the samplers.
+
+pub mod joe_kuo;

@@ -1,0 +1,110 @@
+//! Samplers (book chapter 8; pbrt-v4 `samplers.h`, `samplers.cpp`): the
+//! sources of the sample values that drive rendering, from independent
+//! random numbers to stratified and low-discrepancy sequences.
+//!
+//! Each sampler is deterministic per (pixel, sample index, dimension,
+//! seed): `start_pixel_sample` sets all of its state, so results never
+//! depend on which thread renders which pixel or in what order. Clone one
+//! sampler per thread.
+
+mod create;
+mod data;
+pub mod halton;
+pub mod independent;
+pub mod lowdiscrepancy;
+pub mod pmj02bn;
+pub mod sobol;
+pub mod stratified;
+#[cfg(test)]
+mod tests;
+
+use rpbrt_geometry::float::Float;
+use rpbrt_geometry::tuple::{Point2f, Point2i};
+
+pub use create::create_sampler;
+pub use halton::HaltonSampler;
+pub use independent::IndependentSampler;
+pub use lowdiscrepancy::RandomizeStrategy;
+pub use pmj02bn::Pmj02bnSampler;
+pub use sobol::{PaddedSobolSampler, SobolSampler, ZSobolSampler};
+pub use stratified::StratifiedSampler;
+
+/// A sampler: a closed set of variants with one-line delegation (the
+/// Rust form of pbrt-v4's tagged `Sampler`).
+#[derive(Clone, Debug)]
+pub enum Sampler {
+    /// Independent uniform random samples.
+    Independent(IndependentSampler),
+    /// Jittered stratified samples.
+    Stratified(StratifiedSampler),
+    /// The Halton sequence.
+    Halton(HaltonSampler),
+    /// One Sobol' sequence over the whole image.
+    Sobol(SobolSampler),
+    /// Per-pixel padded Sobol' points.
+    PaddedSobol(PaddedSobolSampler),
+    /// Morton-ordered Sobol' (pbrt-v4's default).
+    ZSobol(ZSobolSampler),
+    /// Progressive multi-jittered (0,2) points with blue-noise selection.
+    Pmj02bn(Pmj02bnSampler),
+}
+
+macro_rules! dispatch {
+    ($self:expr, $s:ident => $e:expr) => {
+        match $self {
+            Sampler::Independent($s) => $e,
+            Sampler::Stratified($s) => $e,
+            Sampler::Halton($s) => $e,
+            Sampler::Sobol($s) => $e,
+            Sampler::PaddedSobol($s) => $e,
+            Sampler::ZSobol($s) => $e,
+            Sampler::Pmj02bn($s) => $e,
+        }
+    };
+}
+
+impl Sampler {
+    /// Samples taken in each pixel.
+    #[inline]
+    pub fn samples_per_pixel(&self) -> i32 {
+        dispatch!(self, s => s.samples_per_pixel())
+    }
+
+    /// Starts sample `sample_index` of pixel `p`, at sample dimension
+    /// `dimension` (0 for a camera sample from scratch).
+    #[inline]
+    pub fn start_pixel_sample(&mut self, p: Point2i, sample_index: i32, dimension: i32) {
+        dispatch!(self, s => s.start_pixel_sample(p, sample_index, dimension))
+    }
+
+    /// The next sample dimension, in [0,1).
+    #[inline]
+    pub fn get_1d(&mut self) -> Float {
+        dispatch!(self, s => s.get_1d())
+    }
+
+    /// The next two sample dimensions, in [0,1)².
+    #[inline]
+    pub fn get_2d(&mut self) -> Point2f {
+        dispatch!(self, s => s.get_2d())
+    }
+
+    /// The sample's position within its pixel, in [0,1)².
+    #[inline]
+    pub fn get_pixel_2d(&mut self) -> Point2f {
+        dispatch!(self, s => s.get_pixel_2d())
+    }
+
+    /// pbrt's scene-file name of the sampler type.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Sampler::Independent(_) => "independent",
+            Sampler::Stratified(_) => "stratified",
+            Sampler::Halton(_) => "halton",
+            Sampler::Sobol(_) => "sobol",
+            Sampler::PaddedSobol(_) => "paddedsobol",
+            Sampler::ZSobol(_) => "zsobol",
+            Sampler::Pmj02bn(_) => "pmj02bn",
+        }
+    }
+}

@@ -1,0 +1,391 @@
+//! Sobol'-based samplers (book section 8.7; pbrt-v4 `SobolSampler`,
+//! `PaddedSobolSampler`, `ZSobolSampler`).
+//!
+//! * [`SobolSampler`]: one Sobol' sequence over the whole image; the
+//!   first two dimensions choose the pixel, so sample `i` of a pixel is the
+//!   `i`-th sequence point that lands in it.
+//! * [`PaddedSobolSampler`]: per pixel, the first `spp` Sobol' points,
+//!   reordered per dimension by a random permutation and scrambled.
+//! * [`ZSobolSampler`] (pbrt-v4's default): pixels are visited in Morton
+//!   order with randomly permuted base-4 digits, which spreads one 2-D
+//!   Sobol' sequence over the image with blue-noise-like error.
+
+use rpbrt_geometry::float::{Float, ONE_MINUS_EPSILON};
+use rpbrt_geometry::tuple::{Point2f, Point2i};
+
+use super::lowdiscrepancy::{
+    encode_morton2, mix_bits, permutation_element, sobol_matrices, sobol_sample, BinaryScrambler,
+    RandomizeStrategy, N_SOBOL_DIMENSIONS, PERMUTATIONS_4, SOBOL_MATRIX_SIZE,
+};
+
+/// Largest supported log2 of the Sobol' sampler's pixel scale (so that
+/// `2 * log2_scale + log2(spp)` fits the 52 generator-matrix columns).
+pub const MAX_SOBOL_LOG2_SCALE: u32 = 20;
+
+/// The global Sobol' sampler.
+#[derive(Clone, Debug)]
+pub struct SobolSampler {
+    samples_per_pixel: i32,
+    scale: i32,
+    log2_scale: u32,
+    seed: i32,
+    randomize: RandomizeStrategy,
+    /// Inverse of the GF(2) system for the unknown index bits, one column
+    /// per bit of the pixel's y coordinate.
+    inv_columns: [u32; MAX_SOBOL_LOG2_SCALE as usize],
+    pixel: Point2i,
+    dimension: i32,
+    sobol_index: u64,
+}
+
+impl SobolSampler {
+    /// A Sobol' sampler over an image of `full_resolution`, whose larger
+    /// side must be at most 2^[`MAX_SOBOL_LOG2_SCALE`]. `seed` randomises
+    /// the scrambling (pbrt-v4 takes it from the `--seed` option).
+    pub fn new(
+        samples_per_pixel: i32,
+        full_resolution: Point2i,
+        randomize: RandomizeStrategy,
+        seed: i32,
+    ) -> Self {
+        let scale = (full_resolution.x.max(full_resolution.y).max(1) as u32).next_power_of_two();
+        let log2_scale = scale.trailing_zeros().min(MAX_SOBOL_LOG2_SCALE);
+        let scale = 1i32 << log2_scale;
+        SobolSampler {
+            samples_per_pixel,
+            scale,
+            log2_scale,
+            seed,
+            randomize,
+            inv_columns: solve_pixel_system(log2_scale),
+            pixel: Point2i::new(0, 0),
+            dimension: 0,
+            sobol_index: 0,
+        }
+    }
+
+    /// Samples per pixel.
+    #[inline]
+    pub fn samples_per_pixel(&self) -> i32 {
+        self.samples_per_pixel
+    }
+
+    /// Finds the sequence index of sample `sample_index` in pixel `p`.
+    #[inline]
+    pub fn start_pixel_sample(&mut self, p: Point2i, sample_index: i32, dim: i32) {
+        self.pixel = p;
+        self.dimension = dim.max(2);
+        self.sobol_index = self.interval_to_index(sample_index as u64, p);
+    }
+
+    /// The index of the `frame`-th Sobol' point whose first two dimensions,
+    /// scaled by `scale`, fall in pixel `p` (pbrt-v4's
+    /// `SobolIntervalToIndex`, solved here directly over GF(2)).
+    ///
+    /// Indices `frame·4^m + low` (`low` < 4^m) form a (0,2m,2)-net, so each
+    /// pixel holds exactly one. Dimension 0 is van der Corput: its top `m`
+    /// bits are the low `m` index bits reversed, which fixes them from
+    /// `p.x`. Dimension 1's top `m` bits are linear in the index; the
+    /// unknown bits `m..2m` follow from `p.y` by the precomputed inverse.
+    pub fn interval_to_index(&self, frame: u64, p: Point2i) -> u64 {
+        let m = self.log2_scale;
+        if m == 0 {
+            return frame;
+        }
+        let mask = (1u32 << m) - 1;
+        let px = (p.x as u32) & mask;
+        let py = (p.y as u32) & mask;
+        let low = (px.reverse_bits() >> (32 - m)) as u64;
+        let mut index = (frame << (2 * m)) | low;
+        // y's top m bits from the known index bits.
+        let c1 = &sobol_matrices()[SOBOL_MATRIX_SIZE..2 * SOBOL_MATRIX_SIZE];
+        let mut known = 0u32;
+        let mut bits = index;
+        let mut j = 0;
+        while bits != 0 {
+            if bits & 1 != 0 {
+                known ^= c1[j] >> (32 - m);
+            }
+            bits >>= 1;
+            j += 1;
+        }
+        let target = py ^ known;
+        let mut unknown = 0u32;
+        for (b, col) in self.inv_columns.iter().enumerate().take(m as usize) {
+            if target >> b & 1 != 0 {
+                unknown ^= col;
+            }
+        }
+        index |= (unknown as u64) << m;
+        index
+    }
+
+    #[inline]
+    fn sample_dimension(&self, dimension: usize) -> Float {
+        let scrambler = if self.randomize == RandomizeStrategy::None {
+            BinaryScrambler::None
+        } else {
+            let hash = mix_bits(((dimension as u64) << 32) ^ self.seed as i64 as u64) as u32;
+            BinaryScrambler::new(self.randomize, hash)
+        };
+        sobol_sample(self.sobol_index, dimension, scrambler)
+    }
+
+    /// The next 1-D value (dimensions wrap to 2 after 1024).
+    #[inline]
+    pub fn get_1d(&mut self) -> Float {
+        if self.dimension as usize >= N_SOBOL_DIMENSIONS {
+            self.dimension = 2;
+        }
+        let d = self.dimension as usize;
+        self.dimension += 1;
+        self.sample_dimension(d)
+    }
+
+    /// The next 2-D value.
+    #[inline]
+    pub fn get_2d(&mut self) -> Point2f {
+        if self.dimension as usize + 1 >= N_SOBOL_DIMENSIONS {
+            self.dimension = 2;
+        }
+        let d = self.dimension as usize;
+        self.dimension += 2;
+        Point2f::new(self.sample_dimension(d), self.sample_dimension(d + 1))
+    }
+
+    /// The position within the pixel: the first two dimensions, scaled
+    /// and offset to the pixel.
+    #[inline]
+    pub fn get_pixel_2d(&mut self) -> Point2f {
+        let u = [
+            sobol_sample(self.sobol_index, 0, BinaryScrambler::None),
+            sobol_sample(self.sobol_index, 1, BinaryScrambler::None),
+        ];
+        let p = [
+            self.pixel.x & (self.scale - 1),
+            self.pixel.y & (self.scale - 1),
+        ];
+        let f =
+            |i: usize| (u[i] * self.scale as Float - p[i] as Float).clamp(0.0, ONE_MINUS_EPSILON);
+        Point2f::new(f(0), f(1))
+    }
+}
+
+/// For the top `m` bits of Sobol' dimension 1 as a function of index bits
+/// `m..2m`, the inverse map: column `b` is the bit pattern of those index
+/// bits that produces a 1 in bit `b` only.
+fn solve_pixel_system(m: u32) -> [u32; MAX_SOBOL_LOG2_SCALE as usize] {
+    let mut out = [0u32; MAX_SOBOL_LOG2_SCALE as usize];
+    if m == 0 {
+        return out;
+    }
+    let c1 = &sobol_matrices()[SOBOL_MATRIX_SIZE..2 * SOBOL_MATRIX_SIZE];
+    // Rows: equation per unknown k: image (m bits) | identity (which unknown).
+    let mut rows: Vec<(u32, u32)> = (0..m)
+        .map(|k| (c1[(m + k) as usize] >> (32 - m), 1u32 << k))
+        .collect();
+    // Gaussian elimination over GF(2) on the image bits: afterwards row b
+    // has image exactly bit b.
+    for b in 0..m as usize {
+        let bit = 1u32 << b;
+        let pivot = (b..rows.len()).find(|&r| rows[r].0 & bit != 0);
+        let Some(pivot) = pivot else {
+            debug_assert!(false, "Sobol' dimensions 0/1 are not a (0,2)-sequence");
+            continue;
+        };
+        rows.swap(b, pivot);
+        for r in 0..rows.len() {
+            if r != b && rows[r].0 & bit != 0 {
+                rows[r].0 ^= rows[b].0;
+                rows[r].1 ^= rows[b].1;
+            }
+        }
+    }
+    for (b, row) in rows.iter().enumerate() {
+        out[b] = row.1;
+    }
+    out
+}
+
+/// Scrambler for sample values from a 32-bit hash.
+#[inline]
+fn scrambler(randomize: RandomizeStrategy, hash: u32) -> BinaryScrambler {
+    BinaryScrambler::new(randomize, hash)
+}
+
+/// The padded Sobol' sampler.
+#[derive(Clone, Debug)]
+pub struct PaddedSobolSampler {
+    samples_per_pixel: i32,
+    seed: i32,
+    randomize: RandomizeStrategy,
+    pixel: Point2i,
+    sample_index: i32,
+    dimension: i32,
+}
+
+impl PaddedSobolSampler {
+    /// A padded Sobol' sampler (best with power-of-two `samples_per_pixel`).
+    pub fn new(samples_per_pixel: i32, randomize: RandomizeStrategy, seed: i32) -> Self {
+        PaddedSobolSampler {
+            samples_per_pixel,
+            seed,
+            randomize,
+            pixel: Point2i::new(0, 0),
+            sample_index: 0,
+            dimension: 0,
+        }
+    }
+
+    /// Samples per pixel.
+    #[inline]
+    pub fn samples_per_pixel(&self) -> i32 {
+        self.samples_per_pixel
+    }
+
+    /// Starts sample `index` of pixel `p` at `dimension`.
+    #[inline]
+    pub fn start_pixel_sample(&mut self, p: Point2i, index: i32, dimension: i32) {
+        self.pixel = p;
+        self.sample_index = index;
+        self.dimension = dimension;
+    }
+
+    #[inline]
+    fn hash_and_index(&self) -> (u64, u64) {
+        let hash = mix_bits(
+            ((self.pixel.x as u64) << 48)
+                ^ ((self.pixel.y as u64) << 32)
+                ^ ((self.dimension as u64) << 16)
+                ^ self.seed as i64 as u64,
+        );
+        let index = permutation_element(
+            self.sample_index as u32,
+            self.samples_per_pixel as u32,
+            hash as u32,
+        );
+        (hash, index as u64)
+    }
+
+    /// The next 1-D value: a permuted, scrambled van der Corput point.
+    #[inline]
+    pub fn get_1d(&mut self) -> Float {
+        let (hash, index) = self.hash_and_index();
+        self.dimension += 1;
+        sobol_sample(index, 0, scrambler(self.randomize, (hash >> 32) as u32))
+    }
+
+    /// The next 2-D value: a permuted, scrambled 2-D Sobol' point.
+    #[inline]
+    pub fn get_2d(&mut self) -> Point2f {
+        let (hash, index) = self.hash_and_index();
+        self.dimension += 2;
+        Point2f::new(
+            sobol_sample(index, 0, scrambler(self.randomize, hash as u32)),
+            sobol_sample(index, 1, scrambler(self.randomize, (hash >> 32) as u32)),
+        )
+    }
+
+    /// The position within the pixel.
+    #[inline]
+    pub fn get_pixel_2d(&mut self) -> Point2f {
+        self.get_2d()
+    }
+}
+
+/// The Morton-ordered ("Z") Sobol' sampler, pbrt-v4's default.
+#[derive(Clone, Debug)]
+pub struct ZSobolSampler {
+    randomize: RandomizeStrategy,
+    seed: i32,
+    log2_samples_per_pixel: u32,
+    n_base4_digits: u32,
+    morton_index: u64,
+    dimension: i32,
+}
+
+impl ZSobolSampler {
+    /// A Z-Sobol' sampler; `samples_per_pixel` is rounded down to a power
+    /// of two (the caller warns).
+    pub fn new(
+        samples_per_pixel: i32,
+        full_resolution: Point2i,
+        randomize: RandomizeStrategy,
+        seed: i32,
+    ) -> Self {
+        let log2_spp = 31 - (samples_per_pixel.max(1) as u32).leading_zeros();
+        let res = (full_resolution.x.max(full_resolution.y).max(1) as u32).next_power_of_two();
+        let log4_spp = log2_spp.div_ceil(2);
+        ZSobolSampler {
+            randomize,
+            seed,
+            log2_samples_per_pixel: log2_spp,
+            n_base4_digits: res.trailing_zeros() + log4_spp,
+            morton_index: 0,
+            dimension: 0,
+        }
+    }
+
+    /// Samples per pixel (a power of two).
+    #[inline]
+    pub fn samples_per_pixel(&self) -> i32 {
+        1 << self.log2_samples_per_pixel
+    }
+
+    /// Starts sample `index` of pixel `p` at `dimension`.
+    #[inline]
+    pub fn start_pixel_sample(&mut self, p: Point2i, index: i32, dimension: i32) {
+        self.dimension = dimension;
+        self.morton_index =
+            (encode_morton2(p.x as u32, p.y as u32) << self.log2_samples_per_pixel) | index as u64;
+    }
+
+    /// The Sobol' index for the current pixel sample and dimension: the
+    /// Morton index with each base-4 digit permuted by a hash of the
+    /// digits above it and the dimension.
+    pub fn sample_index(&self) -> u64 {
+        let mut index = 0u64;
+        let pow2_samples = self.log2_samples_per_pixel & 1 == 1;
+        let last_digit = if pow2_samples { 1 } else { 0 };
+        let dim_mix = 0x5555_5555u64.wrapping_mul(self.dimension as i64 as u64);
+        for i in (last_digit..self.n_base4_digits as i32).rev() {
+            let shift = 2 * i - if pow2_samples { 1 } else { 0 };
+            let digit = ((self.morton_index >> shift) & 3) as usize;
+            let higher = self.morton_index >> (shift + 2);
+            let p = ((mix_bits(higher ^ dim_mix) >> 24) % 24) as usize;
+            index |= (PERMUTATIONS_4[p][digit] as u64) << shift;
+        }
+        if pow2_samples {
+            let digit = self.morton_index & 1;
+            index |= digit ^ (mix_bits((self.morton_index >> 1) ^ dim_mix) & 1);
+        }
+        index
+    }
+
+    /// The next 1-D value.
+    #[inline]
+    pub fn get_1d(&mut self) -> Float {
+        let index = self.sample_index();
+        self.dimension += 1;
+        let hash = mix_bits((self.dimension ^ self.seed) as i64 as u64) as u32;
+        sobol_sample(index, 0, scrambler(self.randomize, hash))
+    }
+
+    /// The next 2-D value.
+    #[inline]
+    pub fn get_2d(&mut self) -> Point2f {
+        let index = self.sample_index();
+        self.dimension += 2;
+        let bits = mix_bits((self.dimension ^ self.seed) as i64 as u64);
+        Point2f::new(
+            sobol_sample(index, 0, scrambler(self.randomize, bits as u32)),
+            sobol_sample(index, 1, scrambler(self.randomize, (bits >> 32) as u32)),
+        )
+    }
+
+    /// The position within the pixel.
+    #[inline]
+    pub fn get_pixel_2d(&mut self) -> Point2f {
+        self.get_2d()
+    }
+}
