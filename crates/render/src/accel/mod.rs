@@ -83,8 +83,21 @@ impl Accelerator {
     /// Builds the structure selected by `params` over `prim_bounds`
     /// (primitive `i` has bounds `prim_bounds[i]`; closures get `i` back).
     pub fn build(prim_bounds: &[Bounds3f], params: &AccelParams) -> Accelerator {
+        Accelerator::build_with_threads(prim_bounds, params, default_threads())
+    }
+
+    /// [`Accelerator::build`] with at most about `threads` build threads
+    /// (the BVH builds in parallel; its result does not depend on
+    /// `threads`).
+    pub fn build_with_threads(
+        prim_bounds: &[Bounds3f],
+        params: &AccelParams,
+        threads: usize,
+    ) -> Accelerator {
         match params.kind {
-            AccelKind::Bvh => Accelerator::Bvh(Bvh::build(prim_bounds, &params.bvh)),
+            AccelKind::Bvh => {
+                Accelerator::Bvh(Bvh::build_with_threads(prim_bounds, &params.bvh, threads))
+            }
             AccelKind::KdTree => Accelerator::KdTree(KdTree::build(prim_bounds, &params.kdtree)),
             AccelKind::Grid => Accelerator::Grid(Grid::build(prim_bounds, &params.grid)),
         }

@@ -138,6 +138,9 @@ fn float_of(key: &str, v: ParamValue) -> Result<Float, String> {
 }
 
 impl AccelParams {
+    /// The accelerator names [`AccelParams::new`] accepts.
+    pub const NAMES: &'static [&'static str] = &["bvh", "kdtree", "grid"];
+
     /// Defaults for the accelerator named `name` (`"bvh"`, `"kdtree"` or
     /// `"grid"`).
     pub fn new(name: &str) -> Result<AccelParams, String> {
