@@ -26,7 +26,7 @@ use obvhs::BvhBuildParams;
 use rpbrt_geometry::{
     cross, dot, Bounds3f, Float, Frame, Normal3f, Point2f, Point3f, Ray, Vector3f,
 };
-use rpbrt_render::accel::{AccelKind, AccelParams, Accelerator, Aggregate};
+use rpbrt_render::accel::{AccelKind, AccelParams, Accelerator, Aggregate, ParamValue};
 use rpbrt_render::rng::Rng;
 use rpbrt_render::sampling::sample_cosine_hemisphere;
 use rpbrt_render::scene::{build_scene_from_str, BuildOptions};
@@ -295,11 +295,19 @@ fn print_result(mesh: &str, accel: &str, threads: usize, v: [f64; 4], default: b
 }
 
 /// The rpbrt structures benchmarked: (name, parameters).
+///
+/// `bvh` is the default BVH (4-wide), `bvh2` the binary one
+/// (`"integer width" 2`).
 fn rpbrt_structures() -> Vec<(&'static str, AccelParams)> {
     let mut v = Vec::new();
     for name in AccelParams::NAMES {
         if let Ok(p) = AccelParams::new(name) {
             v.push((*name, p));
+        }
+        if *name == "bvh" {
+            if let Ok(p) = AccelParams::parse(name, [("width", ParamValue::Int(2))]) {
+                v.push(("bvh2", p));
+            }
         }
     }
     v
