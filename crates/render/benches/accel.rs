@@ -174,7 +174,7 @@ fn camera_rays(b: &Bounds3f) -> Vec<Ray> {
     let c = b.p_min + (b.p_max - b.p_min) * 0.5;
     let r = (b.p_max - b.p_min).length() * 0.5;
     let view = Vector3f::new(0.55, -0.45, 0.7).normalize();
-    let eye = c + view * (2.6 * r);
+    let eye = c + view * (1.7 * r);
     let fwd = -view;
     let frame = Frame::from_z(fwd);
     let tan_half = (0.5 as Float).tan() * 0.8; // ~46° field of view
@@ -205,6 +205,7 @@ fn bounce_rays(tris: &[Tri], accel: &Accelerator, cam: &[Ray]) -> Vec<Ray> {
             hits.push((r.o + r.d * t, n));
         }
     }
+    eprintln!("  {} of {} camera rays hit", hits.len(), cam.len());
     let mut rng = Rng::with_sequence(7);
     if hits.is_empty() {
         return cam.to_vec();
@@ -353,9 +354,35 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
                 })
             };
             let (c, _) = run(&cam_set, threads, closest);
-            let (i, _) = run(&bounce_set, threads, closest);
+            let (i, ih) = run(&bounce_set, threads, closest);
             let (s, _) = run(&bounce_set, threads, any);
-            print_result(&mesh.name, name, threads, [build, c, i, s], params == default_params);
+            if threads == 1 {
+                // Primitive tests per ray: a quality figure, on stderr.
+                let tests = |rays: &[Ray]| {
+                    let mut k = 0usize;
+                    let sample = subset(rays, 20_000);
+                    for r in &sample {
+                        a.intersect(r, Float::INFINITY, |p, r, t| {
+                            k += 1;
+                            hit_tri(tris, p, r, t)
+                        });
+                    }
+                    k as f64 / sample.len() as f64
+                };
+                eprintln!(
+                    "  {name}: {:.2} / {:.2} triangle tests per coherent / incoherent ray, {:.0}% of incoherent rays hit",
+                    tests(&cam_set),
+                    tests(&bounce_set),
+                    100.0 * ih as f64 / bounce_set.len() as f64
+                );
+            }
+            print_result(
+                &mesh.name,
+                name,
+                threads,
+                [build, c, i, s],
+                params == default_params,
+            );
         }
     }
 
@@ -426,7 +453,9 @@ fn main() {
                 }
             }
         }
-        None => eprintln!("../shared/scenes not found: skipping the killeroo and water-caustic meshes"),
+        None => {
+            eprintln!("../shared/scenes not found: skipping the killeroo and water-caustic meshes")
+        }
     }
     if want_mesh("terrain") {
         meshes.push(terrain());

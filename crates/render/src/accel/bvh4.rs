@@ -18,8 +18,8 @@
 
 use super::bvh::{Bvh, BvhNode, STACK_SIZE};
 use super::params::BvhParams;
-use super::{far_pad, fmax, fmin, Aggregate, RayPrecomp};
-use rpbrt_geometry::{Bounds3f, Float, Ray};
+use super::{far_pad, fmax, fmin, Aggregate};
+use rpbrt_geometry::{next_float_down, next_float_up, Bounds3f, Float, Ray};
 use std::mem::MaybeUninit;
 
 /// Children per node.
@@ -143,23 +143,36 @@ struct WideRay {
 impl WideRay {
     #[inline(always)]
     fn new(ray: &Ray) -> WideRay {
-        let pre = RayPrecomp::new(ray);
+        let o = [ray.o.x, ray.o.y, ray.o.z];
+        let d = [ray.d.x, ray.d.y, ray.d.z];
         let mut w = WideRay {
             near: [0, 1, 2],
             far: [3, 4, 5],
-            o_near: pre.o_lo,
-            o_far: pre.o_hi,
-            inv: pre.inv_dir,
+            o_near: o,
+            o_far: o,
+            inv: [0.0; 3],
         };
-        // A negative direction enters through the max plane; the nudged
-        // origins of `RayPrecomp` go with the plane (lo or hi) they are
-        // compared against, so a ray lying in a face counts as inside.
         for a in 0..3 {
-            if pre.dir_is_neg[a] != 0 {
+            let inv = 1.0 / d[a];
+            w.inv[a] = inv;
+            // Zero components: the nudged origins of `RayPrecomp` (lo
+            // planes against an origin one ulp up, hi planes one ulp down)
+            // so that a ray lying in a face counts as inside.
+            let (o_lo, o_hi) = if d[a] == 0.0 {
+                (next_float_up(o[a]), next_float_down(o[a]))
+            } else {
+                (o[a], o[a])
+            };
+            // A negative direction (−0 included) enters through the max
+            // plane.
+            if inv < 0.0 {
                 w.near[a] = 3 + a;
                 w.far[a] = a;
-                w.o_near[a] = pre.o_hi[a];
-                w.o_far[a] = pre.o_lo[a];
+                w.o_near[a] = o_hi;
+                w.o_far[a] = o_lo;
+            } else {
+                w.o_near[a] = o_lo;
+                w.o_far[a] = o_hi;
             }
         }
         w
@@ -234,7 +247,11 @@ impl Bvh4 {
 
     /// Builds with at most about `threads` threads; the result is the same
     /// for every thread count.
-    pub fn build_with_threads(prim_bounds: &[Bounds3f], params: &BvhParams, threads: usize) -> Bvh4 {
+    pub fn build_with_threads(
+        prim_bounds: &[Bounds3f],
+        params: &BvhParams,
+        threads: usize,
+    ) -> Bvh4 {
         Bvh4::from_binary(Bvh::build_with_threads(prim_bounds, params, threads))
     }
 
@@ -300,43 +317,63 @@ impl Aggregate for Bvh4 {
         loop {
             let node = &self.nodes[cur as usize];
             let (t0, mut mask) = w.test(node, t_max);
-            // Hit children sorted near to far (at most four: insertion sort).
-            let mut order = [(0usize, 0.0 as Float); WIDTH];
-            let mut n = 0;
-            while mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                let mut j = n;
-                while j > 0 && order[j - 1].1 > t0[i] {
-                    order[j] = order[j - 1];
-                    j -= 1;
-                }
-                order[j] = (i, t0[i]);
-                n += 1;
-            }
-            // Leaves first, near to far; they shrink `t_max`.
             let mut next: Option<(u32, Float)> = None;
-            for &(i, _) in &order[..n] {
-                let c = node.count[i];
+            if mask != 0 && mask & (mask - 1) == 0 {
+                // One child hit (the common case near the leaves): no
+                // ordering to do.
+                let i = mask.trailing_zeros() as usize;
+                let c = node.count[i] as usize;
                 if c > 0 {
                     let start = node.child[i] as usize;
-                    for &p in &self.prim_indices[start..start + c as usize] {
-                        if let Some(t) = hit(p, ray, t_max) {
-                            debug_assert!(t <= t_max);
-                            t_max = t;
-                            best = Some((p, t));
-                        }
+                    closest_in_leaf(
+                        &self.prim_indices[start..start + c],
+                        ray,
+                        &mut t_max,
+                        &mut best,
+                        &mut hit,
+                    );
+                } else {
+                    next = Some((node.child[i], t0[i]));
+                }
+            } else if mask != 0 {
+                // Hit children sorted near to far (at most four: insertion
+                // sort).
+                let mut order = [(0usize, 0.0 as Float); WIDTH];
+                let mut n = 0;
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let mut j = n;
+                    while j > 0 && order[j - 1].1 > t0[i] {
+                        order[j] = order[j - 1];
+                        j -= 1;
+                    }
+                    order[j] = (i, t0[i]);
+                    n += 1;
+                }
+                // Leaves first, near to far; they shrink `t_max`.
+                for &(i, _) in &order[..n] {
+                    let c = node.count[i] as usize;
+                    if c > 0 {
+                        let start = node.child[i] as usize;
+                        closest_in_leaf(
+                            &self.prim_indices[start..start + c],
+                            ray,
+                            &mut t_max,
+                            &mut best,
+                            &mut hit,
+                        );
                     }
                 }
-            }
-            // Interior children: visit the nearest next, push the rest far
-            // to near.
-            for &(i, tn) in order[..n].iter().rev() {
-                if node.count[i] == 0 && tn <= t_max {
-                    if let Some(prev) = next {
-                        stack.push(prev);
+                // Interior children: visit the nearest next, push the rest
+                // far to near.
+                for &(i, tn) in order[..n].iter().rev() {
+                    if node.count[i] == 0 && tn <= t_max {
+                        if let Some(prev) = next {
+                            stack.push(prev);
+                        }
+                        next = Some((node.child[i], tn));
                     }
-                    next = Some((node.child[i], tn));
                 }
             }
             match next {
@@ -407,5 +444,25 @@ impl Aggregate for Bvh4 {
 
     fn skipped_primitives(&self) -> usize {
         self.n_skipped
+    }
+}
+
+/// Tests the primitives of one leaf, shrinking `t_max` on each closer hit.
+#[inline(always)]
+fn closest_in_leaf<F>(
+    prims: &[u32],
+    ray: &Ray,
+    t_max: &mut Float,
+    best: &mut Option<(u32, Float)>,
+    hit: &mut F,
+) where
+    F: FnMut(u32, &Ray, Float) -> Option<Float>,
+{
+    for &p in prims {
+        if let Some(t) = hit(p, ray, *t_max) {
+            debug_assert!(t <= *t_max);
+            *t_max = t;
+            *best = Some((p, t));
+        }
     }
 }
