@@ -591,6 +591,12 @@ impl Bvh {
         &self.prim_indices
     }
 
+    /// Takes the nodes and the primitive index array apart (for
+    /// [`Bvh4::from_binary`](super::Bvh4::from_binary)).
+    pub fn into_parts(self) -> (Vec<BvhNode>, Vec<u32>) {
+        (self.nodes, self.prim_indices)
+    }
+
     /// The depth of the deepest leaf (the root has depth 0).
     pub fn depth(&self) -> usize {
         if self.nodes.is_empty() {

@@ -98,17 +98,18 @@ fn random_rays(seed: u64, n: usize) -> Vec<(Ray, Float)> {
 fn all_accels(bounds: &[Bounds3f]) -> Vec<(String, Accelerator)> {
     let mut v = Vec::new();
     for method in ["sah", "hlbvh", "middle", "equal"] {
-        for maxp in [1, 4] {
+        for (maxp, width) in [(1, 4), (4, 4), (1, 2), (4, 2)] {
             let p = AccelParams::parse(
                 "bvh",
                 [
                     ("splitmethod", ParamValue::Str(method)),
                     ("maxnodeprims", ParamValue::Int(maxp)),
+                    ("width", ParamValue::Int(width)),
                 ],
             )
             .unwrap();
             v.push((
-                format!("bvh {method} {maxp}"),
+                format!("bvh{width} {method} {maxp}"),
                 Accelerator::build(bounds, &p),
             ));
         }
@@ -192,6 +193,7 @@ where
 #[test]
 fn node_sizes() {
     assert_eq!(std::mem::size_of::<BvhNode>(), 32);
+    assert_eq!(std::mem::size_of::<Bvh4Node>(), 128);
     assert_eq!(std::mem::size_of::<KdNode>(), 8);
 }
 
@@ -450,6 +452,7 @@ fn bvh_depth_is_bounded() {
             &BvhParams {
                 split_method: method,
                 max_prims_in_node: 1,
+                ..Default::default()
             },
         );
         assert!(
@@ -488,6 +491,7 @@ fn builds_are_deterministic() {
         let p = BvhParams {
             split_method: method,
             max_prims_in_node: 4,
+            ..Default::default()
         };
         let a = Bvh::build_with_threads(&bounds, &p, 1);
         let b = Bvh::build_with_threads(&bounds, &p, 4);
@@ -497,6 +501,13 @@ fn builds_are_deterministic() {
             "{method:?}"
         );
         assert!(a.prim_indices() == b.prim_indices() && a.prim_indices() == c.prim_indices());
+        let w1 = Bvh4::build_with_threads(&bounds, &p, 1);
+        let w3 = Bvh4::build_with_threads(&bounds, &p, 3);
+        assert!(w1.nodes() == w3.nodes() && w1.prim_indices() == w3.prim_indices());
+        assert!(
+            w1.prim_indices() == a.prim_indices(),
+            "{method:?}: same leaves"
+        );
     }
     let k1 = KdTree::build(&bounds[..5000], &KdTreeParams::default());
     let k2 = KdTree::build(&bounds[..5000], &KdTreeParams::default());
@@ -518,6 +529,7 @@ fn bvh_leaves_cover_every_primitive_once() {
             &BvhParams {
                 split_method: method,
                 max_prims_in_node: 4,
+                ..Default::default()
             },
         );
         let mut seen = vec![0u32; bounds.len()];
@@ -541,6 +553,53 @@ fn bvh_leaves_cover_every_primitive_once() {
                 assert_eq!(b.union(&bvh.nodes()[c].bounds()), b);
             }
         }
+    }
+}
+
+#[test]
+fn bvh4_collapse_keeps_leaves_and_bounds() {
+    let tris = random_tris(21, 5000, 0.05);
+    let bounds: Vec<Bounds3f> = tris.iter().map(tri_bounds).collect();
+    for maxp in [1, 4] {
+        let p = BvhParams {
+            max_prims_in_node: maxp,
+            ..Default::default()
+        };
+        let w = Bvh4::build(&bounds, &p);
+        let mut seen = vec![0u32; bounds.len()];
+        let mut n_children = 0;
+        // Walk from the root, checking that every child box holds what is
+        // below it.
+        let mut stack = vec![(0usize, w.bounds())];
+        while let Some((i, outer)) = stack.pop() {
+            let node = &w.nodes()[i];
+            for lane in 0..bvh4::WIDTH {
+                let b = node.child_bounds(lane);
+                if b.is_empty() {
+                    continue;
+                }
+                n_children += 1;
+                assert_eq!(outer.union(&b), outer, "child box outside its parent");
+                let c = node.child[lane] as usize;
+                let count = node.count[lane] as usize;
+                if count > 0 {
+                    for &p in &w.prim_indices()[c..c + count] {
+                        seen[p as usize] += 1;
+                        assert_eq!(b.union(&bounds[p as usize]), b, "leaf bounds");
+                    }
+                } else {
+                    assert!(c > i, "children follow their parent");
+                    stack.push((c, b));
+                }
+            }
+        }
+        assert!(seen.iter().all(|&c| c == 1), "every primitive once");
+        // Collapsing fills nodes: far fewer than one per two children.
+        assert!(
+            w.nodes().len() * 3 < n_children,
+            "{} nodes",
+            w.nodes().len()
+        );
     }
 }
 

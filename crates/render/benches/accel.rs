@@ -1,0 +1,466 @@
+//! Acceleration-structure throughput (plain harness:
+//! `cargo bench -p rpbrt-render --bench accel`).
+//!
+//! Meshes: the killeroo (Loop-subdivided to ≥ 100k triangles), each
+//! water-caustic PLY mesh (both from `../shared/scenes`, skipped with a
+//! message when absent), and a generated ~1M-triangle terrain. Rays: 1M
+//! coherent pinhole-camera rays (1000×1000) framing the mesh, and 1M
+//! incoherent rays: cosine-distributed bounces from the camera rays' first
+//! hits (seeded). Each structure is timed on `intersect` for both sets and on
+//! `intersect_p` for the incoherent set, with 1 and 2 threads (rays split in
+//! contiguous chunks across `std::thread::scope` threads), plus its build
+//! rate with that many build threads.
+//!
+//! Every structure, obvhs' CWBVH included, calls the same hit closure:
+//! `intersect_triangle` on the caller's triangle array, so only traversal
+//! differs. Output: one `RESULT` line per mesh, structure and thread count.
+//!
+//! The kd-tree and grid trace a subset of the rays (`SLOW_RAYS`, every k-th
+//! ray of each set) to keep the run short; their Mrays/s are computed from
+//! the rays actually traced. `RPBRT_ACCEL_BENCH_ONLY=bvh4,obvhs` restricts
+//! the structures, `RPBRT_ACCEL_BENCH_MESH=terrain` the meshes.
+
+use obvhs::aabb::Aabb;
+use obvhs::cwbvh::CwBvh;
+use obvhs::BvhBuildParams;
+use rpbrt_geometry::{
+    cross, dot, Bounds3f, Float, Frame, Normal3f, Point2f, Point3f, Ray, Vector3f,
+};
+use rpbrt_render::accel::{AccelKind, AccelParams, Accelerator, Aggregate, ParamValue};
+use rpbrt_render::rng::Rng;
+use rpbrt_render::sampling::sample_cosine_hemisphere;
+use rpbrt_render::scene::{build_scene_from_str, BuildOptions};
+use rpbrt_render::shape::loopsubdiv::loop_subdivide;
+use rpbrt_render::shape::triangle::intersect_triangle;
+use std::path::Path;
+use std::time::Instant;
+
+type Tri = [Point3f; 3];
+
+const RES: usize = 1000;
+/// Rays per set for the slow structures (kd-tree, grid).
+const SLOW_RAYS: usize = 100_000;
+
+struct Mesh {
+    name: String,
+    tris: Vec<Tri>,
+}
+
+fn tris_from_indexed(p: &[Point3f], idx: &[u32]) -> Vec<Tri> {
+    idx.chunks_exact(3)
+        .map(|c| [p[c[0] as usize], p[c[1] as usize], p[c[2] as usize]])
+        .collect()
+}
+
+/// The killeroo's `loopsubdiv` control mesh, subdivided to ≥ 100k triangles.
+fn killeroo(shared: &Path) -> Result<Mesh, String> {
+    let path = shared.join("scenes/killeroos/geometry/killeroo.pbrt");
+    let path = path.canonicalize().map_err(|e| format!("{path:?}: {e}"))?;
+    let text = format!("WorldBegin\nInclude \"{}\"\n", path.display());
+    let (scene, _) = build_scene_from_str(&text, &BuildOptions::default())
+        .map_err(|d| format!("killeroo: {} diagnostics", d.items.len()))?;
+    let shape = scene
+        .shapes
+        .iter()
+        .find(|s| s.base.name == "loopsubdiv" || s.base.name == "trianglemesh")
+        .ok_or("killeroo: no mesh shape")?;
+    let params = &shape.base.params;
+    let p: Vec<Point3f> = params
+        .get_point3_array("P")
+        .map_err(|e| format!("{e:?}"))?
+        .iter()
+        .map(|v| Point3f::new(v[0], v[1], v[2]))
+        .collect();
+    let idx: Vec<u32> = params
+        .get_int_array("indices")
+        .map_err(|e| format!("{e:?}"))?
+        .iter()
+        .map(|&i| i as u32)
+        .collect();
+    let mut levels = 0;
+    while (idx.len() / 3) << (2 * levels) < 100_000 {
+        levels += 1;
+    }
+    let sub = loop_subdivide(levels, &idx, &p).map_err(|e| e.0)?;
+    Ok(Mesh {
+        name: "killeroo".into(),
+        tris: tris_from_indexed(&sub.p, &sub.indices),
+    })
+}
+
+fn ply_mesh(path: &Path) -> Result<Mesh, String> {
+    let m = rpbrt_parser::ply::read_ply(path).map_err(|e| format!("{path:?}: {e}"))?;
+    let p: Vec<Point3f> = m
+        .positions
+        .iter()
+        .map(|v| Point3f::new(v[0], v[1], v[2]))
+        .collect();
+    let mut idx = m.tri_indices.clone();
+    for q in m.quad_indices.chunks_exact(4) {
+        // Bilinear-patch order v0 v1 v3 v2: two triangles.
+        idx.extend_from_slice(&[q[0], q[1], q[3], q[0], q[3], q[2]]);
+    }
+    let stem = path
+        .file_stem()
+        .map_or("mesh".into(), |s| s.to_string_lossy().into_owned());
+    Ok(Mesh {
+        name: format!("water-{stem}"),
+        tris: tris_from_indexed(&p, &idx),
+    })
+}
+
+/// A seeded noisy terrain of 2·710² ≈ 1.01M triangles: a sum of random
+/// sinusoids plus per-vertex jitter.
+fn terrain() -> Mesh {
+    const N: usize = 710;
+    let mut rng = Rng::with_sequence(42);
+    let waves: Vec<[Float; 4]> = (0..8)
+        .map(|k| {
+            let f = 2.0 + 3.0 * k as Float;
+            [
+                f * (rng.uniform_float() - 0.5),
+                f * (rng.uniform_float() - 0.5),
+                6.28 * rng.uniform_float(),
+                0.3 / (1.0 + k as Float),
+            ]
+        })
+        .collect();
+    let mut p = Vec::with_capacity((N + 1) * (N + 1));
+    for j in 0..=N {
+        for i in 0..=N {
+            let x = i as Float / N as Float;
+            let y = j as Float / N as Float;
+            let mut h = 0.0;
+            for w in &waves {
+                h += w[3] * (w[0] * x * 6.28 + w[1] * y * 6.28 + w[2]).sin();
+            }
+            h += 0.002 * (rng.uniform_float() - 0.5);
+            p.push(Point3f::new(x, y, h));
+        }
+    }
+    let mut idx = Vec::with_capacity(N * N * 6);
+    for j in 0..N {
+        for i in 0..N {
+            let a = (j * (N + 1) + i) as u32;
+            let b = a + 1;
+            let c = a + (N + 1) as u32;
+            let d = c + 1;
+            idx.extend_from_slice(&[a, b, d, a, d, c]);
+        }
+    }
+    Mesh {
+        name: "terrain".into(),
+        tris: tris_from_indexed(&p, &idx),
+    }
+}
+
+fn tri_bounds(t: &Tri) -> Bounds3f {
+    Bounds3f::new(t[0], t[1]).union_point(t[2])
+}
+
+/// The shared primitive test: `Some(t)` for a hit strictly before `t_max`.
+#[inline(always)]
+fn hit_tri(tris: &[Tri], p: u32, ray: &Ray, t_max: Float) -> Option<Float> {
+    let t = &tris[p as usize];
+    match intersect_triangle(ray, t_max, t[0], t[1], t[2]) {
+        Some((th, ..)) if th < t_max => Some(th),
+        _ => None,
+    }
+}
+
+/// Pinhole camera rays framing the mesh's bounding sphere, from above and
+/// to the side.
+fn camera_rays(b: &Bounds3f) -> Vec<Ray> {
+    let c = b.p_min + (b.p_max - b.p_min) * 0.5;
+    let r = (b.p_max - b.p_min).length() * 0.5;
+    let view = Vector3f::new(0.55, -0.45, 0.7).normalize();
+    let eye = c + view * (1.7 * r);
+    let fwd = -view;
+    let frame = Frame::from_z(fwd);
+    let tan_half = (0.5 as Float).tan() * 0.8; // ~46° field of view
+    let mut rays = Vec::with_capacity(RES * RES);
+    for y in 0..RES {
+        for x in 0..RES {
+            let sx = (2.0 * (x as Float + 0.5) / RES as Float - 1.0) * tan_half;
+            let sy = (1.0 - 2.0 * (y as Float + 0.5) / RES as Float) * tan_half;
+            let d = frame.from_local(Vector3f::new(sx, sy, 1.0)).normalize();
+            rays.push(Ray::new(eye, d));
+        }
+    }
+    rays
+}
+
+/// Cosine-distributed bounces from the first hits of `cam` (cycling over
+/// the hits so there are as many rays as camera rays).
+fn bounce_rays(tris: &[Tri], accel: &Accelerator, cam: &[Ray]) -> Vec<Ray> {
+    let mut hits = Vec::new();
+    for r in cam {
+        if let Some((p, t)) = accel.intersect(r, Float::INFINITY, |p, r, t| hit_tri(tris, p, r, t))
+        {
+            let tri = &tris[p as usize];
+            let mut n = cross(tri[1] - tri[0], tri[2] - tri[0]).normalize();
+            if dot(n, r.d) > 0.0 {
+                n = -n;
+            }
+            hits.push((r.o + r.d * t, n));
+        }
+    }
+    eprintln!("  {} of {} camera rays hit", hits.len(), cam.len());
+    let mut rng = Rng::with_sequence(7);
+    if hits.is_empty() {
+        return cam.to_vec();
+    }
+    (0..cam.len())
+        .map(|i| {
+            let (p, n) = hits[i % hits.len()];
+            let u = Point2f::new(rng.uniform_float(), rng.uniform_float());
+            let d = Frame::from_normal(Normal3f::from(n)).from_local(sample_cosine_hemisphere(u));
+            let ext = 1e-4 * (1.0 + p.x.abs().max(p.y.abs()).max(p.z.abs()));
+            Ray::new(p + n * ext, d)
+        })
+        .collect()
+}
+
+/// Runs `f` over `rays` split into `threads` contiguous chunks; returns
+/// Mrays/s and the number of hits (to keep the work observable).
+fn run<F>(rays: &[Ray], threads: usize, f: F) -> (f64, usize)
+where
+    F: Fn(&Ray) -> bool + Sync,
+{
+    let t0 = Instant::now();
+    let chunk = rays.len().div_ceil(threads);
+    let hits: usize = std::thread::scope(|s| {
+        let hs: Vec<_> = rays
+            .chunks(chunk)
+            .map(|c| {
+                let f = &f;
+                s.spawn(move || c.iter().filter(|r| f(r)).count())
+            })
+            .collect();
+        hs.into_iter().map(|h| h.join().unwrap_or(0)).sum()
+    });
+    (rays.len() as f64 / t0.elapsed().as_secs_f64() / 1e6, hits)
+}
+
+fn subset(rays: &[Ray], n: usize) -> Vec<Ray> {
+    let step = rays.len().div_ceil(n).max(1);
+    rays.iter().step_by(step).copied().collect()
+}
+
+fn to_vec3a(p: Point3f) -> glam::Vec3A {
+    glam::Vec3A::new(p.x, p.y, p.z)
+}
+
+struct BoxPrim(Aabb);
+impl obvhs::Boundable for BoxPrim {
+    fn aabb(&self) -> Aabb {
+        self.0
+    }
+}
+
+fn build_obvhs(bounds: &[Bounds3f], threads: usize) -> (CwBvh, f64) {
+    let prims: Vec<BoxPrim> = bounds
+        .iter()
+        .map(|b| BoxPrim(Aabb::new(to_vec3a(b.p_min), to_vec3a(b.p_max))))
+        .collect();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap_or_else(|e| panic!("rayon pool: {e}"));
+    let t0 = Instant::now();
+    let bvh = pool.install(|| {
+        let mut d = std::time::Duration::default();
+        obvhs::cwbvh::builder::build_cwbvh(&prims, BvhBuildParams::medium_build(), &mut d)
+    });
+    (bvh, t0.elapsed().as_secs_f64())
+}
+
+fn obvhs_ray(r: &Ray, t_max: Float) -> obvhs::ray::Ray {
+    obvhs::ray::Ray::new(
+        to_vec3a(r.o),
+        glam::Vec3A::new(r.d.x, r.d.y, r.d.z),
+        0.0,
+        t_max,
+    )
+}
+
+fn print_result(mesh: &str, accel: &str, threads: usize, v: [f64; 4], default: bool) {
+    println!(
+        "RESULT mesh={mesh} accel={accel} threads={threads} build_mprims_s={:.2} coherent_mrays_s={:.2} incoherent_mrays_s={:.2} shadow_mrays_s={:.2}{}",
+        v[0],
+        v[1],
+        v[2],
+        v[3],
+        if default { " default=yes" } else { "" }
+    );
+}
+
+/// The rpbrt structures benchmarked: (name, parameters).
+///
+/// `bvh` is the default BVH (4-wide), `bvh2` the binary one
+/// (`"integer width" 2`).
+fn rpbrt_structures() -> Vec<(&'static str, AccelParams)> {
+    let mut v = Vec::new();
+    for name in AccelParams::NAMES {
+        if let Ok(p) = AccelParams::new(name) {
+            v.push((*name, p));
+        }
+        if *name == "bvh" {
+            if let Ok(p) = AccelParams::parse(name, [("width", ParamValue::Int(2))]) {
+                v.push(("bvh2", p));
+            }
+        }
+    }
+    v
+}
+
+fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
+    let tris = &mesh.tris;
+    let bounds: Vec<Bounds3f> = tris.iter().map(tri_bounds).collect();
+    let n = tris.len() as f64;
+    let mut total = Bounds3f::empty();
+    for b in &bounds {
+        total = total.union(b);
+    }
+    let cam = camera_rays(&total);
+    let reference = Accelerator::build(&bounds, &AccelParams::default());
+    let bounce = bounce_rays(tris, &reference, &cam);
+    drop(reference);
+    eprintln!("mesh {}: {} triangles", mesh.name, tris.len());
+    let wanted = |name: &str| only.as_ref().is_none_or(|o| o.iter().any(|s| s == name));
+    let default_params = AccelParams::default();
+
+    for (name, params) in rpbrt_structures() {
+        if !wanted(name) {
+            continue;
+        }
+        let slow = matches!(params.kind, AccelKind::KdTree | AccelKind::Grid);
+        let (cam_set, bounce_set) = if slow {
+            (subset(&cam, SLOW_RAYS), subset(&bounce, SLOW_RAYS))
+        } else {
+            (cam.clone(), bounce.clone())
+        };
+        for threads in [1, 2] {
+            let t0 = Instant::now();
+            let a = Accelerator::build_with_threads(&bounds, &params, threads);
+            let build = n / t0.elapsed().as_secs_f64() / 1e6;
+            let closest = |r: &Ray| {
+                a.intersect(r, Float::INFINITY, |p, r, t| hit_tri(tris, p, r, t))
+                    .is_some()
+            };
+            let any = |r: &Ray| {
+                a.intersect_p(r, Float::INFINITY, |p, r, t| {
+                    hit_tri(tris, p, r, t).is_some()
+                })
+            };
+            let (c, _) = run(&cam_set, threads, closest);
+            let (i, ih) = run(&bounce_set, threads, closest);
+            let (s, _) = run(&bounce_set, threads, any);
+            if threads == 1 {
+                // Primitive tests per ray: a quality figure, on stderr.
+                let tests = |rays: &[Ray]| {
+                    let mut k = 0usize;
+                    let sample = subset(rays, 20_000);
+                    for r in &sample {
+                        a.intersect(r, Float::INFINITY, |p, r, t| {
+                            k += 1;
+                            hit_tri(tris, p, r, t)
+                        });
+                    }
+                    k as f64 / sample.len() as f64
+                };
+                eprintln!(
+                    "  {name}: {:.2} / {:.2} triangle tests per coherent / incoherent ray, {:.0}% of incoherent rays hit",
+                    tests(&cam_set),
+                    tests(&bounce_set),
+                    100.0 * ih as f64 / bounce_set.len() as f64
+                );
+            }
+            print_result(
+                &mesh.name,
+                name,
+                threads,
+                [build, c, i, s],
+                params == default_params,
+            );
+        }
+    }
+
+    if wanted("obvhs") {
+        for threads in [1, 2] {
+            let (bvh, secs) = build_obvhs(&bounds, threads);
+            let build = n / secs / 1e6;
+            let closest = |r: &Ray| {
+                let mut hit = obvhs::ray::RayHit::none();
+                bvh.ray_traverse(obvhs_ray(r, Float::INFINITY), &mut hit, |ray, id| {
+                    let p = bvh.primitive_indices[id];
+                    hit_tri(tris, p, r, ray.tmax).unwrap_or(Float::INFINITY)
+                })
+            };
+            let any = |r: &Ray| {
+                !bvh.ray_traverse_miss(obvhs_ray(r, Float::INFINITY), |ray, id| {
+                    let p = bvh.primitive_indices[id];
+                    hit_tri(tris, p, r, ray.tmax).unwrap_or(Float::INFINITY)
+                })
+            };
+            let (c, _) = run(&cam, threads, closest);
+            let (i, _) = run(&bounce, threads, closest);
+            let (s, _) = run(&bounce, threads, any);
+            print_result(&mesh.name, "obvhs", threads, [build, c, i, s], false);
+        }
+    }
+}
+
+fn main() {
+    let only: Option<Vec<String>> = std::env::var("RPBRT_ACCEL_BENCH_ONLY")
+        .ok()
+        .map(|s| s.split(',').map(str::to_string).collect());
+    let only_mesh: Option<Vec<String>> = std::env::var("RPBRT_ACCEL_BENCH_MESH")
+        .ok()
+        .map(|s| s.split(',').map(str::to_string).collect());
+    let want_mesh = |name: &str| {
+        only_mesh
+            .as_ref()
+            .is_none_or(|o| o.iter().any(|s| name.starts_with(s.as_str())))
+    };
+    // The bench runs from the crate directory; `shared` sits beside the
+    // workspace root.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let shared = [root.join("../shared"), root.join("shared")]
+        .into_iter()
+        .find(|p| p.join("scenes").is_dir());
+    let mut meshes = Vec::new();
+    match &shared {
+        Some(shared) => {
+            if want_mesh("killeroo") {
+                match killeroo(shared) {
+                    Ok(m) => meshes.push(m),
+                    Err(e) => eprintln!("skipping killeroo: {e}"),
+                }
+            }
+            if want_mesh("water") {
+                let dir = shared.join("scenes/water-caustic/models");
+                let mut plys: Vec<_> = std::fs::read_dir(&dir)
+                    .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
+                    .unwrap_or_default();
+                plys.retain(|p| p.extension().is_some_and(|e| e == "ply"));
+                plys.sort();
+                for p in plys {
+                    match ply_mesh(&p) {
+                        Ok(m) => meshes.push(m),
+                        Err(e) => eprintln!("skipping {p:?}: {e}"),
+                    }
+                }
+            }
+        }
+        None => {
+            eprintln!("../shared/scenes not found: skipping the killeroo and water-caustic meshes")
+        }
+    }
+    if want_mesh("terrain") {
+        meshes.push(terrain());
+    }
+    for m in &meshes {
+        bench_mesh(m, &only);
+    }
+}

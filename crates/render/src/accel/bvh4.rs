@@ -1,0 +1,468 @@
+//! A 4-wide BVH (pbrt-v4 section 7.3 builds the binary tree; the wide
+//! layout follows Wald et al., "Getting Rid of Packets", 2008, and Embree's
+//! BVH4): the SAH binary tree of [`Bvh`] collapsed so that every node holds
+//! up to four children whose boxes are tested together.
+//!
+//! A node stores its children's boxes structure-of-arrays (one `[f32; 4]`
+//! per box plane), so the slab test of all four children is a handful of
+//! 4-lane operations that the compiler maps onto SSE/NEON registers without
+//! any `unsafe`. Per ray, the near and far plane of each axis are chosen
+//! once by the direction's sign, so the slab test needs no per-axis min/max.
+//! Leaf children are intersected as soon as their box is hit; interior
+//! children are pushed far to near with their entry distance, and popped
+//! entries that lie beyond the closest hit found so far are dropped.
+//!
+//! Collapsing is sequential, cheap, and a pure function of the binary tree,
+//! which is itself independent of the build thread count, so the wide tree
+//! is deterministic too.
+
+use super::bvh::{Bvh, BvhNode, STACK_SIZE};
+use super::params::BvhParams;
+use super::{far_pad, fmax, fmin, Aggregate};
+use rpbrt_geometry::{next_float_down, next_float_up, Bounds3f, Float, Ray};
+use std::mem::MaybeUninit;
+
+/// Children per node.
+pub const WIDTH: usize = 4;
+
+/// One node of the 4-wide BVH: four child boxes in structure-of-arrays form
+/// and their references, 128 bytes (two cache lines, aligned).
+#[repr(C, align(64))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bvh4Node {
+    /// Child box planes: `[min_x, min_y, min_z, max_x, max_y, max_z]`, each
+    /// with one lane per child. Unused lanes hold an inverted box
+    /// (`min = +∞`, `max = −∞`) that no ray can hit.
+    pub bounds: [[Float; WIDTH]; 6],
+    /// Interior child: its node index. Leaf child: its first entry in the
+    /// primitive index array.
+    pub child: [u32; WIDTH],
+    /// Leaf child: its primitive count; 0 for interior children and unused
+    /// lanes.
+    pub count: [u16; WIDTH],
+    /// Padding to 128 bytes.
+    pub pad: [u32; 2],
+}
+
+impl Bvh4Node {
+    fn empty() -> Bvh4Node {
+        let inf = Float::INFINITY;
+        Bvh4Node {
+            bounds: [
+                [inf; WIDTH],
+                [inf; WIDTH],
+                [inf; WIDTH],
+                [-inf; WIDTH],
+                [-inf; WIDTH],
+                [-inf; WIDTH],
+            ],
+            child: [0; WIDTH],
+            count: [0; WIDTH],
+            pad: [0; 2],
+        }
+    }
+
+    fn set_bounds(&mut self, lane: usize, b: &BvhNode) {
+        for a in 0..3 {
+            self.bounds[a][lane] = b.bounds_min[a];
+            self.bounds[3 + a][lane] = b.bounds_max[a];
+        }
+    }
+
+    /// The box of child `lane` (inverted for unused lanes).
+    pub fn child_bounds(&self, lane: usize) -> Bounds3f {
+        let b = &self.bounds;
+        Bounds3f {
+            p_min: rpbrt_geometry::Point3f::new(b[0][lane], b[1][lane], b[2][lane]),
+            p_max: rpbrt_geometry::Point3f::new(b[3][lane], b[4][lane], b[5][lane]),
+        }
+    }
+}
+
+/// A 4-wide BVH over primitive bounds.
+#[derive(Clone, Debug, Default)]
+pub struct Bvh4 {
+    nodes: Vec<Bvh4Node>,
+    prim_indices: Vec<u32>,
+    bounds: Bounds3f,
+    n_input: usize,
+    n_skipped: usize,
+}
+
+/// Surface area of a binary node (for choosing which child to open).
+fn node_area(n: &BvhNode) -> f64 {
+    super::surface_area_f64(&n.bounds())
+}
+
+/// Appends the wide node for binary interior node `bin` and, depth first,
+/// its descendants; returns its index.
+fn collapse(bin: &[BvhNode], root: usize, out: &mut Vec<Bvh4Node>) -> u32 {
+    // Open the largest interior child until there are four children.
+    let mut kids: Vec<usize> = vec![root + 1, bin[root].offset as usize];
+    while kids.len() < WIDTH {
+        let mut best: Option<(usize, f64)> = None;
+        for (i, &k) in kids.iter().enumerate() {
+            if !bin[k].is_leaf() {
+                let a = node_area(&bin[k]);
+                if best.is_none_or(|(_, ba)| a > ba) {
+                    best = Some((i, a));
+                }
+            }
+        }
+        let Some((i, _)) = best else { break };
+        let k = kids[i];
+        // Keep the binary order (near child first along the split axis).
+        kids.splice(i..=i, [k + 1, bin[k].offset as usize]);
+    }
+    let me = out.len();
+    out.push(Bvh4Node::empty());
+    for (lane, &k) in kids.iter().enumerate() {
+        let n = &bin[k];
+        out[me].set_bounds(lane, n);
+        if n.is_leaf() {
+            out[me].child[lane] = n.offset;
+            out[me].count[lane] = n.count;
+        } else {
+            let c = collapse(bin, k, out);
+            out[me].child[lane] = c;
+        }
+    }
+    me as u32
+}
+
+/// Per-ray state for the 4-wide slab test: the near and far plane rows of
+/// each axis (chosen by the direction's sign) and the matching origins.
+struct WideRay {
+    near: [usize; 3],
+    far: [usize; 3],
+    o_near: [Float; 3],
+    o_far: [Float; 3],
+    inv: [Float; 3],
+}
+
+impl WideRay {
+    #[inline(always)]
+    fn new(ray: &Ray) -> WideRay {
+        let o = [ray.o.x, ray.o.y, ray.o.z];
+        let d = [ray.d.x, ray.d.y, ray.d.z];
+        let mut w = WideRay {
+            near: [0, 1, 2],
+            far: [3, 4, 5],
+            o_near: o,
+            o_far: o,
+            inv: [0.0; 3],
+        };
+        for a in 0..3 {
+            let inv = 1.0 / d[a];
+            w.inv[a] = inv;
+            // Zero components: the nudged origins of `RayPrecomp` (lo
+            // planes against an origin one ulp up, hi planes one ulp down)
+            // so that a ray lying in a face counts as inside.
+            let (o_lo, o_hi) = if d[a] == 0.0 {
+                (next_float_up(o[a]), next_float_down(o[a]))
+            } else {
+                (o[a], o[a])
+            };
+            // A negative direction (−0 included) enters through the max
+            // plane.
+            if inv < 0.0 {
+                w.near[a] = 3 + a;
+                w.far[a] = a;
+                w.o_near[a] = o_hi;
+                w.o_far[a] = o_lo;
+            } else {
+                w.o_near[a] = o_lo;
+                w.o_far[a] = o_hi;
+            }
+        }
+        w
+    }
+
+    /// Entry distances of the four children and the mask of those the ray
+    /// overlaps within `[0, t_max]`.
+    #[inline(always)]
+    fn test(&self, node: &Bvh4Node, t_max: Float) -> ([Float; WIDTH], u32) {
+        let b = &node.bounds;
+        let pad = far_pad();
+        let mut t0 = [0.0 as Float; WIDTH];
+        let mut t1 = [t_max; WIDTH];
+        for a in 0..3 {
+            let nr = &b[self.near[a]];
+            let fr = &b[self.far[a]];
+            let (on, of, inv) = (self.o_near[a], self.o_far[a], self.inv[a]);
+            for i in 0..WIDTH {
+                t0[i] = fmax(t0[i], (nr[i] - on) * inv);
+                t1[i] = fmin(t1[i], (fr[i] - of) * inv * pad);
+            }
+        }
+        let mut mask = 0u32;
+        for i in 0..WIDTH {
+            mask |= ((t0[i] <= t1[i]) as u32) << i;
+        }
+        (t0, mask)
+    }
+}
+
+/// Enough for any tree: at most three entries are pushed per level and the
+/// binary tree (hence the wide one) is at most `STACK_SIZE` deep.
+const WIDE_STACK: usize = 3 * STACK_SIZE + 1;
+
+/// A traversal stack that is not zero-filled per ray.
+struct Stack<T: Copy> {
+    items: [MaybeUninit<T>; WIDE_STACK],
+    len: usize,
+}
+
+impl<T: Copy> Stack<T> {
+    #[inline(always)]
+    fn new() -> Self {
+        Stack {
+            items: [const { MaybeUninit::uninit() }; WIDE_STACK],
+            len: 0,
+        }
+    }
+    #[inline(always)]
+    fn push(&mut self, v: T) {
+        // Bounds-checked: a malformed tree panics instead of corrupting.
+        self.items[self.len] = MaybeUninit::new(v);
+        self.len += 1;
+    }
+    #[inline(always)]
+    fn pop(&mut self) -> Option<T> {
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        // SAFETY: every slot below `len` was written by `push` (slots are
+        // only ever written in order 0, 1, ... and `len` counts them).
+        Some(unsafe { self.items[self.len].assume_init() })
+    }
+}
+
+impl Bvh4 {
+    /// Builds over `prim_bounds` with all available cores.
+    pub fn build(prim_bounds: &[Bounds3f], params: &BvhParams) -> Bvh4 {
+        Bvh4::build_with_threads(prim_bounds, params, super::default_threads())
+    }
+
+    /// Builds with at most about `threads` threads; the result is the same
+    /// for every thread count.
+    pub fn build_with_threads(
+        prim_bounds: &[Bounds3f],
+        params: &BvhParams,
+        threads: usize,
+    ) -> Bvh4 {
+        Bvh4::from_binary(Bvh::build_with_threads(prim_bounds, params, threads))
+    }
+
+    /// Collapses a binary BVH into a 4-wide one (same leaves, same
+    /// primitive order).
+    pub fn from_binary(bin: Bvh) -> Bvh4 {
+        let bounds = bin.bounds();
+        let n_input = bin.primitive_count();
+        let n_skipped = bin.skipped_primitives();
+        let (bnodes, prim_indices) = bin.into_parts();
+        let mut nodes = Vec::with_capacity(bnodes.len() / 2 + 1);
+        if let Some(root) = bnodes.first() {
+            if root.is_leaf() {
+                let mut n = Bvh4Node::empty();
+                n.set_bounds(0, root);
+                n.child[0] = root.offset;
+                n.count[0] = root.count;
+                nodes.push(n);
+            } else {
+                collapse(&bnodes, 0, &mut nodes);
+            }
+        }
+        nodes.shrink_to_fit();
+        Bvh4 {
+            nodes,
+            prim_indices,
+            bounds,
+            n_input,
+            n_skipped,
+        }
+    }
+
+    /// The nodes (root first; empty when there are no primitives).
+    pub fn nodes(&self) -> &[Bvh4Node] {
+        &self.nodes
+    }
+
+    /// Caller primitive indices in leaf order: a leaf child covers
+    /// `prim_indices()[child..child + count]`.
+    pub fn prim_indices(&self) -> &[u32] {
+        &self.prim_indices
+    }
+}
+
+impl Aggregate for Bvh4 {
+    fn bounds(&self) -> Bounds3f {
+        self.bounds
+    }
+
+    #[inline]
+    fn intersect<F>(&self, ray: &Ray, t_max: Float, mut hit: F) -> Option<(u32, Float)>
+    where
+        F: FnMut(u32, &Ray, Float) -> Option<Float>,
+    {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        let w = WideRay::new(ray);
+        let mut t_max = t_max;
+        let mut best = None;
+        let mut stack: Stack<(u32, Float)> = Stack::new();
+        let mut cur = 0u32;
+        loop {
+            let node = &self.nodes[cur as usize];
+            let (t0, mut mask) = w.test(node, t_max);
+            let mut next: Option<(u32, Float)> = None;
+            if mask != 0 && mask & (mask - 1) == 0 {
+                // One child hit (the common case near the leaves): no
+                // ordering to do.
+                let i = mask.trailing_zeros() as usize;
+                let c = node.count[i] as usize;
+                if c > 0 {
+                    let start = node.child[i] as usize;
+                    closest_in_leaf(
+                        &self.prim_indices[start..start + c],
+                        ray,
+                        &mut t_max,
+                        &mut best,
+                        &mut hit,
+                    );
+                } else {
+                    next = Some((node.child[i], t0[i]));
+                }
+            } else if mask != 0 {
+                // Hit children sorted near to far (at most four: insertion
+                // sort).
+                let mut order = [(0usize, 0.0 as Float); WIDTH];
+                let mut n = 0;
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let mut j = n;
+                    while j > 0 && order[j - 1].1 > t0[i] {
+                        order[j] = order[j - 1];
+                        j -= 1;
+                    }
+                    order[j] = (i, t0[i]);
+                    n += 1;
+                }
+                // Leaves first, near to far; they shrink `t_max`.
+                for &(i, _) in &order[..n] {
+                    let c = node.count[i] as usize;
+                    if c > 0 {
+                        let start = node.child[i] as usize;
+                        closest_in_leaf(
+                            &self.prim_indices[start..start + c],
+                            ray,
+                            &mut t_max,
+                            &mut best,
+                            &mut hit,
+                        );
+                    }
+                }
+                // Interior children: visit the nearest next, push the rest
+                // far to near.
+                for &(i, tn) in order[..n].iter().rev() {
+                    if node.count[i] == 0 && tn <= t_max {
+                        if let Some(prev) = next {
+                            stack.push(prev);
+                        }
+                        next = Some((node.child[i], tn));
+                    }
+                }
+            }
+            match next {
+                Some((c, _)) => cur = c,
+                None => loop {
+                    match stack.pop() {
+                        None => return best,
+                        Some((c, tn)) if tn <= t_max => {
+                            cur = c;
+                            break;
+                        }
+                        Some(_) => {}
+                    }
+                },
+            }
+        }
+    }
+
+    #[inline]
+    fn intersect_p<F>(&self, ray: &Ray, t_max: Float, mut hit: F) -> bool
+    where
+        F: FnMut(u32, &Ray, Float) -> bool,
+    {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let w = WideRay::new(ray);
+        let mut stack: Stack<u32> = Stack::new();
+        let mut cur = 0u32;
+        loop {
+            let node = &self.nodes[cur as usize];
+            let (_, mut mask) = w.test(node, t_max);
+            let mut next: Option<u32> = None;
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let c = node.count[i];
+                if c > 0 {
+                    let start = node.child[i] as usize;
+                    for &p in &self.prim_indices[start..start + c as usize] {
+                        if hit(p, ray, t_max) {
+                            return true;
+                        }
+                    }
+                } else {
+                    if let Some(prev) = next {
+                        stack.push(prev);
+                    }
+                    next = Some(node.child[i]);
+                }
+            }
+            match next.or_else(|| stack.pop()) {
+                Some(c) => cur = c,
+                None => return false,
+            }
+        }
+    }
+
+    fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.nodes.capacity() * std::mem::size_of::<Bvh4Node>()
+            + self.prim_indices.capacity() * 4
+    }
+
+    fn primitive_count(&self) -> usize {
+        self.n_input
+    }
+
+    fn skipped_primitives(&self) -> usize {
+        self.n_skipped
+    }
+}
+
+/// Tests the primitives of one leaf, shrinking `t_max` on each closer hit.
+#[inline(always)]
+fn closest_in_leaf<F>(
+    prims: &[u32],
+    ray: &Ray,
+    t_max: &mut Float,
+    best: &mut Option<(u32, Float)>,
+    hit: &mut F,
+) where
+    F: FnMut(u32, &Ray, Float) -> Option<Float>,
+{
+    for &p in prims {
+        if let Some(t) = hit(p, ray, *t_max) {
+            debug_assert!(t <= *t_max);
+            *t_max = t;
+            *best = Some((p, t));
+        }
+    }
+}
