@@ -6,5 +6,6 @@ pub mod rng;
 pub mod sampling;
 pub mod scene;
 pub mod shape;
+pub mod spectrum;
 
 pub use rpbrt_geometry as geometry;
