@@ -5,12 +5,31 @@
 
 use rpbrt_geometry::Float;
 
+pub mod cie;
 mod color;
+mod colorspace;
+mod named;
+mod param;
+pub mod rgb2spec_opt;
 mod sampled;
+mod spectra;
+#[cfg(test)]
+mod tests;
 
+pub use cie::CIE_Y_INTEGRAL;
 pub use color::{sigmoid, ColorMatrix, RgbSigmoidPolynomial, RGB, XYZ};
+pub use colorspace::{
+    convert_rgb_color_space, RgbColorSpace, RgbToSpectrumTable, RGB_TO_SPECTRUM_RES,
+};
+pub use named::{named_spectrum, named_spectrum_names};
+pub use param::{parse_spectrum_text, read_spectrum_file, spectrum_from_param, SpectrumType};
 pub use sampled::{
     sample_visible_wavelengths, visible_wavelengths_pdf, SampledSpectrum, SampledWavelengths,
+};
+pub use spectra::{
+    blackbody, inner_product, spectrum_to_photometric, spectrum_to_xyz, BlackbodySpectrum,
+    DenselySampledSpectrum, PiecewiseLinearSpectrum, RgbAlbedoSpectrum, RgbIlluminantSpectrum,
+    RgbUnboundedSpectrum, Spectrum,
 };
 
 /// How many wavelengths each path carries.
