@@ -8,26 +8,75 @@ use rpbrt_geometry::Float;
 
 use super::spectra::{PiecewiseLinearSpectrum, Spectrum};
 
+#[path = "data/glass.rs"]
+mod glass;
 #[path = "data/illuminants.rs"]
 mod illuminants;
+#[path = "data/metals.rs"]
+mod metals;
 
-/// A named spectrum's source data: interleaved `(nm, value)` pairs and
-/// whether to normalise it to unit luminance (illuminants).
+/// Where a named spectrum's samples live.
+enum Data {
+    /// Interleaved `(nm, value)` pairs.
+    Interleaved(&'static [Float]),
+    /// Wavelengths and values in separate tables.
+    Split(&'static [Float], &'static [Float]),
+}
+
+/// A named spectrum: its data and whether to normalise it to unit
+/// luminance (illuminants only).
 struct Entry {
     name: &'static str,
-    data: &'static [Float],
+    data: Data,
     normalize: bool,
 }
 
 const fn illum(name: &'static str, data: &'static [Float]) -> Entry {
     Entry {
         name,
-        data,
+        data: Data::Interleaved(data),
         normalize: true,
     }
 }
 
+const fn glass(name: &'static str, data: &'static [Float]) -> Entry {
+    Entry {
+        name,
+        data: Data::Interleaved(data),
+        normalize: false,
+    }
+}
+
+const fn metal(name: &'static str, lambda: &'static [Float], v: &'static [Float]) -> Entry {
+    Entry {
+        name,
+        data: Data::Split(lambda, v),
+        normalize: false,
+    }
+}
+
+use metals::{METAL_LAMBDA, MGO_LAMBDA, TIO2_LAMBDA};
+
 const ENTRIES: &[Entry] = &[
+    glass("glass-BK7", &glass::BK7),
+    glass("glass-BAF10", &glass::BAF10),
+    glass("glass-FK51A", &glass::FK51A),
+    glass("glass-LASF9", &glass::LASF9),
+    glass("glass-F5", &glass::SF5),
+    glass("glass-F10", &glass::SF10),
+    glass("glass-F11", &glass::SF11),
+    metal("metal-Ag-eta", &METAL_LAMBDA, &metals::AG_ETA),
+    metal("metal-Ag-k", &METAL_LAMBDA, &metals::AG_K),
+    metal("metal-Al-eta", &METAL_LAMBDA, &metals::AL_ETA),
+    metal("metal-Al-k", &METAL_LAMBDA, &metals::AL_K),
+    metal("metal-Au-eta", &METAL_LAMBDA, &metals::AU_ETA),
+    metal("metal-Au-k", &METAL_LAMBDA, &metals::AU_K),
+    metal("metal-Cu-eta", &METAL_LAMBDA, &metals::CU_ETA),
+    metal("metal-Cu-k", &METAL_LAMBDA, &metals::CU_K),
+    metal("metal-MgO-eta", &MGO_LAMBDA, &metals::MGO_ETA),
+    metal("metal-MgO-k", &MGO_LAMBDA, &metals::MGO_K),
+    metal("metal-TiO2-eta", &TIO2_LAMBDA, &metals::TIO2_ETA),
+    metal("metal-TiO2-k", &TIO2_LAMBDA, &metals::TIO2_K),
     illum("stdillum-A", &illuminants::STDILLUM_A),
     illum("stdillum-D50", &illuminants::STDILLUM_D50),
     illum("stdillum-D65", &illuminants::STDILLUM_D65),
@@ -52,7 +101,16 @@ fn all() -> &'static [(&'static str, Spectrum)] {
         ENTRIES
             .iter()
             .filter_map(|e| {
-                let s = PiecewiseLinearSpectrum::from_interleaved(e.data, e.normalize).ok()?;
+                let s = match e.data {
+                    Data::Interleaved(d) => {
+                        PiecewiseLinearSpectrum::from_interleaved(d, e.normalize)
+                    }
+                    Data::Split(l, v) => {
+                        let d: Vec<Float> = l.iter().zip(v).flat_map(|(&a, &b)| [a, b]).collect();
+                        PiecewiseLinearSpectrum::from_interleaved(&d, e.normalize)
+                    }
+                }
+                .ok()?;
                 Some((e.name, Spectrum::PiecewiseLinear(Arc::new(s))))
             })
             .collect()

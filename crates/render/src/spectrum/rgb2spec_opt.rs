@@ -9,7 +9,12 @@
 //! This file stands alone (no crate imports) so `build.rs` can compile it
 //! with `#[path]` to generate the tables at build time.
 
-#![allow(dead_code)]
+#![allow(
+    dead_code,
+    clippy::needless_range_loop,
+    clippy::excessive_precision,
+    clippy::neg_cmp_op_on_partial_ord
+)]
 
 /// The CIE tables' range and the 5 nm grid the optimiser integrates over.
 const LAMBDA_MIN: f64 = 360.0;

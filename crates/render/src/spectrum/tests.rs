@@ -466,3 +466,40 @@ fn spectrum_parameters() {
     assert!(close(f.evaluate(550.0), 0.5, 1e-6));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn named_metals_and_glasses() {
+    let au_k = named_spectrum("metal-Au-k").unwrap();
+    assert!(
+        (au_k.evaluate(600.0) - 3.0).abs() < 0.1,
+        "{}",
+        au_k.evaluate(600.0)
+    );
+    let cu_eta = named_spectrum("metal-Cu-eta").unwrap();
+    assert!(cu_eta.evaluate(700.0) < 0.3 && cu_eta.evaluate(400.0) > 1.1);
+    let bk7 = named_spectrum("glass-BK7").unwrap();
+    assert!((bk7.evaluate(587.6) - 1.5168).abs() < 1e-3);
+    // MgO data stop at 768 nm and are extended with the last value.
+    assert!(close(
+        named_spectrum("metal-MgO-eta").unwrap().evaluate(800.0),
+        1.72872,
+        1e-5
+    ));
+    for name in named_spectrum_names() {
+        let s = named_spectrum(name).unwrap_or_else(|| panic!("{name} missing"));
+        for l in [360.0, 550.0, 830.0] {
+            let v = s.evaluate(l);
+            assert!(v.is_finite() && v >= 0.0, "{name} at {l}: {v}");
+        }
+    }
+    for name in [
+        "glass-F5",
+        "glass-F10",
+        "glass-F11",
+        "metal-Ag-k",
+        "metal-Al-eta",
+        "metal-TiO2-k",
+    ] {
+        assert!(named_spectrum(name).is_some(), "{name}");
+    }
+}

@@ -1,6 +1,12 @@
 //! The CIE 1931 2° standard observer colour matching functions, tabulated
 //! at 1 nm from 360 nm to 830 nm (CIE 018:2004; the table pbrt-v4 uses).
 
+#![allow(
+    clippy::excessive_precision,
+    clippy::unreadable_literal,
+    clippy::approx_constant
+)]
+
 /// How many 1 nm samples the CIE tables hold (360..=830 nm).
 pub const N_CIE_SAMPLES: usize = 471;
 

@@ -2,6 +2,12 @@
 //! pairs at 5 nm (CIE 15:2004 tables; pbrt-v4's named `stdillum-*` and
 //! `illum-acesD60` spectra). They are normalised to unit luminance on use.
 
+#![allow(
+    clippy::excessive_precision,
+    clippy::unreadable_literal,
+    clippy::approx_constant
+)]
+
 /// CIE standard illuminant A (2856 K tungsten), from its defining formula.
 #[rustfmt::skip]
 pub static STDILLUM_A: [f32; 214] = [
