@@ -11,5 +11,6 @@ pub mod sampler;
 pub mod sampling;
 pub mod scene;
 pub mod shape;
+pub mod spectrum;
 
 pub use rpbrt_geometry as geometry;
