@@ -12,5 +12,6 @@ pub mod sampling;
 pub mod scene;
 pub mod shape;
 pub mod spectrum;
+pub mod texture;
 
 pub use rpbrt_geometry as geometry;
