@@ -2,6 +2,7 @@
 #![deny(missing_docs)]
 
 pub mod accel;
+pub mod bxdf;
 pub mod rng;
 pub mod sampling;
 pub mod scene;
