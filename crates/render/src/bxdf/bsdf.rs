@@ -6,8 +6,7 @@ use rpbrt_geometry::tuple::*;
 use rpbrt_geometry::Frame;
 
 use super::{
-    rho_hd, rho_hh, BSDFSample, BxDF, BxDFFlags, BxDFMethods, BxDFReflTransFlags,
-    TransportMode,
+    rho_hd, rho_hh, BSDFSample, BxDF, BxDFFlags, BxDFMethods, BxDFReflTransFlags, TransportMode,
 };
 use crate::spectrum::SampledSpectrum;
 
@@ -51,7 +50,12 @@ impl BSDF {
 
     /// The BSDF value for rendering-space directions.
     #[inline]
-    pub fn f(&self, wo_render: Vector3f, wi_render: Vector3f, mode: TransportMode) -> SampledSpectrum {
+    pub fn f(
+        &self,
+        wo_render: Vector3f,
+        wi_render: Vector3f,
+        mode: TransportMode,
+    ) -> SampledSpectrum {
         let wi = self.render_to_local(wi_render);
         let wo = self.render_to_local(wo_render);
         if wo.z == 0.0 {

@@ -95,10 +95,9 @@ impl BxDFMethods for DielectricBxDF {
                 d.d(wm) * d.g(wo, wi) * fr / (4.0 * cos_theta(wi) * cos_theta(wo)).abs(),
             )
         } else {
-            let denom =
-                sqr(dot(wi, wm) + dot(wo, wm) / etap) * cos_theta(wi) * cos_theta(wo);
-            let mut ft = d.d(wm) * (1.0 - fr) * d.g(wo, wi)
-                * (dot(wi, wm) * dot(wo, wm) / denom).abs();
+            let denom = sqr(dot(wi, wm) + dot(wo, wm) / etap) * cos_theta(wi) * cos_theta(wo);
+            let mut ft =
+                d.d(wm) * (1.0 - fr) * d.g(wo, wi) * (dot(wi, wm) * dot(wo, wm) / denom).abs();
             if mode == TransportMode::Radiance {
                 ft /= sqr(etap);
             }
@@ -281,11 +280,21 @@ impl BxDFMethods for ThinDielectricBxDF {
         if uc < pr / (pr + pt) {
             let wi = Vector3f::new(-wo.x, -wo.y, wo.z);
             let f = SampledSpectrum::new(r / abs_cos_theta(wi));
-            Some(BSDFSample::new(f, wi, pr / (pr + pt), BxDFFlags::SPECULAR_REFLECTION))
+            Some(BSDFSample::new(
+                f,
+                wi,
+                pr / (pr + pt),
+                BxDFFlags::SPECULAR_REFLECTION,
+            ))
         } else {
             let wi = -wo;
             let f = SampledSpectrum::new(t / abs_cos_theta(wi));
-            Some(BSDFSample::new(f, wi, pt / (pr + pt), BxDFFlags::SPECULAR_TRANSMISSION))
+            Some(BSDFSample::new(
+                f,
+                wi,
+                pt / (pr + pt),
+                BxDFFlags::SPECULAR_TRANSMISSION,
+            ))
         }
     }
 

@@ -55,7 +55,12 @@ impl BxDFMethods for DiffuseBxDF {
         }
         let wi = cosine_in_hemisphere_of(wo, u);
         let pdf = cosine_hemisphere_pdf(abs_cos_theta(wi));
-        Some(BSDFSample::new(self.r * INV_PI, wi, pdf, BxDFFlags::DIFFUSE_REFLECTION))
+        Some(BSDFSample::new(
+            self.r * INV_PI,
+            wi,
+            pdf,
+            BxDFFlags::DIFFUSE_REFLECTION,
+        ))
     }
 
     fn pdf(
@@ -134,11 +139,21 @@ impl BxDFMethods for DiffuseTransmissionBxDF {
         let mut wi = cosine_in_hemisphere_of(wo, u);
         if uc < pr / (pr + pt) {
             let pdf = cosine_hemisphere_pdf(abs_cos_theta(wi)) * pr / (pr + pt);
-            Some(BSDFSample::new(self.f(wo, wi, mode), wi, pdf, BxDFFlags::DIFFUSE_REFLECTION))
+            Some(BSDFSample::new(
+                self.f(wo, wi, mode),
+                wi,
+                pdf,
+                BxDFFlags::DIFFUSE_REFLECTION,
+            ))
         } else {
             wi.z = -wi.z;
             let pdf = cosine_hemisphere_pdf(abs_cos_theta(wi)) * pt / (pr + pt);
-            Some(BSDFSample::new(self.f(wo, wi, mode), wi, pdf, BxDFFlags::DIFFUSE_TRANSMISSION))
+            Some(BSDFSample::new(
+                self.f(wo, wi, mode),
+                wi,
+                pdf,
+                BxDFFlags::DIFFUSE_TRANSMISSION,
+            ))
         }
     }
 

@@ -118,7 +118,13 @@ impl<T: BxDFMethods, B: BxDFMethods> Layer<'_, T, B> {
         }
     }
     #[inline]
-    fn pdf(&self, wo: Vector3f, wi: Vector3f, mode: TransportMode, fl: BxDFReflTransFlags) -> Float {
+    fn pdf(
+        &self,
+        wo: Vector3f,
+        wi: Vector3f,
+        mode: TransportMode,
+        fl: BxDFReflTransFlags,
+    ) -> Float {
         match self {
             Layer::Top(t) => t.pdf(wo, wi, mode, fl),
             Layer::Bottom(b) => b.pdf(wo, wi, mode, fl),
@@ -251,13 +257,15 @@ impl<Top: BxDFMethods, Bottom: BxDFMethods, const TWO_SIDED: bool> BxDFMethods
             // Enter the slab from wo, and presample the exit towards wi.
             let uc = r(&mut rng);
             let u = r2(&mut rng);
-            let Some(wos) = usable(&enter.sample_f(wo, uc, u, mode, BxDFReflTransFlags::TRANSMISSION))
+            let Some(wos) =
+                usable(&enter.sample_f(wo, uc, u, mode, BxDFReflTransFlags::TRANSMISSION))
             else {
                 continue;
             };
             let uc = r(&mut rng);
             let u = r2(&mut rng);
-            let Some(wis) = usable(&exit.sample_f(wi, uc, u, !mode, BxDFReflTransFlags::TRANSMISSION))
+            let Some(wis) =
+                usable(&exit.sample_f(wi, uc, u, !mode, BxDFReflTransFlags::TRANSMISSION))
             else {
                 continue;
             };
@@ -277,7 +285,11 @@ impl<Top: BxDFMethods, Bottom: BxDFMethods, const TWO_SIDED: bool> BxDFMethods
                 }
 
                 if !has_medium {
-                    z = if z == self.thickness { 0.0 } else { self.thickness };
+                    z = if z == self.thickness {
+                        0.0
+                    } else {
+                        self.thickness
+                    };
                     beta *= tr(self.thickness, w);
                 } else {
                     let sigma_t = 1.0;
@@ -365,13 +377,9 @@ impl<Top: BxDFMethods, Bottom: BxDFMethods, const TWO_SIDED: bool> BxDFMethods
                     }
                     let uc = r(&mut rng);
                     let u = r2(&mut rng);
-                    let Some(bs) = usable(&non_exit.sample_f(
-                        -w,
-                        uc,
-                        u,
-                        mode,
-                        BxDFReflTransFlags::REFLECTION,
-                    )) else {
+                    let Some(bs) =
+                        usable(&non_exit.sample_f(-w, uc, u, mode, BxDFReflTransFlags::REFLECTION))
+                    else {
                         break;
                     };
                     beta *= bs.f * abs_cos_theta(bs.wi) / bs.pdf;
@@ -416,7 +424,8 @@ impl<Top: BxDFMethods, Bottom: BxDFMethods, const TWO_SIDED: bool> BxDFMethods
         let first = if entered_top {
             self.top.sample_f(wo, uc, u, mode, BxDFReflTransFlags::ALL)
         } else {
-            self.bottom.sample_f(wo, uc, u, mode, BxDFReflTransFlags::ALL)
+            self.bottom
+                .sample_f(wo, uc, u, mode, BxDFReflTransFlags::ALL)
         };
         let mut bs = usable(&first)?;
         if bs.is_reflection() {
@@ -471,14 +480,19 @@ impl<Top: BxDFMethods, Bottom: BxDFMethods, const TWO_SIDED: bool> BxDFMethods
                 }
                 z = clamp(zp, 0.0, self.thickness);
             } else {
-                z = if z == self.thickness { 0.0 } else { self.thickness };
+                z = if z == self.thickness {
+                    0.0
+                } else {
+                    self.thickness
+                };
                 f *= tr(self.thickness, w);
             }
 
             let uc = r(&mut rng);
             let u = r2(&mut rng);
             let s = if z == 0.0 {
-                self.bottom.sample_f(-w, uc, u, mode, BxDFReflTransFlags::ALL)
+                self.bottom
+                    .sample_f(-w, uc, u, mode, BxDFReflTransFlags::ALL)
             } else {
                 self.top.sample_f(-w, uc, u, mode, BxDFReflTransFlags::ALL)
             };

@@ -4,7 +4,7 @@
 
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;
-use rpbrt_geometry::{cos_phi, cos2_theta, abs_cos_theta, sin_phi, tan2_theta};
+use rpbrt_geometry::{abs_cos_theta, cos2_theta, cos_phi, sin_phi, tan2_theta};
 
 use crate::sampling::sample_uniform_disk_polar;
 

@@ -7,9 +7,9 @@
 
 use std::ops::{BitAnd, BitOr, BitOrAssign, Not};
 
+use rpbrt_geometry::abs_cos_theta;
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;
-use rpbrt_geometry::abs_cos_theta;
 
 use crate::sampling::{sample_uniform_hemisphere, UNIFORM_HEMISPHERE_PDF};
 use crate::spectrum::SampledSpectrum;
@@ -409,8 +409,7 @@ pub fn rho_hd<B: BxDFMethods + ?Sized>(
     }
     let mut r = SampledSpectrum::new(0.0);
     for (&c, &u) in uc.iter().zip(u2) {
-        if let Some(bs) =
-            bxdf.sample_f(wo, c, u, TransportMode::Radiance, BxDFReflTransFlags::ALL)
+        if let Some(bs) = bxdf.sample_f(wo, c, u, TransportMode::Radiance, BxDFReflTransFlags::ALL)
         {
             if bs.pdf > 0.0 {
                 r += bs.f * abs_cos_theta(bs.wi) / bs.pdf;
@@ -438,9 +437,13 @@ pub fn rho_hh<B: BxDFMethods + ?Sized>(
         if wo.z == 0.0 {
             continue;
         }
-        if let Some(bs) =
-            bxdf.sample_f(wo, uc[i], u2[i], TransportMode::Radiance, BxDFReflTransFlags::ALL)
-        {
+        if let Some(bs) = bxdf.sample_f(
+            wo,
+            uc[i],
+            u2[i],
+            TransportMode::Radiance,
+            BxDFReflTransFlags::ALL,
+        ) {
             if bs.pdf > 0.0 {
                 r += bs.f * (abs_cos_theta(bs.wi) * abs_cos_theta(wo))
                     / (UNIFORM_HEMISPHERE_PDF * bs.pdf);
