@@ -196,6 +196,8 @@ impl HairBxDF {
     }
 
     /// The longitudinal scattering function M_p.
+    // pbrt-v4 uses the rounded constant 0.6931 (≈ ln 2) here; keep it.
+    #[allow(clippy::approx_constant)]
     fn mp(cos_i: Float, cos_o: Float, sin_i: Float, sin_o: Float, v: Float) -> Float {
         let a = cos_i * cos_o / v;
         let b = sin_i * sin_o / v;
@@ -420,7 +422,7 @@ mod tests {
     fn special_functions() {
         // I0(0) = 1, I0(1) ≈ 1.2660659.
         assert!((i0(0.0) - 1.0).abs() < 1e-6);
-        assert!((i0(1.0) - 1.266_065_9).abs() < 1e-5);
+        assert!((i0(1.0) - 1.266_066).abs() < 1e-5);
         // Reference values of ln I0 from a long double-precision series.
         assert!((log_i0(2.0) - 0.823_993_5).abs() < 1e-5);
         // pbrt-v4's large-argument expansion halves the 1/(8x) term, so it

@@ -323,8 +323,9 @@ impl<Top: BxDFMethods, Bottom: BxDFMethods, const TWO_SIDED: bool> BxDFMethods
                         if ps_pdf == 0.0 || ps_wi.z == 0.0 {
                             continue;
                         }
-                        // The phase value equals its density.
-                        beta *= self.albedo * ps_pdf / ps_pdf;
+                        // The phase value equals its density, so the weight
+                        // p / pdf is one.
+                        beta *= self.albedo;
                         w = ps_wi;
                         z = zp;
                         // MIS companion: the phase sample may leave through

@@ -523,11 +523,7 @@ fn chi2_p_value(observed: &[f64], expected: &[f64], min_exp: f64) -> (f64, usize
                 "samples in a cell of zero density: {} at {i}",
                 observed[i]
             );
-        } else if expected[i] < min_exp {
-            pooled_o += observed[i];
-            pooled_e += expected[i];
-            pooled_n += 1;
-        } else if pooled_n > 0 && pooled_e < min_exp {
+        } else if expected[i] < min_exp || (pooled_n > 0 && pooled_e < min_exp) {
             pooled_o += observed[i];
             pooled_e += expected[i];
             pooled_n += 1;
