@@ -5,6 +5,7 @@
 
 use crate::accel::{AccelParams, Accelerator, Aggregate};
 use crate::shape::{Shape, ShapeMethods};
+use crate::texture::{FloatTextureRef, TextureEvalContext};
 use rpbrt_geometry::animated::AnimatedTransform;
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::interaction::SurfaceInteraction;
@@ -33,12 +34,14 @@ impl MediumInterface {
 /// How a primitive's alpha mask cuts it out. pbrt-v4 tests alpha
 /// stochastically: a hit with alpha `a` is kept with probability `a`,
 /// decided by a hash of the ray so that the result is deterministic.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub enum Alpha {
     /// Fully opaque.
     Opaque,
     /// A constant alpha in (0, 1); zero alpha primitives are never built.
     Constant(Float),
+    /// An alpha texture, evaluated at the hit point.
+    Texture(FloatTextureRef),
 }
 
 /// What a ray hit: the surface geometry plus the primitive's properties.
@@ -88,18 +91,20 @@ fn hash_float_ray(r: &Ray) -> Float {
 impl GeometricPrimitive {
     /// Keeps a hit or lets the ray pass according to the alpha mask.
     #[inline]
-    fn alpha_passes(&self, ray: &Ray) -> bool {
-        match self.alpha {
-            Alpha::Opaque => true,
-            Alpha::Constant(a) => a >= 1.0 || (a > 0.0 && hash_float_ray(ray) <= a),
-        }
+    fn alpha_passes(&self, ray: &Ray, si: &SurfaceInteraction) -> bool {
+        let a = match &self.alpha {
+            Alpha::Opaque => return true,
+            Alpha::Constant(a) => *a,
+            Alpha::Texture(t) => t.evaluate(&TextureEvalContext::from_si(si)),
+        };
+        a >= 1.0 || (a > 0.0 && hash_float_ray(ray) <= a)
     }
 
     /// The closest hit in (0, t_max).
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
         let isect = self.shape.intersect(ray, t_max)?;
-        if !self.alpha_passes(ray) {
+        if !self.alpha_passes(ray, &isect.intr) {
             return None;
         }
         Some(PrimitiveIntersection {
