@@ -1,0 +1,265 @@
+//! Integrators (book chapters 13–14; pbrt-v4 `cpu/integrators.h/.cpp`):
+//! the light-transport algorithms, the render-ready [`Scene`] they query,
+//! and the parallel render loop.
+//!
+//! Every integrator here is a pbrt-v4 `RayIntegrator`: it estimates the
+//! radiance along one camera ray, and [`render`] drives it over image tiles
+//! in parallel. Results never depend on the thread count: each pixel's
+//! samples come from a sampler seeded by the pixel and sample index, and
+//! each pixel belongs to exactly one tile.
+
+mod path;
+mod render;
+mod simple;
+
+pub use path::PathIntegrator;
+pub use render::{render, RenderOptions, RenderStats};
+pub use simple::{AmbientOcclusionIntegrator, RandomWalkIntegrator, SimplePathIntegrator};
+
+use crate::bxdf::BSDF;
+use crate::camera::Camera;
+use crate::film::Film;
+use crate::filter::Filter;
+use crate::light::{Light, LightSampleContext};
+use crate::lightsampler::LightSampler;
+use crate::material::MaterialSet;
+use crate::primitive::{PrimitiveAggregate, PrimitiveIntersection};
+use crate::sampler::Sampler;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use rpbrt_geometry::float::Float;
+use rpbrt_geometry::interaction::{CameraDifferentials, SurfaceInteraction};
+use rpbrt_geometry::ray::{spawn_ray_to_surface, Ray, RayDifferential, SHADOW_EPSILON};
+use rpbrt_geometry::tuple::*;
+use rpbrt_geometry::Bounds3f;
+use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Counters shared by all threads (for `--stats`).
+#[derive(Debug, Default)]
+pub struct RayCounters {
+    /// Camera rays generated.
+    pub camera_rays: AtomicU64,
+    /// Closest-hit queries (camera and indirect rays).
+    pub intersection_rays: AtomicU64,
+    /// Shadow (any-hit) queries.
+    pub shadow_rays: AtomicU64,
+}
+
+/// Everything an integrator needs to trace rays and shade hits.
+pub struct Scene {
+    /// The camera.
+    pub camera: Camera,
+    /// The film (written by the render loop).
+    pub film: Film,
+    /// The sampler prototype (cloned per tile).
+    pub sampler: Sampler,
+    /// The pixel filter.
+    pub filter: Filter,
+    /// All geometry under its acceleration structure.
+    pub aggregate: PrimitiveAggregate,
+    /// All lights; area lights are referenced by index from primitives.
+    pub lights: Vec<Light>,
+    /// Indices of the infinite lights in `lights`.
+    pub infinite_lights: Vec<u32>,
+    /// The light sampler chosen by the integrator.
+    pub light_sampler: LightSampler,
+    /// The materials, indexed by the primitives' material ids.
+    pub materials: MaterialSet,
+    /// Camera information for texture-filtering footprints of rays without
+    /// differentials.
+    pub camera_differentials: CameraDifferentials,
+    /// Samples per pixel (for the footprint scale).
+    pub samples_per_pixel: i32,
+    /// `--disable-texture-filtering`.
+    pub disable_texture_filtering: bool,
+    /// `--force-diffuse`.
+    pub force_diffuse: bool,
+    /// Ray counters.
+    pub counters: RayCounters,
+}
+
+impl Scene {
+    /// The bounds of the geometry.
+    pub fn bounds(&self) -> Bounds3f {
+        self.aggregate.bounds()
+    }
+
+    /// The closest hit along `ray` in (0, t_max).
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
+        self.counters.intersection_rays.fetch_add(1, Ordering::Relaxed);
+        self.aggregate.intersect(ray, t_max)
+    }
+
+    /// Whether anything blocks `ray` in (0, t_max).
+    #[inline]
+    pub fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
+        self.counters.shadow_rays.fetch_add(1, Ordering::Relaxed);
+        self.aggregate.intersect_p(ray, t_max)
+    }
+
+    /// True when nothing blocks the segment between a surface point and a
+    /// point on a light (pbrt-v4 `Integrator::Unoccluded`).
+    #[inline]
+    pub fn unoccluded(&self, from: &SurfaceInteraction, to_p: Point3fi, to_n: Normal3f) -> bool {
+        let r = spawn_ray_to_surface(from.p(), from.p_error(), from.n, from.time, to_p.midpoint(), to_p.error(), to_n);
+        !self.intersect_p(&r, 1.0 - SHADOW_EPSILON)
+    }
+
+    /// Emitted radiance of the surface hit by a ray, toward `w`.
+    #[inline]
+    pub fn le(&self, hit: &PrimitiveIntersection, w: Vector3f, lambda: &SampledWavelengths) -> SampledSpectrum {
+        match hit.area_light {
+            Some(l) => self.lights[l as usize].l(hit.si.p(), hit.si.n, hit.si.uv, w, lambda),
+            None => SampledSpectrum::new(0.0),
+        }
+    }
+
+    /// pbrt-v4's `SurfaceInteraction::GetBSDF`: computes the screen-space
+    /// differentials, then asks the material for its BSDF (`None` for
+    /// interfaces between media, which the ray passes through).
+    pub fn get_bsdf(&self, hit: &mut PrimitiveIntersection, ray: &RayDifferential, lambda: &mut SampledWavelengths) -> Option<BSDF> {
+        let spp_scale = (1.0 / (self.samples_per_pixel.max(1) as Float).sqrt()).max(0.125);
+        hit.si.compute_differentials(ray, Some(&self.camera_differentials), spp_scale, self.disable_texture_filtering);
+        let material = hit.material?;
+        self.materials.get_bsdf(material, &mut hit.si, lambda, self.force_diffuse)
+    }
+}
+
+/// Continues a ray through a surface without scattering (pbrt-v4
+/// `SurfaceInteraction::SkipIntersection`): a new ray from the hit in the
+/// same direction, its differentials advanced to the surface.
+#[inline]
+pub(crate) fn skip_intersection(ray: &RayDifferential, hit: &PrimitiveIntersection) -> RayDifferential {
+    let mut next = RayDifferential::new(hit.si.spawn_ray(ray.ray.d));
+    next.ray.medium = ray.ray.medium;
+    if ray.has_differentials {
+        let t = hit.t_hit;
+        next.has_differentials = true;
+        next.rx_origin = ray.rx_origin + ray.rx_direction * t;
+        next.ry_origin = ray.ry_origin + ray.ry_direction * t;
+        next.rx_direction = ray.rx_direction;
+        next.ry_direction = ray.ry_direction;
+    }
+    next
+}
+
+/// The closed set of integrators.
+pub enum Integrator {
+    /// `path` (and `volpath` on scenes without participating media).
+    Path(PathIntegrator),
+    /// `simplepath`.
+    SimplePath(SimplePathIntegrator),
+    /// `ambientocclusion`.
+    AmbientOcclusion(AmbientOcclusionIntegrator),
+    /// `randomwalk`.
+    RandomWalk(RandomWalkIntegrator),
+}
+
+impl Integrator {
+    /// The radiance arriving along `ray` for the sampled wavelengths.
+    pub fn li(&self, scene: &Scene, ray: RayDifferential, lambda: &mut SampledWavelengths, sampler: &mut Sampler) -> SampledSpectrum {
+        match self {
+            Integrator::Path(i) => i.li(scene, ray, lambda, sampler),
+            Integrator::SimplePath(i) => i.li(scene, ray, lambda, sampler),
+            Integrator::AmbientOcclusion(i) => i.li(scene, ray, lambda, sampler),
+            Integrator::RandomWalk(i) => i.li(scene, ray, lambda, sampler),
+        }
+    }
+
+    /// The light sampler, if the integrator samples lights.
+    pub fn light_sampler_name(&self) -> Option<&str> {
+        match self {
+            Integrator::Path(i) => Some(&i.light_sampler_name),
+            _ => None,
+        }
+    }
+}
+
+/// Integrator names rpbrt knows, and those it renders.
+pub const INTEGRATOR_NAMES: &[&str] = &["ambientocclusion", "bdpt", "lightpath", "mlt", "path", "randomwalk", "simplepath", "simplevolpath", "sppm", "volpath"];
+
+/// Creates the integrator of an `Integrator` directive. The light sampler
+/// it needs is created by the caller (it needs the lights).
+pub fn create_integrator(name: &str, params: &ParameterDictionary, loc: &FileLoc, scene_has_media: bool) -> Result<Integrator, Diagnostic> {
+    let perr = Diagnostic::from;
+    let max_depth = params.get_one_int("maxdepth", 5).map_err(perr)?;
+    if max_depth < 0 {
+        return Err(Diagnostic::error(params.loc("maxdepth").cloned().unwrap_or_else(|| loc.clone()), format!("\"maxdepth\" must not be negative, got {max_depth}")));
+    }
+    match name {
+        "path" | "volpath" => {
+            if name == "volpath" && scene_has_media {
+                return Err(Diagnostic::error(loc.clone(), "participating media are not supported yet: the \"volpath\" integrator renders only scenes without media"));
+            }
+            Ok(Integrator::Path(PathIntegrator {
+                max_depth,
+                light_sampler_name: params.get_one_string("lightsampler", "bvh").map_err(perr)?,
+                regularize: params.get_one_bool("regularize", false).map_err(perr)?,
+            }))
+        }
+        "simplepath" => Ok(Integrator::SimplePath(SimplePathIntegrator {
+            max_depth,
+            sample_lights: params.get_one_bool("samplelights", true).map_err(perr)?,
+            sample_bsdf: params.get_one_bool("samplebsdf", true).map_err(perr)?,
+        })),
+        "ambientocclusion" => {
+            let max_distance = params.get_one_float("maxdistance", Float::INFINITY).map_err(perr)?;
+            if !(max_distance > 0.0) {
+                return Err(Diagnostic::error(params.loc("maxdistance").cloned().unwrap_or_else(|| loc.clone()), "\"maxdistance\" must be positive"));
+            }
+            Ok(Integrator::AmbientOcclusion(AmbientOcclusionIntegrator { cos_sample: params.get_one_bool("cossample", true).map_err(perr)?, max_distance }))
+        }
+        "randomwalk" => Ok(Integrator::RandomWalk(RandomWalkIntegrator { max_depth })),
+        "bdpt" | "lightpath" | "mlt" | "simplevolpath" | "sppm" => Err(Diagnostic::error(
+            loc.clone(),
+            format!("the \"{name}\" integrator is not supported yet; rpbrt renders with \"path\", \"volpath\" (without media), \"simplepath\", \"ambientocclusion\" and \"randomwalk\""),
+        )),
+        _ => Err(Diagnostic::error(loc.clone(), format!("unknown integrator \"{name}\"; known integrators: {}", INTEGRATOR_NAMES.join(", ")))),
+    }
+}
+
+/// Samples direct lighting at a surface hit with multiple importance
+/// sampling (pbrt-v4 `PathIntegrator::SampleLd`).
+pub(crate) fn sample_ld(
+    scene: &Scene,
+    light_sampler: &LightSampler,
+    si: &SurfaceInteraction,
+    bsdf: &BSDF,
+    lambda: &SampledWavelengths,
+    sampler: &mut Sampler,
+) -> SampledSpectrum {
+    let mut ctx = LightSampleContext::from_si(si);
+    let flags = bsdf.flags();
+    if flags.is_reflective() && !flags.is_transmissive() {
+        ctx.pi = Point3fi::from(si.offset_ray_origin(si.wo));
+    } else if flags.is_transmissive() && !flags.is_reflective() {
+        ctx.pi = Point3fi::from(si.offset_ray_origin(-si.wo));
+    }
+    let u = sampler.get_1d();
+    let sampled = light_sampler.sample(&ctx, u);
+    let u_light = sampler.get_2d();
+    let Some(sampled) = sampled else {
+        return SampledSpectrum::new(0.0);
+    };
+    let light = &scene.lights[sampled.light as usize];
+    let Some(ls) = light.sample_li(&ctx, u_light, lambda, true) else {
+        return SampledSpectrum::new(0.0);
+    };
+    if ls.l.is_black() || ls.pdf == 0.0 {
+        return SampledSpectrum::new(0.0);
+    }
+    let wo = si.wo;
+    let wi = ls.wi;
+    let f = bsdf.f(wo, wi, crate::bxdf::TransportMode::Radiance) * abs_dot(wi, si.shading.n);
+    if f.is_black() || !scene.unoccluded(si, ls.p_light, ls.n_light) {
+        return SampledSpectrum::new(0.0);
+    }
+    let p_l = sampled.p * ls.pdf;
+    if light.light_type().is_delta() {
+        return ls.l * f / p_l;
+    }
+    let p_b = bsdf.pdf(wo, wi, crate::bxdf::TransportMode::Radiance, crate::bxdf::BxDFReflTransFlags::ALL);
+    let w_l = crate::sampling::power_heuristic(1.0, p_l, 1.0, p_b);
+    ls.l * f * (w_l / p_l)
+}

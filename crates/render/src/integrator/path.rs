@@ -1,0 +1,119 @@
+//! The path tracer (pbrt-v4 `PathIntegrator`; book section 13.4): next-event
+//! estimation with multiple importance sampling, Russian roulette and
+//! optional BSDF regularization.
+
+use super::{sample_ld, skip_intersection, Scene};
+use crate::bxdf::{BxDFReflTransFlags, TransportMode};
+use crate::light::LightSampleContext;
+use crate::lightsampler::LightSampler;
+use crate::sampler::Sampler;
+use crate::sampling::power_heuristic;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use rpbrt_geometry::float::Float;
+use rpbrt_geometry::ray::RayDifferential;
+use rpbrt_geometry::tuple::*;
+
+/// pbrt-v4's `path` integrator.
+#[derive(Clone, Debug)]
+pub struct PathIntegrator {
+    /// Maximum number of scattering events.
+    pub max_depth: i32,
+    /// Which light sampler to use ("bvh", "power", "uniform").
+    pub light_sampler_name: String,
+    /// Roughen near-specular BSDFs after the first non-specular bounce.
+    pub regularize: bool,
+}
+
+impl PathIntegrator {
+    /// The radiance arriving along `ray`.
+    pub fn li(&self, scene: &Scene, ray: RayDifferential, lambda: &mut SampledWavelengths, sampler: &mut Sampler) -> SampledSpectrum {
+        let light_sampler: &LightSampler = &scene.light_sampler;
+        let mut ray = ray;
+        let mut l = SampledSpectrum::new(0.0);
+        let mut beta = SampledSpectrum::new(1.0);
+        let mut depth = 0;
+        let mut p_b: Float = 1.0;
+        let mut eta_scale: Float = 1.0;
+        let mut specular_bounce = false;
+        let mut any_non_specular = false;
+        let mut prev_ctx = LightSampleContext::default();
+        loop {
+            let Some(mut hit) = scene.intersect(&ray.ray, Float::INFINITY) else {
+                // Escaped: infinite lights, weighted by MIS unless the last
+                // bounce could not have been light-sampled.
+                for &li in &scene.infinite_lights {
+                    let light = &scene.lights[li as usize];
+                    let le = light.le(&ray.ray, lambda);
+                    if le.is_black() {
+                        continue;
+                    }
+                    if depth == 0 || specular_bounce {
+                        l += beta * le;
+                    } else {
+                        let p_l = light_sampler.pmf(&prev_ctx, li) * light.pdf_li(&prev_ctx, ray.ray.d, true);
+                        let w_b = power_heuristic(1.0, p_b, 1.0, p_l);
+                        l += beta * le * w_b;
+                    }
+                }
+                break;
+            };
+            // Emission from an area light that was hit.
+            let le = scene.le(&hit, -ray.ray.d, lambda);
+            if !le.is_black() {
+                if depth == 0 || specular_bounce {
+                    l += beta * le;
+                } else if let Some(al) = hit.area_light {
+                    let light = &scene.lights[al as usize];
+                    let p_l = light_sampler.pmf(&prev_ctx, al) * light.pdf_li(&prev_ctx, ray.ray.d, true);
+                    let w_l = power_heuristic(1.0, p_b, 1.0, p_l);
+                    l += beta * le * w_l;
+                }
+            }
+            let Some(mut bsdf) = scene.get_bsdf(&mut hit, &ray, lambda) else {
+                specular_bounce = true;
+                ray = skip_intersection(&ray, &hit);
+                continue;
+            };
+            if self.regularize && any_non_specular {
+                bsdf.regularize();
+            }
+            if depth == self.max_depth {
+                break;
+            }
+            depth += 1;
+            let si = &hit.si;
+            if bsdf.flags().is_non_specular() {
+                let ld = sample_ld(scene, light_sampler, si, &bsdf, lambda, sampler);
+                l += beta * ld;
+            }
+            prev_ctx = LightSampleContext::from_si(si);
+            let wo = -ray.ray.d;
+            let u = sampler.get_1d();
+            let u2 = sampler.get_2d();
+            let Some(bs) = bsdf.sample_f(wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL) else {
+                break;
+            };
+            beta *= bs.f * (abs_dot(bs.wi, si.shading.n) / bs.pdf);
+            p_b = if bs.pdf_is_proportional { bsdf.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL) } else { bs.pdf };
+            specular_bounce = bs.is_specular();
+            any_non_specular |= !bs.is_specular();
+            if bs.is_transmission() {
+                eta_scale *= bs.eta * bs.eta;
+            }
+            ray = RayDifferential::new(si.spawn_ray(bs.wi));
+            let rr_beta = beta * eta_scale;
+            let m = rr_beta.max_component_value();
+            if m < 1.0 && depth > 1 {
+                let q = (1.0 - m).max(0.0);
+                if sampler.get_1d() < q {
+                    break;
+                }
+                beta /= 1.0 - q;
+            }
+            if beta.is_black() {
+                break;
+            }
+        }
+        l
+    }
+}

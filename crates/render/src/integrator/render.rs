@@ -1,0 +1,173 @@
+//! The parallel render loop (pbrt-v4 `ImageTileIntegrator::Render` and
+//! `RayIntegrator::EvaluatePixelSample`): image tiles rendered in parallel,
+//! samples taken in waves of doubling size so that progress, interruption
+//! and partial images happen between waves.
+
+use super::{Integrator, Scene};
+use crate::camera::CameraSample;
+use crate::film::FilmTile;
+use crate::image::ImageMetadata;
+use crate::sampler::Sampler;
+use rayon::prelude::*;
+use rpbrt_geometry::bounds::Bounds2i;
+use rpbrt_geometry::float::Float;
+use rpbrt_geometry::tuple::*;
+use std::io::{IsTerminal, Write};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// How the render loop runs (the command line's part).
+#[derive(Clone, Debug, Default)]
+pub struct RenderOptions {
+    /// Worker threads (0: all cores).
+    pub nthreads: usize,
+    /// No progress bar.
+    pub quiet: bool,
+    /// Write the image after every wave of samples.
+    pub write_partial_images: bool,
+    /// Sample pixel centres only.
+    pub disable_pixel_jitter: bool,
+    /// Always use the same wavelengths.
+    pub disable_wavelength_jitter: bool,
+    /// Set (e.g. by a Ctrl-C handler) to stop after the current wave; the
+    /// image rendered so far is written.
+    pub interrupt: Option<Arc<AtomicBool>>,
+}
+
+/// What a render measured (for `--stats`).
+#[derive(Clone, Debug, Default)]
+pub struct RenderStats {
+    /// Wall-clock rendering time.
+    pub render_time: Duration,
+    /// Samples taken in total.
+    pub samples: u64,
+    /// True when the render was interrupted (Ctrl-C).
+    pub interrupted: bool,
+}
+
+/// Side of the square tiles the image is split into.
+const TILE_SIZE: i32 = 16;
+
+fn tiles(bounds: Bounds2i) -> Vec<Bounds2i> {
+    let mut out = Vec::new();
+    let mut y = bounds.p_min.y;
+    while y < bounds.p_max.y {
+        let mut x = bounds.p_min.x;
+        while x < bounds.p_max.x {
+            out.push(Bounds2i::new(Point2i::new(x, y), Point2i::new((x + TILE_SIZE).min(bounds.p_max.x), (y + TILE_SIZE).min(bounds.p_max.y))));
+            x += TILE_SIZE;
+        }
+        y += TILE_SIZE;
+    }
+    out
+}
+
+/// One camera sample through one pixel (pbrt-v4 `EvaluatePixelSample`).
+fn evaluate_pixel_sample(scene: &Scene, integrator: &Integrator, opts: &RenderOptions, p_pixel: Point2i, sampler: &mut Sampler, tile: &mut FilmTile) {
+    let mut lu = sampler.get_1d();
+    if opts.disable_wavelength_jitter {
+        lu = 0.5;
+    }
+    let mut lambda = scene.film.sample_wavelengths(lu);
+    let mut fs = scene.filter.sample(sampler.get_pixel_2d());
+    if opts.disable_pixel_jitter {
+        fs.p = Point2f::new(0.0, 0.0);
+        fs.weight = 1.0;
+    }
+    let time = sampler.get_1d();
+    let p_lens = sampler.get_2d();
+    let cs = CameraSample {
+        p_film: Point2f::new(p_pixel.x as Float + fs.p.x + 0.5, p_pixel.y as Float + fs.p.y + 0.5),
+        p_lens,
+        time,
+        filter_weight: fs.weight,
+    };
+    scene.counters.camera_rays.fetch_add(1, Ordering::Relaxed);
+    let mut l = crate::spectrum::SampledSpectrum::new(0.0);
+    if let Some(mut cr) = scene.camera.generate_ray_differential(&cs) {
+        if !opts.disable_pixel_jitter {
+            let scale = (1.0 / (sampler.samples_per_pixel() as Float).sqrt()).max(0.125);
+            cr.ray.scale_differentials(scale);
+        }
+        l = integrator.li(scene, cr.ray, &mut lambda, sampler) * cr.weight;
+        if l.has_nan() || !l.y(&lambda).is_finite() {
+            // pbrt-v4 drops such samples (and logs them).
+            l = crate::spectrum::SampledSpectrum::new(0.0);
+        }
+    }
+    tile.add_sample(p_pixel, l, &lambda, None, cs.filter_weight);
+}
+
+/// Renders `scene` with `integrator`, writing the film's image (and partial
+/// images when asked). `metadata` is completed with timing and sample
+/// counts.
+pub fn render(scene: &mut Scene, integrator: &Integrator, opts: &RenderOptions, metadata: &mut ImageMetadata) -> Result<RenderStats, String> {
+    let start = Instant::now();
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(opts.nthreads).build().map_err(|e| format!("cannot start worker threads: {e}"))?;
+    let spp = scene.sampler.samples_per_pixel().max(1);
+    let pixel_bounds = scene.film.pixel_bounds();
+    let tile_list = tiles(pixel_bounds);
+    let pixels = pixel_bounds.area().max(0) as u64;
+    let total = pixels * spp as u64;
+    let show_progress = !opts.quiet && std::io::stderr().is_terminal();
+    let mut done: u64 = 0;
+    let mut wave_start = 0;
+    let mut wave_end = 1;
+    let mut next_wave_size = 1;
+    let mut interrupted = false;
+    while wave_start < spp {
+        let results: Vec<FilmTile> = {
+            let scene_ref: &Scene = scene;
+            pool.install(|| {
+                tile_list
+                    .par_iter()
+                    .map(|&b| {
+                        let mut tile = scene_ref.film.make_tile(b);
+                        let mut sampler = scene_ref.sampler.clone();
+                        for p in b.iter() {
+                            for s in wave_start..wave_end {
+                                sampler.start_pixel_sample(p, s, 0);
+                                evaluate_pixel_sample(scene_ref, integrator, opts, p, &mut sampler, &mut tile);
+                            }
+                        }
+                        tile
+                    })
+                    .collect()
+            })
+        };
+        for t in results {
+            scene.film.merge_tile(t);
+        }
+        done += pixels * (wave_end - wave_start) as u64;
+        wave_start = wave_end;
+        wave_end = (wave_end + next_wave_size).min(spp);
+        next_wave_size = (2 * next_wave_size).min(64);
+        if show_progress {
+            let elapsed = start.elapsed().as_secs_f64();
+            let frac = done as f64 / total.max(1) as f64;
+            let eta = if frac > 0.0 { elapsed / frac - elapsed } else { 0.0 };
+            let width = 40;
+            let filled = (frac * width as f64) as usize;
+            eprint!("\r[{}{}] {:5.1}% {:.1}s elapsed, ETA {:.1}s ", "+".repeat(filled), " ".repeat(width - filled), frac * 100.0, elapsed, eta);
+            let _ = std::io::stderr().flush();
+        }
+        if opts.interrupt.as_ref().is_some_and(|f| f.load(Ordering::Relaxed)) {
+            interrupted = true;
+            break;
+        }
+        if opts.write_partial_images && wave_start < spp {
+            metadata.render_time_seconds = Some(start.elapsed().as_secs_f32());
+            metadata.samples_per_pixel = Some(wave_start);
+            scene.film.write_image(metadata, 1.0)?;
+        }
+    }
+    if show_progress {
+        eprintln!();
+    }
+    let render_time = start.elapsed();
+    metadata.render_time_seconds = Some(render_time.as_secs_f32());
+    metadata.samples_per_pixel = Some(wave_start);
+    scene.film.write_image(metadata, 1.0)?;
+    Ok(RenderStats { render_time, samples: done, interrupted })
+}
