@@ -540,12 +540,12 @@ fn create_spectrum_in(
             let mapping = TextureMapping2D::create(params, &rft, loc)?;
             SpectrumTexture::Bilerp(SpectrumBilerpTexture {
                 mapping,
-                v: [
+                v: Box::new([
                     constant("v00", 0.0)?,
                     constant("v01", 1.0)?,
                     constant("v10", 0.0)?,
                     constant("v11", 1.0)?,
-                ],
+                ]),
             })
         }
         "imagemap" => {

@@ -226,8 +226,8 @@ pub struct SpectrumBilerpTexture {
     /// The (s, t) mapping.
     pub mapping: TextureMapping2D,
     /// Spectra at (0,0), (0,1), (1,0), (1,1), converted for the spectrum
-    /// type the texture was created for.
-    pub v: [Spectrum; 4],
+    /// type the texture was created for (boxed to keep the enum small).
+    pub v: Box<[Spectrum; 4]>,
 }
 
 impl SpectrumBilerpTexture {
@@ -240,7 +240,7 @@ impl SpectrumBilerpTexture {
     ) -> SampledSpectrum {
         let c = self.mapping.map(ctx);
         let (s, t) = (c.st.x, c.st.y);
-        let [v00, v01, v10, v11] = &self.v;
+        let [v00, v01, v10, v11] = &*self.v;
         v00.sample(lambda) * ((1.0 - s) * (1.0 - t))
             + v10.sample(lambda) * (s * (1.0 - t))
             + v01.sample(lambda) * ((1.0 - s) * t)
