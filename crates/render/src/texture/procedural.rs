@@ -542,7 +542,7 @@ impl MarbleTexture {
     /// The RGB reflectance at a point.
     pub fn rgb(&self, ctx: &TextureEvalContext) -> RGB {
         let mut c = self.mapping.map(ctx);
-        c.p = c.p * self.scale;
+        c.p *= self.scale;
         let marble = c.p.y
             + self.variation
                 * fbm(

@@ -441,8 +441,7 @@ fn create_ok(text: &str) -> NamedTextures {
 /// The single error of a failed creation.
 fn create_err(text: &str) -> Diagnostic {
     let errs: Vec<Diagnostic> = create(text)
-        .err()
-        .expect("creation should fail")
+        .expect_err("creation should fail")
         .into_iter()
         .filter(|d| d.is_error())
         .collect();
