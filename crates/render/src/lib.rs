@@ -3,6 +3,7 @@
 
 pub mod accel;
 pub mod camera;
+pub mod film;
 pub mod filter;
 pub mod image;
 pub mod primitive;
