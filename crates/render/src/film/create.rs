@@ -288,7 +288,7 @@ pub fn create_film(
                 .get_one_string("coordinatesystem", "camera")
                 .map_err(perr)?;
             let (output_from_render, apply_inverse) = match cs.as_str() {
-                "camera" => (camera_transform.render_from_camera.clone(), true),
+                "camera" => (camera_transform.render_from_camera, true),
                 "world" => (AnimatedTransform::fixed(camera_transform.world_from_render), false),
                 _ => {
                     return Err(Diagnostic::error(

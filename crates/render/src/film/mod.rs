@@ -159,7 +159,7 @@ impl FilmCore {
                 let mut ls = l;
                 let lm = ls.max_component_value();
                 if lm > self.config.max_component_value {
-                    ls = ls * (self.config.max_component_value / lm);
+                    ls *= self.config.max_component_value / lm;
                 }
                 let ls = SampledSpectrum::safe_div(ls, lambda.pdf())
                     * (1.0 / crate::spectrum::N_SPECTRUM_SAMPLES as Float);

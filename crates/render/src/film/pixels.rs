@@ -69,6 +69,7 @@ pub struct SampleConfig {
 
 /// Film-kind specific constants.
 #[derive(Debug)]
+#[allow(clippy::large_enum_variant)] // one per film, never in a hot array
 pub enum KindConfig {
     /// RGB only.
     Rgb,
@@ -236,7 +237,7 @@ impl Pixels {
                 let mut l = l;
                 let lm = l.max_component_value();
                 if lm > cfg.max_component_value {
-                    l = l * (cfg.max_component_value / lm);
+                    l *= cfg.max_component_value / lm;
                 }
                 // Undo the lights' photometric normalisation; the uniform
                 // wavelength density is left out, as pbrt-v4 does, so the

@@ -3,6 +3,8 @@
 //! (pbrt-v4 `util/spectrum.cpp`; PhysLight measurements contributed to
 //! pbrt-v4 by Anders Langlands and Luca Fascione, Weta Digital).
 
+#![allow(clippy::excessive_precision, clippy::unreadable_literal)]
+
 /// Samples per curve.
 pub const N_SENSOR_SAMPLES: usize = 35;
 /// First tabulated wavelength (nm); the spacing is 10 nm.

@@ -3,6 +3,8 @@
 //! measurements, as in pbrt-v4 `film.cpp`), every 10 nm from 380 nm to
 //! 730 nm.
 
+#![allow(clippy::approx_constant)]
+
 /// Number of swatches.
 pub const N_SWATCHES: usize = 24;
 /// Samples per swatch.
