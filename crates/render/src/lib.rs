@@ -4,6 +4,7 @@
 pub mod accel;
 pub mod bxdf;
 pub mod camera;
+pub mod film;
 pub mod filter;
 pub mod image;
 pub mod primitive;
