@@ -5,6 +5,8 @@ pub mod accel;
 pub mod camera;
 pub mod filter;
 pub mod image;
+pub mod light;
+pub mod lightsampler;
 pub mod primitive;
 pub mod rng;
 pub mod sampler;
