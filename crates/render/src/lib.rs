@@ -7,6 +7,8 @@ pub mod camera;
 pub mod film;
 pub mod filter;
 pub mod image;
+pub mod light;
+pub mod lightsampler;
 pub mod primitive;
 pub mod rng;
 pub mod sampler;

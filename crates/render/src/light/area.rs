@@ -1,0 +1,199 @@
+//! Diffuse area lights (book section 12.3; pbrt-v4 `DiffuseAreaLight`).
+
+use rpbrt_geometry::{dot, Float, MediumId, Normal3f, Point2f, Point2i, Point3f, Vector3f, PI};
+
+use super::{rgb_illuminant, LightBounds, LightLiSample, LightSampleContext};
+use crate::image::{Image, WrapMode, WrapMode2D};
+use crate::rng::mix_bits;
+use crate::shape::{Shape, ShapeMethods, ShapeSampleContext};
+use crate::spectrum::{RgbColorSpace, SampledSpectrum, SampledWavelengths, Spectrum};
+use crate::texture::{FloatTextureRef, TextureEvalContext};
+
+/// Where a diffuse area light's radiance comes from.
+#[derive(Clone, Debug)]
+pub enum AreaEmission {
+    /// A spectrum, the same everywhere.
+    Spectrum(Spectrum),
+    /// An RGB image looked up at the surface's (u, v), with its colour
+    /// space.
+    Image(Image, &'static RgbColorSpace),
+}
+
+/// Radiance `scale · L` leaving a shape's surface uniformly in direction
+/// (pbrt-v4 `DiffuseAreaLight`).
+#[derive(Clone, Debug)]
+pub struct DiffuseAreaLight {
+    /// The emitting shape (in render space).
+    pub shape: Shape,
+    /// Cached surface area of `shape`.
+    pub area: Float,
+    /// Emitted radiance.
+    pub emission: AreaEmission,
+    /// Scale (photometric normalisation and power target included).
+    pub scale: Float,
+    /// Emits from both sides of the surface.
+    pub two_sided: bool,
+    /// Optional alpha texture: points with alpha 0 emit nothing.
+    pub alpha: Option<FloatTextureRef>,
+    /// Medium inside the shape.
+    pub medium_inside: Option<MediumId>,
+    /// Medium outside the shape.
+    pub medium_outside: Option<MediumId>,
+}
+
+/// A deterministic hash of a point to [0, 1) (pbrt-v4 `HashFloat`'s role
+/// in stochastic alpha).
+fn hash_point(p: Point3f) -> Float {
+    let bits =
+        ((p.x.to_bits() as u64) << 32) ^ ((p.y.to_bits() as u64) << 16) ^ p.z.to_bits() as u64;
+    let h = mix_bits(bits ^ mix_bits(p.z.to_bits() as u64 + 0x9e37_79b9));
+    (h >> 40) as Float / (1u64 << 24) as Float
+}
+
+impl DiffuseAreaLight {
+    /// True when the alpha texture masks the point out (pbrt-v4
+    /// `AlphaMasked`: alpha ≤ 0 masks, alpha ≥ 1 never does, in between a
+    /// hash of the point decides).
+    fn alpha_masked(&self, p: Point3f, uv: Point2f) -> bool {
+        let Some(alpha) = &self.alpha else {
+            return false;
+        };
+        let ctx = TextureEvalContext {
+            p,
+            uv,
+            ..Default::default()
+        };
+        let a = alpha.evaluate(&ctx);
+        if a >= 1.0 {
+            return false;
+        }
+        if a <= 0.0 {
+            return true;
+        }
+        hash_point(p) > a
+    }
+
+    /// Emitted radiance at `p` (normal `n`, surface coordinates `uv`)
+    /// toward `w`.
+    pub fn l(
+        &self,
+        p: Point3f,
+        n: Normal3f,
+        uv: Point2f,
+        w: Vector3f,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        if !self.two_sided && dot(n, w) < 0.0 {
+            return SampledSpectrum::new(0.0);
+        }
+        if self.alpha_masked(p, uv) {
+            return SampledSpectrum::new(0.0);
+        }
+        match &self.emission {
+            AreaEmission::Spectrum(s) => s.sample(lambda) * self.scale,
+            AreaEmission::Image(image, cs) => {
+                // Image rows run top to bottom while v runs bottom to top.
+                let st = Point2f::new(uv.x, 1.0 - uv.y);
+                let clamp = WrapMode2D::new(WrapMode::Clamp, WrapMode::Clamp);
+                let rgb = [0, 1, 2].map(|c| image.bilerp_channel(st, c, clamp));
+                rgb_illuminant(cs, rgb, lambda) * self.scale
+            }
+        }
+    }
+
+    fn shape_ctx(ctx: &LightSampleContext) -> ShapeSampleContext {
+        ShapeSampleContext {
+            pi: ctx.pi,
+            n: ctx.n,
+            ns: ctx.ns,
+            time: 0.0,
+        }
+    }
+
+    /// Samples a point on the shape by solid angle from `ctx`.
+    pub fn sample_li(
+        &self,
+        ctx: &LightSampleContext,
+        u: Point2f,
+        lambda: &SampledWavelengths,
+        _allow_incomplete_pdf: bool,
+    ) -> Option<LightLiSample> {
+        let ss = self.shape.sample(&Self::shape_ctx(ctx), u)?;
+        if ss.pdf == 0.0 || (ss.p() - ctx.p()).length_squared() == 0.0 {
+            return None;
+        }
+        let wi = (ss.p() - ctx.p()).normalize();
+        let le = self.l(ss.p(), ss.n, ss.uv, -wi, lambda);
+        if le.is_black() {
+            return None;
+        }
+        Some(LightLiSample {
+            l: le,
+            wi,
+            pdf: ss.pdf,
+            p_light: ss.pi,
+            n_light: ss.n,
+        })
+    }
+
+    /// The shape's solid-angle density for `wi` from `ctx`.
+    pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vector3f, _a: bool) -> Float {
+        self.shape.pdf(&Self::shape_ctx(ctx), wi)
+    }
+
+    /// Mean emission · scale · area · π, doubled when two-sided.
+    pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
+        let l = match &self.emission {
+            AreaEmission::Spectrum(s) => s.sample(lambda),
+            AreaEmission::Image(image, cs) => {
+                let res = image.resolution();
+                let clamp = WrapMode2D::new(WrapMode::Clamp, WrapMode::Clamp);
+                let mut sum = SampledSpectrum::new(0.0);
+                for y in 0..res.y {
+                    for x in 0..res.x {
+                        let rgb =
+                            [0, 1, 2].map(|c| image.get_channel(Point2i::new(x, y), c, clamp));
+                        sum += rgb_illuminant(cs, rgb, lambda);
+                    }
+                }
+                sum / (res.x as Float * res.y as Float)
+            }
+        };
+        l * (if self.two_sided { 2.0 } else { 1.0 } * self.scale * self.area * PI)
+    }
+
+    /// The shape's bounds and normal cone, emission over a hemisphere.
+    pub fn bounds(&self) -> Option<LightBounds> {
+        let mut phi = match &self.emission {
+            AreaEmission::Spectrum(s) => s.max_value(),
+            AreaEmission::Image(image, _) => {
+                let res = image.resolution();
+                let clamp = WrapMode2D::new(WrapMode::Clamp, WrapMode::Clamp);
+                let mut sum = 0.0f64;
+                for y in 0..res.y {
+                    for x in 0..res.x {
+                        for c in 0..3 {
+                            sum += image.get_channel(Point2i::new(x, y), c, clamp) as f64;
+                        }
+                    }
+                }
+                (sum / (3.0 * res.x as f64 * res.y as f64)) as Float
+            }
+        };
+        phi *= if self.two_sided { 2.0 } else { 1.0 } * self.scale * self.area * PI;
+        let nb = self.shape.normal_bounds();
+        Some(LightBounds::new(
+            self.shape.bounds(),
+            nb.w,
+            phi,
+            nb.cos_theta,
+            0.0,
+            self.two_sided,
+        ))
+    }
+
+    /// The medium outside the shape.
+    pub fn medium(&self) -> Option<MediumId> {
+        self.medium_outside
+    }
+}

@@ -1,0 +1,462 @@
+//! Light sources (book chapter 12; pbrt-v4 `lights.h/.cpp`, `base/light.h`):
+//! point, spot, goniometric, projection, distant, diffuse area, uniform and
+//! image infinite lights, all in rendering space.
+//!
+//! [`Light`] is a closed enum whose methods delegate in one line to the
+//! concrete lights. Emission spectra are stored densely sampled (pbrt-v4's
+//! `LightBase::LookupSpectrum`) together with a `scale` that already
+//! includes pbrt-v4's photometric normalisation (`scale /=
+//! SpectrumToPhotometric(spectrum)`) and any `power` / `illuminance`
+//! target; see [`create`].
+
+use std::sync::Arc;
+
+use rpbrt_geometry::{
+    dot, safe_acos, Bounds3f, DirectionCone, Float, MediumId, Normal3f, Point2f, Point3f, Point3fi,
+    Ray, SurfaceInteraction, Vector3f,
+};
+
+use crate::spectrum::{
+    DenselySampledSpectrum, RgbColorSpace, RgbIlluminantSpectrum, SampledSpectrum,
+    SampledWavelengths, Spectrum, RGB,
+};
+
+mod area;
+pub mod create;
+mod distant;
+mod infinite;
+mod point;
+#[cfg(test)]
+mod tests;
+
+pub use area::{AreaEmission, DiffuseAreaLight};
+pub use create::{create_area_light, create_light};
+pub use distant::DistantLight;
+pub use infinite::{ImageInfiniteLight, UniformInfiniteLight};
+pub use point::{GoniometricLight, PointLight, ProjectionLight, SpotLight};
+
+/// How a light emits, which decides how integrators may sample it (pbrt-v4
+/// `LightType`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LightType {
+    /// Emits from a single point (point, spot, goniometric, projection).
+    DeltaPosition,
+    /// Emits along a single direction (distant).
+    DeltaDirection,
+    /// Emits from a surface.
+    Area,
+    /// Emits from infinitely far away, reached by rays that leave the scene.
+    Infinite,
+}
+
+impl LightType {
+    /// True for lights described by a delta distribution (position or
+    /// direction): they cannot be hit by rays.
+    #[inline]
+    pub fn is_delta(self) -> bool {
+        matches!(self, LightType::DeltaPosition | LightType::DeltaDirection)
+    }
+}
+
+/// The reference point a light is sampled from (pbrt-v4
+/// `LightSampleContext`): a point with error bounds and, at surfaces, the
+/// geometric and shading normals (zero in participating media).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LightSampleContext {
+    /// The point with its rounding-error intervals.
+    pub pi: Point3fi,
+    /// Geometric normal (zero away from surfaces).
+    pub n: Normal3f,
+    /// Shading normal (zero away from surfaces).
+    pub ns: Normal3f,
+}
+
+impl LightSampleContext {
+    /// The context of a surface hit.
+    #[inline]
+    pub fn from_si(si: &SurfaceInteraction) -> Self {
+        LightSampleContext {
+            pi: si.pi,
+            n: si.n,
+            ns: si.shading.n,
+        }
+    }
+
+    /// A context at a point in space (no surface).
+    #[inline]
+    pub fn from_point(p: Point3f) -> Self {
+        LightSampleContext {
+            pi: Point3fi::from(p),
+            n: Normal3f::default(),
+            ns: Normal3f::default(),
+        }
+    }
+
+    /// The reference point.
+    #[inline]
+    pub fn p(&self) -> Point3f {
+        self.pi.midpoint()
+    }
+}
+
+/// Incident radiance sampled from a light (pbrt-v4 `LightLiSample`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightLiSample {
+    /// Incident radiance (or, for delta lights, the delta's weight).
+    pub l: SampledSpectrum,
+    /// Unit direction from the reference point toward the light.
+    pub wi: Vector3f,
+    /// Density of `wi` by solid angle (1 for delta lights).
+    pub pdf: Float,
+    /// The point on the light (for the shadow ray).
+    pub p_light: Point3fi,
+    /// Surface normal at `p_light` (zero for non-area lights).
+    pub n_light: Normal3f,
+}
+
+/// A bound on a light's position, emitted power and emission directions,
+/// used by the BVH light sampler (pbrt-v4 `LightBounds`, book section
+/// 12.6.3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightBounds {
+    /// Spatial bounds of the emitter.
+    pub bounds: Bounds3f,
+    /// Principal emission direction (unit).
+    pub w: Vector3f,
+    /// Bound on emitted power.
+    pub phi: Float,
+    /// Cosine of the spread of surface normals around `w`.
+    pub cos_theta_o: Float,
+    /// Cosine of the angle beyond the normals over which light is emitted.
+    pub cos_theta_e: Float,
+    /// Whether light leaves both sides of the surface.
+    pub two_sided: bool,
+}
+
+impl Default for LightBounds {
+    /// Bounds of nothing: zero power.
+    fn default() -> Self {
+        LightBounds {
+            bounds: Bounds3f::default(),
+            w: Vector3f::new(0.0, 0.0, 1.0),
+            phi: 0.0,
+            cos_theta_o: 1.0,
+            cos_theta_e: 1.0,
+            two_sided: false,
+        }
+    }
+}
+
+/// cos(max(0, a − b)) from the sines and cosines of `a` and `b`.
+#[inline]
+fn cos_sub_clamped(sin_a: Float, cos_a: Float, sin_b: Float, cos_b: Float) -> Float {
+    if cos_a > cos_b {
+        1.0
+    } else {
+        cos_a * cos_b + sin_a * sin_b
+    }
+}
+
+/// sin(max(0, a − b)) from the sines and cosines of `a` and `b`.
+#[inline]
+fn sin_sub_clamped(sin_a: Float, cos_a: Float, sin_b: Float, cos_b: Float) -> Float {
+    if cos_a > cos_b {
+        0.0
+    } else {
+        sin_a * cos_b - cos_a * sin_b
+    }
+}
+
+#[inline]
+fn safe_sqrt1m(c: Float) -> Float {
+    (1.0 - c * c).max(0.0).sqrt()
+}
+
+impl LightBounds {
+    /// Bounds from their parts; `w` is normalised.
+    pub fn new(
+        bounds: Bounds3f,
+        w: Vector3f,
+        phi: Float,
+        cos_theta_o: Float,
+        cos_theta_e: Float,
+        two_sided: bool,
+    ) -> Self {
+        LightBounds {
+            bounds,
+            w: w.try_normalize().unwrap_or(Vector3f::new(0.0, 0.0, 1.0)),
+            phi,
+            cos_theta_o,
+            cos_theta_e,
+            two_sided,
+        }
+    }
+
+    /// The centre of the spatial bounds.
+    #[inline]
+    pub fn centroid(&self) -> Point3f {
+        self.bounds.lerp(Point3f::new(0.5, 0.5, 0.5))
+    }
+
+    /// A conservative estimate of the light's contribution at `p` with
+    /// surface normal `n` (zero normal: a point in a medium), exactly as
+    /// pbrt-v4's `LightBounds::Importance`.
+    pub fn importance(&self, p: Point3f, n: Normal3f) -> Float {
+        let pc = self.centroid();
+        let d2 = p
+            .distance_squared(pc)
+            .max(self.bounds.diagonal().length() / 2.0);
+        let wi = (p - pc).try_normalize().unwrap_or_default();
+        let mut cos_theta_w = dot(self.w, wi);
+        if self.two_sided {
+            cos_theta_w = cos_theta_w.abs();
+        }
+        let sin_theta_w = safe_sqrt1m(cos_theta_w);
+        // Angle subtended by the bounds as seen from p.
+        let cos_theta_b = DirectionCone::bound_subtended_directions(&self.bounds, p).cos_theta;
+        let sin_theta_b = safe_sqrt1m(cos_theta_b);
+        // θ' = max(0, θ_w − θ_o − θ_b), in two clamped steps.
+        let sin_theta_o = safe_sqrt1m(self.cos_theta_o);
+        let cos_theta_x = cos_sub_clamped(sin_theta_w, cos_theta_w, sin_theta_o, self.cos_theta_o);
+        let sin_theta_x = sin_sub_clamped(sin_theta_w, cos_theta_w, sin_theta_o, self.cos_theta_o);
+        let cos_theta_p = cos_sub_clamped(sin_theta_x, cos_theta_x, sin_theta_b, cos_theta_b);
+        if cos_theta_p <= self.cos_theta_e {
+            return 0.0;
+        }
+        let mut importance = self.phi * cos_theta_p / d2;
+        if n != Normal3f::default() {
+            let cos_theta_i = dot(wi, Vector3f::from(n)).abs();
+            let sin_theta_i = safe_sqrt1m(cos_theta_i);
+            importance *= cos_sub_clamped(sin_theta_i, cos_theta_i, sin_theta_b, cos_theta_b);
+        }
+        importance.max(0.0)
+    }
+
+    /// The bounds of both (pbrt-v4 `Union(LightBounds, LightBounds)`):
+    /// zero-power bounds are ignored.
+    pub fn union(a: &LightBounds, b: &LightBounds) -> LightBounds {
+        if a.phi == 0.0 {
+            return *b;
+        }
+        if b.phi == 0.0 {
+            return *a;
+        }
+        let cone = DirectionCone::union(
+            &DirectionCone::new(a.w, a.cos_theta_o),
+            &DirectionCone::new(b.w, b.cos_theta_o),
+        );
+        LightBounds::new(
+            a.bounds.union(&b.bounds),
+            cone.w,
+            a.phi + b.phi,
+            cone.cos_theta,
+            a.cos_theta_e.min(b.cos_theta_e),
+            a.two_sided || b.two_sided,
+        )
+    }
+}
+
+/// A light source: a closed set of variants, each method a one-line
+/// delegation (pbrt-v4 `Light`).
+#[derive(Clone, Debug)]
+pub enum Light {
+    /// Isotropic point light.
+    Point(PointLight),
+    /// Spotlight with smooth falloff.
+    Spot(SpotLight),
+    /// Point light modulated by an equal-area goniometric diagram.
+    Goniometric(Box<GoniometricLight>),
+    /// Point light projecting an image.
+    Projection(Box<ProjectionLight>),
+    /// Directional light from infinitely far away.
+    Distant(DistantLight),
+    /// Diffuse emission from a shape's surface.
+    DiffuseArea(Box<DiffuseAreaLight>),
+    /// Constant radiance from every direction.
+    UniformInfinite(UniformInfiniteLight),
+    /// Environment map in pbrt-v4's equal-area octahedral layout.
+    ImageInfinite(Box<ImageInfiniteLight>),
+}
+
+macro_rules! dispatch {
+    ($self:expr, $l:ident => $e:expr) => {
+        match $self {
+            Light::Point($l) => $e,
+            Light::Spot($l) => $e,
+            Light::Goniometric($l) => $e,
+            Light::Projection($l) => $e,
+            Light::Distant($l) => $e,
+            Light::DiffuseArea($l) => $e,
+            Light::UniformInfinite($l) => $e,
+            Light::ImageInfinite($l) => $e,
+        }
+    };
+}
+
+impl Light {
+    /// The kind of emission.
+    #[inline]
+    pub fn light_type(&self) -> LightType {
+        match self {
+            Light::Point(_) | Light::Spot(_) | Light::Goniometric(_) | Light::Projection(_) => {
+                LightType::DeltaPosition
+            }
+            Light::Distant(_) => LightType::DeltaDirection,
+            Light::DiffuseArea(_) => LightType::Area,
+            Light::UniformInfinite(_) | Light::ImageInfinite(_) => LightType::Infinite,
+        }
+    }
+
+    /// Samples a direction toward the light from `ctx`. With
+    /// `allow_incomplete_pdf`, lights may skip directions that other
+    /// sampling (BSDF sampling under MIS) covers well.
+    #[inline]
+    pub fn sample_li(
+        &self,
+        ctx: &LightSampleContext,
+        u: Point2f,
+        lambda: &SampledWavelengths,
+        allow_incomplete_pdf: bool,
+    ) -> Option<LightLiSample> {
+        dispatch!(self, l => l.sample_li(ctx, u, lambda, allow_incomplete_pdf))
+    }
+
+    /// The solid-angle density with which [`sample_li`](Self::sample_li)
+    /// picks `wi` (zero for delta lights).
+    #[inline]
+    pub fn pdf_li(
+        &self,
+        ctx: &LightSampleContext,
+        wi: Vector3f,
+        allow_incomplete_pdf: bool,
+    ) -> Float {
+        dispatch!(self, l => l.pdf_li(ctx, wi, allow_incomplete_pdf))
+    }
+
+    /// Emitted radiance of an area light at surface point `p` (normal `n`,
+    /// surface coordinates `uv`) toward `w`; zero for other lights.
+    #[inline]
+    pub fn l(
+        &self,
+        p: Point3f,
+        n: Normal3f,
+        uv: Point2f,
+        w: Vector3f,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        match self {
+            Light::DiffuseArea(l) => l.l(p, n, uv, w, lambda),
+            _ => SampledSpectrum::new(0.0),
+        }
+    }
+
+    /// Radiance an infinite light sends along a ray that left the scene;
+    /// zero for other lights.
+    #[inline]
+    pub fn le(&self, ray: &Ray, lambda: &SampledWavelengths) -> SampledSpectrum {
+        match self {
+            Light::UniformInfinite(l) => l.le(ray, lambda),
+            Light::ImageInfinite(l) => l.le(ray, lambda),
+            _ => SampledSpectrum::new(0.0),
+        }
+    }
+
+    /// Total emitted power.
+    #[inline]
+    pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
+        dispatch!(self, l => l.phi(lambda))
+    }
+
+    /// Called once the scene is known: distant and infinite lights record
+    /// the scene's bounding sphere.
+    #[inline]
+    pub fn preprocess(&mut self, scene_bounds: &Bounds3f) {
+        match self {
+            Light::Distant(l) => l.preprocess(scene_bounds),
+            Light::UniformInfinite(l) => l.preprocess(scene_bounds),
+            Light::ImageInfinite(l) => l.preprocess(scene_bounds),
+            _ => {}
+        }
+    }
+
+    /// Bounds for the BVH light sampler; `None` for lights at infinity.
+    #[inline]
+    pub fn bounds(&self) -> Option<LightBounds> {
+        dispatch!(self, l => l.bounds())
+    }
+
+    /// The medium the light sits in (outside medium for area lights).
+    #[inline]
+    pub fn medium(&self) -> Option<MediumId> {
+        dispatch!(self, l => l.medium())
+    }
+}
+
+/// The scene's bounding sphere as infinite and distant lights need it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneSphere {
+    /// Centre of the scene's bounding sphere.
+    pub center: Point3f,
+    /// Radius of the scene's bounding sphere.
+    pub radius: Float,
+}
+
+impl Default for SceneSphere {
+    fn default() -> Self {
+        SceneSphere {
+            center: Point3f::new(0.0, 0.0, 0.0),
+            radius: 0.0,
+        }
+    }
+}
+
+impl SceneSphere {
+    /// The bounding sphere of `b`.
+    pub fn from_bounds(b: &Bounds3f) -> Self {
+        let (center, radius) = b.bounding_sphere();
+        SceneSphere { center, radius }
+    }
+}
+
+/// pbrt-v4's `SmoothStep`: 0 below `a`, 1 above `b`, a cubic in between.
+#[inline]
+pub fn smooth_step(x: Float, a: Float, b: Float) -> Float {
+    if a == b {
+        return if x < a { 0.0 } else { 1.0 };
+    }
+    let t = ((x - a) / (b - a)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
+}
+
+/// Emission from a stored spectrum (pbrt-v4 `LookupSpectrum`: densely
+/// sampled at 1 nm).
+pub(crate) fn dense(s: &Spectrum) -> Spectrum {
+    match s {
+        Spectrum::Constant(_) | Spectrum::DenselySampled(_) => s.clone(),
+        _ => Spectrum::DenselySampled(Arc::new(DenselySampledSpectrum::new(s))),
+    }
+}
+
+/// The emission spectrum of RGB `rgb` (negative components clamped) in
+/// colour space `cs`, sampled at `lambda`.
+#[inline]
+pub(crate) fn rgb_illuminant(
+    cs: &RgbColorSpace,
+    rgb: [Float; 3],
+    lambda: &SampledWavelengths,
+) -> SampledSpectrum {
+    let rgb = RGB::new(rgb[0].max(0.0), rgb[1].max(0.0), rgb[2].max(0.0));
+    RgbIlluminantSpectrum::new(cs, rgb).sample(lambda)
+}
+
+/// The luminance (Y) weights of a colour space's RGB primaries.
+#[inline]
+pub(crate) fn luminance_vector(cs: &RgbColorSpace) -> [Float; 3] {
+    cs.xyz_from_rgb.m[1]
+}
+
+/// `acos` clamped to [-1, 1].
+#[inline]
+pub(crate) fn acos_c(x: Float) -> Float {
+    safe_acos(x)
+}

@@ -1,0 +1,598 @@
+//! Light tests in the style of pbrt-v4's `lights_test.cpp`: sampling
+//! densities against `pdf_li`, radiance against `l`/`le`, emitted power
+//! against numerical integrals and the `power`/`illuminance` targets.
+
+use std::sync::Arc;
+
+use rpbrt_geometry::{
+    equal_area_square_to_sphere, AnimatedTransform, Float, Normal3f, Point2f, Point2i, Point3f,
+    Ray, Transform, Vector3f, PI,
+};
+use rpbrt_parser::{FileLoc, ParameterDictionary, ParsedParameter};
+
+use super::*;
+use crate::image::Image;
+use crate::rng::Rng;
+use crate::sampling::sample_uniform_sphere;
+use crate::scene::entities::{CameraTransform, LightSceneEntity, SceneEntity};
+use crate::shape::{Disk, Shape, ShapeMethods};
+use crate::spectrum::{spectrum_to_photometric, RgbColorSpace, SampledWavelengths};
+
+fn loc() -> FileLoc {
+    FileLoc::new(Arc::from("test.pbrt"), 1, 1)
+}
+
+fn floats(name: &str, v: &[f32]) -> ParsedParameter {
+    let ty = match v.len() {
+        3 if name == "from" || name == "to" => "point3",
+        3 => "rgb",
+        _ => "float",
+    };
+    ParsedParameter::with_floats(ty, name, loc(), v.to_vec())
+}
+
+fn entity(name: &str, params: Vec<ParsedParameter>) -> LightSceneEntity {
+    LightSceneEntity {
+        base: SceneEntity::new(name, ParameterDictionary::new(params), loc(), "srgb"),
+        render_from_object: AnimatedTransform::fixed(Transform::identity()),
+        medium: String::new(),
+    }
+}
+
+fn make(name: &str, params: Vec<ParsedParameter>) -> Light {
+    match create_light(&entity(name, params), None, &CameraTransform::default()) {
+        Ok((l, w)) => {
+            assert!(w.is_empty(), "unexpected warnings {w:?}");
+            l
+        }
+        Err(e) => panic!("{e:?}"),
+    }
+}
+
+fn rel_eq(a: Float, b: Float, eps: Float) -> bool {
+    (a - b).abs() <= eps * a.abs().max(b.abs()).max(1e-6)
+}
+
+fn lambda(rng: &mut Rng) -> SampledWavelengths {
+    SampledWavelengths::sample_visible(rng.uniform_float())
+}
+
+/// ∫ I(ω) dω over the sphere, by stratified sampling, through `sample_li`
+/// from points on the unit sphere around the light's origin.
+fn integrate_intensity(light: &Light, origin: Point3f, lambda: &SampledWavelengths) -> [Float; 4] {
+    let n = 256;
+    let mut sum = [0.0f64; 4];
+    for i in 0..n {
+        for j in 0..n {
+            let u = Point2f::new(
+                (i as Float + 0.5) / n as Float,
+                (j as Float + 0.5) / n as Float,
+            );
+            let w = sample_uniform_sphere(u);
+            let ctx = LightSampleContext::from_point(origin + w * 2.0);
+            if let Some(ls) = light.sample_li(&ctx, Point2f::new(0.5, 0.5), lambda, false) {
+                assert_eq!(ls.pdf, 1.0);
+                for (k, s) in sum.iter_mut().enumerate() {
+                    *s += (ls.l[k] * 4.0) as f64;
+                }
+            }
+        }
+    }
+    sum.map(|s| (s * 4.0 * PI as f64 / (n * n) as f64) as Float)
+}
+
+fn check_phi_against_integral(light: &Light, origin: Point3f, eps: Float) {
+    let mut rng = Rng::with_sequence(7);
+    let lambda = lambda(&mut rng);
+    let integral = integrate_intensity(light, origin, &lambda);
+    let phi = light.phi(&lambda);
+    for k in 0..4 {
+        assert!(
+            rel_eq(integral[k], phi[k], eps),
+            "∫I = {:?} vs phi {:?}",
+            integral,
+            phi
+        );
+    }
+}
+
+#[test]
+fn point_light_power_and_falloff() {
+    let l = make(
+        "point",
+        vec![floats("power", &[100.0]), floats("from", &[1.0, 2.0, 3.0])],
+    );
+    let Light::Point(p) = &l else { panic!() };
+    // Luminous power exactly as requested.
+    assert!(rel_eq(
+        p.scale * 4.0 * PI * spectrum_to_photometric(&p.i),
+        100.0,
+        1e-4
+    ));
+    check_phi_against_integral(&l, Point3f::new(1.0, 2.0, 3.0), 1e-3);
+    let lambda = SampledWavelengths::sample_visible(0.3);
+    let a = l
+        .sample_li(
+            &LightSampleContext::from_point(Point3f::new(1.0, 2.0, 5.0)),
+            Point2f::new(0.5, 0.5),
+            &lambda,
+            false,
+        )
+        .unwrap();
+    let b = l
+        .sample_li(
+            &LightSampleContext::from_point(Point3f::new(1.0, 2.0, 7.0)),
+            Point2f::new(0.5, 0.5),
+            &lambda,
+            false,
+        )
+        .unwrap();
+    assert!(rel_eq(a.l[0], 4.0 * b.l[0], 1e-4));
+    assert!((a.wi - Vector3f::new(0.0, 0.0, -1.0)).length() < 1e-5);
+    assert_eq!(l.light_type(), LightType::DeltaPosition);
+}
+
+#[test]
+fn spot_light_power_falloff_and_integral() {
+    let l = make(
+        "spot",
+        vec![
+            floats("power", &[50.0]),
+            floats("coneangle", &[40.0]),
+            floats("conedelta", &[10.0]),
+            floats("from", &[0.0, 0.0, 0.0]),
+            floats("to", &[1.0, 0.0, 0.0]),
+        ],
+    );
+    let Light::Spot(s) = &l else { panic!() };
+    let cs = s.cos_falloff_start;
+    let ce = s.cos_falloff_end;
+    let k_e = 2.0 * PI * ((1.0 - cs) + (cs - ce) / 2.0);
+    assert!(rel_eq(
+        s.scale * k_e * spectrum_to_photometric(&s.i),
+        50.0,
+        1e-4
+    ));
+    check_phi_against_integral(&l, Point3f::new(0.0, 0.0, 0.0), 5e-3);
+    let lambda = SampledWavelengths::sample_visible(0.5);
+    let at_angle = |deg: Float| {
+        let t = deg.to_radians();
+        // The light points along +x; the context sits at angle t off axis.
+        let p = Point3f::new(t.cos(), t.sin(), 0.0);
+        l.sample_li(
+            &LightSampleContext::from_point(p),
+            Point2f::new(0.5, 0.5),
+            &lambda,
+            false,
+        )
+        .map(|s| s.l[0])
+        .unwrap_or(0.0)
+    };
+    let full = at_angle(0.0);
+    assert!(full > 0.0);
+    assert!(rel_eq(at_angle(29.9), full, 1e-3));
+    assert!(at_angle(40.1) == 0.0);
+    let mid = at_angle(35.0);
+    assert!(mid > 0.0 && mid < full);
+    // Smoothstep is symmetric about the middle of the falloff band in cosine.
+    let cmid = ((cs + ce) / 2.0).acos().to_degrees();
+    assert!(rel_eq(at_angle(cmid), full / 2.0, 1e-2));
+}
+
+#[test]
+fn distant_light_illuminance() {
+    let l = make(
+        "distant",
+        vec![
+            floats("illuminance", &[5.0]),
+            floats("from", &[0.0, 1.0, 0.0]),
+            floats("to", &[0.0, 0.0, 0.0]),
+        ],
+    );
+    let Light::Distant(d) = &l else { panic!() };
+    // Luminance of the radiance times cos 0 on a perpendicular surface.
+    assert!(rel_eq(
+        d.scale * spectrum_to_photometric(&d.l_emit),
+        5.0,
+        1e-4
+    ));
+    let mut l = l;
+    l.preprocess(&rpbrt_geometry::Bounds3f::new(
+        Point3f::new(-1.0, -1.0, -1.0),
+        Point3f::new(1.0, 1.0, 1.0),
+    ));
+    let lambda = SampledWavelengths::sample_visible(0.5);
+    let s = l
+        .sample_li(
+            &LightSampleContext::from_point(Point3f::new(0.0, 0.0, 0.0)),
+            Point2f::new(0.5, 0.5),
+            &lambda,
+            false,
+        )
+        .unwrap();
+    assert!((s.wi - Vector3f::new(0.0, 1.0, 0.0)).length() < 1e-5);
+    assert!(s.p_light.midpoint().y > 3.0);
+    let r2 = 3.0;
+    assert!(rel_eq(l.phi(&lambda)[0], s.l[0] * PI * r2, 1e-4));
+}
+
+#[test]
+fn uniform_infinite_illuminance_and_pdf() {
+    let mut l = make(
+        "infinite",
+        vec![floats("illuminance", &[3.0]), floats("L", &[0.2, 0.5, 0.9])],
+    );
+    let Light::UniformInfinite(u) = &l else {
+        panic!()
+    };
+    // pbrt-v4 normalises by the illuminant, not the RGB multiplier.
+    let illum = RgbColorSpace::srgb().illuminant_spectrum();
+    assert!(rel_eq(
+        u.scale * spectrum_to_photometric(&illum) * PI,
+        3.0,
+        1e-4
+    ));
+    l.preprocess(&rpbrt_geometry::Bounds3f::new(
+        Point3f::new(0.0, 0.0, 0.0),
+        Point3f::new(1.0, 1.0, 1.0),
+    ));
+    let mut rng = Rng::with_sequence(3);
+    let ctx = LightSampleContext::from_point(Point3f::new(0.5, 0.5, 0.5));
+    for _ in 0..100 {
+        let lambda = lambda(&mut rng);
+        let u = Point2f::new(rng.uniform_float(), rng.uniform_float());
+        let s = l.sample_li(&ctx, u, &lambda, false).unwrap();
+        assert!(rel_eq(s.pdf, l.pdf_li(&ctx, s.wi, false), 1e-5));
+        let le = l.le(&Ray::new(ctx.p(), s.wi), &lambda);
+        assert_eq!(le, s.l);
+        assert!(l.sample_li(&ctx, u, &lambda, true).is_none());
+        assert_eq!(l.pdf_li(&ctx, s.wi, true), 0.0);
+    }
+}
+
+fn disk_light(two_sided: bool, power: Option<f32>, render_from_object: Transform) -> Light {
+    let disk = Disk::new(render_from_object, false, 0.0, 1.5, 0.0, 360.0).unwrap();
+    let shape = Shape::Disk(Box::new(disk));
+    let mut params = vec![floats("L", &[0.7, 0.4, 0.2])];
+    if two_sided {
+        params.push(ParsedParameter {
+            bools: vec![true],
+            ..ParsedParameter::new("bool", "twosided", loc())
+        });
+    }
+    if let Some(p) = power {
+        params.push(floats("power", &[p]));
+    }
+    let e = SceneEntity::new("diffuse", ParameterDictionary::new(params), loc(), "srgb");
+    let l = create_area_light(&e, &render_from_object, &shape, None, None, None).unwrap();
+    assert!(e.params.report_unused().is_empty());
+    l
+}
+
+#[test]
+fn area_light_sampling_power_and_radiance() {
+    let xf = Transform::translate(Vector3f::new(0.0, 0.0, 1.0)) * Transform::rotate_x(20.0);
+    for two_sided in [false, true] {
+        let l = disk_light(two_sided, None, xf);
+        let Light::DiffuseArea(a) = &l else { panic!() };
+        let mut rng = Rng::with_sequence(11);
+        // pdf consistency and radiance from sample_li against l().
+        let mut n_ok = 0;
+        for _ in 0..400 {
+            let p = Point3f::new(
+                rng.uniform_float() * 4.0 - 2.0,
+                rng.uniform_float() * 4.0 - 2.0,
+                rng.uniform_float() * 4.0 - 2.0,
+            );
+            let ctx = LightSampleContext::from_point(p);
+            let lambda = lambda(&mut rng);
+            let u = Point2f::new(rng.uniform_float(), rng.uniform_float());
+            if let Some(s) = l.sample_li(&ctx, u, &lambda, false) {
+                n_ok += 1;
+                let pdf = l.pdf_li(&ctx, s.wi, false);
+                assert!(rel_eq(s.pdf, pdf, 2e-2), "{} vs {}", s.pdf, pdf);
+                let lv = l.l(
+                    s.p_light.midpoint(),
+                    s.n_light,
+                    Point2f::new(0.5, 0.5),
+                    -s.wi,
+                    &lambda,
+                );
+                assert_eq!(lv, s.l);
+            }
+        }
+        assert!(n_ok > 50, "{n_ok}");
+        // Power against ∫∫ L cos over area and directions.
+        let lambda = SampledWavelengths::sample_visible(0.4);
+        let n = 200_000;
+        let mut sum = 0.0f64;
+        for _ in 0..n {
+            let ss = a
+                .shape
+                .sample_area(Point2f::new(rng.uniform_float(), rng.uniform_float()))
+                .unwrap();
+            let w = sample_uniform_sphere(Point2f::new(rng.uniform_float(), rng.uniform_float()));
+            let le = l.l(ss.p(), ss.n, ss.uv, w, &lambda);
+            let cos = rpbrt_geometry::dot(ss.n, w).abs();
+            sum += (le[0] * cos / (ss.pdf * (1.0 / (4.0 * PI)))) as f64;
+        }
+        let integral = (sum / n as f64) as Float;
+        let phi = l.phi(&lambda)[0];
+        assert!(
+            rel_eq(integral, phi, 2e-2),
+            "two_sided {two_sided}: {integral} vs {phi}"
+        );
+    }
+    // `power` gives exactly the requested luminous power.
+    for two_sided in [false, true] {
+        let l = disk_light(two_sided, Some(20.0), xf);
+        let Light::DiffuseArea(a) = &l else { panic!() };
+        let AreaEmission::Spectrum(s) = &a.emission else {
+            panic!()
+        };
+        let cs = RgbColorSpace::srgb();
+        let k = if two_sided { 2.0 } else { 1.0 };
+        let lum_rgb =
+            spectrum_to_photometric(s) / spectrum_to_photometric(&cs.illuminant_spectrum());
+        // pbrt-v4 normalises the illuminant, not the RGB multiplier: the
+        // power is 20 × the spectrum's luminance relative to the illuminant.
+        let phi_v = a.scale * k * a.area * PI * spectrum_to_photometric(&cs.illuminant_spectrum());
+        assert!(
+            rel_eq(phi_v, 20.0, 1e-4),
+            "{phi_v} (rgb luminance {lum_rgb})"
+        );
+    }
+}
+
+#[test]
+fn one_sided_area_light_dark_behind() {
+    let l = disk_light(false, None, Transform::identity());
+    let lambda = SampledWavelengths::sample_visible(0.5);
+    let n = Normal3f::new(0.0, 0.0, 1.0);
+    let front = l.l(
+        Point3f::new(0.0, 0.0, 0.0),
+        n,
+        Point2f::new(0.5, 0.5),
+        Vector3f::new(0.0, 0.0, 1.0),
+        &lambda,
+    );
+    let back = l.l(
+        Point3f::new(0.0, 0.0, 0.0),
+        n,
+        Point2f::new(0.5, 0.5),
+        Vector3f::new(0.0, 0.0, -1.0),
+        &lambda,
+    );
+    assert!(!front.is_black());
+    assert!(back.is_black());
+}
+
+fn test_envmap(res: i32, bright: Point2i) -> Image {
+    let mut data = Vec::new();
+    for y in 0..res {
+        for x in 0..res {
+            let v = if Point2i::new(x, y) == bright {
+                50.0
+            } else {
+                0.1 + 0.05 * ((x * 7 + y * 3) % 5) as f32
+            };
+            data.extend_from_slice(&[v, v * 0.8, v * 0.6]);
+        }
+    }
+    Image::from_f32(data, Point2i::new(res, res), &["R", "G", "B"]).unwrap()
+}
+
+#[test]
+fn image_infinite_light_sampling() {
+    let res = 16;
+    let bright = Point2i::new(3, 11);
+    let xf = Transform::rotate_z(30.0);
+    let mut l = Light::ImageInfinite(Box::new(ImageInfiniteLight::new(
+        xf,
+        test_envmap(res, bright),
+        RgbColorSpace::srgb(),
+        1.0,
+    )));
+    l.preprocess(&rpbrt_geometry::Bounds3f::new(
+        Point3f::new(0.0, 0.0, 0.0),
+        Point3f::new(1.0, 1.0, 1.0),
+    ));
+    let ctx = LightSampleContext::from_point(Point3f::new(0.2, 0.3, 0.4));
+    let mut rng = Rng::with_sequence(5);
+    // pdf integrates to one over the sphere (both distributions).
+    for allow in [false, true] {
+        let n = 400_000;
+        let mut sum = 0.0f64;
+        for _ in 0..n {
+            let w = sample_uniform_sphere(Point2f::new(rng.uniform_float(), rng.uniform_float()));
+            sum += (l.pdf_li(&ctx, w, allow) * 4.0 * PI) as f64;
+        }
+        let mean = sum / n as f64;
+        assert!((mean - 1.0).abs() < 0.03, "allow {allow}: ∫pdf = {mean}");
+    }
+    // sample_li agrees with pdf_li and le; histogram matches the image.
+    let mut counts = vec![0usize; (res * res) as usize];
+    let n = 200_000;
+    let lambda = SampledWavelengths::sample_visible(0.5);
+    for i in 0..n {
+        let u = Point2f::new(rng.uniform_float(), rng.uniform_float());
+        let s = l.sample_li(&ctx, u, &lambda, false).unwrap();
+        if i < 2000 {
+            assert!(rel_eq(s.pdf, l.pdf_li(&ctx, s.wi, false), 1e-3));
+            assert_eq!(s.l, l.le(&Ray::new(ctx.p(), s.wi), &lambda));
+            let sc = l.sample_li(&ctx, u, &lambda, true).unwrap();
+            assert!(rel_eq(sc.pdf, l.pdf_li(&ctx, sc.wi, true), 1e-3));
+        }
+        let wl = xf.apply_inverse_vector(s.wi);
+        let uv = rpbrt_geometry::equal_area_sphere_to_square(wl);
+        let px = ((uv.x * res as Float) as i32).min(res - 1);
+        let py = ((uv.y * res as Float) as i32).min(res - 1);
+        counts[(py * res + px) as usize] += 1;
+    }
+    let Light::ImageInfinite(img) = &l else {
+        panic!()
+    };
+    let mut total = 0.0;
+    let mut w = vec![0.0; (res * res) as usize];
+    for y in 0..res {
+        for x in 0..res {
+            let v: Float = (0..3)
+                .map(|c| {
+                    img.image.get_channel(
+                        Point2i::new(x, y),
+                        c,
+                        crate::image::WrapMode2D::new(
+                            crate::image::WrapMode::Clamp,
+                            crate::image::WrapMode::Clamp,
+                        ),
+                    )
+                })
+                .sum::<Float>();
+            w[(y * res + x) as usize] = v;
+            total += v;
+        }
+    }
+    for i in 0..(res * res) as usize {
+        let expected = w[i] / total * n as Float;
+        let got = counts[i] as Float;
+        assert!(
+            (got - expected).abs() <= 5.0 * expected.sqrt() + 3.0,
+            "pixel {i}: {got} vs {expected}"
+        );
+    }
+    // Orientation: the bright pixel's centre direction (light space,
+    // rotated into render space) sees the bright radiance.
+    let uv = Point2f::new(
+        (bright.x as Float + 0.5) / res as Float,
+        (bright.y as Float + 0.5) / res as Float,
+    );
+    let dir = xf.apply_vector(equal_area_square_to_sphere(uv));
+    let le = l.le(&Ray::new(ctx.p(), dir), &lambda);
+    let le_other = l.le(&Ray::new(ctx.p(), -dir), &lambda);
+    assert!(le[0] > 50.0 * le_other[0]);
+    // Power: 4π · π r² · mean radiance.
+    let phi = l.phi(&lambda)[0];
+    assert!(phi > 0.0);
+}
+
+#[test]
+fn goniometric_and_projection_power_integrals() {
+    let res = 16;
+    let mut data = Vec::new();
+    for y in 0..res {
+        for x in 0..res {
+            data.push(0.2 + ((x + 2 * y) % 7) as f32 * 0.1);
+        }
+    }
+    let image = Image::from_f32(data, Point2i::new(res, res), &["Y"]).unwrap();
+    let cs = RgbColorSpace::srgb();
+    let g = Light::Goniometric(Box::new(GoniometricLight {
+        render_from_light: Transform::translate(Vector3f::new(1.0, 0.0, 0.0)),
+        i: dense(&cs.illuminant_spectrum()),
+        scale: 0.01,
+        image,
+        medium: None,
+    }));
+    check_phi_against_integral(&g, Point3f::new(1.0, 0.0, 0.0), 1e-2);
+
+    let mut data = Vec::new();
+    for y in 0..8 {
+        for x in 0..12 {
+            let v = 0.1 + ((x * y) % 5) as f32 * 0.2;
+            data.extend_from_slice(&[v, 0.5 * v, 0.2]);
+        }
+    }
+    let image = Image::from_f32(data, Point2i::new(12, 8), &["R", "G", "B"]).unwrap();
+    let p = Light::Projection(Box::new(ProjectionLight::new(
+        Transform::identity(),
+        image,
+        cs,
+        0.01,
+        60.0,
+        None,
+    )));
+    check_phi_against_integral(&p, Point3f::new(0.0, 0.0, 0.0), 2e-2);
+}
+
+#[test]
+fn creation_errors_are_located() {
+    let bad = |name: &str, params: Vec<ParsedParameter>| {
+        create_light(&entity(name, params), None, &CameraTransform::default()).unwrap_err()
+    };
+    let e = bad("nosuch", vec![]);
+    assert!(format!("{e:?}").contains("point"));
+    let e = bad("point", vec![floats("scale", &[-1.0])]);
+    assert!(format!("{e:?}").contains("scale"));
+    let e = bad("goniometric", vec![]);
+    assert!(format!("{e:?}").contains("filename"));
+    let e = bad(
+        "infinite",
+        vec![ParsedParameter::with_strings(
+            "string",
+            "filename",
+            loc(),
+            vec!["/nonexistent/env.exr".into()],
+        )],
+    );
+    assert!(format!("{e:?}").contains("env.exr"));
+    let e = bad(
+        "infinite",
+        vec![ParsedParameter::with_floats(
+            "point3",
+            "portal",
+            loc(),
+            vec![0.0; 12],
+        )],
+    );
+    assert!(format!("{e:?}").contains("portals not supported"));
+    // Unused parameters are warned about.
+    let (_, w) = create_light(
+        &entity("point", vec![floats("bogus", &[1.0])]),
+        None,
+        &CameraTransform::default(),
+    )
+    .unwrap();
+    assert_eq!(w.len(), 1);
+}
+
+#[test]
+fn light_bounds_importance_and_union() {
+    let a = LightBounds::new(
+        rpbrt_geometry::Bounds3f::new(Point3f::new(0.0, 0.0, 0.0), Point3f::new(1.0, 1.0, 0.0)),
+        Vector3f::new(0.0, 0.0, 1.0),
+        2.0,
+        1.0,
+        0.0,
+        false,
+    );
+    // In front: positive; behind a one-sided emitter: zero.
+    assert!(a.importance(Point3f::new(0.5, 0.5, 3.0), Normal3f::default()) > 0.0);
+    assert_eq!(
+        a.importance(Point3f::new(0.5, 0.5, -3.0), Normal3f::default()),
+        0.0
+    );
+    let b = LightBounds {
+        two_sided: true,
+        ..a
+    };
+    assert!(b.importance(Point3f::new(0.5, 0.5, -3.0), Normal3f::default()) > 0.0);
+    let u = LightBounds::union(
+        &a,
+        &LightBounds {
+            w: Vector3f::new(1.0, 0.0, 0.0),
+            ..a
+        },
+    );
+    assert_eq!(u.phi, 4.0);
+    assert!(u.cos_theta_o < 0.71 && u.cos_theta_o > 0.70);
+    assert_eq!(LightBounds::union(&LightBounds::default(), &a), a);
+}
+
+#[test]
+fn light_enum_stays_small() {
+    assert!(
+        std::mem::size_of::<Light>() <= 200,
+        "{}",
+        std::mem::size_of::<Light>()
+    );
+}
