@@ -6,6 +6,7 @@ pub mod bxdf;
 pub mod camera;
 pub mod filter;
 pub mod image;
+pub mod material;
 pub mod primitive;
 pub mod rng;
 pub mod sampler;
