@@ -5,6 +5,28 @@
 //! [`FloatTexture`] and [`SpectrumTexture`] are closed enums; each method is
 //! a one-line delegation. Textures are shared with `Arc`, so named textures
 //! are built once and referenced by every material that uses them.
+//!
+//! Submodules: [`mapping`] (texture coordinates, 10.2), [`noise`] (Perlin
+//! noise, FBm, turbulence, 10.6), [`procedural`] (the basic and procedural
+//! textures, 10.3 and 10.5), [`imagemap`] (10.4) and [`create`] (textures
+//! from scene entities, and the parameter lookups materials use).
+//! Ptex textures are not supported: creating one is an error.
+
+pub mod create;
+pub mod imagemap;
+pub mod mapping;
+pub mod noise;
+pub mod procedural;
+#[cfg(test)]
+mod tests;
+
+pub use create::{
+    create_float_texture, create_spectrum_texture, create_textures, get_float_texture,
+    get_float_texture_opt, get_spectrum_texture, NamedTextures, TextureOptions,
+};
+pub use imagemap::{FloatImageTexture, ImageTextureBase, SpectrumImageTexture};
+pub use mapping::{TexCoord2D, TexCoord3D, TextureMapping2D, TextureMapping3D};
+pub use procedural::*;
 
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 use rpbrt_geometry::float::Float;
@@ -62,6 +84,26 @@ impl TextureEvalContext {
 pub enum FloatTexture {
     /// A constant value.
     Constant(Float),
+    /// `tex * scale`.
+    Scaled(FloatScaledTexture),
+    /// A blend of two textures by a third.
+    Mix(FloatMixTexture),
+    /// A blend of two textures by the normal's alignment with a direction.
+    DirectionMix(FloatDirectionMixTexture),
+    /// Bilinear interpolation of four values.
+    Bilerp(FloatBilerpTexture),
+    /// Checks of two textures, 2-D or 3-D.
+    Checkerboard(FloatCheckerboardTexture),
+    /// Random polka dots.
+    Dots(FloatDotsTexture),
+    /// Fractional Brownian motion.
+    FBm(FBmTexture),
+    /// Turbulence.
+    Wrinkled(WrinkledTexture),
+    /// Wind-blown waves.
+    Windy(WindyTexture),
+    /// An image.
+    Image(FloatImageTexture),
 }
 
 impl FloatTexture {
@@ -69,10 +111,26 @@ impl FloatTexture {
     #[inline]
     pub fn evaluate(&self, ctx: &TextureEvalContext) -> Float {
         match self {
-            FloatTexture::Constant(v) => {
-                let _ = ctx;
-                *v
-            }
+            FloatTexture::Constant(v) => *v,
+            FloatTexture::Scaled(t) => t.evaluate(ctx),
+            FloatTexture::Mix(t) => t.evaluate(ctx),
+            FloatTexture::DirectionMix(t) => t.evaluate(ctx),
+            FloatTexture::Bilerp(t) => t.evaluate(ctx),
+            FloatTexture::Checkerboard(t) => t.evaluate(ctx),
+            FloatTexture::Dots(t) => t.evaluate(ctx),
+            FloatTexture::FBm(t) => t.evaluate(ctx),
+            FloatTexture::Wrinkled(t) => t.evaluate(ctx),
+            FloatTexture::Windy(t) => t.evaluate(ctx),
+            FloatTexture::Image(t) => t.evaluate(ctx),
+        }
+    }
+
+    /// The value if the texture is a constant.
+    #[inline]
+    pub fn constant_value(&self) -> Option<Float> {
+        match self {
+            FloatTexture::Constant(v) => Some(*v),
+            _ => None,
         }
     }
 }
@@ -82,17 +140,42 @@ impl FloatTexture {
 pub enum SpectrumTexture {
     /// A constant spectrum.
     Constant(Spectrum),
+    /// `tex * scale`.
+    Scaled(SpectrumScaledTexture),
+    /// A blend of two textures by a float texture.
+    Mix(SpectrumMixTexture),
+    /// A blend of two textures by the normal's alignment with a direction.
+    DirectionMix(SpectrumDirectionMixTexture),
+    /// Bilinear interpolation of four spectra.
+    Bilerp(SpectrumBilerpTexture),
+    /// Checks of two textures, 2-D or 3-D.
+    Checkerboard(SpectrumCheckerboardTexture),
+    /// Random polka dots.
+    Dots(SpectrumDotsTexture),
+    /// Marble.
+    Marble(MarbleTexture),
+    /// An RGB image.
+    Image(SpectrumImageTexture),
 }
 
 impl SpectrumTexture {
     /// The value at a point for the sampled wavelengths.
     #[inline]
-    pub fn evaluate(&self, ctx: &TextureEvalContext, lambda: &SampledWavelengths) -> SampledSpectrum {
+    pub fn evaluate(
+        &self,
+        ctx: &TextureEvalContext,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
         match self {
-            SpectrumTexture::Constant(s) => {
-                let _ = ctx;
-                s.sample(lambda)
-            }
+            SpectrumTexture::Constant(s) => s.sample(lambda),
+            SpectrumTexture::Scaled(t) => t.evaluate(ctx, lambda),
+            SpectrumTexture::Mix(t) => t.evaluate(ctx, lambda),
+            SpectrumTexture::DirectionMix(t) => t.evaluate(ctx, lambda),
+            SpectrumTexture::Bilerp(t) => t.evaluate(ctx, lambda),
+            SpectrumTexture::Checkerboard(t) => t.evaluate(ctx, lambda),
+            SpectrumTexture::Dots(t) => t.evaluate(ctx, lambda),
+            SpectrumTexture::Marble(t) => t.evaluate(ctx, lambda),
+            SpectrumTexture::Image(t) => t.evaluate(ctx, lambda),
         }
     }
 }
