@@ -9,6 +9,7 @@ pub mod filter;
 pub mod image;
 pub mod light;
 pub mod lightsampler;
+pub mod material;
 pub mod primitive;
 pub mod rng;
 pub mod sampler;

@@ -1,0 +1,380 @@
+//! Materials (pbrt-v4 book section 10.5 and chapter 9; pbrt-v4
+//! `base/material.h`, `materials.h/.cpp`, `interaction.cpp`'s
+//! `SurfaceInteraction::GetBSDF`).
+//!
+//! A [`Material`] turns the textures it holds into a BxDF at a surface
+//! point. [`MaterialSet`] keeps every material of a scene, indexed by the
+//! `u32` the primitives carry, and does what pbrt-v4's `GetBSDF` does after
+//! the ray differentials are known: it resolves `mix` materials, skips
+//! `interface` ones, applies normal or bump mapping to the shading geometry
+//! and builds the [`BSDF`].
+//!
+//! [`Material`] is a closed enum; each method is a one-line delegation.
+
+use std::sync::Arc;
+
+use rpbrt_geometry::float::*;
+use rpbrt_geometry::interaction::SurfaceInteraction;
+use rpbrt_geometry::tuple::*;
+
+use crate::bxdf::{BxDF, DiffuseBxDF, TrowbridgeReitzDistribution, BSDF};
+use crate::image::Image;
+use crate::spectrum::{SampledWavelengths, Spectrum};
+use crate::texture::{FloatTextureRef, TextureEvalContext};
+
+mod bump;
+mod coated;
+mod conductor;
+// TEMP mod create;
+pub mod data;
+mod dielectric;
+mod diffuse;
+mod hair;
+mod mix;
+mod subsurface;
+#[cfg(test)]
+mod tests;
+
+pub use bump::{bump_map, normal_map, read_normal_map};
+pub use coated::{CoatedConductorMaterial, CoatedDiffuseMaterial};
+pub use conductor::{ConductorMaterial, ConductorSpectra};
+// TEMP pub use create::{create_materials, CreatedMaterials};
+pub use data::get_medium_scattering_properties;
+pub use dielectric::{DielectricMaterial, ThinDielectricMaterial};
+pub use diffuse::{DiffuseMaterial, DiffuseTransmissionMaterial};
+pub use hair::{HairAbsorption, HairMaterial};
+pub use mix::MixMaterial;
+pub use subsurface::{SubsurfaceCoefficients, SubsurfaceMaterial};
+
+/// The longest chain of `mix` materials [`MaterialSet::resolve`] follows.
+pub const MIX_MAX_DEPTH: usize = 64;
+
+/// What a material sees of the point being shaded (pbrt-v4
+/// `MaterialEvalContext`): the texture context plus the outgoing direction
+/// and the geometric and shading frames.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MaterialEvalContext {
+    /// What textures see.
+    pub tex: TextureEvalContext,
+    /// Outgoing direction ωo.
+    pub wo: Vector3f,
+    /// Geometric normal.
+    pub n: Normal3f,
+    /// Shading normal.
+    pub ns: Normal3f,
+    /// Shading ∂p/∂u.
+    pub dpdus: Vector3f,
+}
+
+impl MaterialEvalContext {
+    /// The context of a surface interaction (after differentials and any
+    /// normal or bump mapping).
+    pub fn from_si(si: &SurfaceInteraction) -> Self {
+        MaterialEvalContext {
+            tex: TextureEvalContext::from_si(si),
+            wo: si.wo,
+            n: si.n,
+            ns: si.shading.n,
+            dpdus: si.shading.dpdu,
+        }
+    }
+}
+
+/// Microfacet roughness given as two float textures (pbrt-v4's
+/// `uroughness`/`vroughness`, both defaulting to `roughness`).
+#[derive(Clone, Debug)]
+pub struct Roughness {
+    /// Roughness along ∂p/∂u.
+    pub u: FloatTextureRef,
+    /// Roughness along ∂p/∂v.
+    pub v: FloatTextureRef,
+    /// Map user roughness in [0, 1] to the distribution's α.
+    pub remap: bool,
+}
+
+impl Roughness {
+    /// The Trowbridge–Reitz distribution at a point.
+    #[inline]
+    pub fn distribution(&self, ctx: &TextureEvalContext) -> TrowbridgeReitzDistribution {
+        let (mut u, mut v) = (self.u.evaluate(ctx), self.v.evaluate(ctx));
+        if self.remap {
+            u = TrowbridgeReitzDistribution::roughness_to_alpha(u);
+            v = TrowbridgeReitzDistribution::roughness_to_alpha(v);
+        }
+        TrowbridgeReitzDistribution::new(u, v)
+    }
+}
+
+/// Normal or bump mapping a material applies before building its BxDF
+/// (pbrt-v4 `GetNormalMap`, `GetDisplacement`).
+#[derive(Clone, Debug, Default)]
+pub struct ShadingPerturbation {
+    /// A displacement texture for bump mapping.
+    pub displacement: Option<FloatTextureRef>,
+    /// A tangent-space normal map (three channels, R G B, linear). It takes
+    /// precedence over `displacement`, as in pbrt-v4.
+    pub normal_map: Option<Arc<Image>>,
+}
+
+impl ShadingPerturbation {
+    /// True when there is something to apply.
+    #[inline]
+    pub fn is_some(&self) -> bool {
+        self.displacement.is_some() || self.normal_map.is_some()
+    }
+
+    /// Updates `si`'s shading geometry as pbrt-v4's `GetBSDF` does: the
+    /// perturbed ∂p/∂u and ∂p/∂v give the shading normal, which is flipped
+    /// to the side of the geometric normal. Degenerate results (parallel
+    /// derivatives) leave the shading geometry unchanged.
+    pub fn apply(&self, si: &mut SurfaceInteraction) {
+        let (dpdu, dpdv) = if let Some(nm) = &self.normal_map {
+            normal_map(nm, si)
+        } else if let Some(d) = &self.displacement {
+            bump_map(d, si)
+        } else {
+            return;
+        };
+        let Some(ns) = cross(dpdu, dpdv).try_normalize() else {
+            return;
+        };
+        if !(ns.x.is_finite() && ns.y.is_finite() && ns.z.is_finite()) {
+            return;
+        }
+        let (dndu, dndv) = (si.shading.dndu, si.shading.dndv);
+        si.set_shading_geometry(Normal3f::from(ns), dpdu, dpdv, dndu, dndv, false);
+    }
+}
+
+/// The index of refraction a spectrum gives at the first wavelength; a
+/// spectrum that varies with wavelength (dispersion) terminates the
+/// secondary wavelengths. A zero index is taken as 1 (pbrt-v4).
+#[inline]
+pub fn sample_eta(eta: &Spectrum, lambda: &mut SampledWavelengths) -> Float {
+    let e = eta.evaluate(lambda[0]);
+    if !matches!(eta, Spectrum::Constant(_)) {
+        lambda.terminate_secondary();
+    }
+    if e == 0.0 {
+        1.0
+    } else {
+        e
+    }
+}
+
+/// The closed set of materials.
+#[derive(Clone, Debug)]
+pub enum Material {
+    /// Lambertian reflection.
+    Diffuse(DiffuseMaterial),
+    /// Lambertian reflection and transmission.
+    DiffuseTransmission(DiffuseTransmissionMaterial),
+    /// Metal.
+    Conductor(ConductorMaterial),
+    /// Glass-like interface.
+    Dielectric(DielectricMaterial),
+    /// Thin dielectric slab.
+    ThinDielectric(ThinDielectricMaterial),
+    /// Dielectric coating over a diffuse base.
+    CoatedDiffuse(Box<CoatedDiffuseMaterial>),
+    /// Dielectric coating over a conductor.
+    CoatedConductor(Box<CoatedConductorMaterial>),
+    /// Hair fibers.
+    Hair(HairMaterial),
+    /// A stochastic choice between two materials.
+    Mix(MixMaterial),
+    /// No surface: only marks a boundary between media (pbrt-v4
+    /// `"interface"`, `""`, `"none"`).
+    Interface,
+    /// A dielectric boundary over a scattering volume.
+    Subsurface(Box<SubsurfaceMaterial>),
+}
+
+impl Material {
+    /// The material's BxDF at a point; `None` for `Interface` and `Mix`
+    /// (mixes are resolved first with [`MaterialSet::resolve`]). `seed` is
+    /// pbrt-v4's `--seed`, which layered BxDFs mix into their random walks.
+    #[inline]
+    pub fn get_bxdf(
+        &self,
+        ctx: &MaterialEvalContext,
+        lambda: &mut SampledWavelengths,
+        seed: i32,
+    ) -> Option<BxDF> {
+        match self {
+            Material::Diffuse(m) => Some(m.get_bxdf(ctx, lambda)),
+            Material::DiffuseTransmission(m) => Some(m.get_bxdf(ctx, lambda)),
+            Material::Conductor(m) => Some(m.get_bxdf(ctx, lambda)),
+            Material::Dielectric(m) => Some(m.get_bxdf(ctx, lambda)),
+            Material::ThinDielectric(m) => Some(m.get_bxdf(ctx, lambda)),
+            Material::CoatedDiffuse(m) => Some(m.get_bxdf(ctx, lambda, seed)),
+            Material::CoatedConductor(m) => Some(m.get_bxdf(ctx, lambda, seed)),
+            Material::Hair(m) => Some(m.get_bxdf(ctx, lambda)),
+            Material::Mix(_) | Material::Interface => None,
+            Material::Subsurface(m) => Some(m.get_bxdf(ctx, lambda)),
+        }
+    }
+
+    /// The normal map and displacement applied before the BxDF is built.
+    #[inline]
+    pub fn perturbation(&self) -> Option<&ShadingPerturbation> {
+        match self {
+            Material::Diffuse(m) => Some(&m.perturbation),
+            Material::DiffuseTransmission(m) => Some(&m.perturbation),
+            Material::Conductor(m) => Some(&m.perturbation),
+            Material::Dielectric(m) => Some(&m.perturbation),
+            Material::ThinDielectric(m) => Some(&m.perturbation),
+            Material::CoatedDiffuse(m) => Some(&m.perturbation),
+            Material::CoatedConductor(m) => Some(&m.perturbation),
+            Material::Subsurface(m) => Some(&m.perturbation),
+            Material::Hair(_) | Material::Mix(_) | Material::Interface => None,
+        }
+    }
+
+    /// True for materials with a BSSRDF (only `subsurface`).
+    #[inline]
+    pub fn has_subsurface_scattering(&self) -> bool {
+        matches!(self, Material::Subsurface(_))
+    }
+
+    /// True for `interface` materials, which have no BSDF.
+    #[inline]
+    pub fn is_interface(&self) -> bool {
+        matches!(self, Material::Interface)
+    }
+
+    /// The scene-file name of the material's type.
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            Material::Diffuse(_) => "diffuse",
+            Material::DiffuseTransmission(_) => "diffusetransmission",
+            Material::Conductor(_) => "conductor",
+            Material::Dielectric(_) => "dielectric",
+            Material::ThinDielectric(_) => "thindielectric",
+            Material::CoatedDiffuse(_) => "coateddiffuse",
+            Material::CoatedConductor(_) => "coatedconductor",
+            Material::Hair(_) => "hair",
+            Material::Mix(_) => "mix",
+            Material::Interface => "interface",
+            Material::Subsurface(_) => "subsurface",
+        }
+    }
+}
+
+/// Every material of a scene, indexed by the `u32` primitives carry.
+#[derive(Clone, Debug, Default)]
+pub struct MaterialSet {
+    materials: Vec<Material>,
+    seed: i32,
+}
+
+impl MaterialSet {
+    /// A set holding `materials`; mix materials must refer to indices
+    /// inside it.
+    pub fn new(materials: Vec<Material>) -> Self {
+        debug_assert!(materials.iter().all(|m| match m {
+            Material::Mix(x) => x.materials.iter().all(|&i| (i as usize) < materials.len()),
+            _ => true,
+        }));
+        MaterialSet { materials, seed: 0 }
+    }
+
+    /// Sets pbrt-v4's `--seed`, mixed into layered BxDFs' random walks.
+    pub fn with_seed(mut self, seed: i32) -> Self {
+        self.seed = seed;
+        self
+    }
+
+    /// The number of materials.
+    pub fn len(&self) -> usize {
+        self.materials.len()
+    }
+
+    /// True when there are none.
+    pub fn is_empty(&self) -> bool {
+        self.materials.is_empty()
+    }
+
+    /// The material at `index`.
+    pub fn get(&self, index: u32) -> Option<&Material> {
+        self.materials.get(index as usize)
+    }
+
+    /// All materials in index order.
+    pub fn materials(&self) -> &[Material] {
+        &self.materials
+    }
+
+    /// Follows mix materials from `material` to the one used at this
+    /// point (pbrt-v4 `MixMaterial::ChooseMaterial`, deterministic in the
+    /// point and ωo). Chains longer than [`MIX_MAX_DEPTH`] (impossible for
+    /// sets built by [`create_materials`]) and unknown indices give `None`.
+    pub fn resolve(&self, material: u32, si: &SurfaceInteraction) -> Option<(u32, &Material)> {
+        let mut index = material;
+        for _ in 0..=MIX_MAX_DEPTH {
+            let m = self.materials.get(index as usize)?;
+            match m {
+                Material::Mix(mix) => {
+                    let ctx = TextureEvalContext::from_si(si);
+                    index = mix.choose_material(&ctx, si.wo);
+                }
+                _ => return Some((index, m)),
+            }
+        }
+        debug_assert!(false, "mix material chain longer than {MIX_MAX_DEPTH}");
+        None
+    }
+
+    /// True when the material at `material` (after resolving mixes at this
+    /// point) has a BSSRDF.
+    pub fn has_subsurface(&self, material: u32, si: &SurfaceInteraction) -> bool {
+        self.resolve(material, si)
+            .is_some_and(|(_, m)| m.has_subsurface_scattering())
+    }
+
+    /// True when any material of the set can have a BSSRDF.
+    pub fn any_subsurface(&self) -> bool {
+        self.materials
+            .iter()
+            .any(Material::has_subsurface_scattering)
+    }
+
+    /// pbrt-v4's `SurfaceInteraction::GetBSDF` after the differentials
+    /// (which the caller computes first): resolves mixes, returns `None`
+    /// for interfaces (the ray passes through), applies normal or bump
+    /// mapping to `si`'s shading geometry and builds the BSDF. Dispersive
+    /// materials may terminate the secondary wavelengths of `lambda`.
+    ///
+    /// For pbrt-v4's `--force-diffuse`, pass the result through
+    /// [`MaterialSet::force_diffuse`] with the sampler's next 1-D and 2-D
+    /// values, which pbrt-v4 draws only when there is a BSDF.
+    pub fn get_bsdf(
+        &self,
+        material: u32,
+        si: &mut SurfaceInteraction,
+        lambda: &mut SampledWavelengths,
+    ) -> Option<BSDF> {
+        let (_, m) = self.resolve(material, si)?;
+        if m.is_interface() {
+            return None;
+        }
+        if let Some(p) = m.perturbation() {
+            p.apply(si);
+        }
+        let ctx = MaterialEvalContext::from_si(si);
+        let bxdf = m.get_bxdf(&ctx, lambda, self.seed)?;
+        Some(BSDF::new(ctx.ns, ctx.dpdus, bxdf))
+    }
+
+    /// pbrt-v4's `--force-diffuse`: a Lambertian BSDF whose reflectance is
+    /// a one-sample estimate of `bsdf`'s directional albedo ρ(ωo) (with
+    /// sample values `uc`, `u`), in `si`'s shading frame.
+    pub fn force_diffuse(bsdf: &BSDF, si: &SurfaceInteraction, uc: Float, u: Point2f) -> BSDF {
+        let r = bsdf.rho_hd(si.wo, &[uc], &[u]);
+        BSDF::new(
+            si.shading.n,
+            si.shading.dpdu,
+            BxDF::Diffuse(DiffuseBxDF::new(r)),
+        )
+    }
+}

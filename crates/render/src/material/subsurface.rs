@@ -1,0 +1,61 @@
+//! Subsurface scattering materials (pbrt-v4 book section 14.4; pbrt-v4
+//! `SubsurfaceMaterial`). Only the BSDF part (a dielectric boundary) is
+//! evaluated here; the scattering parameters are kept for the BSSRDF.
+
+use rpbrt_geometry::float::*;
+
+use crate::bxdf::{BxDF, DielectricBxDF};
+use crate::spectrum::SampledWavelengths;
+use crate::texture::SpectrumTextureRef;
+
+use super::{MaterialEvalContext, Roughness, ShadingPerturbation};
+
+/// How the volume under the surface is described (pbrt-v4's four
+/// mutually exclusive ways collapse to these two).
+#[derive(Clone, Debug)]
+pub enum SubsurfaceCoefficients {
+    /// Absorption and scattering coefficients (given directly, from a named
+    /// measured medium, or pbrt-v4's default whole milk), in mm⁻¹ before
+    /// `scale`.
+    Coefficients {
+        /// σa.
+        sigma_a: SpectrumTextureRef,
+        /// σs.
+        sigma_s: SpectrumTextureRef,
+    },
+    /// A diffuse reflectance and a mean free path, to be inverted into
+    /// coefficients.
+    Reflectance {
+        /// Multiple-scattering albedo.
+        reflectance: SpectrumTextureRef,
+        /// Mean free path.
+        mfp: SpectrumTextureRef,
+    },
+}
+
+/// `subsurface`: a dielectric boundary over a homogeneous scattering
+/// volume.
+#[derive(Clone, Debug)]
+pub struct SubsurfaceMaterial {
+    /// Scale applied to the coefficients.
+    pub scale: Float,
+    /// The volume's coefficients.
+    pub coefficients: SubsurfaceCoefficients,
+    /// Henyey–Greenstein asymmetry (0 for named media, whose scattering
+    /// coefficients are already reduced).
+    pub g: Float,
+    /// Index of refraction of the boundary.
+    pub eta: Float,
+    /// Roughness of the boundary.
+    pub roughness: Roughness,
+    /// Normal or bump mapping.
+    pub perturbation: ShadingPerturbation,
+}
+
+impl SubsurfaceMaterial {
+    /// The boundary's BxDF at a point.
+    pub fn get_bxdf(&self, ctx: &MaterialEvalContext, _lambda: &mut SampledWavelengths) -> BxDF {
+        let distrib = self.roughness.distribution(&ctx.tex);
+        BxDF::Dielectric(DielectricBxDF::new(self.eta, distrib))
+    }
+}
