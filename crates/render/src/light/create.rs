@@ -93,7 +93,7 @@ fn spectrum_param(
 /// `scale`, which must not be negative.
 fn scale_param(params: &ParameterDictionary, loc: &FileLoc) -> Result<Float, Diagnostic> {
     let s = params.get_one_float("scale", 1.0).map_err(perr)?;
-    if !(s >= 0.0) || !s.is_finite() {
+    if s.is_nan() || s < 0.0 || !s.is_finite() {
         return Err(Diagnostic::error(
             at(params, "scale", loc),
             format!("\"scale\" {s} must be finite and non-negative"),
@@ -111,7 +111,7 @@ fn normalize_scale(
     loc: &FileLoc,
 ) -> Result<Float, Diagnostic> {
     let y = spectrum_to_photometric(s);
-    if !(y > 0.0) {
+    if y.is_nan() || y <= 0.0 {
         return Err(Diagnostic::error(
             loc.clone(),
             format!("{what} spectrum has no visible emission (zero luminance)"),

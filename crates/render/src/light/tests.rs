@@ -596,3 +596,63 @@ fn light_enum_stays_small() {
         std::mem::size_of::<Light>()
     );
 }
+
+#[test]
+fn image_infinite_from_file_illuminance_and_square_check() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-light-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let square = dir.join("env.pfm");
+    test_envmap(8, Point2i::new(2, 2))
+        .write(&square, &Default::default())
+        .unwrap();
+    let file = |p: &std::path::Path| {
+        ParsedParameter::with_strings("string", "filename", loc(), vec![p.display().to_string()])
+    };
+    let l = make(
+        "infinite",
+        vec![file(&square), floats("illuminance", &[2.0])],
+    );
+    let Light::ImageInfinite(img) = &l else {
+        panic!()
+    };
+    // Recompute the upward illuminance: ∫_{z>0} Y(L) cos θ dω = 2, with
+    // L = scale · rgb · illuminant and Y(rgb · illuminant) = lum · rgb ·
+    // photometric(illuminant).
+    let cs = RgbColorSpace::srgb();
+    let lum = luminance_vector(cs);
+    let res = img.image.resolution();
+    let wrap =
+        crate::image::WrapMode2D::new(crate::image::WrapMode::Clamp, crate::image::WrapMode::Clamp);
+    let mut e = 0.0;
+    for y in 0..res.y {
+        for x in 0..res.x {
+            let w = equal_area_square_to_sphere(Point2f::new(
+                (x as Float + 0.5) / res.x as Float,
+                (y as Float + 0.5) / res.y as Float,
+            ));
+            if w.z > 0.0 {
+                for c in 0..3 {
+                    e += img.image.get_channel(Point2i::new(x, y), c, wrap) * lum[c] * w.z;
+                }
+            }
+        }
+    }
+    e *= 4.0 * PI / (res.x * res.y) as Float
+        * img.scale
+        * spectrum_to_photometric(&cs.illuminant_spectrum());
+    assert!(rel_eq(e, 2.0, 1e-3), "{e}");
+
+    let nonsquare = dir.join("wide.pfm");
+    Image::from_f32(vec![1.0; 4 * 2 * 3], Point2i::new(4, 2), &["R", "G", "B"])
+        .unwrap()
+        .write(&nonsquare, &Default::default())
+        .unwrap();
+    let err = create_light(
+        &entity("infinite", vec![file(&nonsquare)]),
+        None,
+        &CameraTransform::default(),
+    )
+    .unwrap_err();
+    assert!(format!("{err:?}").contains("non-square"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -81,7 +81,7 @@ impl PowerLightSampler {
             })
             .collect();
         let total: f64 = power.iter().sum();
-        if !(total > 0.0) || !total.is_finite() {
+        if total.is_nan() || total <= 0.0 || !total.is_finite() {
             power.iter_mut().for_each(|p| *p = 1.0);
         }
         let total: f64 = power.iter().sum();
