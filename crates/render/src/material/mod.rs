@@ -25,7 +25,7 @@ use crate::texture::{FloatTextureRef, TextureEvalContext};
 mod bump;
 mod coated;
 mod conductor;
-// TEMP mod create;
+mod create;
 pub mod data;
 mod dielectric;
 mod diffuse;
@@ -34,11 +34,13 @@ mod mix;
 mod subsurface;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_create;
 
 pub use bump::{bump_map, normal_map, read_normal_map};
 pub use coated::{CoatedConductorMaterial, CoatedDiffuseMaterial};
 pub use conductor::{ConductorMaterial, ConductorSpectra};
-// TEMP pub use create::{create_materials, CreatedMaterials};
+pub use create::create_materials;
 pub use data::get_medium_scattering_properties;
 pub use dielectric::{DielectricMaterial, ThinDielectricMaterial};
 pub use diffuse::{DiffuseMaterial, DiffuseTransmissionMaterial};
