@@ -118,7 +118,12 @@ pub fn create_materials(
         .into_iter()
         .map(|(k, (_, index))| (k.to_string(), index))
         .collect();
-    Ok((MaterialSet::new(set), named, diags))
+    let locs = materials
+        .iter()
+        .chain(named_materials.iter().map(|(_, e)| e))
+        .map(|e| e.loc.clone())
+        .collect();
+    Ok((MaterialSet::new(set).with_locs(locs), named, diags))
 }
 
 /// One material's parameters and what reading them needs.

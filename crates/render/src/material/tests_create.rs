@@ -195,6 +195,10 @@ fn every_type_is_created_with_defaults() {
         assert!(b.is_some(), "{i}");
     }
     assert!(set.has_subsurface(6, &si()));
+    let (i, loc) = set.first_subsurface().unwrap();
+    assert_eq!(i, 6);
+    assert_eq!(loc.unwrap().line, 7);
+    assert_eq!(set.loc(1).unwrap().line, 2);
 }
 
 fn loc(line: u32, column: u32) -> FileLoc {
