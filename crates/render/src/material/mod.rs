@@ -16,6 +16,7 @@ use std::sync::Arc;
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::interaction::SurfaceInteraction;
 use rpbrt_geometry::tuple::*;
+use rpbrt_parser::FileLoc;
 
 use crate::bxdf::{BxDF, DiffuseBxDF, TrowbridgeReitzDistribution, BSDF};
 use crate::image::Image;
@@ -25,7 +26,7 @@ use crate::texture::{FloatTextureRef, TextureEvalContext};
 mod bump;
 mod coated;
 mod conductor;
-// TEMP mod create;
+mod create;
 pub mod data;
 mod dielectric;
 mod diffuse;
@@ -34,11 +35,13 @@ mod mix;
 mod subsurface;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_create;
 
 pub use bump::{bump_map, normal_map, read_normal_map};
 pub use coated::{CoatedConductorMaterial, CoatedDiffuseMaterial};
 pub use conductor::{ConductorMaterial, ConductorSpectra};
-// TEMP pub use create::{create_materials, CreatedMaterials};
+pub use create::create_materials;
 pub use data::get_medium_scattering_properties;
 pub use dielectric::{DielectricMaterial, ThinDielectricMaterial};
 pub use diffuse::{DiffuseMaterial, DiffuseTransmissionMaterial};
@@ -265,6 +268,8 @@ impl Material {
 #[derive(Clone, Debug, Default)]
 pub struct MaterialSet {
     materials: Vec<Material>,
+    /// Where each material was defined (empty for sets built in code).
+    locs: Vec<FileLoc>,
     seed: i32,
 }
 
@@ -276,7 +281,34 @@ impl MaterialSet {
             Material::Mix(x) => x.materials.iter().all(|&i| (i as usize) < materials.len()),
             _ => true,
         }));
-        MaterialSet { materials, seed: 0 }
+        MaterialSet {
+            materials,
+            locs: Vec::new(),
+            seed: 0,
+        }
+    }
+
+    /// Records where each material was defined, for messages such as the
+    /// integrator's refusal of subsurface materials.
+    pub fn with_locs(mut self, locs: Vec<FileLoc>) -> Self {
+        debug_assert_eq!(locs.len(), self.materials.len());
+        self.locs = locs;
+        self
+    }
+
+    /// Where material `index` was defined, when known.
+    pub fn loc(&self, index: u32) -> Option<&FileLoc> {
+        self.locs.get(index as usize)
+    }
+
+    /// The first material with subsurface scattering, with its location
+    /// when known.
+    pub fn first_subsurface(&self) -> Option<(u32, Option<&FileLoc>)> {
+        let i = self
+            .materials
+            .iter()
+            .position(Material::has_subsurface_scattering)?;
+        Some((i as u32, self.loc(i as u32)))
     }
 
     /// Sets pbrt-v4's `--seed`, mixed into layered BxDFs' random walks.

@@ -570,13 +570,13 @@ fn force_diffuse_gives_lambertian_with_the_albedo() {
         }),
     ]);
     let s = si();
-    let mut s0 = s.clone();
+    let mut s0 = s;
     let b = set.get_bsdf(0, &mut s0, &mut lambda()).unwrap();
     let d = MaterialSet::force_diffuse(&b, &s0, 0.5, Point2f::new(0.3, 0.6));
     assert!(matches!(d.bxdf, BxDF::Diffuse(_)));
     assert!(close(diffuse_value(&d), 0.3, 1e-4));
 
-    let mut s1 = s.clone();
+    let mut s1 = s;
     let b = set.get_bsdf(1, &mut s1, &mut lambda()).unwrap();
     let d = MaterialSet::force_diffuse(&b, &s1, 0.5, Point2f::new(0.3, 0.6));
     assert!(matches!(d.bxdf, BxDF::Diffuse(_)));
