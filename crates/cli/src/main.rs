@@ -6,11 +6,20 @@ mod args;
 mod imgtool;
 
 use rpbrt_parser::{parse_files, FormattingTarget};
-use rpbrt_render::scene::shapes::create_scene_shapes;
-use rpbrt_render::scene::{build_scene, BuildOptions, RenderingCoordinateSystem};
+use rpbrt_render::accel::Aggregate;
+use rpbrt_render::film::FilmOverrides;
+use rpbrt_render::image::ImageMetadata;
+use rpbrt_render::integrator::{render, RenderOptions};
+use rpbrt_render::scene::assemble::{create_scene, CreateOptions};
+use rpbrt_render::scene::{
+    build_scene, BuildOptions, OptionValue, RenderingCoordinateSystem, SceneDescription,
+};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
 
 fn main() -> ExitCode {
     let argv: Vec<String> = std::env::args().skip(1).collect();
@@ -43,7 +52,7 @@ fn main() -> ExitCode {
         eprintln!("rpbrt: error: --toply is used together with --format or --upgrade");
         return ExitCode::FAILURE;
     }
-    render(&opts)
+    render_command(&opts)
 }
 
 /// `--format` / `--upgrade`: print the scene back as pbrt-v4 text.
@@ -78,11 +87,19 @@ fn format_scene(opts: &args::Options) -> ExitCode {
     ExitCode::SUCCESS
 }
 
-/// Renders the scene: parse and build it, create its shapes, then (not yet
-/// built) render. Every mistake in the file is reported with its location
-/// first; the missing renderer is then reported loudly rather than writing
-/// a wrong image.
-fn render(opts: &args::Options) -> ExitCode {
+/// Peak resident memory in bytes (Linux), for `--stats`.
+fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+/// Renders the scene: parse and build it, create the render objects, render
+/// in parallel and write the image. Every mistake in the file is reported
+/// with its location, and the exit status is 1 on any error.
+fn render_command(opts: &args::Options) -> ExitCode {
+    let t0 = Instant::now();
     let mut build = BuildOptions::default();
     if let Some(r) = opts
         .render_coord_sys
@@ -92,24 +109,130 @@ fn render(opts: &args::Options) -> ExitCode {
         build.render_coord_sys = r;
     }
     let paths: Vec<PathBuf> = opts.files.iter().map(PathBuf::from).collect();
-    let (desc, mut diags) = match build_scene(&paths, &build) {
+    let (desc, diags) = match build_scene(&paths, &build) {
         Ok(r) => r,
         Err(d) => {
             eprint!("{}", d.render());
             return ExitCode::FAILURE;
         }
     };
-    let shapes = create_scene_shapes(&desc);
-    diags.items.extend(shapes.diagnostics);
-    if !opts.quiet || diags.has_errors() {
-        eprint!("{}", diags.render());
+    let t_parse = t0.elapsed();
+    let create_opts = CreateOptions {
+        spp: opts.spp,
+        seed: opts.seed.or_else(|| {
+            desc.option("seed").and_then(|o| match *o {
+                OptionValue::Int(i) => Some(i),
+                _ => None,
+            })
+        }),
+        film: FilmOverrides {
+            outfile: opts.outfile.clone(),
+            crop_window: opts.crop_window,
+            pixel_bounds: opts.pixel_bounds,
+            quick: opts.quick,
+        },
+        disable_texture_filtering: opts.disable_texture_filtering
+            || desc_flag(&desc, "disabletexturefiltering"),
+        force_diffuse: opts.force_diffuse || desc_flag(&desc, "forcediffuse"),
+    };
+    let mut all = diags;
+    let created = match create_scene(&desc, &create_opts) {
+        Ok(c) => c,
+        Err(errors) => {
+            all.items.extend(errors);
+            eprint!("{}", all.render());
+            return ExitCode::FAILURE;
+        }
+    };
+    all.items.extend(created.warnings);
+    if !opts.quiet && !all.is_empty() {
+        eprint!("{}", all.render());
     }
-    if diags.has_errors() {
-        return ExitCode::FAILURE;
-    }
-    eprintln!(
-        "rpbrt: error: the scene is valid ({} shapes), but rendering is not implemented yet in this build",
-        shapes.shapes.len()
+    let mut scene = created.scene;
+    let integrator = created.integrator;
+    let t_create = t0.elapsed() - t_parse;
+
+    let interrupt = Arc::new(AtomicBool::new(false));
+    // A second Ctrl-C ends the process at once; the first one stops the
+    // render after the current wave and writes the image so far.
+    let _ = signal_hook::flag::register_conditional_shutdown(
+        signal_hook::consts::SIGINT,
+        130,
+        Arc::clone(&interrupt),
     );
-    ExitCode::FAILURE
+    let _ = signal_hook::flag::register(signal_hook::consts::SIGINT, Arc::clone(&interrupt));
+    let render_opts = RenderOptions {
+        nthreads: opts.nthreads.unwrap_or(0),
+        quiet: opts.quiet,
+        write_partial_images: opts.write_partial_images,
+        disable_pixel_jitter: opts.disable_pixel_jitter || desc_flag(&desc, "disablepixeljitter"),
+        disable_wavelength_jitter: opts.disable_wavelength_jitter
+            || desc_flag(&desc, "disablewavelengthjitter"),
+        interrupt: Some(Arc::clone(&interrupt)),
+    };
+    let mut metadata = ImageMetadata::default();
+    let stats = match render(&mut scene, &integrator, &render_opts, &mut metadata) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("rpbrt: error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    if opts.stats {
+        let c = &scene.counters;
+        let secs = stats.render_time.as_secs_f64().max(1e-9);
+        eprintln!("Statistics:");
+        eprintln!(
+            "  Parse and build scene      {:>10.3} s",
+            t_parse.as_secs_f64()
+        );
+        eprintln!(
+            "  Create render objects      {:>10.3} s",
+            t_create.as_secs_f64()
+        );
+        eprintln!("  Render                     {:>10.3} s", secs);
+        eprintln!(
+            "  Samples                    {:>10}  ({:.3} M/s)",
+            stats.samples,
+            stats.samples as f64 / secs / 1e6
+        );
+        eprintln!(
+            "  Camera rays                {:>10}",
+            c.camera_rays.load(Ordering::Relaxed)
+        );
+        eprintln!(
+            "  Intersection rays          {:>10}",
+            c.intersection_rays.load(Ordering::Relaxed)
+        );
+        eprintln!(
+            "  Shadow rays                {:>10}",
+            c.shadow_rays.load(Ordering::Relaxed)
+        );
+        let prims = scene.aggregate.primitives().len().max(1);
+        eprintln!(
+            "  Primitives                 {:>10}",
+            scene.aggregate.primitives().len()
+        );
+        eprintln!(
+            "  Accelerator memory         {:>10} bytes ({:.1} bytes/primitive)",
+            scene.aggregate.accelerator().memory_bytes(),
+            scene.aggregate.accelerator().memory_bytes() as f64 / prims as f64
+        );
+        if let Some(m) = peak_memory_bytes() {
+            eprintln!(
+                "  Peak memory                {:>10.1} MiB",
+                m as f64 / (1024.0 * 1024.0)
+            );
+        }
+    }
+    if stats.interrupted {
+        eprintln!("rpbrt: interrupted; wrote the image rendered so far");
+        return ExitCode::from(130);
+    }
+    ExitCode::SUCCESS
+}
+
+/// A boolean `Option` from the scene file.
+fn desc_flag(desc: &SceneDescription, name: &str) -> bool {
+    matches!(desc.option(name), Some(OptionValue::Bool(true)))
 }

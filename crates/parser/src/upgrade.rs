@@ -236,6 +236,9 @@ pub fn upgrade_material(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc)
                 }
             }
         }
+        // A pbrt-v4 mix (it names its materials with "materials") is left
+        // as it is; only the pbrt-v3 form is rewritten.
+        "mix" if e.get("materials", &["string"]).is_some() => {}
         "mix" => {
             if let Some(p) = e.get("amount", &["rgb"]) {
                 let (l, f) = (p.loc.clone(), p.floats.clone());

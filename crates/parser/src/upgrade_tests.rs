@@ -260,3 +260,32 @@ fn shapes() {
     let u = upgrade_shape("trianglemesh", vec![f("float", "uv", &[0.; 3])], &loc(1));
     assert!(u.diagnostics[0].is_error());
 }
+
+#[test]
+fn pbrt_v4_mix_is_left_alone() {
+    let loc = crate::FileLoc::new("t.pbrt".into(), 1, 1);
+    let params = vec![
+        crate::ParsedParameter::with_strings(
+            "string",
+            "materials",
+            loc.clone(),
+            vec!["a".into(), "b".into()],
+        ),
+        crate::ParsedParameter::with_floats("float", "amount", loc.clone(), vec![0.3]),
+    ];
+    let u = upgrade_material("mix", params, &loc);
+    assert_eq!(u.name, "mix");
+    assert!(
+        u.diagnostics.iter().all(|d| !d.is_error()),
+        "{:?}",
+        u.diagnostics
+    );
+    assert!(u
+        .params
+        .iter()
+        .any(|p| p.name == "materials" && p.strings == ["a", "b"]));
+    assert!(u
+        .params
+        .iter()
+        .any(|p| p.name == "amount" && p.floats == [0.3]));
+}

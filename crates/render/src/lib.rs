@@ -7,6 +7,7 @@ pub mod camera;
 pub mod film;
 pub mod filter;
 pub mod image;
+pub mod integrator;
 pub mod light;
 pub mod lightsampler;
 pub mod material;

@@ -87,7 +87,9 @@ impl Scene {
     /// The closest hit along `ray` in (0, t_max).
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
-        self.counters.intersection_rays.fetch_add(1, Ordering::Relaxed);
+        self.counters
+            .intersection_rays
+            .fetch_add(1, Ordering::Relaxed);
         self.aggregate.intersect(ray, t_max)
     }
 
@@ -102,13 +104,26 @@ impl Scene {
     /// point on a light (pbrt-v4 `Integrator::Unoccluded`).
     #[inline]
     pub fn unoccluded(&self, from: &SurfaceInteraction, to_p: Point3fi, to_n: Normal3f) -> bool {
-        let r = spawn_ray_to_surface(from.p(), from.p_error(), from.n, from.time, to_p.midpoint(), to_p.error(), to_n);
+        let r = spawn_ray_to_surface(
+            from.p(),
+            from.p_error(),
+            from.n,
+            from.time,
+            to_p.midpoint(),
+            to_p.error(),
+            to_n,
+        );
         !self.intersect_p(&r, 1.0 - SHADOW_EPSILON)
     }
 
     /// Emitted radiance of the surface hit by a ray, toward `w`.
     #[inline]
-    pub fn le(&self, hit: &PrimitiveIntersection, w: Vector3f, lambda: &SampledWavelengths) -> SampledSpectrum {
+    pub fn le(
+        &self,
+        hit: &PrimitiveIntersection,
+        w: Vector3f,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
         match hit.area_light {
             Some(l) => self.lights[l as usize].l(hit.si.p(), hit.si.n, hit.si.uv, w, lambda),
             None => SampledSpectrum::new(0.0),
@@ -118,11 +133,21 @@ impl Scene {
     /// pbrt-v4's `SurfaceInteraction::GetBSDF`: computes the screen-space
     /// differentials, then asks the material for its BSDF (`None` for
     /// interfaces between media, which the ray passes through).
-    pub fn get_bsdf(&self, hit: &mut PrimitiveIntersection, ray: &RayDifferential, lambda: &mut SampledWavelengths) -> Option<BSDF> {
+    pub fn get_bsdf(
+        &self,
+        hit: &mut PrimitiveIntersection,
+        ray: &RayDifferential,
+        lambda: &mut SampledWavelengths,
+    ) -> Option<BSDF> {
         let spp_scale = (1.0 / (self.samples_per_pixel.max(1) as Float).sqrt()).max(0.125);
-        hit.si.compute_differentials(ray, Some(&self.camera_differentials), spp_scale, self.disable_texture_filtering);
+        hit.si.compute_differentials(
+            ray,
+            Some(&self.camera_differentials),
+            spp_scale,
+            self.disable_texture_filtering,
+        );
         let material = hit.material?;
-        self.materials.get_bsdf(material, &mut hit.si, lambda, self.force_diffuse)
+        self.materials.get_bsdf(material, &mut hit.si, lambda)
     }
 }
 
@@ -130,7 +155,10 @@ impl Scene {
 /// `SurfaceInteraction::SkipIntersection`): a new ray from the hit in the
 /// same direction, its differentials advanced to the surface.
 #[inline]
-pub(crate) fn skip_intersection(ray: &RayDifferential, hit: &PrimitiveIntersection) -> RayDifferential {
+pub(crate) fn skip_intersection(
+    ray: &RayDifferential,
+    hit: &PrimitiveIntersection,
+) -> RayDifferential {
     let mut next = RayDifferential::new(hit.si.spawn_ray(ray.ray.d));
     next.ray.medium = ray.ray.medium;
     if ray.has_differentials {
@@ -158,7 +186,13 @@ pub enum Integrator {
 
 impl Integrator {
     /// The radiance arriving along `ray` for the sampled wavelengths.
-    pub fn li(&self, scene: &Scene, ray: RayDifferential, lambda: &mut SampledWavelengths, sampler: &mut Sampler) -> SampledSpectrum {
+    pub fn li(
+        &self,
+        scene: &Scene,
+        ray: RayDifferential,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+    ) -> SampledSpectrum {
         match self {
             Integrator::Path(i) => i.li(scene, ray, lambda, sampler),
             Integrator::SimplePath(i) => i.li(scene, ray, lambda, sampler),
@@ -177,15 +211,37 @@ impl Integrator {
 }
 
 /// Integrator names rpbrt knows, and those it renders.
-pub const INTEGRATOR_NAMES: &[&str] = &["ambientocclusion", "bdpt", "lightpath", "mlt", "path", "randomwalk", "simplepath", "simplevolpath", "sppm", "volpath"];
+pub const INTEGRATOR_NAMES: &[&str] = &[
+    "ambientocclusion",
+    "bdpt",
+    "lightpath",
+    "mlt",
+    "path",
+    "randomwalk",
+    "simplepath",
+    "simplevolpath",
+    "sppm",
+    "volpath",
+];
 
 /// Creates the integrator of an `Integrator` directive. The light sampler
 /// it needs is created by the caller (it needs the lights).
-pub fn create_integrator(name: &str, params: &ParameterDictionary, loc: &FileLoc, scene_has_media: bool) -> Result<Integrator, Diagnostic> {
+pub fn create_integrator(
+    name: &str,
+    params: &ParameterDictionary,
+    loc: &FileLoc,
+    scene_has_media: bool,
+) -> Result<Integrator, Diagnostic> {
     let perr = Diagnostic::from;
     let max_depth = params.get_one_int("maxdepth", 5).map_err(perr)?;
     if max_depth < 0 {
-        return Err(Diagnostic::error(params.loc("maxdepth").cloned().unwrap_or_else(|| loc.clone()), format!("\"maxdepth\" must not be negative, got {max_depth}")));
+        return Err(Diagnostic::error(
+            params
+                .loc("maxdepth")
+                .cloned()
+                .unwrap_or_else(|| loc.clone()),
+            format!("\"maxdepth\" must not be negative, got {max_depth}"),
+        ));
     }
     match name {
         "path" | "volpath" => {
@@ -259,7 +315,12 @@ pub(crate) fn sample_ld(
     if light.light_type().is_delta() {
         return ls.l * f / p_l;
     }
-    let p_b = bsdf.pdf(wo, wi, crate::bxdf::TransportMode::Radiance, crate::bxdf::BxDFReflTransFlags::ALL);
+    let p_b = bsdf.pdf(
+        wo,
+        wi,
+        crate::bxdf::TransportMode::Radiance,
+        crate::bxdf::BxDFReflTransFlags::ALL,
+    );
     let w_l = crate::sampling::power_heuristic(1.0, p_l, 1.0, p_b);
     ls.l * f * (w_l / p_l)
 }

@@ -26,7 +26,13 @@ pub struct PathIntegrator {
 
 impl PathIntegrator {
     /// The radiance arriving along `ray`.
-    pub fn li(&self, scene: &Scene, ray: RayDifferential, lambda: &mut SampledWavelengths, sampler: &mut Sampler) -> SampledSpectrum {
+    pub fn li(
+        &self,
+        scene: &Scene,
+        ray: RayDifferential,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+    ) -> SampledSpectrum {
         let light_sampler: &LightSampler = &scene.light_sampler;
         let mut ray = ray;
         let mut l = SampledSpectrum::new(0.0);
@@ -50,7 +56,8 @@ impl PathIntegrator {
                     if depth == 0 || specular_bounce {
                         l += beta * le;
                     } else {
-                        let p_l = light_sampler.pmf(&prev_ctx, li) * light.pdf_li(&prev_ctx, ray.ray.d, true);
+                        let p_l = light_sampler.pmf(&prev_ctx, li)
+                            * light.pdf_li(&prev_ctx, ray.ray.d, true);
                         let w_b = power_heuristic(1.0, p_b, 1.0, p_l);
                         l += beta * le * w_b;
                     }
@@ -64,7 +71,8 @@ impl PathIntegrator {
                     l += beta * le;
                 } else if let Some(al) = hit.area_light {
                     let light = &scene.lights[al as usize];
-                    let p_l = light_sampler.pmf(&prev_ctx, al) * light.pdf_li(&prev_ctx, ray.ray.d, true);
+                    let p_l =
+                        light_sampler.pmf(&prev_ctx, al) * light.pdf_li(&prev_ctx, ray.ray.d, true);
                     let w_l = power_heuristic(1.0, p_b, 1.0, p_l);
                     l += beta * le * w_l;
                 }
@@ -90,11 +98,17 @@ impl PathIntegrator {
             let wo = -ray.ray.d;
             let u = sampler.get_1d();
             let u2 = sampler.get_2d();
-            let Some(bs) = bsdf.sample_f(wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL) else {
+            let Some(bs) =
+                bsdf.sample_f(wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL)
+            else {
                 break;
             };
             beta *= bs.f * (abs_dot(bs.wi, si.shading.n) / bs.pdf);
-            p_b = if bs.pdf_is_proportional { bsdf.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL) } else { bs.pdf };
+            p_b = if bs.pdf_is_proportional {
+                bsdf.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL)
+            } else {
+                bs.pdf
+            };
             specular_bounce = bs.is_specular();
             any_non_specular |= !bs.is_specular();
             if bs.is_transmission() {

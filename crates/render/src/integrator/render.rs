@@ -55,7 +55,13 @@ fn tiles(bounds: Bounds2i) -> Vec<Bounds2i> {
     while y < bounds.p_max.y {
         let mut x = bounds.p_min.x;
         while x < bounds.p_max.x {
-            out.push(Bounds2i::new(Point2i::new(x, y), Point2i::new((x + TILE_SIZE).min(bounds.p_max.x), (y + TILE_SIZE).min(bounds.p_max.y))));
+            out.push(Bounds2i::new(
+                Point2i::new(x, y),
+                Point2i::new(
+                    (x + TILE_SIZE).min(bounds.p_max.x),
+                    (y + TILE_SIZE).min(bounds.p_max.y),
+                ),
+            ));
             x += TILE_SIZE;
         }
         y += TILE_SIZE;
@@ -64,7 +70,14 @@ fn tiles(bounds: Bounds2i) -> Vec<Bounds2i> {
 }
 
 /// One camera sample through one pixel (pbrt-v4 `EvaluatePixelSample`).
-fn evaluate_pixel_sample(scene: &Scene, integrator: &Integrator, opts: &RenderOptions, p_pixel: Point2i, sampler: &mut Sampler, tile: &mut FilmTile) {
+fn evaluate_pixel_sample(
+    scene: &Scene,
+    integrator: &Integrator,
+    opts: &RenderOptions,
+    p_pixel: Point2i,
+    sampler: &mut Sampler,
+    tile: &mut FilmTile,
+) {
     let mut lu = sampler.get_1d();
     if opts.disable_wavelength_jitter {
         lu = 0.5;
@@ -78,7 +91,10 @@ fn evaluate_pixel_sample(scene: &Scene, integrator: &Integrator, opts: &RenderOp
     let time = sampler.get_1d();
     let p_lens = sampler.get_2d();
     let cs = CameraSample {
-        p_film: Point2f::new(p_pixel.x as Float + fs.p.x + 0.5, p_pixel.y as Float + fs.p.y + 0.5),
+        p_film: Point2f::new(
+            p_pixel.x as Float + fs.p.x + 0.5,
+            p_pixel.y as Float + fs.p.y + 0.5,
+        ),
         p_lens,
         time,
         filter_weight: fs.weight,
@@ -102,9 +118,17 @@ fn evaluate_pixel_sample(scene: &Scene, integrator: &Integrator, opts: &RenderOp
 /// Renders `scene` with `integrator`, writing the film's image (and partial
 /// images when asked). `metadata` is completed with timing and sample
 /// counts.
-pub fn render(scene: &mut Scene, integrator: &Integrator, opts: &RenderOptions, metadata: &mut ImageMetadata) -> Result<RenderStats, String> {
+pub fn render(
+    scene: &mut Scene,
+    integrator: &Integrator,
+    opts: &RenderOptions,
+    metadata: &mut ImageMetadata,
+) -> Result<RenderStats, String> {
     let start = Instant::now();
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(opts.nthreads).build().map_err(|e| format!("cannot start worker threads: {e}"))?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.nthreads)
+        .build()
+        .map_err(|e| format!("cannot start worker threads: {e}"))?;
     let spp = scene.sampler.samples_per_pixel().max(1);
     let pixel_bounds = scene.film.pixel_bounds();
     let tile_list = tiles(pixel_bounds);
@@ -128,7 +152,14 @@ pub fn render(scene: &mut Scene, integrator: &Integrator, opts: &RenderOptions, 
                         for p in b.iter() {
                             for s in wave_start..wave_end {
                                 sampler.start_pixel_sample(p, s, 0);
-                                evaluate_pixel_sample(scene_ref, integrator, opts, p, &mut sampler, &mut tile);
+                                evaluate_pixel_sample(
+                                    scene_ref,
+                                    integrator,
+                                    opts,
+                                    p,
+                                    &mut sampler,
+                                    &mut tile,
+                                );
                             }
                         }
                         tile
@@ -137,7 +168,7 @@ pub fn render(scene: &mut Scene, integrator: &Integrator, opts: &RenderOptions, 
             })
         };
         for t in results {
-            scene.film.merge_tile(t);
+            scene.film.merge_tile(&t);
         }
         done += pixels * (wave_end - wave_start) as u64;
         wave_start = wave_end;
@@ -146,13 +177,28 @@ pub fn render(scene: &mut Scene, integrator: &Integrator, opts: &RenderOptions, 
         if show_progress {
             let elapsed = start.elapsed().as_secs_f64();
             let frac = done as f64 / total.max(1) as f64;
-            let eta = if frac > 0.0 { elapsed / frac - elapsed } else { 0.0 };
+            let eta = if frac > 0.0 {
+                elapsed / frac - elapsed
+            } else {
+                0.0
+            };
             let width = 40;
             let filled = (frac * width as f64) as usize;
-            eprint!("\r[{}{}] {:5.1}% {:.1}s elapsed, ETA {:.1}s ", "+".repeat(filled), " ".repeat(width - filled), frac * 100.0, elapsed, eta);
+            eprint!(
+                "\r[{}{}] {:5.1}% {:.1}s elapsed, ETA {:.1}s ",
+                "+".repeat(filled),
+                " ".repeat(width - filled),
+                frac * 100.0,
+                elapsed,
+                eta
+            );
             let _ = std::io::stderr().flush();
         }
-        if opts.interrupt.as_ref().is_some_and(|f| f.load(Ordering::Relaxed)) {
+        if opts
+            .interrupt
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::Relaxed))
+        {
             interrupted = true;
             break;
         }
@@ -169,5 +215,9 @@ pub fn render(scene: &mut Scene, integrator: &Integrator, opts: &RenderOptions, 
     metadata.render_time_seconds = Some(render_time.as_secs_f32());
     metadata.samples_per_pixel = Some(wave_start);
     scene.film.write_image(metadata, 1.0)?;
-    Ok(RenderStats { render_time, samples: done, interrupted })
+    Ok(RenderStats {
+        render_time,
+        samples: done,
+        interrupted,
+    })
 }

@@ -27,7 +27,13 @@ pub struct SimplePathIntegrator {
 
 impl SimplePathIntegrator {
     /// The radiance arriving along `ray`.
-    pub fn li(&self, scene: &Scene, ray: RayDifferential, lambda: &mut SampledWavelengths, sampler: &mut Sampler) -> SampledSpectrum {
+    pub fn li(
+        &self,
+        scene: &Scene,
+        ray: RayDifferential,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+    ) -> SampledSpectrum {
         let mut ray = ray;
         let mut l = SampledSpectrum::new(0.0);
         let mut beta = SampledSpectrum::new(1.0);
@@ -66,7 +72,8 @@ impl SimplePathIntegrator {
                     let ctx = LightSampleContext::from_si(si);
                     if let Some(ls) = scene.lights[idx].sample_li(&ctx, u_light, lambda, false) {
                         if !ls.l.is_black() && ls.pdf > 0.0 {
-                            let f = bsdf.f(wo, ls.wi, TransportMode::Radiance) * abs_dot(ls.wi, si.shading.n);
+                            let f = bsdf.f(wo, ls.wi, TransportMode::Radiance)
+                                * abs_dot(ls.wi, si.shading.n);
                             if !f.is_black() && scene.unoccluded(si, ls.p_light, ls.n_light) {
                                 l += beta * f * ls.l / (p_light * ls.pdf);
                             }
@@ -77,7 +84,9 @@ impl SimplePathIntegrator {
             if self.sample_bsdf {
                 let u = sampler.get_1d();
                 let u2 = sampler.get_2d();
-                let Some(bs) = bsdf.sample_f(wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL) else {
+                let Some(bs) =
+                    bsdf.sample_f(wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL)
+                else {
                     break;
                 };
                 beta *= bs.f * (abs_dot(bs.wi, si.shading.n) / bs.pdf);
@@ -122,7 +131,13 @@ pub struct AmbientOcclusionIntegrator {
 
 impl AmbientOcclusionIntegrator {
     /// The AO estimate along `ray`.
-    pub fn li(&self, scene: &Scene, ray: RayDifferential, lambda: &mut SampledWavelengths, sampler: &mut Sampler) -> SampledSpectrum {
+    pub fn li(
+        &self,
+        scene: &Scene,
+        ray: RayDifferential,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+    ) -> SampledSpectrum {
         let mut ray = ray;
         // Interfaces are skipped; bound the number of them.
         for _ in 0..1024 {
@@ -175,7 +190,13 @@ pub struct RandomWalkIntegrator {
 
 impl RandomWalkIntegrator {
     /// The radiance arriving along `ray`.
-    pub fn li(&self, scene: &Scene, ray: RayDifferential, lambda: &mut SampledWavelengths, sampler: &mut Sampler) -> SampledSpectrum {
+    pub fn li(
+        &self,
+        scene: &Scene,
+        ray: RayDifferential,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+    ) -> SampledSpectrum {
         let mut ray = ray;
         let mut l = SampledSpectrum::new(0.0);
         let mut beta = SampledSpectrum::new(1.0);

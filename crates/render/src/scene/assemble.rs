@@ -14,9 +14,12 @@ use crate::integrator::{create_integrator, Integrator, RayCounters, Scene};
 use crate::light::{create_area_light, create_light, Light, LightType};
 use crate::lightsampler::create_light_sampler;
 use crate::material::create_materials;
-use crate::primitive::{Alpha, AnimatedPrimitive, GeometricPrimitive, Primitive, PrimitiveAggregate, TransformedPrimitive};
+use crate::primitive::{
+    Alpha, AnimatedPrimitive, GeometricPrimitive, Primitive, PrimitiveAggregate,
+    TransformedPrimitive,
+};
 use crate::sampler::create_sampler;
-use crate::texture::{create_textures, get_float_texture_opt, NamedTextures};
+use crate::texture::{create_textures, get_float_texture_opt, NamedTextures, TextureOptions};
 use rpbrt_geometry::transform::Transform;
 use rpbrt_parser::{Diagnostic, ParameterDictionary};
 use std::collections::HashMap;
@@ -55,9 +58,18 @@ fn accel_params(e: &SceneEntity) -> Result<AccelParams, Diagnostic> {
             "integer" if param.ints.len() == 1 => ParamValue::Int(param.ints[0]),
             "float" if param.floats.len() == 1 => ParamValue::Float(param.floats[0]),
             "string" if param.strings.len() == 1 => ParamValue::Str(param.strings[0].as_str()),
-            _ => return Err(Diagnostic::error(param.loc.clone(), format!("\"{}\": expected a single integer, float or string value", param.name))),
+            _ => {
+                return Err(Diagnostic::error(
+                    param.loc.clone(),
+                    format!(
+                        "\"{}\": expected a single integer, float or string value",
+                        param.name
+                    ),
+                ))
+            }
         };
-        p.set(&param.name, v).map_err(|m| Diagnostic::error(param.loc.clone(), m))?;
+        p.set(&param.name, v)
+            .map_err(|m| Diagnostic::error(param.loc.clone(), m))?;
         param.mark_used();
     }
     Ok(p)
@@ -74,31 +86,56 @@ fn alpha_of(params: &ParameterDictionary, textures: &NamedTextures) -> Result<Al
     }
 }
 
-/// Builds the render-ready scene.
-pub fn create_scene(desc: &SceneDescription, opts: &CreateOptions) -> Result<CreatedScene, Vec<Diagnostic>> {
-    let mut warnings: Vec<Diagnostic> = Vec::new();
-    let mut errors: Vec<Diagnostic> = Vec::new();
-    let one = |r: Result<_, Diagnostic>, errors: &mut Vec<Diagnostic>| match r {
+fn one<T>(r: Result<T, Diagnostic>, errors: &mut Vec<Diagnostic>) -> Option<T> {
+    match r {
         Ok(v) => Some(v),
         Err(e) => {
             errors.push(e);
             None
         }
-    };
+    }
+}
+
+/// Builds the render-ready scene.
+pub fn create_scene(
+    desc: &SceneDescription,
+    opts: &CreateOptions,
+) -> Result<CreatedScene, Vec<Diagnostic>> {
+    let mut warnings: Vec<Diagnostic> = Vec::new();
+    let mut errors: Vec<Diagnostic> = Vec::new();
 
     // Participating media are not built yet: refuse scenes that use them.
     if let Some(m) = desc.media.first() {
-        errors.push(Diagnostic::error(m.base.loc.clone(), "participating media are not supported yet"));
+        errors.push(Diagnostic::error(
+            m.base.loc.clone(),
+            "participating media are not supported yet",
+        ));
     }
 
     // Filter, film, camera, sampler.
-    let filter = one(create_filter(&desc.filter.name, &desc.filter.params, &desc.filter.loc), &mut errors);
+    let filter = one(
+        create_filter(&desc.filter.name, &desc.filter.params, &desc.filter.loc),
+        &mut errors,
+    );
     let cam_params = &desc.camera.base.params;
-    let exposure = cam_params.get_one_float("shutterclose", 1.0).unwrap_or(1.0) - cam_params.get_one_float("shutteropen", 0.0).unwrap_or(0.0);
-    let film = filter.as_ref().and_then(|f| one(create_film(&desc.film, f, exposure, &opts.film).map(|(film, w)| {
-        warnings.extend(w);
-        film
-    }), &mut errors));
+    let exposure = cam_params.get_one_float("shutterclose", 1.0).unwrap_or(1.0)
+        - cam_params.get_one_float("shutteropen", 0.0).unwrap_or(0.0);
+    let film = filter.as_ref().and_then(|f| {
+        one(
+            create_film(
+                &desc.film,
+                f,
+                exposure,
+                &desc.camera.camera_transform,
+                &opts.film,
+            )
+            .map(|(film, w)| {
+                warnings.extend(w);
+                film
+            }),
+            &mut errors,
+        )
+    });
     let Some((filter, film)) = filter.zip(film) else {
         return Err(errors);
     };
@@ -114,12 +151,30 @@ pub fn create_scene(desc: &SceneDescription, opts: &CreateOptions) -> Result<Cre
         }
     };
     let mut sampler_warnings = Vec::new();
-    let sampler = one(create_sampler(&desc.sampler.name, &desc.sampler.params, geometry.full_resolution, opts.spp, opts.seed, &desc.sampler.loc, &mut sampler_warnings), &mut errors);
+    let sampler = one(
+        create_sampler(
+            &desc.sampler.name,
+            &desc.sampler.params,
+            geometry.full_resolution,
+            opts.spp,
+            opts.seed,
+            &desc.sampler.loc,
+            &mut sampler_warnings,
+        ),
+        &mut errors,
+    );
     warnings.extend(sampler_warnings);
 
     // Textures and materials.
     let cache = MIPMapCache::new();
-    let textures = match create_textures(&desc.float_textures, &desc.spectrum_textures, &cache, opts.disable_texture_filtering) {
+    let textures = match create_textures(
+        &desc.float_textures,
+        &desc.spectrum_textures,
+        &cache,
+        &TextureOptions {
+            disable_texture_filtering: opts.disable_texture_filtering,
+        },
+    ) {
         Ok((t, w)) => {
             warnings.extend(w);
             t
@@ -129,16 +184,17 @@ pub fn create_scene(desc: &SceneDescription, opts: &CreateOptions) -> Result<Cre
             return Err(errors);
         }
     };
-    let (materials, named_material_ids) = match create_materials(&desc.materials, &desc.named_materials, &textures) {
-        Ok((m, ids, w)) => {
-            warnings.extend(w);
-            (m, ids)
-        }
-        Err(e) => {
-            errors.extend(e);
-            return Err(errors);
-        }
-    };
+    let (materials, named_material_ids) =
+        match create_materials(&desc.materials, &desc.named_materials, &textures) {
+            Ok((m, ids, w)) => {
+                warnings.extend(w);
+                (m, ids)
+            }
+            Err(e) => {
+                errors.extend(e);
+                return Err(errors);
+            }
+        };
     let material_id = |r: &MaterialRef| -> Option<u32> {
         match r {
             MaterialRef::Index(i) => Some(*i as u32),
@@ -161,8 +217,16 @@ pub fn create_scene(desc: &SceneDescription, opts: &CreateOptions) -> Result<Cre
 
     // Primitives, with area lights per shape.
     let mut prims: Vec<Primitive> = Vec::new();
-    let mut make_prims = |s: &ShapeSceneEntity, lights: &mut Vec<Light>, errors: &mut Vec<Diagnostic>, warnings: &mut Vec<Diagnostic>, out: &mut Vec<Primitive>| {
-        let created = match create_entity_shapes(&s.base, &s.render_from_object, s.attributes.reverse_orientation) {
+    let make_prims = |s: &ShapeSceneEntity,
+                      lights: &mut Vec<Light>,
+                      errors: &mut Vec<Diagnostic>,
+                      warnings: &mut Vec<Diagnostic>,
+                      out: &mut Vec<Primitive>| {
+        let created = match create_entity_shapes(
+            &s.base,
+            &s.render_from_object,
+            s.attributes.reverse_orientation,
+        ) {
             Ok(c) => c,
             Err(e) => {
                 errors.push(e);
@@ -182,22 +246,33 @@ pub fn create_scene(desc: &SceneDescription, opts: &CreateOptions) -> Result<Cre
             r => match material_id(r) {
                 Some(id) => Some(id),
                 None => {
-                    errors.push(Diagnostic::error(s.base.loc.clone(), format!("material {r:?} is not defined")));
+                    errors.push(Diagnostic::error(
+                        s.base.loc.clone(),
+                        format!("material {r:?} is not defined"),
+                    ));
                     return;
                 }
             },
         };
-        let material = material.filter(|&id| !materials.is_interface(id));
         for shape in created.shapes {
             let area_light = match (s.attributes.light_index, material) {
                 (Some(li), Some(_)) => {
                     let al = &desc.area_lights[li];
                     let alpha_tex = match &alpha {
                         Alpha::Texture(t) => Some(t.clone()),
-                        Alpha::Constant(a) => Some(Arc::new(crate::texture::FloatTexture::Constant(*a))),
+                        Alpha::Constant(a) => {
+                            Some(Arc::new(crate::texture::FloatTexture::Constant(*a)))
+                        }
                         Alpha::Opaque => None,
                     };
-                    match create_area_light(al, &s.render_from_object, &shape, alpha_tex, None) {
+                    match create_area_light(
+                        al,
+                        &s.render_from_object,
+                        &shape,
+                        alpha_tex,
+                        None,
+                        None,
+                    ) {
                         Ok(light) => {
                             lights.push(light);
                             Some((lights.len() - 1) as u32)
@@ -209,15 +284,27 @@ pub fn create_scene(desc: &SceneDescription, opts: &CreateOptions) -> Result<Cre
                     }
                 }
                 (Some(li), None) => {
-                    warnings.push(Diagnostic::warning(desc.area_lights[li].loc.clone(), "ignoring the area light of a shape with an interface material"));
+                    warnings.push(Diagnostic::warning(
+                        desc.area_lights[li].loc.clone(),
+                        "ignoring the area light of a shape with an interface material",
+                    ));
                     None
                 }
                 _ => None,
             };
-            out.push(Primitive::Geometric(GeometricPrimitive { shape, material, area_light, medium_interface: None, alpha: alpha.clone() }));
+            out.push(Primitive::Geometric(GeometricPrimitive {
+                shape,
+                material,
+                area_light,
+                medium_interface: None,
+                alpha: alpha.clone(),
+            }));
         }
         for d in s.base.params.report_unused() {
-            if !super::shapes::LATER_SHAPE_PARAMS.iter().any(|p| d.message.contains(&format!("\"{p}\""))) {
+            if !super::shapes::LATER_SHAPE_PARAMS
+                .iter()
+                .any(|p| d.message.contains(&format!("\"{p}\"")))
+            {
                 warnings.push(d);
             }
         }
@@ -228,7 +315,10 @@ pub fn create_scene(desc: &SceneDescription, opts: &CreateOptions) -> Result<Cre
     let default_accel = AccelParams::default();
     for s in &desc.animated_shapes {
         if s.attributes.light_index.is_some() {
-            errors.push(Diagnostic::error(s.base.loc.clone(), "area lights on animated shapes are not supported (as in pbrt-v4)"));
+            errors.push(Diagnostic::error(
+                s.base.loc.clone(),
+                "area lights on animated shapes are not supported (as in pbrt-v4)",
+            ));
             continue;
         }
         let fixed = ShapeSceneEntity {
@@ -240,7 +330,10 @@ pub fn create_scene(desc: &SceneDescription, opts: &CreateOptions) -> Result<Cre
         let mut inner = Vec::new();
         make_prims(&fixed, &mut lights, &mut errors, &mut warnings, &mut inner);
         if !inner.is_empty() {
-            prims.push(Primitive::Animated(AnimatedPrimitive { primitive: Arc::new(PrimitiveAggregate::new(inner, &default_accel)), render_from_primitive: s.render_from_object }));
+            prims.push(Primitive::Animated(AnimatedPrimitive {
+                primitive: Arc::new(PrimitiveAggregate::new(inner, &default_accel)),
+                render_from_primitive: s.render_from_object,
+            }));
         }
     }
     // Object definitions, built once and shared by their instances.
@@ -249,32 +342,55 @@ pub fn create_scene(desc: &SceneDescription, opts: &CreateOptions) -> Result<Cre
         let mut inner = Vec::new();
         for s in &def.shapes {
             if s.attributes.light_index.is_some() {
-                errors.push(Diagnostic::error(s.base.loc.clone(), "area lights inside object definitions are not supported (as in pbrt-v4)"));
+                errors.push(Diagnostic::error(
+                    s.base.loc.clone(),
+                    "area lights inside object definitions are not supported (as in pbrt-v4)",
+                ));
                 continue;
             }
             make_prims(s, &mut lights, &mut errors, &mut warnings, &mut inner);
         }
         for s in &def.animated_shapes {
-            let fixed = ShapeSceneEntity { base: s.base.clone(), render_from_object: Transform::identity(), object_from_render: Transform::identity(), attributes: s.attributes.clone() };
+            let fixed = ShapeSceneEntity {
+                base: s.base.clone(),
+                render_from_object: Transform::identity(),
+                object_from_render: Transform::identity(),
+                attributes: s.attributes.clone(),
+            };
             let mut shapes = Vec::new();
             make_prims(&fixed, &mut lights, &mut errors, &mut warnings, &mut shapes);
             if !shapes.is_empty() {
-                inner.push(Primitive::Animated(AnimatedPrimitive { primitive: Arc::new(PrimitiveAggregate::new(shapes, &default_accel)), render_from_primitive: s.render_from_object }));
+                inner.push(Primitive::Animated(AnimatedPrimitive {
+                    primitive: Arc::new(PrimitiveAggregate::new(shapes, &default_accel)),
+                    render_from_primitive: s.render_from_object,
+                }));
             }
         }
-        definitions.insert(def.name.as_str(), Arc::new(PrimitiveAggregate::new(inner, &default_accel)));
+        definitions.insert(
+            def.name.as_str(),
+            Arc::new(PrimitiveAggregate::new(inner, &default_accel)),
+        );
     }
     for inst in &desc.instances {
         let Some(def) = definitions.get(inst.name.as_str()) else {
-            errors.push(Diagnostic::error(inst.loc.clone(), format!("object \"{}\" is not defined", inst.name)));
+            errors.push(Diagnostic::error(
+                inst.loc.clone(),
+                format!("object \"{}\" is not defined", inst.name),
+            ));
             continue;
         };
         if def.primitives().is_empty() {
             continue;
         }
         prims.push(match &inst.render_from_instance {
-            InstanceTransform::Fixed(t) => Primitive::Transformed(TransformedPrimitive { primitive: def.clone(), render_from_primitive: *t }),
-            InstanceTransform::Animated(a) => Primitive::Animated(AnimatedPrimitive { primitive: def.clone(), render_from_primitive: **a }),
+            InstanceTransform::Fixed(t) => Primitive::Transformed(TransformedPrimitive {
+                primitive: def.clone(),
+                render_from_primitive: *t,
+            }),
+            InstanceTransform::Animated(a) => Primitive::Animated(AnimatedPrimitive {
+                primitive: def.clone(),
+                render_from_primitive: **a,
+            }),
         });
     }
 
@@ -285,8 +401,22 @@ pub fn create_scene(desc: &SceneDescription, opts: &CreateOptions) -> Result<Cre
             AccelParams::default()
         }
     };
-    let integrator = one(create_integrator(&desc.integrator.name, &desc.integrator.params, &desc.integrator.loc, !desc.media.is_empty()), &mut errors);
-    for e in [&desc.film, &desc.sampler, &desc.filter, &desc.integrator, &desc.camera.base] {
+    let integrator = one(
+        create_integrator(
+            &desc.integrator.name,
+            &desc.integrator.params,
+            &desc.integrator.loc,
+            !desc.media.is_empty(),
+        ),
+        &mut errors,
+    );
+    for e in [
+        &desc.film,
+        &desc.sampler,
+        &desc.filter,
+        &desc.integrator,
+        &desc.camera.base,
+    ] {
         warnings.extend(e.params.report_unused());
     }
     if !errors.is_empty() {
@@ -300,11 +430,16 @@ pub fn create_scene(desc: &SceneDescription, opts: &CreateOptions) -> Result<Cre
     for l in &mut lights {
         l.preprocess(&bounds);
     }
-    let infinite_lights: Vec<u32> = lights.iter().enumerate().filter(|(_, l)| l.light_type() == LightType::Infinite).map(|(i, _)| i as u32).collect();
+    let infinite_lights: Vec<u32> = lights
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.light_type() == LightType::Infinite)
+        .map(|(i, _)| i as u32)
+        .collect();
     let ls_name = integrator.light_sampler_name().unwrap_or("bvh").to_string();
     let light_sampler = match create_light_sampler(&ls_name, &lights) {
         Ok(s) => s,
-        Err(m) => return Err(vec![Diagnostic::error(desc.integrator.loc.clone(), m)]),
+        Err(e) => return Err(vec![e]),
     };
     let spp = sampler.samples_per_pixel();
     let camera_differentials = camera.camera_differentials();
@@ -324,5 +459,9 @@ pub fn create_scene(desc: &SceneDescription, opts: &CreateOptions) -> Result<Cre
         force_diffuse: opts.force_diffuse,
         counters: RayCounters::default(),
     };
-    Ok(CreatedScene { scene, integrator, warnings })
+    Ok(CreatedScene {
+        scene,
+        integrator,
+        warnings,
+    })
 }

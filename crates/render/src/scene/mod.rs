@@ -7,7 +7,7 @@
 //! resulting [`SceneDescription`] with every warning, or every error and
 //! warning when the scene is invalid.
 
-
+pub mod assemble;
 pub mod builder;
 pub mod entities;
 pub mod names;
