@@ -128,23 +128,22 @@ pub fn sqrt_round_down(a: Float) -> Float {
     next_float_down(a.sqrt()).max(0.0)
 }
 
-/// a·b − c·d computed with one fused multiply-add, accurate even when the
-/// two products nearly cancel (Kahan's algorithm).
+/// a·b − c·d, accurate even when the two products nearly cancel.
+///
+/// pbrt-v4 uses Kahan's algorithm with fused multiply-adds. Without a
+/// hardware FMA (the x86-64 baseline has none) `mul_add` becomes a slow
+/// software routine, so the products are formed in double precision
+/// instead: a product of two floats is exact in a double, and the one
+/// rounding of the difference is at least as accurate as Kahan's result.
 #[inline]
 pub fn difference_of_products(a: Float, b: Float, c: Float, d: Float) -> Float {
-    let cd = c * d;
-    let dop = a.mul_add(b, -cd);
-    let err = (-c).mul_add(d, cd);
-    dop + err
+    (a as f64 * b as f64 - c as f64 * d as f64) as Float
 }
 
-/// a·b + c·d with the same compensated evaluation.
+/// a·b + c·d with the same exact-product evaluation.
 #[inline]
 pub fn sum_of_products(a: Float, b: Float, c: Float, d: Float) -> Float {
-    let cd = c * d;
-    let sop = a.mul_add(b, cd);
-    let err = c.mul_add(d, -cd);
-    sop + err
+    (a as f64 * b as f64 + c as f64 * d as f64) as Float
 }
 
 /// An unevaluated sum `v + err` holding more precision than one float.
@@ -259,7 +258,7 @@ pub fn degrees(rad: Float) -> Float {
 pub fn evaluate_polynomial(t: Float, coeffs: &[Float]) -> Float {
     let mut r: Float = 0.0;
     for &c in coeffs.iter().rev() {
-        r = r.mul_add(t, c);
+        r = r * t + c;
     }
     r
 }

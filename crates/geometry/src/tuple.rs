@@ -681,7 +681,7 @@ macro_rules! dot3 {
         impl Dot<$b> for $a {
             #[inline]
             fn dot(self, o: $b) -> Float {
-                self.x.mul_add(o.x, self.y.mul_add(o.y, self.z * o.z))
+                self.x * o.x + self.y * o.y + self.z * o.z
             }
         }
     };
@@ -694,7 +694,7 @@ dot3!(Normal3f, Normal3f);
 impl Dot for Vector2f {
     #[inline]
     fn dot(self, o: Vector2f) -> Float {
-        self.x.mul_add(o.x, self.y * o.y)
+        self.x * o.x + self.y * o.y
     }
 }
 

@@ -57,6 +57,30 @@ pub fn sobol_matrices() -> &'static [u32] {
     M.get_or_init(build_sobol_matrices)
 }
 
+/// For dimensions 0 and 1: the XOR of the matrix columns selected by each
+/// possible value of each byte of the (52-bit) index.
+fn sobol_byte_tables() -> &'static [[[u32; 256]; 7]; 2] {
+    static T: OnceLock<Box<[[[u32; 256]; 7]; 2]>> = OnceLock::new();
+    T.get_or_init(|| {
+        let m = sobol_matrices();
+        let mut t = Box::new([[[0u32; 256]; 7]; 2]);
+        for (dim, tables) in t.iter_mut().enumerate() {
+            for (byte, table) in tables.iter_mut().enumerate() {
+                for (value, out) in table.iter_mut().enumerate() {
+                    let mut v = 0u32;
+                    for bit in 0..8 {
+                        if value & (1 << bit) != 0 && byte * 8 + bit < SOBOL_MATRIX_SIZE {
+                            v ^= m[dim * SOBOL_MATRIX_SIZE + byte * 8 + bit];
+                        }
+                    }
+                    *out = v;
+                }
+            }
+        }
+        t
+    })
+}
+
 fn build_sobol_matrices() -> Vec<u32> {
     let mut out = vec![0u32; N_SOBOL_DIMENSIONS * SOBOL_MATRIX_SIZE];
     let mut m = [0u64; SOBOL_MATRIX_SIZE];
@@ -409,18 +433,37 @@ impl BinaryScrambler {
 /// The Sobol' sample of index `a` in `dimension`, scrambled, as a float
 /// in [0,1).
 #[inline]
-pub fn sobol_sample(mut a: u64, dimension: usize, scrambler: BinaryScrambler) -> Float {
+pub fn sobol_sample(a: u64, dimension: usize, scrambler: BinaryScrambler) -> Float {
     debug_assert!(dimension < N_SOBOL_DIMENSIONS && a < (1u64 << SOBOL_MATRIX_SIZE));
-    let m = &sobol_matrices()[dimension * SOBOL_MATRIX_SIZE..(dimension + 1) * SOBOL_MATRIX_SIZE];
-    let mut v = 0u32;
-    let mut i = 0;
-    while a != 0 {
-        if a & 1 != 0 {
-            v ^= m[i];
+    let v = if dimension < 2 {
+        // The first two dimensions are used for every camera sample and by
+        // the Z-Sobol sampler for everything: look them up a byte at a time.
+        let t = &sobol_byte_tables()[dimension];
+        let mut v = t[0][(a & 0xff) as usize]
+            ^ t[1][((a >> 8) & 0xff) as usize]
+            ^ t[2][((a >> 16) & 0xff) as usize]
+            ^ t[3][((a >> 24) & 0xff) as usize];
+        if a >> 32 != 0 {
+            v ^= t[4][((a >> 32) & 0xff) as usize]
+                ^ t[5][((a >> 40) & 0xff) as usize]
+                ^ t[6][((a >> 48) & 0xff) as usize];
         }
-        a >>= 1;
-        i += 1;
-    }
+        v
+    } else {
+        let m =
+            &sobol_matrices()[dimension * SOBOL_MATRIX_SIZE..(dimension + 1) * SOBOL_MATRIX_SIZE];
+        let mut v = 0u32;
+        let mut a = a;
+        let mut i = 0;
+        // Branch-free: the index bits are random, so a branch per bit
+        // mispredicts half the time.
+        while a != 0 {
+            v ^= m[i] & 0u32.wrapping_sub((a & 1) as u32);
+            a >>= 1;
+            i += 1;
+        }
+        v
+    };
     let v = scrambler.apply(v);
     (v as Float * f32::from_bits(0x2f80_0000)).min(ONE_MINUS_EPSILON)
 }
