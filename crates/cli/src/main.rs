@@ -161,6 +161,20 @@ fn render_command(opts: &args::Options) -> ExitCode {
         Arc::clone(&interrupt),
     );
     let _ = signal_hook::flag::register(signal_hook::consts::SIGINT, Arc::clone(&interrupt));
+    let mse_reference = match &opts.mse_reference_image {
+        Some(path) => match rpbrt_render::image::Image::read(std::path::Path::new(path), None) {
+            Ok(im) => Some(im.image),
+            Err(e) => {
+                eprintln!("rpbrt: error: --mse-reference-image: {e}");
+                return ExitCode::FAILURE;
+            }
+        },
+        None => None,
+    };
+    if opts.mse_reference_out.is_some() && mse_reference.is_none() {
+        eprintln!("rpbrt: error: --mse-reference-out needs --mse-reference-image");
+        return ExitCode::FAILURE;
+    }
     let render_opts = RenderOptions {
         nthreads: opts.nthreads.unwrap_or(0),
         quiet: opts.quiet,
@@ -169,6 +183,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
         disable_wavelength_jitter: opts.disable_wavelength_jitter
             || desc_flag(&desc, "disablewavelengthjitter"),
         interrupt: Some(Arc::clone(&interrupt)),
+        mse_reference,
     };
     let mut metadata = ImageMetadata::default();
     let stats = match render(&mut scene, &integrator, &render_opts, &mut metadata) {
@@ -178,6 +193,17 @@ fn render_command(opts: &args::Options) -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
+    if let Some(path) = &opts.mse_reference_out {
+        let text: String = stats
+            .mse_per_wave
+            .iter()
+            .map(|(spp, mse)| format!("{spp} {mse:e}\n"))
+            .collect();
+        if let Err(e) = std::fs::write(path, text) {
+            eprintln!("rpbrt: error: --mse-reference-out {path}: {e}");
+            return ExitCode::FAILURE;
+        }
+    }
     if opts.stats {
         let c = &scene.counters;
         let secs = stats.render_time.as_secs_f64().max(1e-9);

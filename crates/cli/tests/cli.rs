@@ -118,3 +118,58 @@ fn imgtool_reports_bad_files() {
     let out = rpbrt().args(["imgtool", "frob"]).output().unwrap();
     assert_eq!(out.status.code(), Some(1));
 }
+
+#[test]
+fn renders_png_and_reports_mse_against_a_reference() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-cli-render-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" 45\nSampler \"zsobol\" \"integer pixelsamples\" 4\nFilm \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nWorldBegin\nAttributeBegin\nReverseOrientation\nMaterial \"diffuse\" \"rgb reflectance\" [ 0.5 0.5 0.5 ]\nAreaLightSource \"diffuse\" \"rgb L\" [ 0.5 0.5 0.5 ]\nShape \"sphere\"\nAttributeEnd\n";
+    let p = dir.join("furnace.pbrt");
+    std::fs::write(&p, scene).unwrap();
+    let exr = dir.join("ref.exr");
+    let out = rpbrt()
+        .arg("--quiet")
+        .arg("--outfile")
+        .arg(&exr)
+        .arg(&p)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let png = dir.join("img.png");
+    let mse = dir.join("mse.txt");
+    let out = rpbrt()
+        .args(["--quiet", "--spp", "4", "--outfile"])
+        .arg(&png)
+        .arg("--mse-reference-image")
+        .arg(&exr)
+        .arg("--mse-reference-out")
+        .arg(&mse)
+        .arg(&p)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(std::fs::metadata(&png).unwrap().len() > 0);
+    let text = std::fs::read_to_string(&mse).unwrap();
+    let last = text.lines().last().unwrap();
+    let (spp, err) = last.split_once(' ').unwrap();
+    assert_eq!(spp, "4");
+    // The same deterministic render: its MSE against itself is tiny (the
+    // reference is stored as half floats).
+    assert!(err.parse::<f64>().unwrap() < 1e-4, "{text}");
+    // A bad output extension is an error before rendering.
+    let out = rpbrt()
+        .arg("--outfile")
+        .arg(dir.join("x.bmp"))
+        .arg(&p)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+}

@@ -33,6 +33,9 @@ pub struct RenderOptions {
     /// Set (e.g. by a Ctrl-C handler) to stop after the current wave; the
     /// image rendered so far is written.
     pub interrupt: Option<Arc<AtomicBool>>,
+    /// `--mse-reference-image`: after every wave of samples, the image's
+    /// MSE against this reference is recorded.
+    pub mse_reference: Option<crate::image::Image>,
 }
 
 /// What a render measured (for `--stats`).
@@ -44,6 +47,9 @@ pub struct RenderStats {
     pub samples: u64,
     /// True when the render was interrupted (Ctrl-C).
     pub interrupted: bool,
+    /// (samples per pixel, MSE against the reference) after each wave, when
+    /// a reference image was given.
+    pub mse_per_wave: Vec<(i32, f64)>,
 }
 
 /// Side of the square tiles the image is split into.
@@ -140,6 +146,7 @@ pub fn render(
     let mut wave_end = 1;
     let mut next_wave_size = 1;
     let mut interrupted = false;
+    let mut mse_per_wave = Vec::new();
     while wave_start < spp {
         let results: Vec<FilmTile> = {
             let scene_ref: &Scene = scene;
@@ -194,6 +201,13 @@ pub fn render(
             );
             let _ = std::io::stderr().flush();
         }
+        if let Some(reference) = &opts.mse_reference {
+            let mut md = ImageMetadata::default();
+            let image = scene.film.get_image(&mut md, 1.0);
+            let d = crate::image::ops::diff(&image, reference)
+                .map_err(|e| format!("--mse-reference-image: {e}"))?;
+            mse_per_wave.push((wave_start, d.mse));
+        }
         if opts
             .interrupt
             .as_ref()
@@ -214,10 +228,14 @@ pub fn render(
     let render_time = start.elapsed();
     metadata.render_time_seconds = Some(render_time.as_secs_f32());
     metadata.samples_per_pixel = Some(wave_start);
+    if let Some(&(_, mse)) = mse_per_wave.last() {
+        metadata.mse = Some(mse as f32);
+    }
     scene.film.write_image(metadata, 1.0)?;
     Ok(RenderStats {
         render_time,
         samples: done,
         interrupted,
+        mse_per_wave,
     })
 }
