@@ -15,7 +15,8 @@ use rpbrt_parser::{Diagnostic, FileLoc, ParamError, ParameterDictionary};
 use super::area::AreaEmission;
 use super::{
     dense, luminance_vector, DiffuseAreaLight, DistantLight, GoniometricLight, ImageInfiniteLight,
-    Light, PointLight, ProjectionLight, SceneSphere, SpotLight, UniformInfiniteLight,
+    Light, PointLight, PortalImageInfiniteLight, ProjectionLight, SceneSphere, SpotLight,
+    UniformInfiniteLight,
 };
 use crate::image::{Image, WrapMode, WrapMode2D};
 use crate::scene::entities::{CameraTransform, LightSceneEntity, SceneEntity};
@@ -172,14 +173,13 @@ fn rgb_image(
 }
 
 /// Creates the light of a `LightSource` directive in `medium`, with
-/// unused-parameter warnings. `camera_transform` is accepted for pbrt-v4
-/// parity; none of the supported lights needs it.
+/// unused-parameter warnings. `camera_transform` takes infinite-light
+/// portals, given in world space, into render space.
 pub fn create_light(
     entity: &LightSceneEntity,
     medium: Option<MediumId>,
     camera_transform: &CameraTransform,
 ) -> Result<(Light, Vec<Diagnostic>), Diagnostic> {
-    let _ = camera_transform;
     let base = &entity.base;
     let params = &base.params;
     let loc = &base.loc;
@@ -363,7 +363,7 @@ pub fn create_light(
                 scene: SceneSphere::default(),
             })
         }
-        "infinite" => create_infinite(params, loc, cs, render_from_light)?,
+        "infinite" => create_infinite(params, loc, cs, render_from_light, camera_transform)?,
         other => {
             return Err(Diagnostic::error(
                 loc.clone(),
@@ -426,16 +426,17 @@ fn create_infinite(
     loc: &FileLoc,
     cs: &'static RgbColorSpace,
     render_from_light: Transform,
+    camera_transform: &CameraTransform,
 ) -> Result<Light, Diagnostic> {
     let l = spectrum_param(params, "L", cs, loc)?;
     let scale = scale_param(params, loc)?;
     let portal = params.get_point3_array("portal").map_err(perr)?;
     let filename = params.get_one_string("filename", "").map_err(perr)?;
     let e_v = params.get_one_float("illuminance", -1.0).map_err(perr)?;
-    if !portal.is_empty() {
+    if l.is_some() && !portal.is_empty() {
         return Err(Diagnostic::error(
             at(params, "portal", loc),
-            "infinite light \"portal\": portals not supported yet",
+            "portals are not supported for infinite lights without \"filename\"",
         ));
     }
     if l.is_some() && !filename.is_empty() {
@@ -497,6 +498,28 @@ fn create_infinite(
         if k_e > 0.0 {
             scale *= e_v / k_e;
         }
+    }
+    if !portal.is_empty() {
+        let ploc = at(params, "portal", loc);
+        let corners: [Point3f; 4] = match portal.as_slice() {
+            [a, b, c, d] => [*a, *b, *c, *d].map(|p| {
+                camera_transform
+                    .render_from_world()
+                    .apply_point(Point3f::new(p[0], p[1], p[2]))
+            }),
+            _ => {
+                return Err(Diagnostic::error(
+                    ploc,
+                    format!(
+                        "expected 4 vertices for infinite light portal but given {}",
+                        portal.len()
+                    ),
+                ))
+            }
+        };
+        let light = PortalImageInfiniteLight::new(render_from_light, &image, ics, scale, corners)
+            .map_err(|msg| Diagnostic::error(ploc, msg))?;
+        return Ok(Light::PortalImageInfinite(Box::new(light)));
     }
     Ok(Light::ImageInfinite(Box::new(ImageInfiniteLight::new(
         render_from_light,

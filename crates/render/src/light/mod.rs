@@ -1,6 +1,6 @@
 //! Light sources (book chapter 12; pbrt-v4 `lights.h/.cpp`, `base/light.h`):
-//! point, spot, goniometric, projection, distant, diffuse area, uniform and
-//! image infinite lights, all in rendering space.
+//! point, spot, goniometric, projection, distant, diffuse area, uniform,
+//! image and portal image infinite lights, all in rendering space.
 //!
 //! [`Light`] is a closed enum whose methods delegate in one line to the
 //! concrete lights. Emission spectra are stored densely sampled (pbrt-v4's
@@ -26,6 +26,7 @@ pub mod create;
 mod distant;
 mod infinite;
 mod point;
+mod portal;
 #[cfg(test)]
 mod tests;
 
@@ -34,6 +35,9 @@ pub use create::{create_area_light, create_light};
 pub use distant::DistantLight;
 pub use infinite::{ImageInfiniteLight, UniformInfiniteLight};
 pub use point::{GoniometricLight, PointLight, ProjectionLight, SpotLight};
+pub use portal::{
+    portal_frame, PortalImageInfiniteLight, SummedAreaTable, WindowedPiecewiseConstant2D,
+};
 
 /// How a light emits, which decides how integrators may sample it (pbrt-v4
 /// `LightType`).
@@ -276,6 +280,8 @@ pub enum Light {
     UniformInfinite(UniformInfiniteLight),
     /// Environment map in pbrt-v4's equal-area octahedral layout.
     ImageInfinite(Box<ImageInfiniteLight>),
+    /// Environment map seen only through a rectangular portal.
+    PortalImageInfinite(Box<PortalImageInfiniteLight>),
 }
 
 macro_rules! dispatch {
@@ -289,6 +295,7 @@ macro_rules! dispatch {
             Light::DiffuseArea($l) => $e,
             Light::UniformInfinite($l) => $e,
             Light::ImageInfinite($l) => $e,
+            Light::PortalImageInfinite($l) => $e,
         }
     };
 }
@@ -303,7 +310,9 @@ impl Light {
             }
             Light::Distant(_) => LightType::DeltaDirection,
             Light::DiffuseArea(_) => LightType::Area,
-            Light::UniformInfinite(_) | Light::ImageInfinite(_) => LightType::Infinite,
+            Light::UniformInfinite(_) | Light::ImageInfinite(_) | Light::PortalImageInfinite(_) => {
+                LightType::Infinite
+            }
         }
     }
 
@@ -357,6 +366,7 @@ impl Light {
         match self {
             Light::UniformInfinite(l) => l.le(ray, lambda),
             Light::ImageInfinite(l) => l.le(ray, lambda),
+            Light::PortalImageInfinite(l) => l.le(ray, lambda),
             _ => SampledSpectrum::new(0.0),
         }
     }
@@ -375,6 +385,7 @@ impl Light {
             Light::Distant(l) => l.preprocess(scene_bounds),
             Light::UniformInfinite(l) => l.preprocess(scene_bounds),
             Light::ImageInfinite(l) => l.preprocess(scene_bounds),
+            Light::PortalImageInfinite(l) => l.preprocess(scene_bounds),
             _ => {}
         }
     }

@@ -537,14 +537,12 @@ fn creation_errors_are_located() {
     assert!(format!("{e:?}").contains("env.exr"));
     let e = bad(
         "infinite",
-        vec![ParsedParameter::with_floats(
-            "point3",
-            "portal",
-            loc(),
-            vec![0.0; 12],
-        )],
+        vec![
+            floats("L", &[1.0, 1.0, 1.0]),
+            ParsedParameter::with_floats("point3", "portal", loc(), vec![0.0; 12]),
+        ],
     );
-    assert!(format!("{e:?}").contains("portals not supported"));
+    assert!(format!("{e:?}").contains("portals are not supported"));
     // Unused parameters are warned about.
     let (_, w) = create_light(
         &entity("point", vec![floats("bogus", &[1.0])]),

@@ -55,7 +55,7 @@ const fn metal(name: &'static str, lambda: &'static [Float], v: &'static [Float]
     }
 }
 
-use metals::{METAL_LAMBDA, MGO_LAMBDA, TIO2_LAMBDA};
+use metals::{CUZN_LAMBDA, METAL_LAMBDA, MGO_LAMBDA, TIO2_LAMBDA};
 
 const ENTRIES: &[Entry] = &[
     glass("glass-BK7", &glass::BK7),
@@ -73,6 +73,8 @@ const ENTRIES: &[Entry] = &[
     metal("metal-Au-k", &METAL_LAMBDA, &metals::AU_K),
     metal("metal-Cu-eta", &METAL_LAMBDA, &metals::CU_ETA),
     metal("metal-Cu-k", &METAL_LAMBDA, &metals::CU_K),
+    metal("metal-CuZn-eta", &CUZN_LAMBDA, &metals::CUZN_ETA),
+    metal("metal-CuZn-k", &CUZN_LAMBDA, &metals::CUZN_K),
     metal("metal-MgO-eta", &MGO_LAMBDA, &metals::MGO_ETA),
     metal("metal-MgO-k", &MGO_LAMBDA, &metals::MGO_K),
     metal("metal-TiO2-eta", &TIO2_LAMBDA, &metals::TIO2_ETA),

@@ -503,3 +503,49 @@ fn named_metals_and_glasses() {
         assert!(named_spectrum(name).is_some(), "{name}");
     }
 }
+
+#[test]
+fn named_brass_spectra() {
+    let eta = named_spectrum("metal-CuZn-eta").expect("metal-CuZn-eta");
+    let k = named_spectrum("metal-CuZn-k").expect("metal-CuZn-k");
+    // pbrt-v4's table entries come back exactly at their wavelengths.
+    for (l, e, kk) in [
+        (290.0, 1.358, 1.688),
+        (450.0, 1.094, 1.829),
+        (600.0, 0.450, 3.253),
+        (700.0, 0.446, 4.106),
+        (890.0, 0.515, 5.575),
+    ] {
+        assert_eq!(eta.evaluate(l), e, "η at {l}");
+        assert_eq!(k.evaluate(l), kk, "k at {l}");
+    }
+    // Linear between entries.
+    assert!(close(eta.evaluate(595.0), 0.455, 1e-6));
+    assert!(close(k.evaluate(455.0), 0.5 * (1.829 + 1.883), 1e-6));
+    // Finite and positive across the visible range; k grows with
+    // wavelength beyond 440 nm, as for copper alloys.
+    let mut last_k = 0.0;
+    for l in 360..=830 {
+        let (e, kv) = (eta.evaluate(l as Float), k.evaluate(l as Float));
+        assert!(
+            e.is_finite() && e > 0.0 && kv.is_finite() && kv > 0.0,
+            "{l}"
+        );
+        if l >= 440 {
+            assert!(kv >= last_k, "k not increasing at {l}");
+        }
+        last_k = kv;
+    }
+    // Brass-like normal-incidence reflectance: yellow, brighter in the red
+    // than in the blue.
+    let r = |l: Float| {
+        let (n, kv) = (eta.evaluate(l), k.evaluate(l));
+        ((n - 1.0).powi(2) + kv * kv) / ((n + 1.0).powi(2) + kv * kv)
+    };
+    assert!(
+        r(650.0) > 0.85 && r(450.0) < 0.6,
+        "{} {}",
+        r(650.0),
+        r(450.0)
+    );
+}
