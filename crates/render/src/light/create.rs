@@ -494,7 +494,11 @@ fn create_infinite(
                 }
             }
         }
-        let k_e = k_e as Float * 4.0 * PI / (res.x as Float * res.y as Float);
+        // pbrt-v4 multiplies by 2π/N here (each equal-area pixel covers
+        // 4π/N sr, so the map's true illuminance is twice this); rpbrt keeps
+        // pbrt-v4's factor so that scenes using "illuminance" render at the
+        // same brightness as in pbrt-v4.
+        let k_e = k_e as Float * 2.0 * PI / (res.x as Float * res.y as Float);
         if k_e > 0.0 {
             scale *= e_v / k_e;
         }

@@ -613,9 +613,10 @@ fn image_infinite_from_file_illuminance_and_square_check() {
     let Light::ImageInfinite(img) = &l else {
         panic!()
     };
-    // Recompute the upward illuminance: ∫_{z>0} Y(L) cos θ dω = 2, with
-    // L = scale · rgb · illuminant and Y(rgb · illuminant) = lum · rgb ·
-    // photometric(illuminant).
+    // Recompute the upward illuminance the way pbrt-v4 measures it (its
+    // factor is 2π/N, half of the true 4π/N solid angle per pixel, so the
+    // true illuminance comes out at twice the target): with L = scale · rgb
+    // · illuminant and Y(rgb · illuminant) = lum · rgb · photometric(illuminant).
     let cs = RgbColorSpace::srgb();
     let lum = luminance_vector(cs);
     let res = img.image.resolution();
@@ -635,7 +636,7 @@ fn image_infinite_from_file_illuminance_and_square_check() {
             }
         }
     }
-    e *= 4.0 * PI / (res.x * res.y) as Float
+    e *= 2.0 * PI / (res.x * res.y) as Float
         * img.scale
         * spectrum_to_photometric(&cs.illuminant_spectrum());
     assert!(rel_eq(e, 2.0, 1e-3), "{e}");
