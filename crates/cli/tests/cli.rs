@@ -173,3 +173,22 @@ fn renders_png_and_reports_mse_against_a_reference() {
         .unwrap();
     assert_eq!(out.status.code(), Some(1));
 }
+
+#[test]
+fn unsupported_features_are_located_errors_not_wrong_images() {
+    let cases = [
+        ("ss.pbrt", "WorldBegin\nLightSource \"point\" \"rgb I\" [1 1 1]\nMaterial \"subsurface\"\nShape \"sphere\"\n", "ss.pbrt:3:1"),
+        ("bdpt.pbrt", "Integrator \"bdpt\"\nWorldBegin\nShape \"sphere\"\n", "bdpt.pbrt:1:1"),
+        ("medium.pbrt", "WorldBegin\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nShape \"sphere\"\n", "medium.pbrt:2:"),
+    ];
+    for (name, text, loc) in cases {
+        let p = temp_scene(name, text);
+        let out = rpbrt().arg("--quiet").arg(&p).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{name}");
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            e.contains(loc) && e.contains("not supported"),
+            "{name}: {e}"
+        );
+    }
+}

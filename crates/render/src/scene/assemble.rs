@@ -195,6 +195,13 @@ pub fn create_scene(
                 return Err(errors);
             }
         };
+    if let Some((_, loc)) = materials.first_subsurface() {
+        let loc = loc.cloned().unwrap_or_else(|| desc.integrator.loc.clone());
+        errors.push(Diagnostic::error(
+            loc,
+            "subsurface scattering is not supported yet: no rpbrt integrator renders BSSRDFs",
+        ));
+    }
     let material_id = |r: &MaterialRef| -> Option<u32> {
         match r {
             MaterialRef::Index(i) => Some(*i as u32),
