@@ -495,13 +495,13 @@ fn measured_material_from_scene_file() {
     );
     let (set, _, w) = create_ok(&text);
     assert!(w.is_empty(), "{w:?}");
-    let (Some(Material::Measured(a)), Some(Material::Measured(b))) = (set.get(0), set.get(1))
+    let (Some(Material::Measured(a)), Some(Material::Measured(b))) = (set.get(1), set.get(2))
     else {
         panic!()
     };
     assert!(std::ptr::eq(a.data, b.data), "data are shared per file");
     let mut s = si();
-    let bsdf = set.get_bsdf(0, &mut s, &mut lambda()).unwrap();
+    let bsdf = set.get_bsdf(1, &mut s, &mut lambda()).unwrap();
     assert!(matches!(bsdf.bxdf, BxDF::Measured(_)));
     let wo = Vector3f::from(s.shading.n);
     let f = bsdf.f(wo, wo, TransportMode::Radiance);

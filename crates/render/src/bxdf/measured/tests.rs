@@ -363,7 +363,7 @@ fn piecewise_linear_2d_samples_inverts_and_normalizes() {
 
 #[test]
 fn lambertian_table_gives_albedo_over_pi() {
-    for n_phi in [1, 5] {
+    for n_phi in [1, 9] {
         let data = lambertian(n_phi);
         assert_eq!(data.isotropic, n_phi == 1);
         let l = lambda();
@@ -404,7 +404,7 @@ fn lambertian_table_gives_albedo_over_pi() {
 
 #[test]
 fn sample_f_matches_f_and_pdf() {
-    for n_phi in [1, 5] {
+    for n_phi in [1, 9] {
         let b = MeasuredBxDF::new(lambertian(n_phi), &lambda());
         assert_eq!(b.flags(), BxDFFlags::GLOSSY_REFLECTION);
         let mut rng = Rng::with_sequence(5);
@@ -476,8 +476,10 @@ fn energy_is_conserved_and_pdf_integrates_to_at_most_one() {
                 / UNIFORM_HEMISPHERE_PDF;
         }
         integral /= n as Float;
+        // At normal incidence only normals within 45° of the normal reflect
+        // into the hemisphere: P = sin²45° = 1/2 for this NDF.
         assert!(
-            integral <= 1.02 && integral > 0.6,
+            integral <= 1.02 && integral > 0.4,
             "cos {cos_o}: {integral}"
         );
     }
