@@ -20,6 +20,7 @@ mod dielectric;
 mod diffuse;
 mod hair;
 mod layered;
+pub mod measured;
 mod microfacet;
 mod scattering;
 #[cfg(test)]
@@ -31,6 +32,7 @@ pub use dielectric::{DielectricBxDF, ThinDielectricBxDF};
 pub use diffuse::{DiffuseBxDF, DiffuseTransmissionBxDF, NormalizedFresnelBxDF};
 pub use hair::HairBxDF;
 pub use layered::{CoatedConductorBxDF, CoatedDiffuseBxDF, LayeredBxDF};
+pub use measured::{MeasuredBxDF, MeasuredBxDFData};
 pub use microfacet::TrowbridgeReitzDistribution;
 pub use scattering::{
     fr_complex, fr_complex_spectrum, fr_dielectric, fresnel_moment1, fresnel_moment2,
@@ -312,6 +314,8 @@ pub enum BxDF {
     Hair(HairBxDF),
     /// The normalized Fresnel lobe at subsurface exits.
     NormalizedFresnel(NormalizedFresnelBxDF),
+    /// Tabulated measured reflectance (RGL `.bsdf` data).
+    Measured(MeasuredBxDF),
 }
 
 macro_rules! dispatch {
@@ -326,6 +330,7 @@ macro_rules! dispatch {
             BxDF::CoatedConductor($b) => $e,
             BxDF::Hair($b) => $e,
             BxDF::NormalizedFresnel($b) => $e,
+            BxDF::Measured($b) => $e,
         }
     };
 }
@@ -379,6 +384,7 @@ impl BxDF {
             BxDF::CoatedConductor(_) => "CoatedConductorBxDF",
             BxDF::Hair(_) => "HairBxDF",
             BxDF::NormalizedFresnel(_) => "NormalizedFresnelBxDF",
+            BxDF::Measured(_) => "MeasuredBxDF",
         }
     }
 

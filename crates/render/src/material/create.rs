@@ -18,6 +18,7 @@ use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary};
 
 use super::coated::LayerSettings;
 use super::*;
+use crate::bxdf::MeasuredBxDFData;
 use crate::image::Image;
 use crate::scene::entities::SceneEntity;
 use crate::scene::names::EntityKind;
@@ -463,10 +464,21 @@ fn create_material(
         "mix" => create_mix(cx, visible)?,
         "subsurface" => create_subsurface(cx, cache)?,
         "measured" => {
-            return Err(Diagnostic::error(
-                cx.loc.clone(),
-                "measured materials are not supported yet",
-            ))
+            let file = cx.params.get_one_string("filename", "")?;
+            if file.is_empty() {
+                return Err(Diagnostic::error(
+                    cx.loc.clone(),
+                    "\"measured\" material: \"filename\" must be provided",
+                ));
+            }
+            let loc = cx.ploc("filename");
+            let path = dir_of(&loc).join(&file);
+            let data =
+                MeasuredBxDFData::cached(&path).map_err(|m| Diagnostic::error(loc.clone(), m))?;
+            Material::Measured(Box::new(MeasuredMaterial {
+                data,
+                perturbation: cx.perturbation(cache)?,
+            }))
         }
         _ => {
             return Err(Diagnostic::error(

@@ -31,6 +31,7 @@ pub mod data;
 mod dielectric;
 mod diffuse;
 mod hair;
+mod measured;
 mod mix;
 mod subsurface;
 #[cfg(test)]
@@ -46,6 +47,7 @@ pub use data::get_medium_scattering_properties;
 pub use dielectric::{DielectricMaterial, ThinDielectricMaterial};
 pub use diffuse::{DiffuseMaterial, DiffuseTransmissionMaterial};
 pub use hair::{HairAbsorption, HairMaterial};
+pub use measured::MeasuredMaterial;
 pub use mix::MixMaterial;
 pub use subsurface::{SubsurfaceCoefficients, SubsurfaceMaterial};
 
@@ -191,6 +193,8 @@ pub enum Material {
     Interface,
     /// A dielectric boundary over a scattering volume.
     Subsurface(Box<SubsurfaceMaterial>),
+    /// Tabulated measured reflectance.
+    Measured(Box<MeasuredMaterial>),
 }
 
 impl Material {
@@ -215,6 +219,7 @@ impl Material {
             Material::Hair(m) => Some(m.get_bxdf(ctx, lambda)),
             Material::Mix(_) | Material::Interface => None,
             Material::Subsurface(m) => Some(m.get_bxdf(ctx, lambda)),
+            Material::Measured(m) => Some(m.get_bxdf(ctx, lambda)),
         }
     }
 
@@ -230,6 +235,7 @@ impl Material {
             Material::CoatedDiffuse(m) => Some(&m.perturbation),
             Material::CoatedConductor(m) => Some(&m.perturbation),
             Material::Subsurface(m) => Some(&m.perturbation),
+            Material::Measured(m) => Some(&m.perturbation),
             Material::Hair(_) | Material::Mix(_) | Material::Interface => None,
         }
     }
@@ -260,6 +266,7 @@ impl Material {
             Material::Mix(_) => "mix",
             Material::Interface => "interface",
             Material::Subsurface(_) => "subsurface",
+            Material::Measured(_) => "measured",
         }
     }
 }

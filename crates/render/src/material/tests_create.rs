@@ -330,11 +330,13 @@ fn unknown_type_lists_known_names() {
 
 #[test]
 fn measured_and_conflicting_parameters_are_errors() {
-    let e = create_err("Material \"measured\" \"string filename\" \"x.bsdf\"\n");
+    let e = create_err("Material \"measured\" \"string filename\" \"/nonexistent/x.bsdf\"\n");
     assert!(
-        e.starts_with("2:1: ") && e.contains("not supported yet"),
+        e.starts_with("2:21: ") && e.contains("x.bsdf") && e.contains("unable to open"),
         "{e}"
     );
+    let e = create_err("Material \"measured\"\n");
+    assert!(e.starts_with("2:1: ") && e.contains("\"filename\""), "{e}");
     let e = create_err("Material \"conductor\" \"rgb reflectance\" [0.5 0.5 0.5] \"spectrum eta\" \"metal-Ag-eta\"\n");
     assert!(e.contains("can't both be given"), "{e}");
     let e = create_err("Material \"subsurface\" \"string name\" \"Jelly\"\n");
@@ -438,4 +440,76 @@ fn linear_displacement_tilts_the_normal_by_the_gradient() {
         assert!((angle - analytic).abs() < 2e-3, "{angle} vs {analytic}");
         assert!(dot(s.shading.n, s.n) > 0.0);
     }
+}
+
+/// A minimal consistent RGL tensor file: flat tables on 2×2 grids.
+fn tiny_bsdf(spectra: f32) -> Vec<u8> {
+    use crate::bxdf::measured::{write_tensor_bytes, TensorField, TensorType};
+    let f = |shape: &[usize], v: f32| TensorField {
+        dtype: TensorType::Float32,
+        shape: shape.to_vec(),
+        data: (0..shape.iter().product::<usize>())
+            .flat_map(|_| v.to_le_bytes())
+            .collect(),
+    };
+    let theta = TensorField {
+        data: [0.0f32, PI / 2.0]
+            .iter()
+            .flat_map(|x| x.to_le_bytes())
+            .collect(),
+        ..f(&[2], 0.0)
+    };
+    let u8f = |v: &[u8]| TensorField {
+        dtype: TensorType::UInt8,
+        shape: vec![v.len()],
+        data: v.to_vec(),
+    };
+    let fields = [
+        ("description", u8f(b"tiny")),
+        ("jacobian", u8f(&[1])),
+        ("theta_i", theta),
+        ("phi_i", f(&[1], 0.0)),
+        ("wavelengths", f(&[1], 550.0)),
+        ("ndf", f(&[2, 2], 1.0)),
+        ("sigma", f(&[2, 2], 1.0)),
+        ("vndf", f(&[1, 2, 2, 2], 1.0)),
+        ("luminance", f(&[1, 2, 2, 2], 1.0)),
+        ("spectra", f(&[1, 2, 1, 2, 2], spectra)),
+    ];
+    let refs: Vec<(&str, &TensorField)> = fields.iter().map(|(n, x)| (*n, x)).collect();
+    write_tensor_bytes(&refs)
+}
+
+#[test]
+fn measured_material_from_scene_file() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-material-measured-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = dir.join("tiny.bsdf");
+    std::fs::write(&good, tiny_bsdf(0.5)).unwrap();
+    let bad = dir.join("bad.bsdf");
+    std::fs::write(&bad, &tiny_bsdf(0.5)[..40]).unwrap();
+    let text = format!(
+        "Material \"measured\" \"string filename\" \"{p}\"\n\
+         Material \"measured\" \"string filename\" \"{p}\"\n",
+        p = good.display()
+    );
+    let (set, _, w) = create_ok(&text);
+    assert!(w.is_empty(), "{w:?}");
+    let (Some(Material::Measured(a)), Some(Material::Measured(b))) = (set.get(1), set.get(2))
+    else {
+        panic!()
+    };
+    assert!(std::ptr::eq(a.data, b.data), "data are shared per file");
+    let mut s = si();
+    let bsdf = set.get_bsdf(1, &mut s, &mut lambda()).unwrap();
+    assert!(matches!(bsdf.bxdf, BxDF::Measured(_)));
+    let wo = Vector3f::from(s.shading.n);
+    let f = bsdf.f(wo, wo, TransportMode::Radiance);
+    assert!(f[0] > 0.0 && f[0].is_finite(), "{f:?}");
+    let e = create_err(&format!(
+        "Material \"measured\" \"string filename\" \"{}\"\n",
+        bad.display()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(e.starts_with("2:21: ") && e.contains("truncated"), "{e}");
 }
