@@ -217,6 +217,7 @@ impl PtexFace {
 
     /// Adds `weight` × texel (iu, iv) at resolution 2^ulog2 × 2^vlog2 (at
     /// most the face's) to `acc`.
+    #[allow(clippy::too_many_arguments)]
     fn accumulate(
         &self,
         nc: usize,
@@ -320,7 +321,7 @@ impl PtexFile {
             )
         };
         let total = ku.weight() * kv.weight();
-        if !(total > 0.0) {
+        if total.is_nan() || total <= 0.0 {
             out[..nc].copy_from_slice(&f.constant);
             return;
         }

@@ -330,8 +330,10 @@ fn texels_round_trip() {
     }
 }
 
-/// The B-spline lookup at a texel centre with zero derivatives, computed
-/// independently: weights 1/6, 2/3, 1/6 with clamped edges.
+/// The lookup at a texel centre with zero derivatives, computed
+/// independently: per axis, B-spline weights 1/6, 2/3, 1/6 on faces of 4
+/// or more texels, Ptex's smoothstep kernel (stretched by 1/0.8) on faces
+/// of 2; edges clamped.
 fn centre_reference(
     t: &[f32],
     w: usize,
@@ -341,10 +343,19 @@ fn centre_reference(
     iv: usize,
     c: usize,
 ) -> f32 {
-    let k = [(-1i32, 1.0 / 6.0), (0, 2.0 / 3.0), (1, 1.0 / 6.0)];
+    let axis = |n: usize| -> [(i32, f32); 3] {
+        if n >= 4 {
+            [(-1, 1.0 / 6.0), (0, 2.0 / 3.0), (1, 1.0 / 6.0)]
+        } else {
+            let x: f32 = 0.8;
+            let e = (2.0 * x - 3.0) * x * x + 1.0;
+            let sum = 1.0 + 2.0 * e;
+            [(-1, e / sum), (0, 1.0 / sum), (1, e / sum)]
+        }
+    };
     let mut s = 0.0;
-    for (dv, wv) in k {
-        for (du, wu) in k {
+    for (dv, wv) in axis(h) {
+        for (du, wu) in axis(w) {
             let u = (iu as i32 + du).clamp(0, w as i32 - 1) as usize;
             let v = (iv as i32 + dv).clamp(0, h as i32 - 1) as usize;
             s += wu * wv * t[(v * w + u) * nc + c];
@@ -354,6 +365,7 @@ fn centre_reference(
 }
 
 #[test]
+#[allow(clippy::needless_range_loop)]
 fn lookups_at_texel_centres() {
     for dt in TYPES {
         for nc in [1, 3] {
