@@ -17,6 +17,7 @@ use std::sync::Arc;
 use super::imagemap::{FloatImageTexture, ImageTextureBase, SpectrumImageTexture};
 use super::mapping::{TextureMapping2D, TextureMapping3D};
 use super::procedural::*;
+use super::ptex::{load_ptex, FloatPtexTexture, PtexTextureBase, SpectrumPtexTexture};
 use super::{FloatTexture, FloatTextureRef, SpectrumTexture, SpectrumTextureRef};
 use crate::image::{ColorEncoding, FilterFunction, MIPMapCache, MIPMapFilterOptions, WrapMode};
 use crate::scene::entities::{TextureKind, TextureSceneEntity};
@@ -357,14 +358,45 @@ fn checkerboard_dimension(params: &ParameterDictionary, loc: &FileLoc) -> Result
     Ok(dim)
 }
 
-fn ptex_unsupported(entity: &TextureSceneEntity) -> Diagnostic {
-    Diagnostic::error(
-        entity.base.loc.clone(),
-        format!(
-            "texture \"{}\": ptex textures are not supported yet",
-            entity.name
-        ),
-    )
+/// The file, encoding and scale of a ptex texture (pbrt-v4
+/// `FloatPtexTexture::Create`: "filename", "encoding" (default
+/// "gamma 2.2"), "scale").
+fn ptex_base(entity: &TextureSceneEntity) -> Result<PtexTextureBase, Diagnostic> {
+    let params = &entity.base.params;
+    let loc = &entity.base.loc;
+    let filename = params.get_one_string("filename", "")?;
+    if filename.is_empty() {
+        return Err(Diagnostic::error(
+            loc.clone(),
+            format!("ptex texture \"{}\": no \"filename\" given", entity.name),
+        ));
+    }
+    let encoding_name = params.get_one_string("encoding", "gamma 2.2")?;
+    let Some(encoding) = ColorEncoding::parse(&encoding_name) else {
+        return Err(Diagnostic::error(
+            param_loc(params, "encoding", Some(loc)),
+            format!(
+                "\"{encoding_name}\": color encoding unknown (known: linear, sRGB, gamma <value>)"
+            ),
+        ));
+    };
+    let scale = params.get_one_float("scale", 1.0)?;
+    let path = dir_of(loc).join(&filename);
+    let file = load_ptex(&path).map_err(|e| {
+        Diagnostic::error(
+            param_loc(params, "filename", Some(loc)),
+            format!(
+                "ptex texture \"{}\": unable to read ptex file: {e}",
+                entity.name
+            ),
+        )
+    })?;
+    Ok(PtexTextureBase {
+        filename: path.display().to_string(),
+        file,
+        encoding,
+        scale,
+    })
 }
 
 /// The float texture classes [`create_float_texture`] knows.
@@ -457,7 +489,9 @@ fn create_float_in(
         "windy" => FloatTexture::Windy(WindyTexture {
             mapping: TextureMapping3D::new(&rft),
         }),
-        "ptex" => return Err(ptex_unsupported(entity)),
+        "ptex" => FloatTexture::Ptex(FloatPtexTexture {
+            base: ptex_base(entity)?,
+        }),
         other => {
             return Err(Diagnostic::error(
                 loc.clone(),
@@ -581,7 +615,10 @@ fn create_spectrum_in(
             scale: params.get_one_float("scale", 1.0)?,
             variation: params.get_one_float("variation", 0.2)?,
         }),
-        "ptex" => return Err(ptex_unsupported(entity)),
+        "ptex" => SpectrumTexture::Ptex(SpectrumPtexTexture {
+            base: ptex_base(entity)?,
+            spectrum_type: ty,
+        }),
         other => {
             return Err(Diagnostic::error(
                 loc.clone(),

@@ -8,15 +8,16 @@
 //!
 //! Submodules: [`mapping`] (texture coordinates, 10.2), [`noise`] (Perlin
 //! noise, FBm, turbulence, 10.6), [`procedural`] (the basic and procedural
-//! textures, 10.3 and 10.5), [`imagemap`] (10.4) and [`create`] (textures
-//! from scene entities, and the parameter lookups materials use).
-//! Ptex textures are not supported: creating one is an error.
+//! textures, 10.3 and 10.5), [`imagemap`] (10.4), [`ptex`] (per-face Ptex
+//! textures, with our own Ptex reader) and [`create`] (textures from scene
+//! entities, and the parameter lookups materials use).
 
 pub mod create;
 pub mod imagemap;
 pub mod mapping;
 pub mod noise;
 pub mod procedural;
+pub mod ptex;
 #[cfg(test)]
 mod tests;
 
@@ -27,6 +28,7 @@ pub use create::{
 pub use imagemap::{FloatImageTexture, ImageTextureBase, SpectrumImageTexture};
 pub use mapping::{TexCoord2D, TexCoord3D, TextureMapping2D, TextureMapping3D};
 pub use procedural::*;
+pub use ptex::{FloatPtexTexture, PtexTextureBase, SpectrumPtexTexture};
 
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 use rpbrt_geometry::float::Float;
@@ -104,6 +106,8 @@ pub enum FloatTexture {
     Windy(WindyTexture),
     /// An image.
     Image(FloatImageTexture),
+    /// A Ptex file.
+    Ptex(FloatPtexTexture),
 }
 
 impl FloatTexture {
@@ -122,6 +126,7 @@ impl FloatTexture {
             FloatTexture::Wrinkled(t) => t.evaluate(ctx),
             FloatTexture::Windy(t) => t.evaluate(ctx),
             FloatTexture::Image(t) => t.evaluate(ctx),
+            FloatTexture::Ptex(t) => t.evaluate(ctx),
         }
     }
 
@@ -156,6 +161,8 @@ pub enum SpectrumTexture {
     Marble(MarbleTexture),
     /// An RGB image.
     Image(SpectrumImageTexture),
+    /// A Ptex file.
+    Ptex(SpectrumPtexTexture),
 }
 
 impl SpectrumTexture {
@@ -176,6 +183,7 @@ impl SpectrumTexture {
             SpectrumTexture::Dots(t) => t.evaluate(ctx, lambda),
             SpectrumTexture::Marble(t) => t.evaluate(ctx, lambda),
             SpectrumTexture::Image(t) => t.evaluate(ctx, lambda),
+            SpectrumTexture::Ptex(t) => t.evaluate(ctx, lambda),
         }
     }
 }

@@ -411,7 +411,7 @@ fn temp_dir(tag: &str) -> PathBuf {
     d
 }
 
-fn scene(text: &str) -> SceneDescription {
+pub(super) fn scene(text: &str) -> SceneDescription {
     // Textures belong in the world block; the tests' line numbers count
     // from the line after `WorldBegin`.
     let full = format!("WorldBegin\n{text}");
@@ -421,7 +421,7 @@ fn scene(text: &str) -> SceneDescription {
     }
 }
 
-fn create(text: &str) -> Result<(NamedTextures, Vec<Diagnostic>), Vec<Diagnostic>> {
+pub(super) fn create(text: &str) -> Result<(NamedTextures, Vec<Diagnostic>), Vec<Diagnostic>> {
     let s = scene(text);
     create_textures(
         &s.float_textures,
@@ -686,13 +686,13 @@ fn creation_errors_are_located() {
     );
     assert_at(&e, text, "\"string mapping\"");
 
-    let text = "Texture \"p\" \"float\" \"ptex\" \"string filename\" \"x.ptx\"\n";
+    let text = "Texture \"p\" \"float\" \"ptex\" \"string filename\" \"/nonexistent/dir/x.ptx\"\n";
     let e = create_err(text);
     assert!(
-        e.message.contains("ptex textures are not supported yet"),
+        e.message.contains("x.ptx") && e.message.contains("\"p\""),
         "{e:?}"
     );
-    assert_at(&e, text, "Texture");
+    assert_at(&e, text, "\"string filename\"");
 
     let dir = temp_dir("errs");
     let path = write_pfm(&dir);
