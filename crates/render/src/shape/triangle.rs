@@ -10,7 +10,7 @@ use super::{
     ShapeSample, ShapeSampleContext,
 };
 use crate::sampling::spherical::{
-    invert_spherical_triangle_sample, sample_spherical_triangle, spherical_triangle_area,
+    invert_spherical_triangle_sample_dirs, sample_spherical_triangle_dirs, spherical_triangle_area,
 };
 use crate::sampling::{bilinear_pdf, sample_bilinear, sample_uniform_triangle};
 use rpbrt_geometry::float::*;
@@ -370,12 +370,21 @@ impl Triangle {
 
     /// The solid angle the triangle subtends from `p`.
     pub fn solid_angle(&self, p: Point3f) -> Float {
+        let [a, b, c] = self.directions_from(p);
+        spherical_triangle_area(a, b, c)
+    }
+
+    /// The unit directions from `p` to the vertices (NaN components when
+    /// `p` is a vertex), shared by the solid angle, the cos θ weights and
+    /// spherical sampling so that each is normalised once.
+    #[inline]
+    fn directions_from(&self, p: Point3f) -> [Vector3f; 3] {
         let [p0, p1, p2] = self.vertices();
-        spherical_triangle_area(
+        [
             (p0 - p).normalize(),
             (p1 - p).normalize(),
             (p2 - p).normalize(),
-        )
+        ]
     }
 
     /// The geometric normal at barycentrics `b`, oriented as intersections
@@ -418,11 +427,11 @@ impl Triangle {
     /// The weights of the bilinear cos θ warp for spherical sampling from
     /// `ctx`: corner (0,0) and (1,0) map to vertex 1, (0,1) to vertex 0 and
     /// (1,1) to vertex 2, as the spherical triangle sampler lays them out.
-    fn cos_weights(&self, ctx: &ShapeSampleContext) -> [Float; 4] {
-        let [p0, p1, p2] = self.vertices();
-        let rp = ctx.p();
-        let w = |q: Point3f| abs_dot(ctx.ns, (q - rp).normalize()).max(0.01);
-        let (w0, w1, w2) = (w(p0), w(p1), w(p2));
+    /// `dirs` are the unit directions from the reference point to the
+    /// vertices.
+    fn cos_weights(ctx: &ShapeSampleContext, dirs: &[Vector3f; 3]) -> [Float; 4] {
+        let w = |d: Vector3f| abs_dot(ctx.ns, d).max(0.01);
+        let (w0, w1, w2) = (w(dirs[0]), w(dirs[1]), w(dirs[2]));
         [w1, w1, w0, w2]
     }
 
@@ -624,7 +633,8 @@ impl ShapeMethods for Triangle {
     }
 
     fn sample(&self, ctx: &ShapeSampleContext, u: Point2f) -> Option<ShapeSample> {
-        let sa = self.solid_angle(ctx.p());
+        let dirs = self.directions_from(ctx.p());
+        let sa = spherical_triangle_area(dirs[0], dirs[1], dirs[2]);
         if !(MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA).contains(&sa) {
             let mut ss = self.sample_area(u)?;
             ss.time = ctx.time;
@@ -635,11 +645,13 @@ impl ShapeMethods for Triangle {
         let mut pdf = 1.0;
         let mut u = u;
         if ctx.ns != Normal3f::default() {
-            let w = self.cos_weights(ctx);
+            let w = Self::cos_weights(ctx, &dirs);
             u = sample_bilinear(u, w);
             pdf *= bilinear_pdf(u, w);
         }
-        let (b, tri_pdf) = sample_spherical_triangle(self.vertices(), ctx.p(), u)?;
+        // In this branch the solid angle is finite and positive, so the
+        // directions are the ones `try_normalize` would give.
+        let (b, tri_pdf) = sample_spherical_triangle_dirs(self.vertices(), ctx.p(), dirs, u)?;
         if !(tri_pdf > 0.0) {
             return None;
         }
@@ -647,7 +659,8 @@ impl ShapeMethods for Triangle {
     }
 
     fn pdf(&self, ctx: &ShapeSampleContext, wi: Vector3f) -> Float {
-        let sa = self.solid_angle(ctx.p());
+        let dirs = self.directions_from(ctx.p());
+        let sa = spherical_triangle_area(dirs[0], dirs[1], dirs[2]);
         if !(MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA).contains(&sa) {
             return pdf_by_intersection(self, ctx, wi);
         }
@@ -656,8 +669,8 @@ impl ShapeMethods for Triangle {
         }
         let mut pdf = 1.0 / sa;
         if ctx.ns != Normal3f::default() {
-            let w = self.cos_weights(ctx);
-            let u = invert_spherical_triangle_sample(self.vertices(), ctx.p(), wi.normalize());
+            let w = Self::cos_weights(ctx, &dirs);
+            let u = invert_spherical_triangle_sample_dirs(dirs, wi.normalize());
             pdf *= bilinear_pdf(u, w);
         }
         pdf
