@@ -4,7 +4,7 @@
 //! acceleration structure over a set of primitives.
 
 use crate::accel::{AccelParams, Accelerator, Aggregate};
-use crate::shape::{Shape, ShapeMethods};
+use crate::shape::{Shape, ShapeMethods, Triangle};
 use crate::texture::{FloatTextureRef, TextureEvalContext};
 use rpbrt_geometry::animated::AnimatedTransform;
 use rpbrt_geometry::float::Float;
@@ -245,15 +245,61 @@ impl PrimitiveAggregate {
     }
 
     /// The closest hit in (0, t_max).
+    ///
+    /// Opaque triangles (nearly all primitives in practice) are tested
+    /// without building their surface interaction; only the closest hit's
+    /// is built, at the end. The result is the same as building every
+    /// hit's, as pbrt-v4 does.
     pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
-        let mut best: Option<PrimitiveIntersection> = None;
+        enum Closest<'a> {
+            None,
+            Full(PrimitiveIntersection),
+            Triangle {
+                prim: &'a GeometricPrimitive,
+                tri: &'a Triangle,
+                b: (Float, Float, Float),
+                t_hit: Float,
+                ray: Ray,
+            },
+        }
+        let mut closest = Closest::None;
         self.accel.intersect(ray, t_max, |i, r, t| {
-            let pi = self.prims[i as usize].intersect(r, t)?;
+            let prim = &self.prims[i as usize];
+            if let Primitive::Geometric(g) = prim {
+                if let (Shape::Triangle(tri), Alpha::Opaque) = (&g.shape, &g.alpha) {
+                    let (b0, b1, b2, t_hit) = tri.intersect_barycentrics(r, t)?;
+                    closest = Closest::Triangle {
+                        prim: g,
+                        tri,
+                        b: (b0, b1, b2),
+                        t_hit,
+                        ray: *r,
+                    };
+                    return Some(t_hit);
+                }
+            }
+            let pi = prim.intersect(r, t)?;
             let th = pi.t_hit;
-            best = Some(pi);
+            closest = Closest::Full(pi);
             Some(th)
         });
-        best
+        match closest {
+            Closest::None => None,
+            Closest::Full(pi) => Some(pi),
+            Closest::Triangle {
+                prim,
+                tri,
+                b,
+                t_hit,
+                ray,
+            } => Some(PrimitiveIntersection {
+                si: tri.interaction_at_hit(b.0, b.1, b.2, &ray),
+                t_hit,
+                material: prim.material,
+                area_light: prim.area_light,
+                medium_interface: prim.medium_interface,
+            }),
+        }
     }
 
     /// Whether anything is hit in (0, t_max).

@@ -435,6 +435,33 @@ impl Triangle {
         [w1, w1, w0, w2]
     }
 
+    /// The closest hit along `ray` in (0, `t_max`) as barycentrics and
+    /// `t`, without the surface interaction (which an aggregate needs only
+    /// for the closest of its hits: see [`Triangle::interaction_at_hit`]).
+    #[inline]
+    pub fn intersect_barycentrics(
+        &self,
+        ray: &Ray,
+        t_max: Float,
+    ) -> Option<(Float, Float, Float, Float)> {
+        let [p0, p1, p2] = self.vertices();
+        intersect_triangle(ray, t_max, p0, p1, p2)
+    }
+
+    /// The surface interaction of a hit of `ray` found by
+    /// [`Triangle::intersect_barycentrics`] at barycentrics (b0, b1, b2):
+    /// what [`ShapeMethods::intersect`] returns for that hit.
+    pub fn interaction_at_hit(
+        &self,
+        b0: Float,
+        b1: Float,
+        b2: Float,
+        ray: &Ray,
+    ) -> SurfaceInteraction {
+        let wo = (-ray.d).try_normalize().unwrap_or_default();
+        self.interaction(b0, b1, b2, ray.time, wo)
+    }
+
     /// The full surface interaction at barycentrics (b0, b1, b2).
     fn interaction(
         &self,
@@ -607,11 +634,9 @@ impl ShapeMethods for Triangle {
     }
 
     fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
-        let [p0, p1, p2] = self.vertices();
-        let (b0, b1, b2, t) = intersect_triangle(ray, t_max, p0, p1, p2)?;
-        let wo = (-ray.d).try_normalize().unwrap_or_default();
+        let (b0, b1, b2, t) = self.intersect_barycentrics(ray, t_max)?;
         Some(ShapeIntersection {
-            intr: self.interaction(b0, b1, b2, ray.time, wo),
+            intr: self.interaction_at_hit(b0, b1, b2, ray),
             t_hit: t,
         })
     }
