@@ -113,15 +113,23 @@ pub fn offset_ray_origin(p: Point3f, p_error: Vector3f, n: Normal3f, w: Vector3f
     if dot(w, n) < 0.0 {
         offset = -offset;
     }
-    let mut po = p + offset;
-    for i in 0..3 {
-        if offset[i] > 0.0 {
-            po[i] = next_float_up(po[i]);
-        } else if offset[i] < 0.0 {
-            po[i] = next_float_down(po[i]);
+    let po = p + offset;
+    // Branch-free rounding away from the surface: the offset's signs are
+    // as good as random, so branches on them mispredict.
+    let round = |v: Float, o: Float| {
+        let (up, down) = (next_float_up(v), next_float_down(v));
+        let v = if o < 0.0 { down } else { v };
+        if o > 0.0 {
+            up
+        } else {
+            v
         }
-    }
-    po
+    };
+    Point3f::new(
+        round(po.x, offset.x),
+        round(po.y, offset.y),
+        round(po.z, offset.z),
+    )
 }
 
 /// A ray leaving a surface point toward `d` that never hits that surface

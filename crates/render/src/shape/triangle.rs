@@ -14,7 +14,7 @@ use crate::sampling::spherical::{
 };
 use crate::sampling::{bilinear_pdf, sample_bilinear, sample_uniform_triangle};
 use rpbrt_geometry::float::*;
-use rpbrt_geometry::interaction::SurfaceInteraction;
+use rpbrt_geometry::interaction::{ShadingGeometry, SurfaceInteraction};
 use rpbrt_geometry::ray::Ray;
 use rpbrt_geometry::spherical::DirectionCone;
 use rpbrt_geometry::transform::Transform;
@@ -521,24 +521,32 @@ impl Triangle {
         let p_error = Vector3f::from(abs_sum) * gamma(7);
 
         let flip = mesh.reverse_orientation ^ mesh.transform_swaps_handedness;
-        let mut isect = SurfaceInteraction::new(
-            Point3fi::from_value_and_error(p_hit, p_error),
-            uv_hit,
-            wo,
-            dpdu,
-            dpdv,
-            Normal3f::default(),
-            Normal3f::default(),
-            time,
-            flip,
-        );
-        // The geometric normal follows the vertex order, not dpdu × dpdv.
+        // What `SurfaceInteraction::new` builds, except that the geometric
+        // normal follows the vertex order, not dpdu × dpdv (so that one is
+        // never computed).
         let mut n = Normal3f::from(cross(dp02, dp12).normalize());
         if flip {
             n = -n;
         }
-        isect.n = n;
-        isect.shading.n = n;
+        let mut isect = SurfaceInteraction {
+            pi: Point3fi::from_value_and_error(p_hit, p_error),
+            time,
+            wo,
+            n,
+            uv: uv_hit,
+            dpdu,
+            dpdv,
+            dndu: Normal3f::default(),
+            dndv: Normal3f::default(),
+            shading: ShadingGeometry {
+                n,
+                dpdu,
+                dpdv,
+                dndu: Normal3f::default(),
+                dndv: Normal3f::default(),
+            },
+            ..Default::default()
+        };
         isect.face_index = mesh
             .face_indices
             .as_ref()
