@@ -240,9 +240,31 @@ pub fn intersect_triangle(
     p2: Point3f,
 ) -> Option<(Float, Float, Float, Float)> {
     // Degenerate triangles (and NaN vertices) never hit.
-    if !(cross(p2 - p0, p1 - p0).length_squared() > 0.0) {
+    if !triangle_is_nondegenerate(p0, p1, p2) {
         return None;
     }
+    intersect_nondegenerate_triangle(ray, t_max, p0, p1, p2)
+}
+
+/// The test [`intersect_triangle`] starts with: false for triangles of zero
+/// area (as computed in `f32`) and for NaN vertices, which never hit.
+#[inline]
+pub fn triangle_is_nondegenerate(p0: Point3f, p1: Point3f, p2: Point3f) -> bool {
+    cross(p2 - p0, p1 - p0).length_squared() > 0.0
+}
+
+/// [`intersect_triangle`] for a triangle already known to pass
+/// [`triangle_is_nondegenerate`] (aggregates check that once, at build
+/// time).
+#[inline]
+pub fn intersect_nondegenerate_triangle(
+    ray: &Ray,
+    t_max: Float,
+    p0: Point3f,
+    p1: Point3f,
+    p2: Point3f,
+) -> Option<(Float, Float, Float, Float)> {
+    debug_assert!(triangle_is_nondegenerate(p0, p1, p2));
     // Translate to the ray origin, permute so the ray's largest direction
     // component is z, and shear so the ray becomes the +z axis.
     let o = Vector3f::from(ray.o);
@@ -446,6 +468,12 @@ impl Triangle {
     ) -> Option<(Float, Float, Float, Float)> {
         let [p0, p1, p2] = self.vertices();
         intersect_triangle(ray, t_max, p0, p1, p2)
+    }
+
+    /// The rendering-space vertices.
+    #[inline]
+    pub fn vertex_positions(&self) -> [Point3f; 3] {
+        self.vertices()
     }
 
     /// The surface interaction of a hit of `ray` found by
