@@ -106,7 +106,9 @@ impl From<Ray> for RayDifferential {
 /// Moves a point with error bounds `p_error` around `p` along the normal
 /// `n` just far enough that a ray leaving toward `w` cannot re-intersect the
 /// surface it came from, then rounds away from it (book section 6.8.6).
-#[inline]
+// Always inlined: called a few times per path vertex, and as a call its
+// by-value vectors go through memory.
+#[inline(always)]
 pub fn offset_ray_origin(p: Point3f, p_error: Vector3f, n: Normal3f, w: Vector3f) -> Point3f {
     let d = dot(n.abs(), p_error);
     let mut offset = Vector3f::from(n) * d;
