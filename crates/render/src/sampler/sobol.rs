@@ -410,7 +410,7 @@ impl ZSobolSampler {
     /// [`ZSobolSampler::sample_index`], taking the digits that depend on
     /// the pixel alone from the cache. Digit `i` and everything above it
     /// lie in the pixel's Morton code exactly when `i ≥ ⌈log2(spp) / 2⌉`.
-    #[inline]
+    #[inline(always)]
     fn cached_sample_index(&mut self) -> u64 {
         let d = self.dimension as usize;
         if d >= ZSOBOL_CACHED_DIMENSIONS {

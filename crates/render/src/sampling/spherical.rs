@@ -64,7 +64,7 @@ impl SphericalTriangle {
     }
 
     /// The spherical triangle of the unit directions `a`, `b`, `c`.
-    #[inline]
+    #[inline(always)]
     fn from_dirs(a: Vector3f, b: Vector3f, c: Vector3f) -> Option<Self> {
         let n_ab = cross(a, b).try_normalize()?;
         let n_bc = cross(b, c).try_normalize()?;
@@ -115,7 +115,7 @@ pub(crate) fn sample_spherical_triangle_dirs(
     sample_spherical(&st, v, p, u)
 }
 
-#[inline]
+#[inline(always)]
 fn sample_spherical(
     st: &SphericalTriangle,
     v: [Point3f; 3],

@@ -199,7 +199,7 @@ impl TriangleMesh {
     }
 
     /// The rendering-space vertices of triangle `i`.
-    #[inline]
+    #[inline(always)]
     pub fn vertices(&self, i: usize) -> [Point3f; 3] {
         let v = self.vertex_indices(i);
         [self.p[v[0]], self.p[v[1]], self.p[v[2]]]
