@@ -259,7 +259,7 @@ impl PreparedLightBounds {
     }
 
     /// pbrt-v4's `LightBounds::Importance` (see [`LightBounds::importance`]).
-    #[inline]
+    #[inline(always)]
     pub fn importance(&self, p: Point3f, n: Normal3f) -> Float {
         let lb = &self.bounds;
         let pc = self.centroid;

@@ -256,7 +256,7 @@ pub fn triangle_is_nondegenerate(p0: Point3f, p1: Point3f, p2: Point3f) -> bool 
 /// [`intersect_triangle`] for a triangle already known to pass
 /// [`triangle_is_nondegenerate`] (aggregates check that once, at build
 /// time).
-#[inline]
+#[inline(always)]
 pub fn intersect_nondegenerate_triangle(
     ray: &Ray,
     t_max: Float,
@@ -427,6 +427,7 @@ impl Triangle {
     }
 
     /// The sample at barycentrics `b` with density `pdf`.
+    #[inline(always)]
     fn sample_at(&self, b: [Float; 3], pdf: Float, time: Float) -> ShapeSample {
         let [p0, p1, p2] = self.vertices();
         let p = p0 * b[0] + p1 * b[1] + p2 * b[2];
