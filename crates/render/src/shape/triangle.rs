@@ -694,6 +694,7 @@ impl ShapeMethods for Triangle {
         pdf.is_finite().then(|| self.sample_at(b, pdf, 0.0))
     }
 
+    #[inline(always)]
     fn sample(&self, ctx: &ShapeSampleContext, u: Point2f) -> Option<ShapeSample> {
         let dirs = self.directions_from(ctx.p());
         let sa = spherical_triangle_area(dirs[0], dirs[1], dirs[2]);
