@@ -106,22 +106,32 @@ impl From<Ray> for RayDifferential {
 /// Moves a point with error bounds `p_error` around `p` along the normal
 /// `n` just far enough that a ray leaving toward `w` cannot re-intersect the
 /// surface it came from, then rounds away from it (book section 6.8.6).
-#[inline]
+// Always inlined: called a few times per path vertex, and as a call its
+// by-value vectors go through memory.
+#[inline(always)]
 pub fn offset_ray_origin(p: Point3f, p_error: Vector3f, n: Normal3f, w: Vector3f) -> Point3f {
     let d = dot(n.abs(), p_error);
     let mut offset = Vector3f::from(n) * d;
     if dot(w, n) < 0.0 {
         offset = -offset;
     }
-    let mut po = p + offset;
-    for i in 0..3 {
-        if offset[i] > 0.0 {
-            po[i] = next_float_up(po[i]);
-        } else if offset[i] < 0.0 {
-            po[i] = next_float_down(po[i]);
+    let po = p + offset;
+    // Branch-free rounding away from the surface: the offset's signs are
+    // as good as random, so branches on them mispredict.
+    let round = |v: Float, o: Float| {
+        let (up, down) = (next_float_up(v), next_float_down(v));
+        let v = if o < 0.0 { down } else { v };
+        if o > 0.0 {
+            up
+        } else {
+            v
         }
-    }
-    po
+    };
+    Point3f::new(
+        round(po.x, offset.x),
+        round(po.y, offset.y),
+        round(po.z, offset.z),
+    )
 }
 
 /// A ray leaving a surface point toward `d` that never hits that surface

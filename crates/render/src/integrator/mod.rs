@@ -45,6 +45,28 @@ pub struct RayCounters {
     pub shadow_rays: AtomicU64,
 }
 
+thread_local! {
+    /// This thread's closest-hit and shadow query counts not yet added to
+    /// a scene's shared [`RayCounters`]: counting in shared atomics would
+    /// bounce their cache line between threads on every ray.
+    static LOCAL_RAY_COUNTS: std::cell::Cell<(u64, u64)> = const { std::cell::Cell::new((0, 0)) };
+}
+
+impl RayCounters {
+    /// Forgets the calling thread's pending counts (at the start of a
+    /// unit of work whose counts [`RayCounters::flush_local`] will add).
+    pub(crate) fn reset_local() {
+        LOCAL_RAY_COUNTS.with(|c| c.set((0, 0)));
+    }
+
+    /// Adds the calling thread's pending counts to these counters.
+    pub(crate) fn flush_local(&self) {
+        let (closest, shadow) = LOCAL_RAY_COUNTS.with(|c| c.replace((0, 0)));
+        self.intersection_rays.fetch_add(closest, Ordering::Relaxed);
+        self.shadow_rays.fetch_add(shadow, Ordering::Relaxed);
+    }
+}
+
 /// Everything an integrator needs to trace rays and shade hits.
 pub struct Scene {
     /// The camera.
@@ -87,16 +109,20 @@ impl Scene {
     /// The closest hit along `ray` in (0, t_max).
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
-        self.counters
-            .intersection_rays
-            .fetch_add(1, Ordering::Relaxed);
+        LOCAL_RAY_COUNTS.with(|c| {
+            let (closest, shadow) = c.get();
+            c.set((closest + 1, shadow));
+        });
         self.aggregate.intersect(ray, t_max)
     }
 
     /// Whether anything blocks `ray` in (0, t_max).
     #[inline]
     pub fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
-        self.counters.shadow_rays.fetch_add(1, Ordering::Relaxed);
+        LOCAL_RAY_COUNTS.with(|c| {
+            let (closest, shadow) = c.get();
+            c.set((closest, shadow + 1));
+        });
         self.aggregate.intersect_p(ray, t_max)
     }
 
@@ -131,7 +157,7 @@ impl Scene {
     }
 
     /// pbrt-v4's `SurfaceInteraction::GetBSDF`: computes the screen-space
-    /// differentials, then asks the material for its BSDF (`None` for
+    /// differentials (when the material can use them), then asks the material for its BSDF (`None` for
     /// interfaces between media, which the ray passes through).
     pub fn get_bsdf(
         &self,
@@ -139,14 +165,18 @@ impl Scene {
         ray: &RayDifferential,
         lambda: &mut SampledWavelengths,
     ) -> Option<BSDF> {
-        let spp_scale = (1.0 / (self.samples_per_pixel.max(1) as Float).sqrt()).max(0.125);
-        hit.si.compute_differentials(
-            ray,
-            Some(&self.camera_differentials),
-            spp_scale,
-            self.disable_texture_filtering,
-        );
         let material = hit.material?;
+        // The differentials only feed texture filtering and bump mapping;
+        // materials that do neither get the same BSDF without them.
+        if self.materials.needs_differentials(material) {
+            let spp_scale = (1.0 / (self.samples_per_pixel.max(1) as Float).sqrt()).max(0.125);
+            hit.si.compute_differentials(
+                ray,
+                Some(&self.camera_differentials),
+                spp_scale,
+                self.disable_texture_filtering,
+            );
+        }
         self.materials.get_bsdf(material, &mut hit.si, lambda)
     }
 }

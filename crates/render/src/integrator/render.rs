@@ -105,7 +105,6 @@ fn evaluate_pixel_sample(
         time,
         filter_weight: fs.weight,
     };
-    scene.counters.camera_rays.fetch_add(1, Ordering::Relaxed);
     let mut l = crate::spectrum::SampledSpectrum::new(0.0);
     if let Some(mut cr) = scene.camera.generate_ray_differential(&cs) {
         if !opts.disable_pixel_jitter {
@@ -156,6 +155,8 @@ pub fn render(
                     .map(|&b| {
                         let mut tile = scene_ref.film.make_tile(b);
                         let mut sampler = scene_ref.sampler.clone();
+                        super::RayCounters::reset_local();
+                        let mut camera_rays = 0u64;
                         for p in b.iter() {
                             for s in wave_start..wave_end {
                                 sampler.start_pixel_sample(p, s, 0);
@@ -168,7 +169,13 @@ pub fn render(
                                     &mut tile,
                                 );
                             }
+                            camera_rays += (wave_end - wave_start) as u64;
                         }
+                        scene_ref.counters.flush_local();
+                        scene_ref
+                            .counters
+                            .camera_rays
+                            .fetch_add(camera_rays, Ordering::Relaxed);
                         tile
                     })
                     .collect()

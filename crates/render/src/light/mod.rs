@@ -206,34 +206,7 @@ impl LightBounds {
     /// surface normal `n` (zero normal: a point in a medium), exactly as
     /// pbrt-v4's `LightBounds::Importance`.
     pub fn importance(&self, p: Point3f, n: Normal3f) -> Float {
-        let pc = self.centroid();
-        let d2 = p
-            .distance_squared(pc)
-            .max(self.bounds.diagonal().length() / 2.0);
-        let wi = (p - pc).try_normalize().unwrap_or_default();
-        let mut cos_theta_w = dot(self.w, wi);
-        if self.two_sided {
-            cos_theta_w = cos_theta_w.abs();
-        }
-        let sin_theta_w = safe_sqrt1m(cos_theta_w);
-        // Angle subtended by the bounds as seen from p.
-        let cos_theta_b = DirectionCone::bound_subtended_directions(&self.bounds, p).cos_theta;
-        let sin_theta_b = safe_sqrt1m(cos_theta_b);
-        // θ' = max(0, θ_w − θ_o − θ_b), in two clamped steps.
-        let sin_theta_o = safe_sqrt1m(self.cos_theta_o);
-        let cos_theta_x = cos_sub_clamped(sin_theta_w, cos_theta_w, sin_theta_o, self.cos_theta_o);
-        let sin_theta_x = sin_sub_clamped(sin_theta_w, cos_theta_w, sin_theta_o, self.cos_theta_o);
-        let cos_theta_p = cos_sub_clamped(sin_theta_x, cos_theta_x, sin_theta_b, cos_theta_b);
-        if cos_theta_p <= self.cos_theta_e {
-            return 0.0;
-        }
-        let mut importance = self.phi * cos_theta_p / d2;
-        if n != Normal3f::default() {
-            let cos_theta_i = dot(wi, Vector3f::from(n)).abs();
-            let sin_theta_i = safe_sqrt1m(cos_theta_i);
-            importance *= cos_sub_clamped(sin_theta_i, cos_theta_i, sin_theta_b, cos_theta_b);
-        }
-        importance.max(0.0)
+        PreparedLightBounds::new(self).importance(p, n)
     }
 
     /// The bounds of both (pbrt-v4 `Union(LightBounds, LightBounds)`):
@@ -257,6 +230,74 @@ impl LightBounds {
             a.cos_theta_e.min(b.cos_theta_e),
             a.two_sided || b.two_sided,
         )
+    }
+}
+
+/// [`LightBounds`] with the quantities [`LightBounds::importance`] derives
+/// from the bounds alone computed once (the BVH light sampler evaluates
+/// the importance of the same nodes at every shading point). Importance
+/// values are bit-identical to [`LightBounds::importance`].
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PreparedLightBounds {
+    /// The bounds.
+    pub bounds: LightBounds,
+    centroid: Point3f,
+    half_diagonal: Float,
+    sphere_center: Point3f,
+    sphere_radius2: Float,
+    sin_theta_o: Float,
+}
+
+impl PreparedLightBounds {
+    /// Precomputes the parts of the importance that depend on `lb` alone.
+    pub fn new(lb: &LightBounds) -> Self {
+        let (sphere_center, radius) = lb.bounds.bounding_sphere();
+        PreparedLightBounds {
+            bounds: *lb,
+            centroid: lb.centroid(),
+            half_diagonal: lb.bounds.diagonal().length() / 2.0,
+            sphere_center,
+            sphere_radius2: radius * radius,
+            sin_theta_o: safe_sqrt1m(lb.cos_theta_o),
+        }
+    }
+
+    /// pbrt-v4's `LightBounds::Importance` (see [`LightBounds::importance`]).
+    #[inline(always)]
+    pub fn importance(&self, p: Point3f, n: Normal3f) -> Float {
+        let lb = &self.bounds;
+        let pc = self.centroid;
+        let d2 = p.distance_squared(pc).max(self.half_diagonal);
+        let wi = (p - pc).try_normalize().unwrap_or_default();
+        let mut cos_theta_w = dot(lb.w, wi);
+        if lb.two_sided {
+            cos_theta_w = cos_theta_w.abs();
+        }
+        let sin_theta_w = safe_sqrt1m(cos_theta_w);
+        // Angle subtended by the bounds' bounding sphere as seen from p
+        // (the whole sphere of directions from inside it).
+        let ds2 = p.distance_squared(self.sphere_center);
+        let cos_theta_b = if ds2 < self.sphere_radius2 {
+            -1.0
+        } else {
+            rpbrt_geometry::safe_sqrt(1.0 - self.sphere_radius2 / ds2)
+        };
+        let sin_theta_b = safe_sqrt1m(cos_theta_b);
+        // θ' = max(0, θ_w − θ_o − θ_b), in two clamped steps.
+        let (sin_theta_o, cos_theta_o) = (self.sin_theta_o, lb.cos_theta_o);
+        let cos_theta_x = cos_sub_clamped(sin_theta_w, cos_theta_w, sin_theta_o, cos_theta_o);
+        let sin_theta_x = sin_sub_clamped(sin_theta_w, cos_theta_w, sin_theta_o, cos_theta_o);
+        let cos_theta_p = cos_sub_clamped(sin_theta_x, cos_theta_x, sin_theta_b, cos_theta_b);
+        if cos_theta_p <= lb.cos_theta_e {
+            return 0.0;
+        }
+        let mut importance = lb.phi * cos_theta_p / d2;
+        if n != Normal3f::default() {
+            let cos_theta_i = dot(wi, Vector3f::from(n)).abs();
+            let sin_theta_i = safe_sqrt1m(cos_theta_i);
+            importance *= cos_sub_clamped(sin_theta_i, cos_theta_i, sin_theta_b, cos_theta_b);
+        }
+        importance.max(0.0)
     }
 }
 

@@ -8,7 +8,7 @@
 use rpbrt_geometry::{safe_acos, Bounds3f, Float, Point3f, PI};
 
 use super::{SampledLight, ONE_MINUS_EPSILON};
-use crate::light::{Light, LightBounds, LightSampleContext};
+use crate::light::{Light, LightBounds, LightSampleContext, PreparedLightBounds};
 
 /// Number of buckets per axis for the split heuristic.
 const N_BUCKETS: usize = 12;
@@ -17,7 +17,7 @@ const MAX_SAH_DEPTH: u32 = 40;
 
 #[derive(Clone, Copy, Debug)]
 struct Node {
-    bounds: LightBounds,
+    bounds: PreparedLightBounds,
     /// Second child for interior nodes (the first follows the node);
     /// the light's index for leaves.
     child_or_light: u32,
@@ -108,7 +108,7 @@ impl BvhLightSampler {
         if lights.len() == 1 {
             let (li, lb) = lights[0];
             self.nodes.push(Node {
-                bounds: lb,
+                bounds: PreparedLightBounds::new(&lb),
                 child_or_light: li,
                 is_leaf: true,
             });
@@ -166,7 +166,7 @@ impl BvhLightSampler {
 
         let node_index = self.nodes.len();
         self.nodes.push(Node {
-            bounds: LightBounds::default(),
+            bounds: PreparedLightBounds::default(),
             child_or_light: 0,
             is_leaf: false,
         });
@@ -176,7 +176,7 @@ impl BvhLightSampler {
         let b1 = self.build(right, bit_trail | (1u64 << depth), depth + 1);
         let lb = LightBounds::union(&b0, &b1);
         self.nodes[node_index] = Node {
-            bounds: lb,
+            bounds: PreparedLightBounds::new(&lb),
             child_or_light: child1,
             is_leaf: false,
         };
@@ -209,7 +209,7 @@ impl BvhLightSampler {
         let mut node_index = 0usize;
         let mut pmf = 1.0 - p_inf;
         loop {
-            let node = self.nodes[node_index];
+            let node = &self.nodes[node_index];
             if node.is_leaf {
                 if node_index > 0 || node.bounds.importance(p, n) > 0.0 {
                     return Some(SampledLight {
@@ -259,7 +259,7 @@ impl BvhLightSampler {
         let mut pmf = 1.0 - self.p_infinite();
         let mut node_index = 0usize;
         loop {
-            let node = self.nodes[node_index];
+            let node = &self.nodes[node_index];
             if node.is_leaf {
                 if node_index == 0 && node.bounds.importance(p, n) <= 0.0 {
                     return 0.0;

@@ -371,6 +371,24 @@ impl MaterialSet {
             .is_some_and(|(_, m)| m.has_subsurface_scattering())
     }
 
+    /// True when shading material `material` may read the hit's
+    /// screen-space differentials: a texture that filters over its
+    /// footprint, or bump or normal mapping. Only materials proven to read
+    /// constant textures alone answer false (the rest conservatively
+    /// true), so skipping the differentials for them cannot change a BSDF.
+    pub fn needs_differentials(&self, material: u32) -> bool {
+        use crate::texture::SpectrumTexture;
+        match self.materials.get(material as usize) {
+            Some(Material::Diffuse(m)) => {
+                !matches!(*m.reflectance, SpectrumTexture::Constant(_))
+                    || m.perturbation.displacement.is_some()
+                    || m.perturbation.normal_map.is_some()
+            }
+            Some(Material::Interface) => false,
+            _ => true,
+        }
+    }
+
     /// True when any material of the set can have a BSSRDF.
     pub fn any_subsurface(&self) -> bool {
         self.materials

@@ -4,6 +4,7 @@
 //! acceleration structure over a set of primitives.
 
 use crate::accel::{AccelParams, Accelerator, Aggregate};
+use crate::shape::triangle::{intersect_nondegenerate_triangle, triangle_is_nondegenerate};
 use crate::shape::{Shape, ShapeMethods};
 use crate::texture::{FloatTextureRef, TextureEvalContext};
 use rpbrt_geometry::animated::AnimatedTransform;
@@ -11,6 +12,7 @@ use rpbrt_geometry::float::Float;
 use rpbrt_geometry::interaction::SurfaceInteraction;
 use rpbrt_geometry::ray::{MediumId, Ray};
 use rpbrt_geometry::transform::Transform;
+use rpbrt_geometry::tuple::Point3f;
 use rpbrt_geometry::Bounds3f;
 use std::sync::Arc;
 
@@ -214,11 +216,19 @@ impl Primitive {
     }
 }
 
+/// Aggregates with at most this many primitives keep the vertices of their
+/// triangles beside the primitives for the traversal.
+const MAX_CACHED_TRIANGLE_PRIMITIVES: usize = 1 << 22;
+
 /// Primitives under an acceleration structure (pbrt-v4's aggregates).
 #[derive(Clone, Debug)]
 pub struct PrimitiveAggregate {
     prims: Vec<Primitive>,
     accel: Accelerator,
+    /// Per primitive: the vertices of an opaque, non-degenerate triangle,
+    /// so that the traversal tests it without going through the primitive
+    /// and its mesh (`None` for every other primitive).
+    triangle_vertices: Vec<Option<[Point3f; 3]>>,
 }
 
 impl PrimitiveAggregate {
@@ -226,7 +236,29 @@ impl PrimitiveAggregate {
     pub fn new(prims: Vec<Primitive>, params: &AccelParams) -> Self {
         let bounds: Vec<Bounds3f> = prims.iter().map(Primitive::bounds).collect();
         let accel = Accelerator::build(&bounds, params);
-        PrimitiveAggregate { prims, accel }
+        // 40 bytes per primitive: bounded so that huge scenes do not pay
+        // gigabytes for it (they fall back to going through the mesh).
+        let cache_triangles = prims.len() <= MAX_CACHED_TRIANGLE_PRIMITIVES;
+        let triangle_vertices = prims
+            .iter()
+            .take(if cache_triangles { prims.len() } else { 0 })
+            .map(|p| match p {
+                Primitive::Geometric(GeometricPrimitive {
+                    shape: Shape::Triangle(tri),
+                    alpha: Alpha::Opaque,
+                    ..
+                }) => {
+                    let [p0, p1, p2] = tri.vertex_positions();
+                    triangle_is_nondegenerate(p0, p1, p2).then_some([p0, p1, p2])
+                }
+                _ => None,
+            })
+            .collect();
+        PrimitiveAggregate {
+            prims,
+            accel,
+            triangle_vertices,
+        }
     }
 
     /// The primitives.
@@ -245,21 +277,74 @@ impl PrimitiveAggregate {
     }
 
     /// The closest hit in (0, t_max).
+    ///
+    /// Opaque triangles (nearly all primitives in practice) are tested
+    /// without building their surface interaction; only the closest hit's
+    /// is built, at the end. The result is the same as building every
+    /// hit's, as pbrt-v4 does.
     pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
-        let mut best: Option<PrimitiveIntersection> = None;
+        enum Closest {
+            None,
+            Full(PrimitiveIntersection),
+            Triangle {
+                prim: u32,
+                b: (Float, Float, Float),
+                t_hit: Float,
+                ray: Ray,
+            },
+        }
+        let mut closest = Closest::None;
         self.accel.intersect(ray, t_max, |i, r, t| {
+            if let Some(Some([p0, p1, p2])) = self.triangle_vertices.get(i as usize) {
+                let (p0, p1, p2) = (*p0, *p1, *p2);
+                let (b0, b1, b2, t_hit) = intersect_nondegenerate_triangle(r, t, p0, p1, p2)?;
+                closest = Closest::Triangle {
+                    prim: i,
+                    b: (b0, b1, b2),
+                    t_hit,
+                    ray: *r,
+                };
+                return Some(t_hit);
+            }
             let pi = self.prims[i as usize].intersect(r, t)?;
             let th = pi.t_hit;
-            best = Some(pi);
+            closest = Closest::Full(pi);
             Some(th)
         });
-        best
+        match closest {
+            Closest::None => None,
+            Closest::Full(pi) => Some(pi),
+            Closest::Triangle {
+                prim,
+                b,
+                t_hit,
+                ray,
+            } => match &self.prims[prim as usize] {
+                Primitive::Geometric(g) => match &g.shape {
+                    Shape::Triangle(tri) => Some(PrimitiveIntersection {
+                        si: tri.interaction_at_hit(b.0, b.1, b.2, &ray),
+                        t_hit,
+                        material: g.material,
+                        area_light: g.area_light,
+                        medium_interface: g.medium_interface,
+                    }),
+                    // `triangle_vertices` holds only triangles.
+                    _ => None,
+                },
+                _ => None,
+            },
+        }
     }
 
     /// Whether anything is hit in (0, t_max).
     pub fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
         self.accel.intersect_p(ray, t_max, |i, r, t| {
-            self.prims[i as usize].intersect_p(r, t)
+            match self.triangle_vertices.get(i as usize) {
+                Some(Some([p0, p1, p2])) => {
+                    intersect_nondegenerate_triangle(r, t, *p0, *p1, *p2).is_some()
+                }
+                _ => self.prims[i as usize].intersect_p(r, t),
+            }
         })
     }
 }

@@ -432,7 +432,7 @@ impl BinaryScrambler {
 
 /// The Sobol' sample of index `a` in `dimension`, scrambled, as a float
 /// in [0,1).
-#[inline]
+#[inline(always)]
 pub fn sobol_sample(a: u64, dimension: usize, scrambler: BinaryScrambler) -> Float {
     debug_assert!(dimension < N_SOBOL_DIMENSIONS && a < (1u64 << SOBOL_MATRIX_SIZE));
     let v = if dimension < 2 {

@@ -293,6 +293,23 @@ impl PaddedSobolSampler {
     }
 }
 
+/// Dimensions whose pixel-only index digits [`ZSobolSampler`] caches.
+const ZSOBOL_CACHED_DIMENSIONS: usize = 64;
+
+/// The permuted base-4 digits of a Z-Sobol' index that depend on the pixel
+/// alone (not on the sample index), per dimension, for one pixel. The
+/// render loop takes all of a wave's samples of a pixel in a row, so most
+/// of these are reused; results are identical to recomputing them.
+#[derive(Clone, Debug)]
+struct PixelDigitCache {
+    /// The pixel's Morton code the entries belong to (`u64::MAX`: none).
+    pixel: u64,
+    /// Bit `d` set: `high[d]` is valid.
+    valid: u64,
+    /// The permuted pixel digits of the index, per dimension.
+    high: [u64; ZSOBOL_CACHED_DIMENSIONS],
+}
+
 /// The Morton-ordered ("Z") Sobol' sampler, pbrt-v4's default.
 #[derive(Clone, Debug)]
 pub struct ZSobolSampler {
@@ -302,6 +319,7 @@ pub struct ZSobolSampler {
     n_base4_digits: u32,
     morton_index: u64,
     dimension: i32,
+    cache: Box<PixelDigitCache>,
 }
 
 impl ZSobolSampler {
@@ -323,6 +341,11 @@ impl ZSobolSampler {
             n_base4_digits: res.trailing_zeros() + log4_spp,
             morton_index: 0,
             dimension: 0,
+            cache: Box::new(PixelDigitCache {
+                pixel: u64::MAX,
+                valid: 0,
+                high: [0; ZSOBOL_CACHED_DIMENSIONS],
+            }),
         }
     }
 
@@ -336,36 +359,82 @@ impl ZSobolSampler {
     #[inline]
     pub fn start_pixel_sample(&mut self, p: Point2i, index: i32, dimension: i32) {
         self.dimension = dimension;
-        self.morton_index =
-            (encode_morton2(p.x as u32, p.y as u32) << self.log2_samples_per_pixel) | index as u64;
+        let pixel = encode_morton2(p.x as u32, p.y as u32);
+        self.morton_index = (pixel << self.log2_samples_per_pixel) | index as u64;
+        if self.cache.pixel != pixel {
+            self.cache.pixel = pixel;
+            self.cache.valid = 0;
+        }
+    }
+
+    /// The permuted base-4 digits `lo..hi` of the index (digit `i` at bit
+    /// `2i`, or `2i - 1` when the samples per pixel are an odd power of
+    /// two), each permuted by a hash of the digits above it and
+    /// `dim_mix`.
+    #[inline]
+    fn permuted_digits(&self, lo: i32, hi: i32, dim_mix: u64) -> u64 {
+        let odd = (self.log2_samples_per_pixel & 1) as i32;
+        let mut index = 0u64;
+        for i in (lo..hi).rev() {
+            let shift = 2 * i - odd;
+            let digit = ((self.morton_index >> shift) & 3) as usize;
+            let higher = self.morton_index >> (shift + 2);
+            let p = ((mix_bits(higher ^ dim_mix) >> 24) % 24) as usize;
+            index |= (PERMUTATIONS_4[p][digit] as u64) << shift;
+        }
+        index
+    }
+
+    /// The last bit of the index when the samples per pixel are an odd
+    /// power of two (0 otherwise).
+    #[inline]
+    fn permuted_last_bit(&self, dim_mix: u64) -> u64 {
+        if self.log2_samples_per_pixel & 1 == 1 {
+            let digit = self.morton_index & 1;
+            digit ^ (mix_bits((self.morton_index >> 1) ^ dim_mix) & 1)
+        } else {
+            0
+        }
     }
 
     /// The Sobol' index for the current pixel sample and dimension: the
     /// Morton index with each base-4 digit permuted by a hash of the
     /// digits above it and the dimension.
     pub fn sample_index(&self) -> u64 {
-        let mut index = 0u64;
-        let pow2_samples = self.log2_samples_per_pixel & 1 == 1;
-        let last_digit = if pow2_samples { 1 } else { 0 };
+        let last_digit = (self.log2_samples_per_pixel & 1) as i32;
         let dim_mix = 0x5555_5555u64.wrapping_mul(self.dimension as i64 as u64);
-        for i in (last_digit..self.n_base4_digits as i32).rev() {
-            let shift = 2 * i - if pow2_samples { 1 } else { 0 };
-            let digit = ((self.morton_index >> shift) & 3) as usize;
-            let higher = self.morton_index >> (shift + 2);
-            let p = ((mix_bits(higher ^ dim_mix) >> 24) % 24) as usize;
-            index |= (PERMUTATIONS_4[p][digit] as u64) << shift;
+        self.permuted_digits(last_digit, self.n_base4_digits as i32, dim_mix)
+            | self.permuted_last_bit(dim_mix)
+    }
+
+    /// [`ZSobolSampler::sample_index`], taking the digits that depend on
+    /// the pixel alone from the cache. Digit `i` and everything above it
+    /// lie in the pixel's Morton code exactly when `i ≥ ⌈log2(spp) / 2⌉`.
+    #[inline(always)]
+    fn cached_sample_index(&mut self) -> u64 {
+        let d = self.dimension as usize;
+        if d >= ZSOBOL_CACHED_DIMENSIONS {
+            return self.sample_index();
         }
-        if pow2_samples {
-            let digit = self.morton_index & 1;
-            index |= digit ^ (mix_bits((self.morton_index >> 1) ^ dim_mix) & 1);
-        }
-        index
+        let last_digit = (self.log2_samples_per_pixel & 1) as i32;
+        let split = self.log2_samples_per_pixel.div_ceil(2) as i32;
+        let dim_mix = 0x5555_5555u64.wrapping_mul(self.dimension as i64 as u64);
+        let high = if self.cache.valid >> d & 1 != 0 {
+            self.cache.high[d]
+        } else {
+            let h = self.permuted_digits(split, self.n_base4_digits as i32, dim_mix);
+            self.cache.high[d] = h;
+            self.cache.valid |= 1 << d;
+            h
+        };
+        high | self.permuted_digits(last_digit, split.min(self.n_base4_digits as i32), dim_mix)
+            | self.permuted_last_bit(dim_mix)
     }
 
     /// The next 1-D value.
     #[inline]
     pub fn get_1d(&mut self) -> Float {
-        let index = self.sample_index();
+        let index = self.cached_sample_index();
         self.dimension += 1;
         let hash = mix_bits((self.dimension ^ self.seed) as i64 as u64) as u32;
         sobol_sample(index, 0, scrambler(self.randomize, hash))
@@ -374,7 +443,7 @@ impl ZSobolSampler {
     /// The next 2-D value.
     #[inline]
     pub fn get_2d(&mut self) -> Point2f {
-        let index = self.sample_index();
+        let index = self.cached_sample_index();
         self.dimension += 2;
         let bits = mix_bits((self.dimension ^ self.seed) as i64 as u64);
         Point2f::new(

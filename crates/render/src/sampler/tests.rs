@@ -531,3 +531,36 @@ fn sampler_enum_is_small() {
         std::mem::size_of::<Sampler>()
     );
 }
+
+/// Z-Sobol' caches the pixel-only index digits per dimension; reusing one
+/// sampler across pixels, samples and more than the cached dimensions
+/// must give exactly what a fresh sampler gives (even and odd log2 spp).
+#[test]
+fn zsobol_digit_cache_matches_fresh_samplers() {
+    for spp in [1, 2, 8, 16, 64] {
+        let proto = ZSobolSampler::new(spp, Point2i::new(40, 30), RandomizeStrategy::FastOwen, 7);
+        let mut reused = proto.clone();
+        for p in [
+            Point2i::new(3, 5),
+            Point2i::new(3, 5),
+            Point2i::new(39, 0),
+            Point2i::new(3, 5),
+        ] {
+            for s in 0..spp {
+                reused.start_pixel_sample(p, s, 0);
+                let mut d = 0;
+                while d < 100 {
+                    let mut fresh = proto.clone();
+                    fresh.start_pixel_sample(p, s, d);
+                    if d % 3 == 0 {
+                        assert_eq!(reused.get_2d(), fresh.get_2d(), "spp {spp} {p:?} {s} {d}");
+                        d += 2;
+                    } else {
+                        assert_eq!(reused.get_1d(), fresh.get_1d(), "spp {spp} {p:?} {s} {d}");
+                        d += 1;
+                    }
+                }
+            }
+        }
+    }
+}

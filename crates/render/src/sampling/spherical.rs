@@ -60,6 +60,12 @@ impl SphericalTriangle {
         let a = (v[0] - p).try_normalize()?;
         let b = (v[1] - p).try_normalize()?;
         let c = (v[2] - p).try_normalize()?;
+        Self::from_dirs(a, b, c)
+    }
+
+    /// The spherical triangle of the unit directions `a`, `b`, `c`.
+    #[inline(always)]
+    fn from_dirs(a: Vector3f, b: Vector3f, c: Vector3f) -> Option<Self> {
         let n_ab = cross(a, b).try_normalize()?;
         let n_bc = cross(b, c).try_normalize()?;
         let n_ca = cross(c, a).try_normalize()?;
@@ -93,6 +99,29 @@ pub fn sample_spherical_triangle(
     u: Point2f,
 ) -> Option<([Float; 3], Float)> {
     let st = SphericalTriangle::new(&v, p)?;
+    sample_spherical(&st, v, p, u)
+}
+
+/// [`sample_spherical_triangle`] given the unit directions `dirs` from `p`
+/// to the vertices (`(v[i] - p).normalize()`, all finite), which the
+/// caller has already computed.
+pub(crate) fn sample_spherical_triangle_dirs(
+    v: [Point3f; 3],
+    p: Point3f,
+    dirs: [Vector3f; 3],
+    u: Point2f,
+) -> Option<([Float; 3], Float)> {
+    let st = SphericalTriangle::from_dirs(dirs[0], dirs[1], dirs[2])?;
+    sample_spherical(&st, v, p, u)
+}
+
+#[inline(always)]
+fn sample_spherical(
+    st: &SphericalTriangle,
+    v: [Point3f; 3],
+    p: Point3f,
+    u: Point2f,
+) -> Option<([Float; 3], Float)> {
     let (a, b, c) = (st.a, st.b, st.c);
     let a_pi = st.alpha + st.beta + st.gamma;
     let area = a_pi - PI;
@@ -156,10 +185,23 @@ pub fn sample_spherical_triangle(
 /// direction `w` (unit length, pointing from `p` into the triangle).
 /// Returns (0.5, 0.5) for degenerate spherical triangles.
 pub fn invert_spherical_triangle_sample(v: [Point3f; 3], p: Point3f, w: Vector3f) -> Point2f {
-    let st = match SphericalTriangle::new(&v, p) {
-        Some(st) => st,
-        None => return Point2f::new(0.5, 0.5),
-    };
+    match SphericalTriangle::new(&v, p) {
+        Some(st) => invert_spherical(&st, w),
+        None => Point2f::new(0.5, 0.5),
+    }
+}
+
+/// [`invert_spherical_triangle_sample`] given the unit directions `dirs`
+/// from the reference point to the vertices (all finite).
+pub(crate) fn invert_spherical_triangle_sample_dirs(dirs: [Vector3f; 3], w: Vector3f) -> Point2f {
+    match SphericalTriangle::from_dirs(dirs[0], dirs[1], dirs[2]) {
+        Some(st) => invert_spherical(&st, w),
+        None => Point2f::new(0.5, 0.5),
+    }
+}
+
+#[inline]
+fn invert_spherical(st: &SphericalTriangle, w: Vector3f) -> Point2f {
     let (a, b, c) = (st.a, st.b, st.c);
 
     // c' is where the great circle through b and w meets the arc a–c.

@@ -10,11 +10,11 @@ use super::{
     ShapeSample, ShapeSampleContext,
 };
 use crate::sampling::spherical::{
-    invert_spherical_triangle_sample, sample_spherical_triangle, spherical_triangle_area,
+    invert_spherical_triangle_sample_dirs, sample_spherical_triangle_dirs, spherical_triangle_area,
 };
 use crate::sampling::{bilinear_pdf, sample_bilinear, sample_uniform_triangle};
 use rpbrt_geometry::float::*;
-use rpbrt_geometry::interaction::SurfaceInteraction;
+use rpbrt_geometry::interaction::{ShadingGeometry, SurfaceInteraction};
 use rpbrt_geometry::ray::Ray;
 use rpbrt_geometry::spherical::DirectionCone;
 use rpbrt_geometry::transform::Transform;
@@ -199,7 +199,7 @@ impl TriangleMesh {
     }
 
     /// The rendering-space vertices of triangle `i`.
-    #[inline]
+    #[inline(always)]
     pub fn vertices(&self, i: usize) -> [Point3f; 3] {
         let v = self.vertex_indices(i);
         [self.p[v[0]], self.p[v[1]], self.p[v[2]]]
@@ -240,9 +240,31 @@ pub fn intersect_triangle(
     p2: Point3f,
 ) -> Option<(Float, Float, Float, Float)> {
     // Degenerate triangles (and NaN vertices) never hit.
-    if !(cross(p2 - p0, p1 - p0).length_squared() > 0.0) {
+    if !triangle_is_nondegenerate(p0, p1, p2) {
         return None;
     }
+    intersect_nondegenerate_triangle(ray, t_max, p0, p1, p2)
+}
+
+/// The test [`intersect_triangle`] starts with: false for triangles of zero
+/// area (as computed in `f32`) and for NaN vertices, which never hit.
+#[inline]
+pub fn triangle_is_nondegenerate(p0: Point3f, p1: Point3f, p2: Point3f) -> bool {
+    cross(p2 - p0, p1 - p0).length_squared() > 0.0
+}
+
+/// [`intersect_triangle`] for a triangle already known to pass
+/// [`triangle_is_nondegenerate`] (aggregates check that once, at build
+/// time).
+#[inline(always)]
+pub fn intersect_nondegenerate_triangle(
+    ray: &Ray,
+    t_max: Float,
+    p0: Point3f,
+    p1: Point3f,
+    p2: Point3f,
+) -> Option<(Float, Float, Float, Float)> {
+    debug_assert!(triangle_is_nondegenerate(p0, p1, p2));
     // Translate to the ray origin, permute so the ray's largest direction
     // component is z, and shear so the ray becomes the +z axis.
     let o = Vector3f::from(ray.o);
@@ -370,12 +392,21 @@ impl Triangle {
 
     /// The solid angle the triangle subtends from `p`.
     pub fn solid_angle(&self, p: Point3f) -> Float {
+        let [a, b, c] = self.directions_from(p);
+        spherical_triangle_area(a, b, c)
+    }
+
+    /// The unit directions from `p` to the vertices (NaN components when
+    /// `p` is a vertex), shared by the solid angle, the cos θ weights and
+    /// spherical sampling so that each is normalised once.
+    #[inline]
+    fn directions_from(&self, p: Point3f) -> [Vector3f; 3] {
         let [p0, p1, p2] = self.vertices();
-        spherical_triangle_area(
+        [
             (p0 - p).normalize(),
             (p1 - p).normalize(),
             (p2 - p).normalize(),
-        )
+        ]
     }
 
     /// The geometric normal at barycentrics `b`, oriented as intersections
@@ -396,6 +427,7 @@ impl Triangle {
     }
 
     /// The sample at barycentrics `b` with density `pdf`.
+    #[inline(always)]
     fn sample_at(&self, b: [Float; 3], pdf: Float, time: Float) -> ShapeSample {
         let [p0, p1, p2] = self.vertices();
         let p = p0 * b[0] + p1 * b[1] + p2 * b[2];
@@ -418,12 +450,45 @@ impl Triangle {
     /// The weights of the bilinear cos θ warp for spherical sampling from
     /// `ctx`: corner (0,0) and (1,0) map to vertex 1, (0,1) to vertex 0 and
     /// (1,1) to vertex 2, as the spherical triangle sampler lays them out.
-    fn cos_weights(&self, ctx: &ShapeSampleContext) -> [Float; 4] {
-        let [p0, p1, p2] = self.vertices();
-        let rp = ctx.p();
-        let w = |q: Point3f| abs_dot(ctx.ns, (q - rp).normalize()).max(0.01);
-        let (w0, w1, w2) = (w(p0), w(p1), w(p2));
+    /// `dirs` are the unit directions from the reference point to the
+    /// vertices.
+    fn cos_weights(ctx: &ShapeSampleContext, dirs: &[Vector3f; 3]) -> [Float; 4] {
+        let w = |d: Vector3f| abs_dot(ctx.ns, d).max(0.01);
+        let (w0, w1, w2) = (w(dirs[0]), w(dirs[1]), w(dirs[2]));
         [w1, w1, w0, w2]
+    }
+
+    /// The closest hit along `ray` in (0, `t_max`) as barycentrics and
+    /// `t`, without the surface interaction (which an aggregate needs only
+    /// for the closest of its hits: see [`Triangle::interaction_at_hit`]).
+    #[inline]
+    pub fn intersect_barycentrics(
+        &self,
+        ray: &Ray,
+        t_max: Float,
+    ) -> Option<(Float, Float, Float, Float)> {
+        let [p0, p1, p2] = self.vertices();
+        intersect_triangle(ray, t_max, p0, p1, p2)
+    }
+
+    /// The rendering-space vertices.
+    #[inline]
+    pub fn vertex_positions(&self) -> [Point3f; 3] {
+        self.vertices()
+    }
+
+    /// The surface interaction of a hit of `ray` found by
+    /// [`Triangle::intersect_barycentrics`] at barycentrics (b0, b1, b2):
+    /// what [`ShapeMethods::intersect`] returns for that hit.
+    pub fn interaction_at_hit(
+        &self,
+        b0: Float,
+        b1: Float,
+        b2: Float,
+        ray: &Ray,
+    ) -> SurfaceInteraction {
+        let wo = (-ray.d).try_normalize().unwrap_or_default();
+        self.interaction(b0, b1, b2, ray.time, wo)
     }
 
     /// The full surface interaction at barycentrics (b0, b1, b2).
@@ -485,24 +550,32 @@ impl Triangle {
         let p_error = Vector3f::from(abs_sum) * gamma(7);
 
         let flip = mesh.reverse_orientation ^ mesh.transform_swaps_handedness;
-        let mut isect = SurfaceInteraction::new(
-            Point3fi::from_value_and_error(p_hit, p_error),
-            uv_hit,
-            wo,
-            dpdu,
-            dpdv,
-            Normal3f::default(),
-            Normal3f::default(),
-            time,
-            flip,
-        );
-        // The geometric normal follows the vertex order, not dpdu × dpdv.
+        // What `SurfaceInteraction::new` builds, except that the geometric
+        // normal follows the vertex order, not dpdu × dpdv (so that one is
+        // never computed).
         let mut n = Normal3f::from(cross(dp02, dp12).normalize());
         if flip {
             n = -n;
         }
-        isect.n = n;
-        isect.shading.n = n;
+        let mut isect = SurfaceInteraction {
+            pi: Point3fi::from_value_and_error(p_hit, p_error),
+            time,
+            wo,
+            n,
+            uv: uv_hit,
+            dpdu,
+            dpdv,
+            dndu: Normal3f::default(),
+            dndv: Normal3f::default(),
+            shading: ShadingGeometry {
+                n,
+                dpdu,
+                dpdv,
+                dndu: Normal3f::default(),
+                dndv: Normal3f::default(),
+            },
+            ..Default::default()
+        };
         isect.face_index = mesh
             .face_indices
             .as_ref()
@@ -598,11 +671,9 @@ impl ShapeMethods for Triangle {
     }
 
     fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
-        let [p0, p1, p2] = self.vertices();
-        let (b0, b1, b2, t) = intersect_triangle(ray, t_max, p0, p1, p2)?;
-        let wo = (-ray.d).try_normalize().unwrap_or_default();
+        let (b0, b1, b2, t) = self.intersect_barycentrics(ray, t_max)?;
         Some(ShapeIntersection {
-            intr: self.interaction(b0, b1, b2, ray.time, wo),
+            intr: self.interaction_at_hit(b0, b1, b2, ray),
             t_hit: t,
         })
     }
@@ -623,8 +694,10 @@ impl ShapeMethods for Triangle {
         pdf.is_finite().then(|| self.sample_at(b, pdf, 0.0))
     }
 
+    #[inline(always)]
     fn sample(&self, ctx: &ShapeSampleContext, u: Point2f) -> Option<ShapeSample> {
-        let sa = self.solid_angle(ctx.p());
+        let dirs = self.directions_from(ctx.p());
+        let sa = spherical_triangle_area(dirs[0], dirs[1], dirs[2]);
         if !(MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA).contains(&sa) {
             let mut ss = self.sample_area(u)?;
             ss.time = ctx.time;
@@ -635,11 +708,13 @@ impl ShapeMethods for Triangle {
         let mut pdf = 1.0;
         let mut u = u;
         if ctx.ns != Normal3f::default() {
-            let w = self.cos_weights(ctx);
+            let w = Self::cos_weights(ctx, &dirs);
             u = sample_bilinear(u, w);
             pdf *= bilinear_pdf(u, w);
         }
-        let (b, tri_pdf) = sample_spherical_triangle(self.vertices(), ctx.p(), u)?;
+        // In this branch the solid angle is finite and positive, so the
+        // directions are the ones `try_normalize` would give.
+        let (b, tri_pdf) = sample_spherical_triangle_dirs(self.vertices(), ctx.p(), dirs, u)?;
         if !(tri_pdf > 0.0) {
             return None;
         }
@@ -647,7 +722,8 @@ impl ShapeMethods for Triangle {
     }
 
     fn pdf(&self, ctx: &ShapeSampleContext, wi: Vector3f) -> Float {
-        let sa = self.solid_angle(ctx.p());
+        let dirs = self.directions_from(ctx.p());
+        let sa = spherical_triangle_area(dirs[0], dirs[1], dirs[2]);
         if !(MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA).contains(&sa) {
             return pdf_by_intersection(self, ctx, wi);
         }
@@ -656,8 +732,8 @@ impl ShapeMethods for Triangle {
         }
         let mut pdf = 1.0 / sa;
         if ctx.ns != Normal3f::default() {
-            let w = self.cos_weights(ctx);
-            let u = invert_spherical_triangle_sample(self.vertices(), ctx.p(), wi.normalize());
+            let w = Self::cos_weights(ctx, &dirs);
+            let u = invert_spherical_triangle_sample_dirs(dirs, wi.normalize());
             pdf *= bilinear_pdf(u, w);
         }
         pdf
