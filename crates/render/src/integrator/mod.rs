@@ -18,7 +18,7 @@ pub use simple::{AmbientOcclusionIntegrator, RandomWalkIntegrator, SimplePathInt
 
 use crate::bxdf::BSDF;
 use crate::camera::Camera;
-use crate::film::Film;
+use crate::film::{Film, VisibleSurface};
 use crate::filter::Filter;
 use crate::light::{Light, LightSampleContext};
 use crate::lightsampler::LightSampler;
@@ -164,6 +164,7 @@ impl Scene {
         hit: &mut PrimitiveIntersection,
         ray: &RayDifferential,
         lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
     ) -> Option<BSDF> {
         let material = hit.material?;
         // The differentials only feed texture filtering and bump mapping;
@@ -177,7 +178,44 @@ impl Scene {
                 self.disable_texture_filtering,
             );
         }
-        self.materials.get_bsdf(material, &mut hit.si, lambda)
+        let bsdf = self.materials.get_bsdf(material, &mut hit.si, lambda)?;
+        if self.force_diffuse {
+            // pbrt-v4's --force-diffuse: a diffuse BSDF with the material's
+            // estimated albedo (two extra sampler dimensions, as pbrt-v4).
+            let uc = sampler.get_1d();
+            let u = sampler.get_2d();
+            return Some(MaterialSet::force_diffuse(&bsdf, &hit.si, uc, u));
+        }
+        Some(bsdf)
+    }
+
+    /// The first visible surface of a camera path, for G-buffer films
+    /// (pbrt-v4 `VisibleSurface`, with the BSDF's albedo estimated from 16
+    /// fixed stratified samples).
+    pub fn visible_surface(&self, hit: &PrimitiveIntersection, bsdf: &BSDF) -> VisibleSurface {
+        const N: usize = 16;
+        let mut uc = [0.0; N];
+        let mut u = [Point2f::default(); N];
+        for i in 0..N {
+            // A (0,2)-net: Hammersley points with a shifted 1-D dimension.
+            uc[i] = ((i as Float + 0.5) / N as Float + 0.37).fract();
+            u[i] = Point2f::new(
+                (i as Float + 0.5) / N as Float,
+                (i as u32).reverse_bits() as Float / 4_294_967_296.0 + 0.5 / N as Float,
+            );
+        }
+        let si = &hit.si;
+        VisibleSurface {
+            p: si.p(),
+            n: si.n.face_forward(si.wo),
+            ns: si.shading.n.face_forward(si.wo),
+            uv: si.uv,
+            time: si.time,
+            dpdx: si.dpdx,
+            dpdy: si.dpdy,
+            albedo: bsdf.rho_hd(si.wo, &uc, &u),
+            set: true,
+        }
     }
 }
 
@@ -222,9 +260,10 @@ impl Integrator {
         ray: RayDifferential,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
+        visible: Option<&mut VisibleSurface>,
     ) -> SampledSpectrum {
         match self {
-            Integrator::Path(i) => i.li(scene, ray, lambda, sampler),
+            Integrator::Path(i) => i.li(scene, ray, lambda, sampler, visible),
             Integrator::SimplePath(i) => i.li(scene, ray, lambda, sampler),
             Integrator::AmbientOcclusion(i) => i.li(scene, ray, lambda, sampler),
             Integrator::RandomWalk(i) => i.li(scene, ray, lambda, sampler),

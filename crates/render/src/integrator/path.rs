@@ -4,6 +4,7 @@
 
 use super::{sample_ld, skip_intersection, Scene};
 use crate::bxdf::{BxDFReflTransFlags, TransportMode};
+use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
 use crate::lightsampler::LightSampler;
 use crate::sampler::Sampler;
@@ -32,6 +33,7 @@ impl PathIntegrator {
         ray: RayDifferential,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
+        mut visible: Option<&mut VisibleSurface>,
     ) -> SampledSpectrum {
         let light_sampler: &LightSampler = &scene.light_sampler;
         let mut ray = ray;
@@ -77,11 +79,16 @@ impl PathIntegrator {
                     l += beta * le * w_l;
                 }
             }
-            let Some(mut bsdf) = scene.get_bsdf(&mut hit, &ray, lambda) else {
+            let Some(mut bsdf) = scene.get_bsdf(&mut hit, &ray, lambda, sampler) else {
                 specular_bounce = true;
                 ray = skip_intersection(&ray, &hit);
                 continue;
             };
+            if depth == 0 {
+                if let Some(v) = visible.take() {
+                    *v = scene.visible_surface(&hit, &bsdf);
+                }
+            }
             if self.regularize && any_non_specular {
                 bsdf.regularize();
             }

@@ -5,7 +5,7 @@
 
 use super::{Integrator, Scene};
 use crate::camera::CameraSample;
-use crate::film::FilmTile;
+use crate::film::{FilmTile, VisibleSurface};
 use crate::image::ImageMetadata;
 use crate::sampler::Sampler;
 use rayon::prelude::*;
@@ -106,18 +106,30 @@ fn evaluate_pixel_sample(
         filter_weight: fs.weight,
     };
     let mut l = crate::spectrum::SampledSpectrum::new(0.0);
+    // Only G-buffer films record the first visible surface.
+    let mut visible: Option<VisibleSurface> = if scene.film.uses_visible_surface() {
+        Some(VisibleSurface::default())
+    } else {
+        None
+    };
     if let Some(mut cr) = scene.camera.generate_ray_differential(&cs) {
         if !opts.disable_pixel_jitter {
             let scale = (1.0 / (sampler.samples_per_pixel() as Float).sqrt()).max(0.125);
             cr.ray.scale_differentials(scale);
         }
-        l = integrator.li(scene, cr.ray, &mut lambda, sampler) * cr.weight;
+        l = integrator.li(scene, cr.ray, &mut lambda, sampler, visible.as_mut()) * cr.weight;
         if l.has_nan() || !l.y(&lambda).is_finite() {
             // pbrt-v4 drops such samples (and logs them).
             l = crate::spectrum::SampledSpectrum::new(0.0);
         }
     }
-    tile.add_sample(p_pixel, l, &lambda, None, cs.filter_weight);
+    tile.add_sample(
+        p_pixel,
+        l,
+        &lambda,
+        visible.as_ref().filter(|v| v.set),
+        cs.filter_weight,
+    );
 }
 
 /// Renders `scene` with `integrator`, writing the film's image (and partial

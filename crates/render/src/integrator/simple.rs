@@ -55,7 +55,7 @@ impl SimplePathIntegrator {
                 break;
             }
             depth += 1;
-            let Some(bsdf) = scene.get_bsdf(&mut hit, &ray, lambda) else {
+            let Some(bsdf) = scene.get_bsdf(&mut hit, &ray, lambda, sampler) else {
                 specular_bounce = true;
                 ray = skip_intersection(&ray, &hit);
                 continue;
@@ -144,7 +144,7 @@ impl AmbientOcclusionIntegrator {
             let Some(mut hit) = scene.intersect(&ray.ray, Float::INFINITY) else {
                 return SampledSpectrum::new(0.0);
             };
-            if scene.get_bsdf(&mut hit, &ray, lambda).is_none() {
+            if scene.get_bsdf(&mut hit, &ray, lambda, sampler).is_none() {
                 ray = skip_intersection(&ray, &hit);
                 continue;
             }
@@ -213,7 +213,7 @@ impl RandomWalkIntegrator {
             if depth == self.max_depth {
                 return l;
             }
-            let Some(bsdf) = scene.get_bsdf(&mut hit, &ray, lambda) else {
+            let Some(bsdf) = scene.get_bsdf(&mut hit, &ray, lambda, sampler) else {
                 return l;
             };
             let u = sampler.get_2d();
