@@ -159,10 +159,11 @@ fn transform_hit(
 pub enum Primitive {
     /// A shape with its properties.
     Geometric(GeometricPrimitive),
-    /// An object instance.
-    Transformed(TransformedPrimitive),
-    /// Motion-blurred primitives.
-    Animated(AnimatedPrimitive),
+    /// An object instance (boxed: two matrices would make every
+    /// primitive large).
+    Transformed(Box<TransformedPrimitive>),
+    /// Motion-blurred primitives (boxed: an animated transform is large).
+    Animated(Box<AnimatedPrimitive>),
 }
 
 impl Primitive {

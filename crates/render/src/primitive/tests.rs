@@ -69,10 +69,10 @@ fn instances_match_direct_geometry() {
         &AccelParams::default(),
     ));
     let inst = PrimitiveAggregate::new(
-        vec![Primitive::Transformed(TransformedPrimitive {
+        vec![Primitive::Transformed(Box::new(TransformedPrimitive {
             primitive: inner,
             render_from_primitive: xf,
-        })],
+        }))],
         &AccelParams::default(),
     );
     let mut rng = Rng::new(2, 0);
@@ -112,10 +112,10 @@ fn animated_primitive_follows_its_motion() {
         &AccelParams::default(),
     ));
     let agg = PrimitiveAggregate::new(
-        vec![Primitive::Animated(AnimatedPrimitive {
+        vec![Primitive::Animated(Box::new(AnimatedPrimitive {
             primitive: inner,
             render_from_primitive: at,
-        })],
+        }))],
         &AccelParams::default(),
     );
     // The bounds cover the whole motion.
@@ -180,4 +180,15 @@ fn empty_aggregate_hits_nothing() {
     let r = Ray::new(Point3f::default(), Vector3f::new(0.0, 0.0, 1.0));
     assert!(agg.intersect(&r, Float::INFINITY).is_none());
     assert!(!agg.intersect_p(&r, Float::INFINITY));
+}
+
+#[test]
+fn primitive_enum_stays_small() {
+    // Millions of triangles are primitives: keep the enum near the size of
+    // a geometric primitive.
+    assert!(
+        std::mem::size_of::<Primitive>() <= 80,
+        "Primitive is {} bytes",
+        std::mem::size_of::<Primitive>()
+    );
 }

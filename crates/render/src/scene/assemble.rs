@@ -337,10 +337,10 @@ pub fn create_scene(
         let mut inner = Vec::new();
         make_prims(&fixed, &mut lights, &mut errors, &mut warnings, &mut inner);
         if !inner.is_empty() {
-            prims.push(Primitive::Animated(AnimatedPrimitive {
+            prims.push(Primitive::Animated(Box::new(AnimatedPrimitive {
                 primitive: Arc::new(PrimitiveAggregate::new(inner, &default_accel)),
                 render_from_primitive: s.render_from_object,
-            }));
+            })));
         }
     }
     // Object definitions, built once and shared by their instances.
@@ -367,10 +367,10 @@ pub fn create_scene(
             let mut shapes = Vec::new();
             make_prims(&fixed, &mut lights, &mut errors, &mut warnings, &mut shapes);
             if !shapes.is_empty() {
-                inner.push(Primitive::Animated(AnimatedPrimitive {
+                inner.push(Primitive::Animated(Box::new(AnimatedPrimitive {
                     primitive: Arc::new(PrimitiveAggregate::new(shapes, &default_accel)),
                     render_from_primitive: s.render_from_object,
-                }));
+                })));
             }
         }
         definitions.insert(
@@ -390,14 +390,14 @@ pub fn create_scene(
             continue;
         }
         prims.push(match &inst.render_from_instance {
-            InstanceTransform::Fixed(t) => Primitive::Transformed(TransformedPrimitive {
+            InstanceTransform::Fixed(t) => Primitive::Transformed(Box::new(TransformedPrimitive {
                 primitive: def.clone(),
                 render_from_primitive: *t,
-            }),
-            InstanceTransform::Animated(a) => Primitive::Animated(AnimatedPrimitive {
+            })),
+            InstanceTransform::Animated(a) => Primitive::Animated(Box::new(AnimatedPrimitive {
                 primitive: def.clone(),
                 render_from_primitive: **a,
-            }),
+            })),
         });
     }
 
