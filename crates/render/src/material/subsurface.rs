@@ -1,9 +1,11 @@
 //! Subsurface scattering materials (pbrt-v4 book section 14.4; pbrt-v4
 //! `SubsurfaceMaterial`). Only the BSDF part (a dielectric boundary) is
-//! evaluated here; the scattering parameters are kept for the BSSRDF.
+//! evaluated here; [`SubsurfaceMaterial::get_bssrdf`] builds the tabulated
+//! BSSRDF from the scattering parameters.
 
 use rpbrt_geometry::float::*;
 
+use crate::bssrdf::{beam_diffusion_table, subsurface_from_diffuse, TabulatedBssrdf};
 use crate::bxdf::{BxDF, DielectricBxDF};
 use crate::spectrum::SampledWavelengths;
 use crate::texture::SpectrumTextureRef;
@@ -57,5 +59,30 @@ impl SubsurfaceMaterial {
     pub fn get_bxdf(&self, ctx: &MaterialEvalContext, _lambda: &mut SampledWavelengths) -> BxDF {
         let distrib = self.roughness.distribution(&ctx.tex);
         BxDF::Dielectric(DielectricBxDF::new(self.eta, distrib))
+    }
+
+    /// The BSSRDF leaving the point (pbrt-v4 `SubsurfaceMaterial::GetBSSRDF`):
+    /// σa and σs scaled by `scale` (clamped to be non-negative), or found
+    /// from the reflectance and the scaled mean free path by inverting the
+    /// beam-diffusion table's effective albedo; the table for this
+    /// material's (g, eta) is computed on first use and then shared.
+    pub fn get_bssrdf(
+        &self,
+        ctx: &MaterialEvalContext,
+        lambda: &SampledWavelengths,
+    ) -> TabulatedBssrdf<'static> {
+        let table = beam_diffusion_table(self.g, self.eta);
+        let (sigma_a, sigma_s) = match &self.coefficients {
+            SubsurfaceCoefficients::Coefficients { sigma_a, sigma_s } => (
+                (sigma_a.evaluate(&ctx.tex, lambda) * self.scale).clamp_zero(),
+                (sigma_s.evaluate(&ctx.tex, lambda) * self.scale).clamp_zero(),
+            ),
+            SubsurfaceCoefficients::Reflectance { reflectance, mfp } => {
+                let mfree = (mfp.evaluate(&ctx.tex, lambda) * self.scale).clamp_zero();
+                let r = reflectance.evaluate(&ctx.tex, lambda).clamp(0.0, 1.0);
+                subsurface_from_diffuse(table, r, mfree)
+            }
+        };
+        TabulatedBssrdf::new(ctx.tex.p, ctx.ns, ctx.wo, self.eta, sigma_a, sigma_s, table)
     }
 }
