@@ -156,9 +156,9 @@ pub fn invert_catmull_rom(x: &[Float], values: &[Float], u: Float) -> Float {
     let (Some(&first), Some(&last)) = (values.first(), values.last()) else {
         return 0.0;
     };
-    if !(u > first) {
+    if u.is_nan() || u <= first {
         return x[0];
-    } else if !(u < last) {
+    } else if u >= last {
         return x[x.len() - 1];
     }
     let i = find_interval(values.len(), |k| values[k] <= u);
@@ -222,7 +222,7 @@ pub fn sample_catmull_rom_2d(
         v
     };
     let maximum = interpolate(cdf, n2 - 1);
-    if !(maximum > 0.0) {
+    if maximum.is_nan() || maximum <= 0.0 {
         return None;
     }
     let u = u * maximum;
