@@ -2,6 +2,7 @@
 #![deny(missing_docs)]
 
 pub mod accel;
+pub mod bssrdf;
 pub mod bxdf;
 pub mod camera;
 pub mod film;
