@@ -11,6 +11,7 @@
 
 use rpbrt_render::rng::Rng;
 use rpbrt_render::scene::shapes::create_scene_shapes;
+use rpbrt_render::scene::assemble::{create_scene, CreateOptions};
 use rpbrt_render::scene::{build_scene_from_bytes, BuildOptions};
 use std::path::{Path, PathBuf};
 
@@ -111,6 +112,15 @@ fn run_one(name: &str, bytes: &[u8], dir: &Path) {
         // the parse is the point there, and creating them each time is slow.
         if desc.shapes.len() < 2000 {
             let _ = create_scene_shapes(&desc);
+            // The whole render-object creation (film, camera, sampler,
+            // textures, materials, lights, aggregate, integrator) must
+            // also turn any input into a scene or located errors. Films are
+            // kept small so that a mutated resolution does not allocate
+            // gigabytes here.
+            let px = |n: &str, d: i32| desc.film.params.get_one_int(n, d).unwrap_or(d) as i64;
+            if px("xresolution", 1280) * px("yresolution", 720) <= 1 << 20 {
+                let _ = create_scene(&desc, &CreateOptions::default());
+            }
         }
     }
 }
