@@ -11,6 +11,9 @@
 
 use rpbrt_render::rng::Rng;
 use rpbrt_render::scene::shapes::create_scene_shapes;
+use rpbrt_render::film::FilmOverrides;
+use rpbrt_render::image::ImageMetadata;
+use rpbrt_render::integrator::{render, RenderOptions};
 use rpbrt_render::scene::assemble::{create_scene, CreateOptions};
 use rpbrt_render::scene::{build_scene_from_bytes, BuildOptions};
 use std::path::{Path, PathBuf};
@@ -120,6 +123,19 @@ fn run_one(name: &str, bytes: &[u8], dir: &Path) {
             let px = |n: &str, d: i32| desc.film.params.get_one_int(n, d).unwrap_or(d) as i64;
             if px("xresolution", 1280) * px("yresolution", 720) <= 1 << 20 {
                 let _ = create_scene(&desc, &CreateOptions::default());
+                // And render a few pixels at one sample each: shading code
+                // must not panic on whatever parameters the scene has.
+                let out = std::env::temp_dir().join(format!("rpbrt-fuzz-{}.exr", std::process::id()));
+                let opts = CreateOptions {
+                    spp: Some(1),
+                    film: FilmOverrides { outfile: Some(out.display().to_string()), pixel_bounds: Some([0, 4, 0, 4]), ..Default::default() },
+                    ..Default::default()
+                };
+                if let Ok(c) = create_scene(&desc, &opts) {
+                    let mut scene = c.scene;
+                    let ro = RenderOptions { nthreads: 1, quiet: true, ..Default::default() };
+                    let _ = render(&mut scene, &c.integrator, &ro, &mut ImageMetadata::default());
+                }
             }
         }
     }
