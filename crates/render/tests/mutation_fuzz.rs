@@ -9,12 +9,12 @@
 //! of mutations per scene is `RPBRT_FUZZ_ITERS` (default 150).
 //! Crashes it ever finds are kept below as regression tests.
 
-use rpbrt_render::rng::Rng;
-use rpbrt_render::scene::shapes::create_scene_shapes;
 use rpbrt_render::film::FilmOverrides;
 use rpbrt_render::image::ImageMetadata;
 use rpbrt_render::integrator::{render, RenderOptions};
+use rpbrt_render::rng::Rng;
 use rpbrt_render::scene::assemble::{create_scene, CreateOptions};
+use rpbrt_render::scene::shapes::create_scene_shapes;
 use rpbrt_render::scene::{build_scene_from_bytes, BuildOptions};
 use std::path::{Path, PathBuf};
 
@@ -125,16 +125,30 @@ fn run_one(name: &str, bytes: &[u8], dir: &Path) {
                 let _ = create_scene(&desc, &CreateOptions::default());
                 // And render a few pixels at one sample each: shading code
                 // must not panic on whatever parameters the scene has.
-                let out = std::env::temp_dir().join(format!("rpbrt-fuzz-{}.exr", std::process::id()));
+                let out =
+                    std::env::temp_dir().join(format!("rpbrt-fuzz-{}.exr", std::process::id()));
                 let opts = CreateOptions {
                     spp: Some(1),
-                    film: FilmOverrides { outfile: Some(out.display().to_string()), pixel_bounds: Some([0, 4, 0, 4]), ..Default::default() },
+                    film: FilmOverrides {
+                        outfile: Some(out.display().to_string()),
+                        pixel_bounds: Some([0, 4, 0, 4]),
+                        ..Default::default()
+                    },
                     ..Default::default()
                 };
                 if let Ok(c) = create_scene(&desc, &opts) {
                     let mut scene = c.scene;
-                    let ro = RenderOptions { nthreads: 1, quiet: true, ..Default::default() };
-                    let _ = render(&mut scene, &c.integrator, &ro, &mut ImageMetadata::default());
+                    let ro = RenderOptions {
+                        nthreads: 1,
+                        quiet: true,
+                        ..Default::default()
+                    };
+                    let _ = render(
+                        &mut scene,
+                        &c.integrator,
+                        &ro,
+                        &mut ImageMetadata::default(),
+                    );
                 }
             }
         }

@@ -227,6 +227,37 @@ fn screen_window(
 }
 
 /// Resolves a file name against the scene file's directory, as pbrt-v4's
+/// Reads an aperture image file (pbrt-v4: RGB images are averaged to one
+/// channel; the image is flipped and normalised by `ApertureImage`).
+fn read_aperture_image(path: &Path) -> Result<ApertureImage, String> {
+    let image = crate::image::Image::read(path, Some(crate::image::ColorEncoding::Linear))
+        .map_err(|e| e.to_string())?
+        .image;
+    let res = image.resolution();
+    let nc = image.n_channels();
+    let values = image.to_f32_vec();
+    let names = image.channel_names();
+    let rgb: Option<Vec<usize>> = ["R", "G", "B"]
+        .iter()
+        .map(|c| names.iter().position(|n| n == c))
+        .collect();
+    let mono: Vec<Float> = match (nc, rgb) {
+        (1, _) => values,
+        (_, Some(idx)) => values
+            .chunks_exact(nc)
+            .map(|px| idx.iter().map(|&i| px[i]).sum::<Float>() / 3.0)
+            .collect(),
+        _ => {
+            return Err(format!(
+                "{}: aperture images need one channel or R, G and B",
+                path.display()
+            ))
+        }
+    };
+    ApertureImage::from_pixels(res.x.max(0) as usize, res.y.max(0) as usize, mono)
+        .ok_or_else(|| format!("{}: the aperture image is empty or black", path.display()))
+}
+
 /// `ResolveFilename`: absolute names and names not found there are kept.
 fn resolve(loc: &FileLoc, name: &str) -> PathBuf {
     let p = Path::new(name);
@@ -334,15 +365,16 @@ fn create_realistic(
     } else {
         match ApertureImage::builtin(&aperture) {
             Some(img) => Some(img),
-            None => {
-                return Err(Diagnostic::error(
-                    at(params, "aperture", loc),
-                    format!(
-                        "aperture \"{aperture}\": aperture images read from files are not \
-                         supported yet; use \"gaussian\", \"square\", \"pentagon\" or \"star\""
-                    ),
-                ))
-            }
+            None => Some(
+                read_aperture_image(&resolve(&at(params, "aperture", loc), &aperture)).map_err(
+                    |m| {
+                        Diagnostic::error(
+                            at(params, "aperture", loc),
+                            format!("aperture \"{aperture}\": {m}"),
+                        )
+                    },
+                )?,
+            ),
         }
     };
 

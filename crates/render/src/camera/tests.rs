@@ -840,3 +840,42 @@ fn time_full_exit_pupil_precomputation() {
         cam.exit_pupil_bounds[0]
     );
 }
+
+#[test]
+fn aperture_image_from_a_file() {
+    // A 16x16 single-channel image: an open square in the middle.
+    let mut values = vec![0.0f32; 16 * 16];
+    for y in 4..12 {
+        for x in 4..12 {
+            values[y * 16 + x] = 1.0;
+        }
+    }
+    let dir = std::env::temp_dir().join(format!("rpbrt-camera-tests-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("aperture.pfm");
+    crate::image::Image::from_f32(values, rpbrt_geometry::Point2i::new(16, 16), &["Y"])
+        .unwrap()
+        .write(&path, &Default::default())
+        .unwrap();
+    let lens = write_temp("dgauss-file-aperture.dat", DGAUSS);
+    let c = make(
+        "realistic",
+        &[
+            P::S("lensfile", &lens),
+            P::S("aperture", &path.to_string_lossy()),
+        ],
+        FilmGeometry::new(16, 16),
+    );
+    let mut got = 0;
+    for i in 0..256 {
+        let mut s = sample(8.0, 8.0);
+        s.p_lens = Point2f::new(
+            (i % 16) as Float / 16.0 + 0.03,
+            (i / 16) as Float / 16.0 + 0.03,
+        );
+        got += c.generate_ray(&s).is_some() as i32;
+    }
+    // Only lens samples inside the open square (a quarter of the image)
+    // can pass; some of those are vignetted.
+    assert!(got > 0 && got <= 64 + 16, "{got}");
+}
