@@ -404,15 +404,7 @@ impl BinaryScrambler {
         match self {
             BinaryScrambler::None => v,
             BinaryScrambler::Permute(p) => v ^ p,
-            BinaryScrambler::FastOwen(seed) => {
-                let mut v = v.reverse_bits();
-                v ^= v.wrapping_mul(0x3d20_adea);
-                v = v.wrapping_add(seed);
-                v = v.wrapping_mul((seed >> 16) | 1);
-                v ^= v.wrapping_mul(0x0552_6c56);
-                v ^= v.wrapping_mul(0x53a2_2864);
-                v.reverse_bits()
-            }
+            BinaryScrambler::FastOwen(seed) => fast_owen_reversed(v.reverse_bits(), seed),
             BinaryScrambler::Owen(seed) => {
                 let mut v = v;
                 if seed & 1 != 0 {
@@ -466,6 +458,50 @@ pub fn sobol_sample(a: u64, dimension: usize, scrambler: BinaryScrambler) -> Flo
     };
     let v = scrambler.apply(v);
     (v as Float * f32::from_bits(0x2f80_0000)).min(ONE_MINUS_EPSILON)
+}
+
+/// [`sobol_byte_tables`] with every entry bit-reversed.
+fn sobol_reversed_byte_tables() -> &'static [[[u32; 256]; 7]; 2] {
+    static T: OnceLock<Box<[[[u32; 256]; 7]; 2]>> = OnceLock::new();
+    T.get_or_init(|| {
+        let mut t = Box::new(*sobol_byte_tables());
+        for v in t.iter_mut().flatten().flatten() {
+            *v = v.reverse_bits();
+        }
+        t
+    })
+}
+
+/// `sobol_sample(a, dimension, BinaryScrambler::FastOwen(seed))` for
+/// dimension 0 or 1, bit for bit: bit reversal commutes with XOR, so the
+/// generator columns are looked up already reversed, saving the first
+/// reversal of the fast Owen scramble.
+#[inline(always)]
+pub fn sobol_sample_fast_owen_01(a: u64, dimension: usize, seed: u32) -> Float {
+    debug_assert!(dimension < 2 && a < (1u64 << SOBOL_MATRIX_SIZE));
+    let t = &sobol_reversed_byte_tables()[dimension & 1];
+    let mut v = t[0][(a & 0xff) as usize]
+        ^ t[1][((a >> 8) & 0xff) as usize]
+        ^ t[2][((a >> 16) & 0xff) as usize]
+        ^ t[3][((a >> 24) & 0xff) as usize];
+    if a >> 32 != 0 {
+        v ^= t[4][((a >> 32) & 0xff) as usize]
+            ^ t[5][((a >> 40) & 0xff) as usize]
+            ^ t[6][((a >> 48) & 0xff) as usize];
+    }
+    let v = fast_owen_reversed(v, seed);
+    (v as Float * f32::from_bits(0x2f80_0000)).min(ONE_MINUS_EPSILON)
+}
+
+/// The fast Owen scramble of `v.reverse_bits()`, given the reversed value.
+#[inline(always)]
+fn fast_owen_reversed(mut v: u32, seed: u32) -> u32 {
+    v ^= v.wrapping_mul(0x3d20_adea);
+    v = v.wrapping_add(seed);
+    v = v.wrapping_mul((seed >> 16) | 1);
+    v ^= v.wrapping_mul(0x0552_6c56);
+    v ^= v.wrapping_mul(0x53a2_2864);
+    v.reverse_bits()
 }
 
 /// Interleaves the low 32 bits of `x` with zeros.
@@ -570,6 +606,23 @@ mod tests {
                 let cell = (v * (1 << k) as Float) as usize;
                 assert!(!seen[cell], "dim {dim}");
                 seen[cell] = true;
+            }
+        }
+    }
+
+    #[test]
+    fn fast_owen_01_matches_generic() {
+        let mut rng = crate::rng::Rng::new(17, 0);
+        for _ in 0..20_000 {
+            let a = (rng.uniform_u32() as u64) << 20 ^ rng.uniform_u32() as u64;
+            let a = a >> (rng.uniform_u32() % 52);
+            let seed = rng.uniform_u32();
+            for dim in 0..2 {
+                let generic = sobol_sample(a, dim, BinaryScrambler::FastOwen(seed));
+                assert_eq!(
+                    sobol_sample_fast_owen_01(a, dim, seed).to_bits(),
+                    generic.to_bits()
+                );
             }
         }
     }

@@ -14,8 +14,9 @@ use rpbrt_geometry::float::{Float, ONE_MINUS_EPSILON};
 use rpbrt_geometry::tuple::{Point2f, Point2i};
 
 use super::lowdiscrepancy::{
-    encode_morton2, mix_bits, permutation_element, sobol_matrices, sobol_sample, BinaryScrambler,
-    RandomizeStrategy, N_SOBOL_DIMENSIONS, PERMUTATIONS_4, SOBOL_MATRIX_SIZE,
+    encode_morton2, mix_bits, permutation_element, sobol_matrices, sobol_sample,
+    sobol_sample_fast_owen_01, BinaryScrambler, RandomizeStrategy, N_SOBOL_DIMENSIONS,
+    PERMUTATIONS_4, SOBOL_MATRIX_SIZE,
 };
 
 /// Largest supported log2 of the Sobol' sampler's pixel scale (so that
@@ -308,6 +309,12 @@ struct PixelDigitCache {
     valid: u64,
     /// The permuted pixel digits of the index, per dimension.
     high: [u64; ZSOBOL_CACHED_DIMENSIONS],
+    /// Per dimension, the permutation (into `PERMUTATIONS_4`) of the
+    /// highest sample digit, whose hash covers only pixel digits.
+    top_perm: [u8; ZSOBOL_CACHED_DIMENSIONS],
+    /// `mix_bits(d ^ seed)` for `d` in `0..ZSOBOL_CACHED_DIMENSIONS + 2`:
+    /// the scrambling hashes, which depend on the dimension and seed alone.
+    scramble_hash: [u64; ZSOBOL_CACHED_DIMENSIONS + 2],
 }
 
 /// The Morton-ordered ("Z") Sobol' sampler, pbrt-v4's default.
@@ -345,6 +352,8 @@ impl ZSobolSampler {
                 pixel: u64::MAX,
                 valid: 0,
                 high: [0; ZSOBOL_CACHED_DIMENSIONS],
+                top_perm: [0; ZSOBOL_CACHED_DIMENSIONS],
+                scramble_hash: std::array::from_fn(|d| mix_bits((d as i32 ^ seed) as i64 as u64)),
             }),
         }
     }
@@ -379,10 +388,17 @@ impl ZSobolSampler {
             let shift = 2 * i - odd;
             let digit = ((self.morton_index >> shift) & 3) as usize;
             let higher = self.morton_index >> (shift + 2);
-            let p = ((mix_bits(higher ^ dim_mix) >> 24) % 24) as usize;
+            let p = Self::digit_permutation(higher, dim_mix);
             index |= (PERMUTATIONS_4[p][digit] as u64) << shift;
         }
         index
+    }
+
+    /// Which of the 24 permutations of a base-4 digit the digits above it
+    /// (`higher`) and the dimension select.
+    #[inline(always)]
+    fn digit_permutation(higher: u64, dim_mix: u64) -> usize {
+        ((mix_bits(higher ^ dim_mix) >> 24) % 24) as usize
     }
 
     /// The last bit of the index when the samples per pixel are an odd
@@ -419,16 +435,41 @@ impl ZSobolSampler {
         let last_digit = (self.log2_samples_per_pixel & 1) as i32;
         let split = self.log2_samples_per_pixel.div_ceil(2) as i32;
         let dim_mix = 0x5555_5555u64.wrapping_mul(self.dimension as i64 as u64);
-        let high = if self.cache.valid >> d & 1 != 0 {
-            self.cache.high[d]
-        } else {
-            let h = self.permuted_digits(split, self.n_base4_digits as i32, dim_mix);
-            self.cache.high[d] = h;
+        let n_digits = self.n_base4_digits as i32;
+        let split = split.min(n_digits);
+        let odd = (self.log2_samples_per_pixel & 1) as i32;
+        // The highest sample digit, `split - 1`, is permuted by a hash of
+        // pixel digits only: its permutation is cached with `high`.
+        let has_top = split > last_digit;
+        let top_shift = 2 * split - 2 - odd;
+        if self.cache.valid >> d & 1 == 0 {
+            self.cache.high[d] = self.permuted_digits(split, n_digits, dim_mix);
+            if has_top {
+                let higher = self.morton_index >> (top_shift + 2);
+                self.cache.top_perm[d] = Self::digit_permutation(higher, dim_mix) as u8;
+            }
             self.cache.valid |= 1 << d;
-            h
-        };
-        high | self.permuted_digits(last_digit, split.min(self.n_base4_digits as i32), dim_mix)
-            | self.permuted_last_bit(dim_mix)
+        }
+        let mut index = self.cache.high[d] | self.permuted_last_bit(dim_mix);
+        if has_top {
+            let digit = ((self.morton_index >> top_shift) & 3) as usize;
+            let p = self.cache.top_perm[d] as usize;
+            index |= (PERMUTATIONS_4[p][digit] as u64) << top_shift;
+            index |= self.permuted_digits(last_digit, split - 1, dim_mix);
+        }
+        index
+    }
+
+    /// The scrambling hash `mix_bits(dimension ^ seed)` for the current
+    /// dimension.
+    #[inline(always)]
+    fn scramble_hash(&self) -> u64 {
+        let d = self.dimension as usize;
+        if d < ZSOBOL_CACHED_DIMENSIONS + 2 {
+            self.cache.scramble_hash[d]
+        } else {
+            mix_bits((self.dimension ^ self.seed) as i64 as u64)
+        }
     }
 
     /// The next 1-D value.
@@ -436,7 +477,10 @@ impl ZSobolSampler {
     pub fn get_1d(&mut self) -> Float {
         let index = self.cached_sample_index();
         self.dimension += 1;
-        let hash = mix_bits((self.dimension ^ self.seed) as i64 as u64) as u32;
+        let hash = self.scramble_hash() as u32;
+        if self.randomize == RandomizeStrategy::FastOwen {
+            return sobol_sample_fast_owen_01(index, 0, hash);
+        }
         sobol_sample(index, 0, scrambler(self.randomize, hash))
     }
 
@@ -445,7 +489,13 @@ impl ZSobolSampler {
     pub fn get_2d(&mut self) -> Point2f {
         let index = self.cached_sample_index();
         self.dimension += 2;
-        let bits = mix_bits((self.dimension ^ self.seed) as i64 as u64);
+        let bits = self.scramble_hash();
+        if self.randomize == RandomizeStrategy::FastOwen {
+            return Point2f::new(
+                sobol_sample_fast_owen_01(index, 0, bits as u32),
+                sobol_sample_fast_owen_01(index, 1, (bits >> 32) as u32),
+            );
+        }
         Point2f::new(
             sobol_sample(index, 0, scrambler(self.randomize, bits as u32)),
             sobol_sample(index, 1, scrambler(self.randomize, (bits >> 32) as u32)),
@@ -456,5 +506,36 @@ impl ZSobolSampler {
     #[inline]
     pub fn get_pixel_2d(&mut self) -> Point2f {
         self.get_2d()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cached index digits (pixel digits, the highest sample digit's
+    /// permutation, the scrambling hashes) equal the uncached computation.
+    #[test]
+    fn cached_sample_index_matches_uncached() {
+        for spp in [1, 2, 4, 8, 16, 32, 64, 128] {
+            let mut s =
+                ZSobolSampler::new(spp, Point2i::new(37, 21), RandomizeStrategy::FastOwen, 3);
+            for p in [
+                Point2i::new(0, 0),
+                Point2i::new(36, 20),
+                Point2i::new(5, 17),
+            ] {
+                for i in 0..spp {
+                    for d in [0, 1, 2, 5, 17, 63, 64, 65, 66, 90] {
+                        s.start_pixel_sample(p, i, d);
+                        let uncached = s.sample_index();
+                        assert_eq!(s.cached_sample_index(), uncached, "spp {spp} {p:?} {i} {d}");
+                        s.dimension = d;
+                        let expected = mix_bits((d ^ s.seed) as i64 as u64);
+                        assert_eq!(s.scramble_hash(), expected);
+                    }
+                }
+            }
+        }
     }
 }
