@@ -178,15 +178,18 @@ impl Scene {
                 self.disable_texture_filtering,
             );
         }
-        let bsdf = self.materials.get_bsdf(material, &mut hit.si, lambda)?;
+        // Returned as is (not unwrapped and rewrapped): the BSDF is large
+        // and this lets it be built in the caller's slot.
+        let bsdf = self.materials.get_bsdf(material, &mut hit.si, lambda);
         if self.force_diffuse {
             // pbrt-v4's --force-diffuse: a diffuse BSDF with the material's
             // estimated albedo (two extra sampler dimensions, as pbrt-v4).
+            let bsdf = bsdf?;
             let uc = sampler.get_1d();
             let u = sampler.get_2d();
             return Some(MaterialSet::force_diffuse(&bsdf, &hit.si, uc, u));
         }
-        Some(bsdf)
+        bsdf
     }
 
     /// The first visible surface of a camera path, for G-buffer films

@@ -79,14 +79,16 @@ impl PathIntegrator {
                     l += beta * le * w_l;
                 }
             }
-            let Some(mut bsdf) = scene.get_bsdf(&mut hit, &ray, lambda, sampler) else {
+            // Borrowed in place: moving the (large) BSDF out would copy it.
+            let mut bsdf_slot = scene.get_bsdf(&mut hit, &ray, lambda, sampler);
+            let Some(bsdf) = bsdf_slot.as_mut() else {
                 specular_bounce = true;
                 ray = skip_intersection(&ray, &hit);
                 continue;
             };
             if depth == 0 {
                 if let Some(v) = visible.take() {
-                    *v = scene.visible_surface(&hit, &bsdf);
+                    *v = scene.visible_surface(&hit, bsdf);
                 }
             }
             if self.regularize && any_non_specular {
@@ -98,7 +100,7 @@ impl PathIntegrator {
             depth += 1;
             let si = &hit.si;
             if bsdf.flags().is_non_specular() {
-                let ld = sample_ld(scene, light_sampler, si, &bsdf, lambda, sampler);
+                let ld = sample_ld(scene, light_sampler, si, bsdf, lambda, sampler);
                 l += beta * ld;
             }
             prev_ctx = LightSampleContext::from_si(si);
