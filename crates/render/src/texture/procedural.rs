@@ -13,6 +13,18 @@ use crate::spectrum::{
 use rpbrt_geometry::float::{lerp, Float};
 use rpbrt_geometry::tuple::*;
 
+/// `(1 − w)·a + w·b`, evaluating neither texture whose weight is zero
+/// (pbrt-v4's mix and checkerboard textures skip them the same way).
+#[inline]
+fn blend<T>(w: Float, a: impl FnOnce() -> T, b: impl FnOnce() -> T) -> T
+where
+    T: Default + std::ops::Mul<Float, Output = T> + std::ops::Add<Output = T>,
+{
+    let ta = if w != 1.0 { a() } else { T::default() };
+    let tb = if w != 0.0 { b() } else { T::default() };
+    ta * (1.0 - w) + tb * w
+}
+
 /// `tex * scale` (pbrt-v4 `FloatScaledTexture`).
 #[derive(Clone, Debug)]
 pub struct FloatScaledTexture {
@@ -75,17 +87,7 @@ impl FloatMixTexture {
     #[inline]
     pub fn evaluate(&self, ctx: &TextureEvalContext) -> Float {
         let amt = self.amount.evaluate(ctx);
-        let t1 = if amt != 1.0 {
-            self.tex1.evaluate(ctx)
-        } else {
-            0.0
-        };
-        let t2 = if amt != 0.0 {
-            self.tex2.evaluate(ctx)
-        } else {
-            0.0
-        };
-        (1.0 - amt) * t1 + amt * t2
+        blend(amt, || self.tex1.evaluate(ctx), || self.tex2.evaluate(ctx))
     }
 }
 
@@ -110,18 +112,11 @@ impl SpectrumMixTexture {
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
         let amt = self.amount.evaluate(ctx);
-        let zero = SampledSpectrum::new(0.0);
-        let t1 = if amt != 1.0 {
-            self.tex1.evaluate(ctx, lambda)
-        } else {
-            zero
-        };
-        let t2 = if amt != 0.0 {
-            self.tex2.evaluate(ctx, lambda)
-        } else {
-            zero
-        };
-        t1 * (1.0 - amt) + t2 * amt
+        blend(
+            amt,
+            || self.tex1.evaluate(ctx, lambda),
+            || self.tex2.evaluate(ctx, lambda),
+        )
     }
 }
 
@@ -316,17 +311,7 @@ impl FloatCheckerboardTexture {
     #[inline]
     pub fn evaluate(&self, ctx: &TextureEvalContext) -> Float {
         let w = checkerboard(ctx, &self.mapping);
-        let t0 = if w != 1.0 {
-            self.tex1.evaluate(ctx)
-        } else {
-            0.0
-        };
-        let t1 = if w != 0.0 {
-            self.tex2.evaluate(ctx)
-        } else {
-            0.0
-        };
-        (1.0 - w) * t0 + w * t1
+        blend(w, || self.tex1.evaluate(ctx), || self.tex2.evaluate(ctx))
     }
 }
 
@@ -350,18 +335,11 @@ impl SpectrumCheckerboardTexture {
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
         let w = checkerboard(ctx, &self.mapping);
-        let zero = SampledSpectrum::new(0.0);
-        let t0 = if w != 1.0 {
-            self.tex1.evaluate(ctx, lambda)
-        } else {
-            zero
-        };
-        let t1 = if w != 0.0 {
-            self.tex2.evaluate(ctx, lambda)
-        } else {
-            zero
-        };
-        t0 * (1.0 - w) + t1 * w
+        blend(
+            w,
+            || self.tex1.evaluate(ctx, lambda),
+            || self.tex2.evaluate(ctx, lambda),
+        )
     }
 }
 
