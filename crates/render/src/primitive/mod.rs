@@ -4,7 +4,7 @@
 //! acceleration structure over a set of primitives.
 
 use crate::accel::{AccelParams, Accelerator, Aggregate};
-use crate::shape::triangle::{intersect_nondegenerate_triangle, triangle_is_nondegenerate};
+use crate::shape::triangle::{intersect_prepared_triangle, triangle_is_nondegenerate, TriangleRay};
 use crate::shape::{Shape, ShapeMethods};
 use crate::texture::{FloatTextureRef, TextureEvalContext};
 use rpbrt_geometry::animated::AnimatedTransform;
@@ -295,10 +295,11 @@ impl PrimitiveAggregate {
             },
         }
         let mut closest = Closest::None;
+        let tr = TriangleRay::new(ray);
         self.accel.intersect(ray, t_max, |i, r, t| {
             if let Some(Some([p0, p1, p2])) = self.triangle_vertices.get(i as usize) {
                 let (p0, p1, p2) = (*p0, *p1, *p2);
-                let (b0, b1, b2, t_hit) = intersect_nondegenerate_triangle(r, t, p0, p1, p2)?;
+                let (b0, b1, b2, t_hit) = intersect_prepared_triangle(&tr, t, p0, p1, p2)?;
                 closest = Closest::Triangle {
                     prim: i,
                     b: (b0, b1, b2),
@@ -339,10 +340,11 @@ impl PrimitiveAggregate {
 
     /// Whether anything is hit in (0, t_max).
     pub fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
+        let tr = TriangleRay::new(ray);
         self.accel.intersect_p(ray, t_max, |i, r, t| {
             match self.triangle_vertices.get(i as usize) {
                 Some(Some([p0, p1, p2])) => {
-                    intersect_nondegenerate_triangle(r, t, *p0, *p1, *p2).is_some()
+                    intersect_prepared_triangle(&tr, t, *p0, *p1, *p2).is_some()
                 }
                 _ => self.prims[i as usize].intersect_p(r, t),
             }

@@ -297,10 +297,23 @@ impl PaddedSobolSampler {
 /// Dimensions whose pixel-only index digits [`ZSobolSampler`] caches.
 const ZSOBOL_CACHED_DIMENSIONS: usize = 64;
 
+/// Sample digits (base 4, below the pixel's) whose permutations
+/// [`ZSobolSampler`] caches: enough for 2^16 samples per pixel.
+const ZSOBOL_CACHED_SAMPLE_DIGITS: usize = 8;
+
+/// One cached digit permutation: the bits above the digit that its hash
+/// covers (`u64::MAX`: none) and the permutation they select.
+#[derive(Clone, Copy, Debug)]
+struct DigitPermutation {
+    key: u64,
+    perm: u8,
+}
+
 /// The permuted base-4 digits of a Z-Sobol' index that depend on the pixel
-/// alone (not on the sample index), per dimension, for one pixel. The
-/// render loop takes all of a wave's samples of a pixel in a row, so most
-/// of these are reused; results are identical to recomputing them.
+/// alone (not on the sample index), per dimension, for one pixel, and the
+/// last permutation chosen for each sample digit. The render loop takes all
+/// of a wave's samples of a pixel in a row, so most of these are reused;
+/// results are identical to recomputing them.
 #[derive(Clone, Debug)]
 struct PixelDigitCache {
     /// The pixel's Morton code the entries belong to (`u64::MAX`: none).
@@ -309,13 +322,25 @@ struct PixelDigitCache {
     valid: u64,
     /// The permuted pixel digits of the index, per dimension.
     high: [u64; ZSOBOL_CACHED_DIMENSIONS],
-    /// Per dimension, the permutation (into `PERMUTATIONS_4`) of the
-    /// highest sample digit, whose hash covers only pixel digits.
-    top_perm: [u8; ZSOBOL_CACHED_DIMENSIONS],
+    /// Per dimension and sample digit, the permutation last used. A sample
+    /// digit's permutation depends on the digits above it only, so with
+    /// samples taken in order the low digit's changes every 4 samples, the
+    /// next one's every 16, and so on; the key makes entries valid across
+    /// pixels as well.
+    sample_digits: [[DigitPermutation; ZSOBOL_CACHED_SAMPLE_DIGITS]; ZSOBOL_CACHED_DIMENSIONS],
+    /// Per dimension, the flip of the last index bit (odd powers of two
+    /// samples per pixel), under the same kind of key.
+    last_bit: [DigitPermutation; ZSOBOL_CACHED_DIMENSIONS],
     /// `mix_bits(d ^ seed)` for `d` in `0..ZSOBOL_CACHED_DIMENSIONS + 2`:
     /// the scrambling hashes, which depend on the dimension and seed alone.
     scramble_hash: [u64; ZSOBOL_CACHED_DIMENSIONS + 2],
 }
+
+/// An empty [`DigitPermutation`] cache entry.
+const NO_DIGIT_PERMUTATION: DigitPermutation = DigitPermutation {
+    key: u64::MAX,
+    perm: 0,
+};
 
 /// The Morton-ordered ("Z") Sobol' sampler, pbrt-v4's default.
 #[derive(Clone, Debug)]
@@ -352,7 +377,9 @@ impl ZSobolSampler {
                 pixel: u64::MAX,
                 valid: 0,
                 high: [0; ZSOBOL_CACHED_DIMENSIONS],
-                top_perm: [0; ZSOBOL_CACHED_DIMENSIONS],
+                sample_digits: [[NO_DIGIT_PERMUTATION; ZSOBOL_CACHED_SAMPLE_DIGITS];
+                    ZSOBOL_CACHED_DIMENSIONS],
+                last_bit: [NO_DIGIT_PERMUTATION; ZSOBOL_CACHED_DIMENSIONS],
                 scramble_hash: std::array::from_fn(|d| mix_bits((d as i32 ^ seed) as i64 as u64)),
             }),
         }
@@ -424,38 +451,53 @@ impl ZSobolSampler {
     }
 
     /// [`ZSobolSampler::sample_index`], taking the digits that depend on
-    /// the pixel alone from the cache. Digit `i` and everything above it
-    /// lie in the pixel's Morton code exactly when `i ≥ ⌈log2(spp) / 2⌉`.
+    /// the pixel alone from the cache, and the sample digits' permutations
+    /// from the cache when the digits above them are the same as last time.
+    /// Digit `i` and everything above it lie in the pixel's Morton code
+    /// exactly when `i ≥ ⌈log2(spp) / 2⌉`.
     #[inline(always)]
     fn cached_sample_index(&mut self) -> u64 {
         let d = self.dimension as usize;
-        if d >= ZSOBOL_CACHED_DIMENSIONS {
+        let split = self.log2_samples_per_pixel.div_ceil(2) as usize;
+        if d >= ZSOBOL_CACHED_DIMENSIONS || split > ZSOBOL_CACHED_SAMPLE_DIGITS {
             return self.sample_index();
         }
-        let last_digit = (self.log2_samples_per_pixel & 1) as i32;
-        let split = self.log2_samples_per_pixel.div_ceil(2) as i32;
+        let last_digit = (self.log2_samples_per_pixel & 1) as usize;
         let dim_mix = 0x5555_5555u64.wrapping_mul(self.dimension as i64 as u64);
-        let n_digits = self.n_base4_digits as i32;
+        let n_digits = self.n_base4_digits as usize;
         let split = split.min(n_digits);
-        let odd = (self.log2_samples_per_pixel & 1) as i32;
-        // The highest sample digit, `split - 1`, is permuted by a hash of
-        // pixel digits only: its permutation is cached with `high`.
-        let has_top = split > last_digit;
-        let top_shift = 2 * split - 2 - odd;
+        let odd = (self.log2_samples_per_pixel & 1) as usize;
+        let morton = self.morton_index;
         if self.cache.valid >> d & 1 == 0 {
-            self.cache.high[d] = self.permuted_digits(split, n_digits, dim_mix);
-            if has_top {
-                let higher = self.morton_index >> (top_shift + 2);
-                self.cache.top_perm[d] = Self::digit_permutation(higher, dim_mix) as u8;
-            }
+            let high = self.permuted_digits(split as i32, n_digits as i32, dim_mix);
+            self.cache.high[d] = high;
             self.cache.valid |= 1 << d;
         }
-        let mut index = self.cache.high[d] | self.permuted_last_bit(dim_mix);
-        if has_top {
-            let digit = ((self.morton_index >> top_shift) & 3) as usize;
-            let p = self.cache.top_perm[d] as usize;
-            index |= (PERMUTATIONS_4[p][digit] as u64) << top_shift;
-            index |= self.permuted_digits(last_digit, split - 1, dim_mix);
+        let cache = &mut *self.cache;
+        let mut index = cache.high[d];
+        for i in last_digit..split {
+            let shift = 2 * i - odd;
+            let digit = ((morton >> shift) & 3) as usize;
+            let higher = morton >> (shift + 2);
+            let slot = &mut cache.sample_digits[d][i];
+            if slot.key != higher {
+                *slot = DigitPermutation {
+                    key: higher,
+                    perm: Self::digit_permutation(higher, dim_mix) as u8,
+                };
+            }
+            index |= (PERMUTATIONS_4[slot.perm as usize][digit] as u64) << shift;
+        }
+        if odd == 1 {
+            let higher = morton >> 1;
+            let slot = &mut cache.last_bit[d];
+            if slot.key != higher {
+                *slot = DigitPermutation {
+                    key: higher,
+                    perm: (mix_bits(higher ^ dim_mix) & 1) as u8,
+                };
+            }
+            index |= (morton & 1) ^ slot.perm as u64;
         }
         index
     }

@@ -537,7 +537,7 @@ fn sampler_enum_is_small() {
 /// must give exactly what a fresh sampler gives (even and odd log2 spp).
 #[test]
 fn zsobol_digit_cache_matches_fresh_samplers() {
-    for spp in [1, 2, 8, 16, 64] {
+    for spp in [1, 2, 8, 16, 64, 128] {
         let proto = ZSobolSampler::new(spp, Point2i::new(40, 30), RandomizeStrategy::FastOwen, 7);
         let mut reused = proto.clone();
         for p in [
@@ -546,7 +546,10 @@ fn zsobol_digit_cache_matches_fresh_samplers() {
             Point2i::new(39, 0),
             Point2i::new(3, 5),
         ] {
-            for s in 0..spp {
+            // In order, then in a scrambled order (the sample digits'
+            // cache entries must notice every change of the digits above).
+            let order = (0..spp).chain((0..spp).map(|s| (s * 37 + 11) % spp));
+            for s in order {
                 reused.start_pixel_sample(p, s, 0);
                 let mut d = 0;
                 while d < 100 {

@@ -44,15 +44,12 @@ pub fn spherical_quad_area(a: Vector3f, b: Vector3f, c: Vector3f, d: Vector3f) -
 }
 
 /// A triangle seen from a reference point: the unit directions to its
-/// vertices and the spherical triangle's interior angles.
+/// vertices and the solid angle it subtends.
 struct SphericalTriangle {
     a: Vector3f,
     b: Vector3f,
     c: Vector3f,
-    n_ab: Vector3f,
-    alpha: Float,
-    beta: Float,
-    gamma: Float,
+    area: Float,
 }
 
 impl SphericalTriangle {
@@ -63,28 +60,25 @@ impl SphericalTriangle {
         Self::from_dirs(a, b, c)
     }
 
-    /// The spherical triangle of the unit directions `a`, `b`, `c`.
+    /// The spherical triangle of the unit directions `a`, `b`, `c`; `None`
+    /// when it is degenerate.
     #[inline(always)]
     fn from_dirs(a: Vector3f, b: Vector3f, c: Vector3f) -> Option<Self> {
-        let n_ab = cross(a, b).try_normalize()?;
-        let n_bc = cross(b, c).try_normalize()?;
-        let n_ca = cross(c, a).try_normalize()?;
         if !(a.is_finite() && b.is_finite() && c.is_finite()) {
             return None;
         }
-        // Angles at the vertices, between the planes of the adjacent edges.
-        let alpha = n_ab.angle_between(-n_ca);
-        let beta = n_bc.angle_between(-n_ab);
-        let gamma = n_ca.angle_between(-n_bc);
-        Some(SphericalTriangle {
-            a,
-            b,
-            c,
-            n_ab,
-            alpha,
-            beta,
-            gamma,
-        })
+        cross(b, c).try_normalize()?;
+        Self::with_area(a, b, c, spherical_triangle_area(a, b, c))
+    }
+
+    /// The spherical triangle of the unit directions `a`, `b`, `c`, whose
+    /// area the caller has computed with [`spherical_triangle_area`].
+    #[inline(always)]
+    fn with_area(a: Vector3f, b: Vector3f, c: Vector3f, area: Float) -> Option<Self> {
+        if !(area > 0.0) {
+            return None;
+        }
+        Some(SphericalTriangle { a, b, c, area })
     }
 }
 
@@ -103,15 +97,17 @@ pub fn sample_spherical_triangle(
 }
 
 /// [`sample_spherical_triangle`] given the unit directions `dirs` from `p`
-/// to the vertices (`(v[i] - p).normalize()`, all finite), which the
-/// caller has already computed.
+/// to the vertices (`(v[i] - p).normalize()`, all finite) and the solid
+/// angle `area` they subtend ([`spherical_triangle_area`] of them), which
+/// the caller has already computed.
 pub(crate) fn sample_spherical_triangle_dirs(
     v: [Point3f; 3],
     p: Point3f,
     dirs: [Vector3f; 3],
+    area: Float,
     u: Point2f,
 ) -> Option<([Float; 3], Float)> {
-    let st = SphericalTriangle::from_dirs(dirs[0], dirs[1], dirs[2])?;
+    let st = SphericalTriangle::with_area(dirs[0], dirs[1], dirs[2], area)?;
     sample_spherical(&st, v, p, u)
 }
 
@@ -123,23 +119,26 @@ fn sample_spherical(
     u: Point2f,
 ) -> Option<([Float; 3], Float)> {
     let (a, b, c) = (st.a, st.b, st.c);
-    let a_pi = st.alpha + st.beta + st.gamma;
-    let area = a_pi - PI;
-    if !(area > 0.0) {
-        return None;
-    }
+    let area = st.area;
     let pdf = 1.0 / area;
 
+    // The interior angle α at a, between the planes of the edges ab and
+    // ac, by its sine and cosine.
+    let n_ab = cross(a, b).try_normalize()?;
+    let n_ac = cross(a, c).try_normalize()?;
+    let cos_alpha = clamp(dot(n_ab, n_ac), -1.0, 1.0);
+    let sin_alpha = cross(n_ab, n_ac).length().min(1.0);
+
     // Pick the area A' of the sub-triangle (a, b, c') uniformly, then find
-    // cos of the arc length from a to c' that yields it.
-    let ap_pi = lerp(u.x, PI, a_pi);
-    let (sin_ap, cos_ap) = ap_pi.sin_cos();
-    let (sin_alpha, cos_alpha) = st.alpha.sin_cos();
-    let sin_phi = sin_ap * -cos_alpha + cos_ap * sin_alpha;
-    let cos_phi = -cos_ap * cos_alpha - sin_ap * sin_alpha;
-    let k1 = cos_phi - cos_alpha;
-    let k2 = sin_phi + sin_alpha * dot(a, b);
-    let cos_bp = (difference_of_products(k2, cos_phi, k1, sin_phi) * cos_alpha - k2)
+    // cos of the arc length from a to c' that yields it. The sub-triangle's
+    // angle sum is A' + π, whose sine and cosine are −sin A' and −cos A'.
+    let (sin_a, cos_a) = (u.x * area).sin_cos();
+    let (sin_ap, cos_ap) = (-sin_a, -cos_a);
+    let sin_phi = sin_ap * cos_alpha - cos_ap * sin_alpha;
+    let cos_phi = cos_ap * cos_alpha + sin_ap * sin_alpha;
+    let k1 = cos_phi + cos_alpha;
+    let k2 = sin_phi - sin_alpha * dot(a, b);
+    let cos_bp = (k2 + difference_of_products(k2, cos_phi, k1, sin_phi) * cos_alpha)
         / (sum_of_products(k2, sin_phi, k1, cos_phi) * sin_alpha);
     // NaN when the triangle covers (nearly) a whole hemisphere.
     if cos_bp.is_nan() {
@@ -192,9 +191,14 @@ pub fn invert_spherical_triangle_sample(v: [Point3f; 3], p: Point3f, w: Vector3f
 }
 
 /// [`invert_spherical_triangle_sample`] given the unit directions `dirs`
-/// from the reference point to the vertices (all finite).
-pub(crate) fn invert_spherical_triangle_sample_dirs(dirs: [Vector3f; 3], w: Vector3f) -> Point2f {
-    match SphericalTriangle::from_dirs(dirs[0], dirs[1], dirs[2]) {
+/// from the reference point to the vertices (all finite) and the solid
+/// angle `area` they subtend.
+pub(crate) fn invert_spherical_triangle_sample_dirs(
+    dirs: [Vector3f; 3],
+    area: Float,
+    w: Vector3f,
+) -> Point2f {
+    match SphericalTriangle::with_area(dirs[0], dirs[1], dirs[2], area) {
         Some(st) => invert_spherical(&st, w),
         None => Point2f::new(0.5, 0.5),
     }
@@ -211,18 +215,13 @@ fn invert_spherical(st: &SphericalTriangle, w: Vector3f) -> Point2f {
     };
     let cp = if dot(cp, a + c) < 0.0 { -cp } else { cp };
 
+    // u0 is the fraction of the area in the sub-triangle (a, b, c').
     // 0.99999847691 = cos(0.1°): below that the sub-triangle is too thin to
     // measure and u0 is 0.
     let u0 = if dot(a, cp) > 0.999_998_5 {
         0.0
     } else {
-        let (n_cpb, n_acp) = match (cross(cp, b).try_normalize(), cross(a, cp).try_normalize()) {
-            (Some(x), Some(y)) => (x, y),
-            _ => return Point2f::new(0.5, 0.5),
-        };
-        let ap_pi = st.alpha + st.n_ab.angle_between(n_cpb) + n_acp.angle_between(-n_cpb);
-        let a_pi = st.alpha + st.beta + st.gamma;
-        (ap_pi - PI) / (a_pi - PI)
+        spherical_triangle_area(a, b, cp) / st.area
     };
     let u1 = (1.0 - dot(w, b)) / (1.0 - dot(cp, b));
     let fix = |x: Float| if x.is_nan() { 0.5 } else { clamp(x, 0.0, 1.0) };

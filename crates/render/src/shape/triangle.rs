@@ -253,6 +253,38 @@ pub fn triangle_is_nondegenerate(p0: Point3f, p1: Point3f, p2: Point3f) -> bool 
     cross(p2 - p0, p1 - p0).length_squared() > 0.0
 }
 
+/// The per-ray part of the watertight test: the permutation that makes the
+/// ray direction's largest component z and the shear that maps the ray to
+/// the +z axis. Aggregates compute it once per ray instead of once per
+/// triangle tested (the result is the same).
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleRay {
+    o: Vector3f,
+    perm: [usize; 3],
+    sx: Float,
+    sy: Float,
+    sz: Float,
+}
+
+impl TriangleRay {
+    /// The permutation and shear for `ray`.
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> Self {
+        let kz = ray.d.abs().max_dimension();
+        let kx = (kz + 1) % 3;
+        let ky = (kx + 1) % 3;
+        let perm = [kx, ky, kz];
+        let d = ray.d.permute(perm);
+        TriangleRay {
+            o: Vector3f::from(ray.o),
+            perm,
+            sx: -d.x / d.z,
+            sy: -d.y / d.z,
+            sz: 1.0 / d.z,
+        }
+    }
+}
+
 /// [`intersect_triangle`] for a triangle already known to pass
 /// [`triangle_is_nondegenerate`] (aggregates check that once, at build
 /// time).
@@ -264,21 +296,26 @@ pub fn intersect_nondegenerate_triangle(
     p1: Point3f,
     p2: Point3f,
 ) -> Option<(Float, Float, Float, Float)> {
+    intersect_prepared_triangle(&TriangleRay::new(ray), t_max, p0, p1, p2)
+}
+
+/// [`intersect_nondegenerate_triangle`] with the ray's permutation and
+/// shear already computed.
+#[inline(always)]
+pub fn intersect_prepared_triangle(
+    tr: &TriangleRay,
+    t_max: Float,
+    p0: Point3f,
+    p1: Point3f,
+    p2: Point3f,
+) -> Option<(Float, Float, Float, Float)> {
     debug_assert!(triangle_is_nondegenerate(p0, p1, p2));
     // Translate to the ray origin, permute so the ray's largest direction
     // component is z, and shear so the ray becomes the +z axis.
-    let o = Vector3f::from(ray.o);
-    let kz = ray.d.abs().max_dimension();
-    let kx = (kz + 1) % 3;
-    let ky = (kx + 1) % 3;
-    let perm = [kx, ky, kz];
-    let d = ray.d.permute(perm);
+    let (o, perm, sx, sy, sz) = (tr.o, tr.perm, tr.sx, tr.sy, tr.sz);
     let mut p0t = (p0 - o).permute(perm);
     let mut p1t = (p1 - o).permute(perm);
     let mut p2t = (p2 - o).permute(perm);
-    let sx = -d.x / d.z;
-    let sy = -d.y / d.z;
-    let sz = 1.0 / d.z;
     for q in [&mut p0t, &mut p1t, &mut p2t] {
         q.x += sx * q.z;
         q.y += sy * q.z;
@@ -714,7 +751,7 @@ impl ShapeMethods for Triangle {
         }
         // In this branch the solid angle is finite and positive, so the
         // directions are the ones `try_normalize` would give.
-        let (b, tri_pdf) = sample_spherical_triangle_dirs(self.vertices(), ctx.p(), dirs, u)?;
+        let (b, tri_pdf) = sample_spherical_triangle_dirs(self.vertices(), ctx.p(), dirs, sa, u)?;
         if !(tri_pdf > 0.0) {
             return None;
         }
@@ -733,7 +770,7 @@ impl ShapeMethods for Triangle {
         let mut pdf = 1.0 / sa;
         if ctx.ns != Normal3f::default() {
             let w = Self::cos_weights(ctx, &dirs);
-            let u = invert_spherical_triangle_sample_dirs(dirs, wi.normalize());
+            let u = invert_spherical_triangle_sample_dirs(dirs, sa, wi.normalize());
             pdf *= bilinear_pdf(u, w);
         }
         pdf
