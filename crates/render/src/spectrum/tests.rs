@@ -123,6 +123,16 @@ fn visible_pdf_integrates_to_one_and_matches_sampling() {
         let l = sample_visible_wavelengths(u);
         assert!(close(1.0 / dl, visible_wavelengths_pdf(l), 2e-2));
     }
+    // `sample_visible` computes the densities from the sample (no cosh):
+    // they agree with the density of the wavelengths it returns.
+    for i in 0..1000 {
+        let lw = SampledWavelengths::sample_visible(i as Float / 1000.0);
+        for j in 0..N_SPECTRUM_SAMPLES {
+            let (l, p) = (lw.get(j), lw.pdf()[j]);
+            let q = visible_wavelengths_pdf(l);
+            assert!((p - q).abs() <= 1e-5 * q, "{l}: {p} vs {q}");
+        }
+    }
 }
 
 #[test]
