@@ -11,6 +11,7 @@ use crate::sampler::Sampler;
 use rayon::prelude::*;
 use rpbrt_geometry::bounds::Bounds2i;
 use rpbrt_geometry::float::Float;
+use rpbrt_geometry::ray::RayDifferential;
 use rpbrt_geometry::tuple::*;
 use std::io::{IsTerminal, Write};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -83,6 +84,7 @@ fn evaluate_pixel_sample(
     p_pixel: Point2i,
     sampler: &mut Sampler,
     tile: &mut FilmTile,
+    differentials: bool,
 ) {
     let mut lu = sampler.get_1d();
     if opts.disable_wavelength_jitter {
@@ -112,12 +114,23 @@ fn evaluate_pixel_sample(
     } else {
         None
     };
-    if let Some(mut cr) = scene.camera.generate_ray_differential(&cs) {
-        if !opts.disable_pixel_jitter {
-            let scale = (1.0 / (sampler.samples_per_pixel() as Float).sqrt()).max(0.125);
-            cr.ray.scale_differentials(scale);
-        }
-        l = integrator.li(scene, cr.ray, &mut lambda, sampler, visible.as_mut()) * cr.weight;
+    let camera_ray = if differentials {
+        scene.camera.generate_ray_differential(&cs).map(|mut cr| {
+            if !opts.disable_pixel_jitter {
+                let scale = (1.0 / (sampler.samples_per_pixel() as Float).sqrt()).max(0.125);
+                cr.ray.scale_differentials(scale);
+            }
+            (cr.ray, cr.weight)
+        })
+    } else {
+        // Nothing reads them: the same main ray without its offset rays.
+        scene
+            .camera
+            .generate_ray(&cs)
+            .map(|cr| (RayDifferential::new(cr.ray), cr.weight))
+    };
+    if let Some((ray, weight)) = camera_ray {
+        l = integrator.li(scene, ray, &mut lambda, sampler, visible.as_mut()) * weight;
         if l.has_nan() || !l.y(&lambda).is_finite() {
             // pbrt-v4 drops such samples (and logs them).
             l = crate::spectrum::SampledSpectrum::new(0.0);
@@ -152,6 +165,10 @@ pub fn render(
     let pixels = pixel_bounds.area().max(0) as u64;
     let total = pixels * spp as u64;
     let show_progress = !opts.quiet && std::io::stderr().is_terminal();
+    // Camera rays carry differentials only when something reads them:
+    // texture filtering or bump mapping, or a G-buffer film's depth slopes.
+    let differentials =
+        scene.film.uses_visible_surface() || scene.materials.any_needs_differentials();
     let mut done: u64 = 0;
     let mut wave_start = 0;
     let mut wave_end = 1;
@@ -179,6 +196,7 @@ pub fn render(
                                     p,
                                     &mut sampler,
                                     &mut tile,
+                                    differentials,
                                 );
                             }
                             camera_rays += (wave_end - wave_start) as u64;

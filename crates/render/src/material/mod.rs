@@ -389,6 +389,12 @@ impl MaterialSet {
         }
     }
 
+    /// True when some material of the set may read hits' screen-space
+    /// differentials (see [`MaterialSet::needs_differentials`]).
+    pub fn any_needs_differentials(&self) -> bool {
+        (0..self.materials.len()).any(|i| self.needs_differentials(i as u32))
+    }
+
     /// True when any material of the set can have a BSSRDF.
     pub fn any_subsurface(&self) -> bool {
         self.materials
