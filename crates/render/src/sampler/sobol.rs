@@ -297,50 +297,57 @@ impl PaddedSobolSampler {
 /// Dimensions whose pixel-only index digits [`ZSobolSampler`] caches.
 const ZSOBOL_CACHED_DIMENSIONS: usize = 64;
 
-/// Sample digits (base 4, below the pixel's) whose permutations
-/// [`ZSobolSampler`] caches: enough for 2^16 samples per pixel.
-const ZSOBOL_CACHED_SAMPLE_DIGITS: usize = 8;
+/// Base-4 index digits whose permutations [`ZSobolSampler`] caches:
+/// enough for 2^12 × 2^12 pixels at 2^16 samples per pixel (or any
+/// trade between the two); larger indices are computed uncached.
+const ZSOBOL_CACHED_DIGITS: usize = 20;
 
-/// One cached digit permutation: the bits above the digit that its hash
-/// covers (`u64::MAX`: none) and the permutation they select.
-#[derive(Clone, Copy, Debug)]
-struct DigitPermutation {
-    key: u64,
-    perm: u8,
-}
-
-/// The permuted base-4 digits of a Z-Sobol' index that depend on the pixel
-/// alone (not on the sample index), per dimension, for one pixel, and the
-/// last permutation chosen for each sample digit. The render loop takes all
-/// of a wave's samples of a pixel in a row, so most of these are reused;
-/// results are identical to recomputing them.
+/// The Z-Sobol' index digits' permutations last used, per dimension, and
+/// the permuted digits that depend on the pixel alone (not on the sample
+/// index) for one pixel. A digit's permutation is chosen by a hash of the
+/// digits above it, which change rarely from one call to the next: with a
+/// pixel's samples taken in order, the lowest sample digit's every 4
+/// samples, the next one's every 16; across the pixels of a tile, the
+/// low pixel digits' every few pixels and the high ones' never. Each entry
+/// is keyed by those higher digits, so results are identical to
+/// recomputing them.
 #[derive(Clone, Debug)]
 struct PixelDigitCache {
-    /// The pixel's Morton code the entries belong to (`u64::MAX`: none).
+    /// The pixel's Morton code `high` belongs to (`u64::MAX`: none).
     pixel: u64,
     /// Bit `d` set: `high[d]` is valid.
     valid: u64,
     /// The permuted pixel digits of the index, per dimension.
     high: [u64; ZSOBOL_CACHED_DIMENSIONS],
-    /// Per dimension and sample digit, the permutation last used. A sample
-    /// digit's permutation depends on the digits above it only, so with
-    /// samples taken in order the low digit's changes every 4 samples, the
-    /// next one's every 16, and so on; the key makes entries valid across
-    /// pixels as well.
-    sample_digits: [[DigitPermutation; ZSOBOL_CACHED_SAMPLE_DIGITS]; ZSOBOL_CACHED_DIMENSIONS],
-    /// Per dimension, the flip of the last index bit (odd powers of two
-    /// samples per pixel), under the same kind of key.
-    last_bit: [DigitPermutation; ZSOBOL_CACHED_DIMENSIONS],
+    /// Per dimension and digit, the index bits above the digit when its
+    /// permutation was last chosen (`u64::MAX`: never).
+    digit_keys: [[u64; ZSOBOL_CACHED_DIGITS]; ZSOBOL_CACHED_DIMENSIONS],
+    /// Per dimension and digit, that permutation (into `PERMUTATIONS_4`).
+    digit_perms: [[u8; ZSOBOL_CACHED_DIGITS]; ZSOBOL_CACHED_DIMENSIONS],
+    /// Per dimension, the key and flip of the last index bit (odd powers
+    /// of two samples per pixel).
+    last_bit: [(u64, u8); ZSOBOL_CACHED_DIMENSIONS],
     /// `mix_bits(d ^ seed)` for `d` in `0..ZSOBOL_CACHED_DIMENSIONS + 2`:
     /// the scrambling hashes, which depend on the dimension and seed alone.
     scramble_hash: [u64; ZSOBOL_CACHED_DIMENSIONS + 2],
 }
 
-/// An empty [`DigitPermutation`] cache entry.
-const NO_DIGIT_PERMUTATION: DigitPermutation = DigitPermutation {
-    key: u64::MAX,
-    perm: 0,
-};
+impl PixelDigitCache {
+    /// Permuted digit `i` of `morton` in place (at bit `2i - odd`), for
+    /// dimension `d`, from the cache when the digits above it are the ones
+    /// it was last chosen for.
+    #[inline(always)]
+    fn digit(&mut self, morton: u64, d: usize, i: usize, odd: usize, dim_mix: u64) -> u64 {
+        let shift = 2 * i - odd;
+        let digit = ((morton >> shift) & 3) as usize;
+        let higher = morton >> (shift + 2);
+        if self.digit_keys[d][i] != higher {
+            self.digit_keys[d][i] = higher;
+            self.digit_perms[d][i] = ZSobolSampler::digit_permutation(higher, dim_mix) as u8;
+        }
+        (PERMUTATIONS_4[self.digit_perms[d][i] as usize][digit] as u64) << shift
+    }
+}
 
 /// The Morton-ordered ("Z") Sobol' sampler, pbrt-v4's default.
 #[derive(Clone, Debug)]
@@ -377,9 +384,9 @@ impl ZSobolSampler {
                 pixel: u64::MAX,
                 valid: 0,
                 high: [0; ZSOBOL_CACHED_DIMENSIONS],
-                sample_digits: [[NO_DIGIT_PERMUTATION; ZSOBOL_CACHED_SAMPLE_DIGITS];
-                    ZSOBOL_CACHED_DIMENSIONS],
-                last_bit: [NO_DIGIT_PERMUTATION; ZSOBOL_CACHED_DIMENSIONS],
+                digit_keys: [[u64::MAX; ZSOBOL_CACHED_DIGITS]; ZSOBOL_CACHED_DIMENSIONS],
+                digit_perms: [[0; ZSOBOL_CACHED_DIGITS]; ZSOBOL_CACHED_DIMENSIONS],
+                last_bit: [(u64::MAX, 0); ZSOBOL_CACHED_DIMENSIONS],
                 scramble_hash: std::array::from_fn(|d| mix_bits((d as i32 ^ seed) as i64 as u64)),
             }),
         }
@@ -450,54 +457,43 @@ impl ZSobolSampler {
             | self.permuted_last_bit(dim_mix)
     }
 
-    /// [`ZSobolSampler::sample_index`], taking the digits that depend on
-    /// the pixel alone from the cache, and the sample digits' permutations
-    /// from the cache when the digits above them are the same as last time.
-    /// Digit `i` and everything above it lie in the pixel's Morton code
-    /// exactly when `i ≥ ⌈log2(spp) / 2⌉`.
+    /// [`ZSobolSampler::sample_index`], with the digits that depend on the
+    /// pixel alone cached per pixel and every digit's permutation cached
+    /// under the digits above it. Digit `i` and everything above it lie in
+    /// the pixel's Morton code exactly when `i ≥ ⌈log2(spp) / 2⌉`.
     #[inline(always)]
     fn cached_sample_index(&mut self) -> u64 {
         let d = self.dimension as usize;
-        let split = self.log2_samples_per_pixel.div_ceil(2) as usize;
-        if d >= ZSOBOL_CACHED_DIMENSIONS || split > ZSOBOL_CACHED_SAMPLE_DIGITS {
+        let n_digits = self.n_base4_digits as usize;
+        if d >= ZSOBOL_CACHED_DIMENSIONS || n_digits > ZSOBOL_CACHED_DIGITS {
             return self.sample_index();
         }
-        let last_digit = (self.log2_samples_per_pixel & 1) as usize;
-        let dim_mix = 0x5555_5555u64.wrapping_mul(self.dimension as i64 as u64);
-        let n_digits = self.n_base4_digits as usize;
-        let split = split.min(n_digits);
+        let split = (self.log2_samples_per_pixel.div_ceil(2) as usize).min(n_digits);
         let odd = (self.log2_samples_per_pixel & 1) as usize;
+        let dim_mix = 0x5555_5555u64.wrapping_mul(self.dimension as i64 as u64);
         let morton = self.morton_index;
-        if self.cache.valid >> d & 1 == 0 {
-            let high = self.permuted_digits(split as i32, n_digits as i32, dim_mix);
-            self.cache.high[d] = high;
-            self.cache.valid |= 1 << d;
-        }
         let cache = &mut *self.cache;
-        let mut index = cache.high[d];
-        for i in last_digit..split {
-            let shift = 2 * i - odd;
-            let digit = ((morton >> shift) & 3) as usize;
-            let higher = morton >> (shift + 2);
-            let slot = &mut cache.sample_digits[d][i];
-            if slot.key != higher {
-                *slot = DigitPermutation {
-                    key: higher,
-                    perm: Self::digit_permutation(higher, dim_mix) as u8,
-                };
+        if cache.valid >> d & 1 == 0 {
+            let mut high = 0;
+            for i in split..n_digits {
+                high |= cache.digit(morton, d, i, odd, dim_mix);
             }
-            index |= (PERMUTATIONS_4[slot.perm as usize][digit] as u64) << shift;
+            cache.high[d] = high;
+            cache.valid |= 1 << d;
+        }
+        let mut index = cache.high[d];
+        // Digit 0 is the last bit (below) when log2(spp) is odd.
+        for i in odd..split {
+            index |= cache.digit(morton, d, i, odd, dim_mix);
         }
         if odd == 1 {
             let higher = morton >> 1;
-            let slot = &mut cache.last_bit[d];
-            if slot.key != higher {
-                *slot = DigitPermutation {
-                    key: higher,
-                    perm: (mix_bits(higher ^ dim_mix) & 1) as u8,
-                };
+            let (key, flip) = &mut cache.last_bit[d];
+            if *key != higher {
+                *key = higher;
+                *flip = (mix_bits(higher ^ dim_mix) & 1) as u8;
             }
-            index |= (morton & 1) ^ slot.perm as u64;
+            index |= (morton & 1) ^ *flip as u64;
         }
         index
     }
