@@ -51,7 +51,7 @@ pub fn z() -> &'static Spectrum {
 /// The table index for `lambda` rounded to the nearest nm, if tabulated.
 #[inline]
 fn index(lambda: Float) -> Option<usize> {
-    let i = lambda.round() as i64 - CIE_LAMBDA_START as i64;
+    let i = super::round_nm(lambda) - CIE_LAMBDA_START as i64;
     (i >= 0 && (i as usize) < N_CIE_SAMPLES).then_some(i as usize)
 }
 

@@ -253,6 +253,20 @@ impl RgbSigmoidPolynomial {
         sigmoid((self.c0 * lambda + self.c1) * lambda + self.c2)
     }
 
+    /// [`RgbSigmoidPolynomial::evaluate`] at each of `lambda`, bit for bit,
+    /// written without branches so that the lanes are computed together.
+    #[inline(always)]
+    pub fn evaluate_n<const N: usize>(&self, lambda: &[Float; N]) -> [Float; N] {
+        let mut out = [0.0; N];
+        for i in 0..N {
+            let x = (self.c0 * lambda[i] + self.c1) * lambda[i] + self.c2;
+            let y = 0.5 + x / (2.0 * (1.0 + x * x).sqrt());
+            let at_infinity = if x > 0.0 { 1.0 } else { 0.0 };
+            out[i] = if x.is_infinite() { at_infinity } else { y };
+        }
+        out
+    }
+
     /// The largest value over `[LAMBDA_MIN, LAMBDA_MAX]`: at an end or at the
     /// polynomial's extremum.
     pub fn max_value(&self) -> Float {

@@ -38,3 +38,17 @@ pub const N_SPECTRUM_SAMPLES: usize = 4;
 pub const LAMBDA_MIN: Float = 360.0;
 /// The longest wavelength rendered, in nm.
 pub const LAMBDA_MAX: Float = 830.0;
+
+/// `lambda.round() as i64` (to the nearest nm, halves away from zero)
+/// without a call to the C library's `roundf`, which the x86-64 baseline
+/// lacks an instruction for: for 1 ≤ λ < 2^23, λ + ½ is exact or rounds
+/// without crossing an integer, so truncating it is the same (checked for
+/// every float in that range).
+#[inline(always)]
+pub(crate) fn round_nm(lambda: Float) -> i64 {
+    if (1.0..8_388_608.0).contains(&lambda) {
+        (lambda + 0.5) as i64
+    } else {
+        lambda.round() as i64
+    }
+}

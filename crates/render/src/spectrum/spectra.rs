@@ -54,8 +54,10 @@ impl Spectrum {
             Spectrum::DenselySampled(s) => s.sample(lambda),
             Spectrum::PiecewiseLinear(s) => sample_with(lambda, |l| s.evaluate(l)),
             Spectrum::Blackbody(s) => sample_with(lambda, |l| s.evaluate(l)),
-            Spectrum::RgbAlbedo(s) => sample_with(lambda, |l| s.evaluate(l)),
-            Spectrum::RgbUnbounded(s) => sample_with(lambda, |l| s.evaluate(l)),
+            Spectrum::RgbAlbedo(s) => SampledSpectrum::from_array(s.rsp.evaluate_n(&lambda.lambda)),
+            Spectrum::RgbUnbounded(s) => {
+                SampledSpectrum::from_array(s.rsp.evaluate_n(&lambda.lambda)) * s.scale
+            }
             Spectrum::RgbIlluminant(s) => s.sample(lambda),
         }
     }
@@ -124,7 +126,7 @@ impl DenselySampledSpectrum {
     /// The value at `lambda` (nm), zero outside the table.
     #[inline]
     pub fn evaluate(&self, lambda: Float) -> Float {
-        let offset = lambda.round() as i64 - self.lambda_min as i64;
+        let offset = super::round_nm(lambda) - self.lambda_min as i64;
         if offset < 0 || offset as usize >= self.values.len() {
             return 0.0;
         }
@@ -409,8 +411,9 @@ impl RgbIlluminantSpectrum {
     #[inline]
     pub fn sample(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
         let mut s = self.illuminant.sample(lambda);
+        let r = self.rsp.evaluate_n(&lambda.lambda);
         for i in 0..N_SPECTRUM_SAMPLES {
-            s[i] *= self.scale * self.rsp.evaluate(lambda[i]);
+            s[i] *= self.scale * r[i];
         }
         s
     }

@@ -559,3 +559,46 @@ fn named_brass_spectra() {
         r(450.0)
     );
 }
+
+#[test]
+fn round_nm_matches_round() {
+    let mut rng = Rng::with_sequence(11);
+    let edges = [
+        0.0,
+        0.49999997,
+        0.5,
+        1.0,
+        1.5,
+        359.5,
+        360.49997,
+        829.5,
+        8_388_607.5,
+        1e9,
+        -3.5,
+    ];
+    for &x in edges.iter() {
+        assert_eq!(super::round_nm(x), (x as Float).round() as i64, "{x}");
+    }
+    for _ in 0..200_000 {
+        let x = 1000.0 * rng.uniform_float();
+        assert_eq!(super::round_nm(x), x.round() as i64, "{x}");
+    }
+}
+
+#[test]
+fn sigmoid_lanes_match_scalar_evaluation() {
+    let mut rng = Rng::with_sequence(5);
+    for _ in 0..10_000 {
+        let c = [0, 1, 2].map(|_| (rng.uniform_float() - 0.5) * 200.0);
+        let p = RgbSigmoidPolynomial::new(c[0] * 1e-4, c[1] * 1e-1, c[2]);
+        let l = [0, 1, 2, 3].map(|_| 360.0 + 470.0 * rng.uniform_float());
+        let v = p.evaluate_n(&l);
+        for i in 0..4 {
+            assert_eq!(v[i].to_bits(), p.evaluate(l[i]).to_bits());
+        }
+    }
+    let inf = RgbSigmoidPolynomial::new(0.0, 0.0, Float::INFINITY);
+    assert_eq!(inf.evaluate_n(&[500.0]), [1.0]);
+    let ninf = RgbSigmoidPolynomial::new(0.0, 0.0, -Float::INFINITY);
+    assert_eq!(ninf.evaluate_n(&[500.0]), [0.0]);
+}
