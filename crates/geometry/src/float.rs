@@ -294,23 +294,29 @@ pub fn quadratic(a: Float, b: Float, c: Float) -> Option<(Float, Float)> {
 
 /// Finds the largest index `i` in `[0, size − 2]` with `pred(i)` true,
 /// assuming `pred` is true then false (pbrt's `FindInterval`).
+///
+/// The same answer as pbrt's binary search, found without data-dependent
+/// branches (the range halves by a conditional move, which
+/// `select_unpredictable` asks for), since the outcome of each probe is a
+/// coin flip for random lookups such as sampling.
+#[inline]
 pub fn find_interval(size: usize, pred: impl Fn(usize) -> bool) -> usize {
     if size < 2 {
         return 0;
     }
-    let mut first = 1usize;
-    let mut sz = size - 2;
-    while sz > 0 {
-        let half = sz >> 1;
-        let middle = first + half;
-        if pred(middle) {
-            first = middle + 1;
-            sz -= half + 1;
-        } else {
-            sz = half;
-        }
+    // The first index in [1, size − 1] where `pred` is false (size − 1 if
+    // none) lies in [base, base + len].
+    let mut base = 1usize;
+    let mut len = size - 2;
+    while len > 1 {
+        let half = len / 2;
+        base = std::hint::select_unpredictable(pred(base + half - 1), base + half, base);
+        len -= half;
     }
-    (first - 1).min(size - 2)
+    if len == 1 && pred(base) {
+        base += 1;
+    }
+    (base - 1).min(size - 2)
 }
 
 /// sin(x)/x, well-behaved at zero.
@@ -403,6 +409,32 @@ mod tests {
         assert_eq!(find_interval(4, |i| v[i] <= 1.5), 1);
         assert_eq!(find_interval(4, |i| v[i] <= -1.0), 0);
         assert_eq!(find_interval(4, |i| v[i] <= 10.0), 2);
+        // Against pbrt's branching binary search on monotone tables with
+        // repeated entries, for every size up to 70 and every threshold.
+        fn reference(size: usize, pred: impl Fn(usize) -> bool) -> usize {
+            if size < 2 {
+                return 0;
+            }
+            let (mut first, mut sz) = (1usize, size - 2);
+            while sz > 0 {
+                let half = sz >> 1;
+                let middle = first + half;
+                if pred(middle) {
+                    first = middle + 1;
+                    sz -= half + 1;
+                } else {
+                    sz = half;
+                }
+            }
+            (first - 1).min(size - 2)
+        }
+        for size in 0..70usize {
+            let t: Vec<usize> = (0..size).map(|i| (i * 7 + i / 3) / 5).collect();
+            for u in 0..(size * 2 + 2) {
+                let pred = |i: usize| t[i] <= u / 2;
+                assert_eq!(find_interval(size, pred), reference(size, pred), "{size} {u}");
+            }
+        }
     }
 
     #[test]
