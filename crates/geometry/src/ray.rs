@@ -111,21 +111,16 @@ impl From<Ray> for RayDifferential {
 #[inline(always)]
 pub fn offset_ray_origin(p: Point3f, p_error: Vector3f, n: Normal3f, w: Vector3f) -> Point3f {
     let d = dot(n.abs(), p_error);
-    let mut offset = Vector3f::from(n) * d;
-    if dot(w, n) < 0.0 {
-        offset = -offset;
-    }
+    let offset = Vector3f::from(n) * d;
+    // Which side to leave by, and the offset's signs below, are as good as
+    // random: selected, not branched on (branches would mispredict).
+    let offset = std::hint::select_unpredictable(dot(w, n) < 0.0, -offset, offset);
     let po = p + offset;
-    // Branch-free rounding away from the surface: the offset's signs are
-    // as good as random, so branches on them mispredict.
+    // Round away from the surface.
     let round = |v: Float, o: Float| {
         let (up, down) = (next_float_up(v), next_float_down(v));
-        let v = if o < 0.0 { down } else { v };
-        if o > 0.0 {
-            up
-        } else {
-            v
-        }
+        let v = std::hint::select_unpredictable(o < 0.0, down, v);
+        std::hint::select_unpredictable(o > 0.0, up, v)
     };
     Point3f::new(
         round(po.x, offset.x),
