@@ -334,11 +334,12 @@ pub fn intersect_prepared_triangle(
         e1 = f(p2t.x, p0t.y, p2t.y, p0t.x);
         e2 = f(p0t.x, p1t.y, p0t.y, p1t.x);
     }
-    if (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) && (e0 > 0.0 || e1 > 0.0 || e2 > 0.0) {
-        return None;
-    }
+    // The tests are combined with `|` and `&`, not `||` and `&&`: whether a
+    // ray hits is unpredictable, and one branch mispredicts less than six.
+    let mixed_signs =
+        (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) & (e0 > 0.0 || e1 > 0.0 || e2 > 0.0);
     let det = e0 + e1 + e2;
-    if det == 0.0 || det.is_nan() {
+    if mixed_signs | (det == 0.0) | det.is_nan() {
         return None;
     }
 
@@ -347,10 +348,9 @@ pub fn intersect_prepared_triangle(
     p1t.z *= sz;
     p2t.z *= sz;
     let t_scaled = e0 * p0t.z + e1 * p1t.z + e2 * p2t.z;
-    if det < 0.0 && (t_scaled >= 0.0 || t_scaled < t_max * det) {
-        return None;
-    }
-    if det > 0.0 && (t_scaled <= 0.0 || t_scaled > t_max * det) {
+    let behind_neg = (det < 0.0) & ((t_scaled >= 0.0) | (t_scaled < t_max * det));
+    let behind_pos = (det > 0.0) & ((t_scaled <= 0.0) | (t_scaled > t_max * det));
+    if behind_neg | behind_pos {
         return None;
     }
     let inv_det = 1.0 / det;
