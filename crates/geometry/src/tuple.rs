@@ -784,11 +784,8 @@ impl Normal3f {
     where
         Normal3f: Dot<V>,
     {
-        if self.dot(v) < 0.0 {
-            -self
-        } else {
-            self
-        }
+        // Selected, not branched on: the side is often unpredictable.
+        std::hint::select_unpredictable(self.dot(v) < 0.0, -self, self)
     }
 }
 
@@ -799,11 +796,8 @@ impl Vector3f {
     where
         Vector3f: Dot<V>,
     {
-        if self.dot(v) < 0.0 {
-            -self
-        } else {
-            self
-        }
+        // Selected, not branched on: the side is often unpredictable.
+        std::hint::select_unpredictable(self.dot(v) < 0.0, -self, self)
     }
 
     /// The numerically stable angle between two unit vectors.

@@ -226,16 +226,14 @@ impl BvhLightSampler {
                 return None;
             }
             let p0 = ci0 / (ci0 + ci1);
-            if u < p0 {
-                pmf *= p0;
-                u = (u / p0).min(ONE_MINUS_EPSILON);
-                node_index += 1;
-            } else {
-                let p1 = 1.0 - p0;
-                pmf *= ci1 / (ci0 + ci1);
-                u = ((u - p0) / p1).min(ONE_MINUS_EPSILON);
-                node_index = c1;
-            }
+            // Both outcomes computed and one selected: which child is taken
+            // is as random as `u`, so a branch would often mispredict.
+            let first = u < p0;
+            let p1 = 1.0 - p0;
+            pmf *= std::hint::select_unpredictable(first, p0, ci1 / (ci0 + ci1));
+            u = std::hint::select_unpredictable(first, u / p0, (u - p0) / p1)
+                .min(ONE_MINUS_EPSILON);
+            node_index = std::hint::select_unpredictable(first, node_index + 1, c1);
         }
     }
 
