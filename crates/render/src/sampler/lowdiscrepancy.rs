@@ -479,7 +479,13 @@ fn sobol_reversed_byte_tables() -> &'static [[[u32; 256]; 7]; 2] {
 #[inline(always)]
 pub fn sobol_sample_fast_owen_01(a: u64, dimension: usize, seed: u32) -> Float {
     debug_assert!(dimension < 2 && a < (1u64 << SOBOL_MATRIX_SIZE));
-    let t = &sobol_reversed_byte_tables()[dimension & 1];
+    if dimension == 0 {
+        // Sobol' dimension 0 is the van der Corput sequence: its generator
+        // matrix reverses the low 32 bits of the index (and ignores the
+        // rest), so its bit-reversed value is the index itself.
+        return fast_owen_01(a as u32, seed);
+    }
+    let t = &sobol_reversed_byte_tables()[1];
     let mut v = t[0][(a & 0xff) as usize]
         ^ t[1][((a >> 8) & 0xff) as usize]
         ^ t[2][((a >> 16) & 0xff) as usize]
@@ -489,7 +495,14 @@ pub fn sobol_sample_fast_owen_01(a: u64, dimension: usize, seed: u32) -> Float {
             ^ t[5][((a >> 40) & 0xff) as usize]
             ^ t[6][((a >> 48) & 0xff) as usize];
     }
-    let v = fast_owen_reversed(v, seed);
+    fast_owen_01(v, seed)
+}
+
+/// The fast Owen scramble of `v_reversed.reverse_bits()` as a float in
+/// [0, 1).
+#[inline(always)]
+fn fast_owen_01(v_reversed: u32, seed: u32) -> Float {
+    let v = fast_owen_reversed(v_reversed, seed);
     (v as Float * f32::from_bits(0x2f80_0000)).min(ONE_MINUS_EPSILON)
 }
 
