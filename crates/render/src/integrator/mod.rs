@@ -348,14 +348,17 @@ pub fn create_integrator(
 }
 
 /// Samples direct lighting at a surface hit with multiple importance
-/// sampling (pbrt-v4 `PathIntegrator::SampleLd`).
+/// sampling (pbrt-v4 `PathIntegrator::SampleLd`), given its two sampler
+/// draws: `u` chooses the light and `u_light` the point on it.
+#[inline]
 pub(crate) fn sample_ld(
     scene: &Scene,
     light_sampler: &LightSampler,
     si: &SurfaceInteraction,
     bsdf: &BSDF,
     lambda: &SampledWavelengths,
-    sampler: &mut Sampler,
+    u: Float,
+    u_light: Point2f,
 ) -> SampledSpectrum {
     let mut ctx = LightSampleContext::from_si(si);
     let flags = bsdf.flags();
@@ -364,9 +367,7 @@ pub(crate) fn sample_ld(
     } else if flags.is_transmissive() && !flags.is_reflective() {
         ctx.pi = Point3fi::from(si.offset_ray_origin(-si.wo));
     }
-    let u = sampler.get_1d();
     let sampled = light_sampler.sample(&ctx, u);
-    let u_light = sampler.get_2d();
     let Some(sampled) = sampled else {
         return SampledSpectrum::new(0.0);
     };

@@ -99,14 +99,18 @@ impl PathIntegrator {
             }
             depth += 1;
             let si = &hit.si;
-            if bsdf.flags().is_non_specular() {
-                let ld = sample_ld(scene, light_sampler, si, bsdf, lambda, sampler);
+            // Sampler draws in pbrt-v4's order: the light's two, then the
+            // BSDF's two (taken together when there is a light sample).
+            let (u, u2) = if bsdf.flags().is_non_specular() {
+                let (u_light, u_light_2d, u, u2) = sampler.get_vertex_samples();
+                let ld = sample_ld(scene, light_sampler, si, bsdf, lambda, u_light, u_light_2d);
                 l += beta * ld;
-            }
+                (u, u2)
+            } else {
+                (sampler.get_1d(), sampler.get_2d())
+            };
             prev_ctx = LightSampleContext::from_si(si);
             let wo = -ray.ray.d;
-            let u = sampler.get_1d();
-            let u2 = sampler.get_2d();
             let Some(bs) =
                 bsdf.sample_f(wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL)
             else {
