@@ -86,18 +86,16 @@ fn evaluate_pixel_sample(
     tile: &mut FilmTile,
     differentials: bool,
 ) {
-    let mut lu = sampler.get_1d();
+    let (mut lu, u_pixel, time, p_lens) = sampler.get_camera_samples();
     if opts.disable_wavelength_jitter {
         lu = 0.5;
     }
     let mut lambda = scene.film.sample_wavelengths(lu);
-    let mut fs = scene.filter.sample(sampler.get_pixel_2d());
+    let mut fs = scene.filter.sample(u_pixel);
     if opts.disable_pixel_jitter {
         fs.p = Point2f::new(0.0, 0.0);
         fs.weight = 1.0;
     }
-    let time = sampler.get_1d();
-    let p_lens = sampler.get_2d();
     let cs = CameraSample {
         p_film: Point2f::new(
             p_pixel.x as Float + fs.p.x + 0.5,

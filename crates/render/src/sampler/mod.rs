@@ -106,6 +106,20 @@ impl Sampler {
         })
     }
 
+    /// The draws that start a camera sample, in pbrt-v4's order and taken
+    /// together (see [`Sampler::get_vertex_samples`]): wavelengths (1-D),
+    /// position in the pixel, time (1-D), lens position (2-D).
+    #[inline]
+    pub fn get_camera_samples(&mut self) -> (Float, Point2f, Float, Point2f) {
+        dispatch!(self, s => {
+            let u_lambda = s.get_1d();
+            let u_pixel = s.get_pixel_2d();
+            let u_time = s.get_1d();
+            let u_lens = s.get_2d();
+            (u_lambda, u_pixel, u_time, u_lens)
+        })
+    }
+
     /// The sample's position within its pixel, in [0,1)².
     #[inline]
     pub fn get_pixel_2d(&mut self) -> Point2f {
