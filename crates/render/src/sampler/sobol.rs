@@ -324,6 +324,13 @@ struct PixelDigitCache {
     digit_keys: [[u64; ZSOBOL_CACHED_DIGITS]; ZSOBOL_CACHED_DIMENSIONS],
     /// Per dimension and digit, that permutation (into `PERMUTATIONS_4`).
     digit_perms: [[u8; ZSOBOL_CACHED_DIGITS]; ZSOBOL_CACHED_DIMENSIONS],
+    /// Per dimension, the index bits above the lowest sample digit when
+    /// `low_upper` and `low_perm` were computed (`u64::MAX`: never).
+    low_key: [u64; ZSOBOL_CACHED_DIMENSIONS],
+    /// Per dimension, the permuted digits above the lowest sample digit.
+    low_upper: [u64; ZSOBOL_CACHED_DIMENSIONS],
+    /// Per dimension, the lowest sample digit's permutation.
+    low_perm: [u8; ZSOBOL_CACHED_DIMENSIONS],
     /// Per dimension, the key and flip of the last index bit (odd powers
     /// of two samples per pixel).
     last_bit: [(u64, u8); ZSOBOL_CACHED_DIMENSIONS],
@@ -387,6 +394,9 @@ impl ZSobolSampler {
                 digit_keys: [[u64::MAX; ZSOBOL_CACHED_DIGITS]; ZSOBOL_CACHED_DIMENSIONS],
                 digit_perms: [[0; ZSOBOL_CACHED_DIGITS]; ZSOBOL_CACHED_DIMENSIONS],
                 last_bit: [(u64::MAX, 0); ZSOBOL_CACHED_DIMENSIONS],
+                low_key: [u64::MAX; ZSOBOL_CACHED_DIMENSIONS],
+                low_upper: [0; ZSOBOL_CACHED_DIMENSIONS],
+                low_perm: [0; ZSOBOL_CACHED_DIMENSIONS],
                 scramble_hash: std::array::from_fn(|d| mix_bits((d as i32 ^ seed) as i64 as u64)),
             }),
         }
@@ -481,11 +491,29 @@ impl ZSobolSampler {
             cache.high[d] = high;
             cache.valid |= 1 << d;
         }
-        let mut index = cache.high[d];
-        // Digit 0 is the last bit (below) when log2(spp) is odd.
-        for i in odd..split {
-            index |= cache.digit(morton, d, i, odd, dim_mix);
-        }
+        let mut index = if split > odd {
+            // The lowest sample digit (digit 0, or 1 when digit 0 is the
+            // last bit below): everything else it takes, the digits above
+            // it and its own permutation, depends only on the index bits
+            // above it, which change every fourth sample. Those are kept
+            // under that key, so most draws cost one comparison.
+            let shift = odd;
+            let key = morton >> (shift + 2);
+            if cache.low_key[d] != key {
+                let mut upper = cache.high[d];
+                for i in odd + 1..split {
+                    upper |= cache.digit(morton, d, i, odd, dim_mix);
+                }
+                cache.low_key[d] = key;
+                cache.low_upper[d] = upper;
+                cache.low_perm[d] = Self::digit_permutation(key, dim_mix) as u8;
+            }
+            let digit = ((morton >> shift) & 3) as usize;
+            cache.low_upper[d]
+                | (PERMUTATIONS_4[cache.low_perm[d] as usize][digit] as u64) << shift
+        } else {
+            cache.high[d]
+        };
         if odd == 1 {
             let higher = morton >> 1;
             let (key, flip) = &mut cache.last_bit[d];
