@@ -436,7 +436,11 @@ mod tests {
             let t: Vec<usize> = (0..size).map(|i| (i * 7 + i / 3) / 5).collect();
             for u in 0..(size * 2 + 2) {
                 let pred = |i: usize| t[i] <= u / 2;
-                assert_eq!(find_interval(size, pred), reference(size, pred), "{size} {u}");
+                assert_eq!(
+                    find_interval(size, pred),
+                    reference(size, pred),
+                    "{size} {u}"
+                );
             }
         }
     }

@@ -340,6 +340,29 @@ struct PixelDigitCache {
 }
 
 impl PixelDigitCache {
+    /// The permuted digits `split..n_digits` of `morton` (those of the
+    /// pixel alone) for dimension `d`, cached for the current pixel.
+    #[inline(always)]
+    fn pixel_digits(
+        &mut self,
+        morton: u64,
+        d: usize,
+        split: usize,
+        n_digits: usize,
+        odd: usize,
+        dim_mix: u64,
+    ) -> u64 {
+        if self.valid >> d & 1 == 0 {
+            let mut high = 0;
+            for i in split..n_digits {
+                high |= self.digit(morton, d, i, odd, dim_mix);
+            }
+            self.high[d] = high;
+            self.valid |= 1 << d;
+        }
+        self.high[d]
+    }
+
     /// Permuted digit `i` of `morton` in place (at bit `2i - odd`), for
     /// dimension `d`, from the cache when the digits above it are the ones
     /// it was last chosen for.
@@ -483,14 +506,6 @@ impl ZSobolSampler {
         let dim_mix = 0x5555_5555u64.wrapping_mul(self.dimension as i64 as u64);
         let morton = self.morton_index;
         let cache = &mut *self.cache;
-        if cache.valid >> d & 1 == 0 {
-            let mut high = 0;
-            for i in split..n_digits {
-                high |= cache.digit(morton, d, i, odd, dim_mix);
-            }
-            cache.high[d] = high;
-            cache.valid |= 1 << d;
-        }
         let mut index = if split > odd {
             // The lowest sample digit (digit 0, or 1 when digit 0 is the
             // last bit below): everything else it takes, the digits above
@@ -500,7 +515,9 @@ impl ZSobolSampler {
             let shift = odd;
             let key = morton >> (shift + 2);
             if cache.low_key[d] != key {
-                let mut upper = cache.high[d];
+                // A new key whenever the pixel changes, so `high` is
+                // brought up to date here.
+                let mut upper = cache.pixel_digits(morton, d, split, n_digits, odd, dim_mix);
                 for i in odd + 1..split {
                     upper |= cache.digit(morton, d, i, odd, dim_mix);
                 }
@@ -509,10 +526,9 @@ impl ZSobolSampler {
                 cache.low_perm[d] = Self::digit_permutation(key, dim_mix) as u8;
             }
             let digit = ((morton >> shift) & 3) as usize;
-            cache.low_upper[d]
-                | (PERMUTATIONS_4[cache.low_perm[d] as usize][digit] as u64) << shift
+            cache.low_upper[d] | (PERMUTATIONS_4[cache.low_perm[d] as usize][digit] as u64) << shift
         } else {
-            cache.high[d]
+            cache.pixel_digits(morton, d, split, n_digits, odd, dim_mix)
         };
         if odd == 1 {
             let higher = morton >> 1;

@@ -336,8 +336,7 @@ pub fn intersect_prepared_triangle(
     }
     // The tests are combined with `|` and `&`, not `||` and `&&`: whether a
     // ray hits is unpredictable, and one branch mispredicts less than six.
-    let mixed_signs =
-        (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) & (e0 > 0.0 || e1 > 0.0 || e2 > 0.0);
+    let mixed_signs = (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) & (e0 > 0.0 || e1 > 0.0 || e2 > 0.0);
     let det = e0 + e1 + e2;
     if mixed_signs | (det == 0.0) | det.is_nan() {
         return None;
