@@ -259,29 +259,50 @@ pub fn triangle_is_nondegenerate(p0: Point3f, p1: Point3f, p2: Point3f) -> bool 
 /// triangle tested (the result is the same).
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleRay {
-    o: Vector3f,
+    /// The ray origin with a zero fourth lane.
+    o: [Float; 4],
+    /// Which components become x, y and z (each < 3).
     perm: [usize; 3],
     sx: Float,
     sy: Float,
     sz: Float,
 }
 
+/// `v` with its components reordered by `perm` (each < 4; lane 3 holds
+/// `w`): the components are picked by index from an array rather than by
+/// a `match`, since the permutation depends on the ray's direction and
+/// branches on it would mispredict.
+#[inline(always)]
+fn gather(v: [Float; 4], perm: [usize; 3]) -> Vector3f {
+    Vector3f::new(v[perm[0] & 3], v[perm[1] & 3], v[perm[2] & 3])
+}
+
 impl TriangleRay {
     /// The permutation and shear for `ray`.
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
-        let kz = ray.d.abs().max_dimension();
-        let kx = (kz + 1) % 3;
-        let ky = (kx + 1) % 3;
+        // `max_dimension` of |d| (same ties), by selection.
+        let a = ray.d.abs();
+        let sel = std::hint::select_unpredictable;
+        let kz: usize = sel(a.x > a.y, sel(a.x > a.z, 0, 2), sel(a.y > a.z, 1, 2));
+        let kx = [1, 2, 0][kz];
+        let ky = [2, 0, 1][kz];
         let perm = [kx, ky, kz];
-        let d = ray.d.permute(perm);
+        let d = gather([ray.d.x, ray.d.y, ray.d.z, 0.0], perm);
         TriangleRay {
-            o: Vector3f::from(ray.o),
+            o: [ray.o.x, ray.o.y, ray.o.z, 0.0],
             perm,
             sx: -d.x / d.z,
             sy: -d.y / d.z,
             sz: 1.0 / d.z,
         }
+    }
+
+    /// `p − o`, permuted.
+    #[inline(always)]
+    fn relative(&self, p: Point3f) -> Vector3f {
+        let o = self.o;
+        gather([p.x - o[0], p.y - o[1], p.z - o[2], 0.0], self.perm)
     }
 }
 
@@ -312,10 +333,10 @@ pub fn intersect_prepared_triangle(
     debug_assert!(triangle_is_nondegenerate(p0, p1, p2));
     // Translate to the ray origin, permute so the ray's largest direction
     // component is z, and shear so the ray becomes the +z axis.
-    let (o, perm, sx, sy, sz) = (tr.o, tr.perm, tr.sx, tr.sy, tr.sz);
-    let mut p0t = (p0 - o).permute(perm);
-    let mut p1t = (p1 - o).permute(perm);
-    let mut p2t = (p2 - o).permute(perm);
+    let (sx, sy, sz) = (tr.sx, tr.sy, tr.sz);
+    let mut p0t = tr.relative(p0);
+    let mut p1t = tr.relative(p1);
+    let mut p2t = tr.relative(p2);
     for q in [&mut p0t, &mut p1t, &mut p2t] {
         q.x += sx * q.z;
         q.y += sy * q.z;
