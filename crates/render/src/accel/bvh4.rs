@@ -164,16 +164,14 @@ impl WideRay {
                 (o[a], o[a])
             };
             // A negative direction (−0 included) enters through the max
-            // plane.
-            if inv < 0.0 {
-                w.near[a] = 3 + a;
-                w.far[a] = a;
-                w.o_near[a] = o_hi;
-                w.o_far[a] = o_lo;
-            } else {
-                w.o_near[a] = o_lo;
-                w.o_far[a] = o_hi;
-            }
+            // plane. Selected, not branched on: the signs of a ray's
+            // direction are as good as random.
+            let neg = inv < 0.0;
+            use std::hint::select_unpredictable as sel;
+            w.near[a] = sel(neg, 3 + a, a);
+            w.far[a] = sel(neg, a, 3 + a);
+            w.o_near[a] = sel(neg, o_hi, o_lo);
+            w.o_far[a] = sel(neg, o_lo, o_hi);
         }
         w
     }
