@@ -313,12 +313,12 @@ const ZSOBOL_CACHED_DIGITS: usize = 20;
 /// recomputing them.
 #[derive(Clone, Debug)]
 struct PixelDigitCache {
-    /// The pixel's Morton code `high` belongs to (`u64::MAX`: none).
-    pixel: u64,
-    /// Bit `d` set: `high[d]` is valid.
-    valid: u64,
     /// The permuted pixel digits of the index, per dimension.
     high: [u64; ZSOBOL_CACHED_DIMENSIONS],
+    /// Per dimension, the index bits above the sample digits (the pixel's
+    /// Morton code, shifted) that `high` was computed for (`u64::MAX`:
+    /// none).
+    high_pixel: [u64; ZSOBOL_CACHED_DIMENSIONS],
     /// Per dimension and digit, the index bits above the digit when its
     /// permutation was last chosen (`u64::MAX`: never).
     digit_keys: [[u64; ZSOBOL_CACHED_DIGITS]; ZSOBOL_CACHED_DIMENSIONS],
@@ -341,7 +341,11 @@ struct PixelDigitCache {
 
 impl PixelDigitCache {
     /// The permuted digits `split..n_digits` of `morton` (those of the
-    /// pixel alone) for dimension `d`, cached for the current pixel.
+    /// pixel alone) for dimension `d`. Cached per dimension; when the pixel
+    /// changes, only the digits up to the highest one that differs from
+    /// the cached pixel's are recomputed (the ones above, and their
+    /// permutations, are the same), which for the next pixel of a tile is
+    /// one or two.
     #[inline(always)]
     fn pixel_digits(
         &mut self,
@@ -352,15 +356,29 @@ impl PixelDigitCache {
         odd: usize,
         dim_mix: u64,
     ) -> u64 {
-        if self.valid >> d & 1 == 0 {
-            let mut high = 0;
-            for i in split..n_digits {
-                high |= self.digit(morton, d, i, odd, dim_mix);
-            }
-            self.high[d] = high;
-            self.valid |= 1 << d;
+        // Digit `split` starts at bit 2·split − odd, the lowest pixel bit.
+        let pixel_shift = 2 * split - odd;
+        let pixel = morton.checked_shr(pixel_shift as u32).unwrap_or(0);
+        let old = self.high_pixel[d];
+        if old == pixel {
+            return self.high[d];
         }
-        self.high[d]
+        let (mut high, top) = if old == u64::MAX {
+            (0, n_digits)
+        } else {
+            // Highest differing index bit, and the digit holding it.
+            let b = 63 - (old ^ pixel).leading_zeros() as usize + pixel_shift;
+            let top = ((b + odd) / 2 + 1).min(n_digits);
+            let keep_from = 2 * top - odd;
+            let keep = if keep_from >= 64 { 0 } else { u64::MAX << keep_from };
+            (self.high[d] & keep, top)
+        };
+        for i in split..top {
+            high |= self.digit(morton, d, i, odd, dim_mix);
+        }
+        self.high[d] = high;
+        self.high_pixel[d] = pixel;
+        high
     }
 
     /// Permuted digit `i` of `morton` in place (at bit `2i - odd`), for
@@ -411,9 +429,8 @@ impl ZSobolSampler {
             morton_index: 0,
             dimension: 0,
             cache: Box::new(PixelDigitCache {
-                pixel: u64::MAX,
-                valid: 0,
                 high: [0; ZSOBOL_CACHED_DIMENSIONS],
+                high_pixel: [u64::MAX; ZSOBOL_CACHED_DIMENSIONS],
                 digit_keys: [[u64::MAX; ZSOBOL_CACHED_DIGITS]; ZSOBOL_CACHED_DIMENSIONS],
                 digit_perms: [[0; ZSOBOL_CACHED_DIGITS]; ZSOBOL_CACHED_DIMENSIONS],
                 last_bit: [(u64::MAX, 0); ZSOBOL_CACHED_DIMENSIONS],
@@ -437,10 +454,6 @@ impl ZSobolSampler {
         self.dimension = dimension;
         let pixel = encode_morton2(p.x as u32, p.y as u32);
         self.morton_index = (pixel << self.log2_samples_per_pixel) | index as u64;
-        if self.cache.pixel != pixel {
-            self.cache.pixel = pixel;
-            self.cache.valid = 0;
-        }
     }
 
     /// The permuted base-4 digits `lo..hi` of the index (digit `i` at bit
@@ -516,7 +529,7 @@ impl ZSobolSampler {
             let key = morton >> (shift + 2);
             if cache.low_key[d] != key {
                 // A new key whenever the pixel changes, so `high` is
-                // brought up to date here.
+                // checked here.
                 let mut upper = cache.pixel_digits(morton, d, split, n_digits, odd, dim_mix);
                 for i in odd + 1..split {
                     upper |= cache.digit(morton, d, i, odd, dim_mix);

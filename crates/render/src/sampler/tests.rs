@@ -540,12 +540,19 @@ fn zsobol_digit_cache_matches_fresh_samplers() {
     for spp in [1, 2, 8, 16, 64, 128] {
         let proto = ZSobolSampler::new(spp, Point2i::new(40, 30), RandomizeStrategy::FastOwen, 7);
         let mut reused = proto.clone();
-        for p in [
+        // Revisits, a jump, and a scanline sweep over a block that crosses
+        // 2×2, 4×4 and 8×8 Morton blocks (the cached pixel digits are
+        // updated from the previous pixel's).
+        let sweep = (5..14).flat_map(|y| (6..17).map(move |x| Point2i::new(x, y)));
+        let pixels = [
             Point2i::new(3, 5),
             Point2i::new(3, 5),
             Point2i::new(39, 0),
             Point2i::new(3, 5),
-        ] {
+        ]
+        .into_iter()
+        .chain(sweep);
+        for p in pixels {
             // In order, then in a scrambled order (the sample digits'
             // cache entries must notice every change of the digits above).
             let order = (0..spp).chain((0..spp).map(|s| (s * 37 + 11) % spp));
