@@ -370,7 +370,11 @@ impl PixelDigitCache {
             let b = 63 - (old ^ pixel).leading_zeros() as usize + pixel_shift;
             let top = ((b + odd) / 2 + 1).min(n_digits);
             let keep_from = 2 * top - odd;
-            let keep = if keep_from >= 64 { 0 } else { u64::MAX << keep_from };
+            let keep = if keep_from >= 64 {
+                0
+            } else {
+                u64::MAX << keep_from
+            };
             (self.high[d] & keep, top)
         };
         for i in split..top {
