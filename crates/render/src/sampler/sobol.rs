@@ -615,16 +615,42 @@ mod tests {
     /// The cached index digits (pixel digits, the highest sample digit's
     /// permutation, the scrambling hashes) equal the uncached computation.
     #[test]
+    fn cached_sample_index_matches_uncached_for_large_indices() {
+        // 2^10 × 2^10 pixels at 2^20 samples: 20 digits, the most cached;
+        // 2^12 × 2^12 at 2^20: 22 digits, computed uncached.
+        for res in [1 << 10, 1 << 12] {
+            let spp = 1 << 20;
+            let mut s =
+                ZSobolSampler::new(spp, Point2i::new(res, res), RandomizeStrategy::FastOwen, 9);
+            for (x, y) in [(0, 0), (res - 1, res - 1), (517, 3), (518, 3), (519, 3)] {
+                for i in [0, 1, 5, 4097, spp - 1] {
+                    for d in [0, 3, 40] {
+                        s.start_pixel_sample(Point2i::new(x, y), i, d);
+                        let uncached = s.sample_index();
+                        assert_eq!(s.cached_sample_index(), uncached, "{res} {x} {y} {i} {d}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
     fn cached_sample_index_matches_uncached() {
         for spp in [1, 2, 4, 8, 16, 32, 64, 128] {
             let mut s =
                 ZSobolSampler::new(spp, Point2i::new(37, 21), RandomizeStrategy::FastOwen, 3);
-            for p in [
+            // A few far-apart pixels, then a scanline sweep (the pixel
+            // digits are updated from the previous pixel's).
+            let sweep = (0..12).flat_map(|y| (0..9).map(move |x| Point2i::new(x + 3, y + 2)));
+            let pixels = [
                 Point2i::new(0, 0),
                 Point2i::new(36, 20),
                 Point2i::new(5, 17),
-            ] {
-                for i in 0..spp {
+            ]
+            .into_iter()
+            .chain(sweep);
+            for p in pixels {
+                for i in 0..spp.min(8) {
                     for d in [0, 1, 2, 5, 17, 63, 64, 65, 66, 90] {
                         s.start_pixel_sample(p, i, d);
                         let uncached = s.sample_index();
