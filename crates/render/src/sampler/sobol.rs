@@ -612,8 +612,8 @@ impl ZSobolSampler {
 mod tests {
     use super::*;
 
-    /// The cached index digits (pixel digits, the highest sample digit's
-    /// permutation, the scrambling hashes) equal the uncached computation.
+    /// The cached index equals the uncached computation for the widest
+    /// indices the cache covers, and the uncached fallback beyond them.
     #[test]
     fn cached_sample_index_matches_uncached_for_large_indices() {
         // 2^10 × 2^10 pixels at 2^20 samples: 20 digits, the most cached;
@@ -634,6 +634,9 @@ mod tests {
         }
     }
 
+    /// The cached index digits (pixel digits, per-digit permutations, the
+    /// lowest sample digit's key, the last bit's flip, the scrambling
+    /// hashes) equal the uncached computation.
     #[test]
     fn cached_sample_index_matches_uncached() {
         for spp in [1, 2, 4, 8, 16, 32, 64, 128] {
