@@ -10,8 +10,8 @@ use super::data::cie_d::{CIE_S0, CIE_S1, CIE_S2, CIE_S_LAMBDA_START, CIE_S_LAMBD
 use super::data::sensors::{SENSORS, SENSOR_LAMBDA_START};
 use super::data::swatches::{SWATCHES, SWATCH_LAMBDA_START};
 use crate::spectrum::{
-    cie, ColorMatrix, DenselySampledSpectrum, RgbColorSpace, SampledSpectrum, SampledWavelengths,
-    Spectrum, RGB, XYZ,
+    cie, round_nm, ColorMatrix, DenselySampledSpectrum, RgbColorSpace, SampledSpectrum,
+    SampledWavelengths, Spectrum, N_SPECTRUM_SAMPLES, RGB, XYZ,
 };
 
 /// Linear interpolation in a table sampled every `step` nm from `start`;
@@ -135,12 +135,53 @@ pub struct PixelSensor {
     r_bar: DenselySampledSpectrum,
     g_bar: DenselySampledSpectrum,
     b_bar: DenselySampledSpectrum,
+    /// The three responses side by side, per nanometre from `table_min`
+    /// (the three tables cover the same range), so that a sample looks up
+    /// each wavelength's index once.
+    table: Vec<[Float; 3]>,
+    table_min: i32,
     imaging_ratio: Float,
     /// Sensor RGB to XYZ (white balance included).
     pub xyz_from_sensor_rgb: ColorMatrix,
 }
 
+/// The responses interleaved per wavelength; empty when the tables do not
+/// cover the same range (then each is looked up on its own).
+fn interleave(
+    r: &DenselySampledSpectrum,
+    g: &DenselySampledSpectrum,
+    b: &DenselySampledSpectrum,
+) -> Vec<[Float; 3]> {
+    let same = |s: &DenselySampledSpectrum| {
+        s.lambda_min() == r.lambda_min() && s.values().len() == r.values().len()
+    };
+    if !(same(g) && same(b)) {
+        return Vec::new();
+    }
+    (0..r.values().len())
+        .map(|i| [r.values()[i], g.values()[i], b.values()[i]])
+        .collect()
+}
+
 impl PixelSensor {
+    fn with_responses(
+        r_bar: DenselySampledSpectrum,
+        g_bar: DenselySampledSpectrum,
+        b_bar: DenselySampledSpectrum,
+        imaging_ratio: Float,
+        xyz_from_sensor_rgb: ColorMatrix,
+    ) -> Self {
+        PixelSensor {
+            table: interleave(&r_bar, &g_bar, &b_bar),
+            table_min: r_bar.lambda_min(),
+            r_bar,
+            g_bar,
+            b_bar,
+            imaging_ratio,
+            xyz_from_sensor_rgb,
+        }
+    }
+
     /// The `cie1931` sensor: the XYZ matching functions as responses;
     /// white balanced from daylight of `wb_temp` K to the output colour
     /// space's white unless `wb_temp` is zero.
@@ -156,13 +197,13 @@ impl PixelSensor {
         } else {
             ColorMatrix::IDENTITY
         };
-        PixelSensor {
-            r_bar: DenselySampledSpectrum::new(cie::x()),
-            g_bar: DenselySampledSpectrum::new(cie::y()),
-            b_bar: DenselySampledSpectrum::new(cie::z()),
+        PixelSensor::with_responses(
+            DenselySampledSpectrum::new(cie::x()),
+            DenselySampledSpectrum::new(cie::y()),
+            DenselySampledSpectrum::new(cie::z()),
             imaging_ratio,
             xyz_from_sensor_rgb,
-        }
+        )
     }
 
     /// A measured camera sensor by pbrt-v4's name (`canon_eos_5d`...),
@@ -224,13 +265,13 @@ impl PixelSensor {
                 )))
             }
         };
-        Some(Ok(PixelSensor {
+        Some(Ok(PixelSensor::with_responses(
             r_bar,
             g_bar,
             b_bar,
             imaging_ratio,
-            xyz_from_sensor_rgb: m,
-        }))
+            m,
+        )))
     }
 
     /// The imaging ratio (exposure time × ISO / 100).
@@ -247,6 +288,22 @@ impl PixelSensor {
     #[inline]
     pub fn to_sensor_rgb(&self, l: SampledSpectrum, lambda: &SampledWavelengths) -> RGB {
         let l = SampledSpectrum::safe_div(l, lambda.pdf());
+        if !self.table.is_empty() {
+            // The same values as the three `sample` calls below.
+            let (mut r, mut g, mut b) = (
+                SampledSpectrum::new(0.0),
+                SampledSpectrum::new(0.0),
+                SampledSpectrum::new(0.0),
+            );
+            for i in 0..N_SPECTRUM_SAMPLES {
+                let offset = round_nm(lambda[i]) - self.table_min as i64;
+                if let Some(v) = usize::try_from(offset).ok().and_then(|o| self.table.get(o)) {
+                    (r[i], g[i], b[i]) = (v[0], v[1], v[2]);
+                }
+            }
+            return RGB::new((r * l).average(), (g * l).average(), (b * l).average())
+                * self.imaging_ratio;
+        }
         RGB::new(
             (self.r_bar.sample(lambda) * l).average(),
             (self.g_bar.sample(lambda) * l).average(),

@@ -118,6 +118,11 @@ impl DenselySampledSpectrum {
         DenselySampledSpectrum { lambda_min, values }
     }
 
+    /// The wavelength (nm) of the first tabulated value.
+    pub fn lambda_min(&self) -> i32 {
+        self.lambda_min
+    }
+
     /// The tabulated values.
     pub fn values(&self) -> &[Float] {
         &self.values
