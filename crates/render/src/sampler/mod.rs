@@ -97,6 +97,9 @@ impl Sampler {
     /// path in turn.
     #[inline]
     pub fn get_vertex_samples(&mut self) -> (Float, Point2f, Float, Point2f) {
+        if let Sampler::ZSobol(s) = self {
+            return s.get_vertex_samples();
+        }
         dispatch!(self, s => {
             let u_light = s.get_1d();
             let u_light_2d = s.get_2d();
@@ -111,6 +114,9 @@ impl Sampler {
     /// position in the pixel, time (1-D), lens position (2-D).
     #[inline]
     pub fn get_camera_samples(&mut self) -> (Float, Point2f, Float, Point2f) {
+        if let Sampler::ZSobol(s) = self {
+            return s.get_camera_samples();
+        }
         dispatch!(self, s => {
             let u_lambda = s.get_1d();
             let u_pixel = s.get_pixel_2d();

@@ -574,6 +574,40 @@ impl ZSobolSampler {
     /// The next 1-D value.
     #[inline]
     pub fn get_1d(&mut self) -> Float {
+        self.draw_1d()
+    }
+
+    /// The next 2-D value.
+    #[inline]
+    pub fn get_2d(&mut self) -> Point2f {
+        self.draw_2d()
+    }
+
+    /// [`Sampler::get_vertex_samples`](super::Sampler::get_vertex_samples):
+    /// the four draws in one call, each inlined, so that a vertex pays one
+    /// call's overhead instead of four and their work overlaps.
+    #[inline(never)]
+    pub fn get_vertex_samples(&mut self) -> (Float, Point2f, Float, Point2f) {
+        let u_light = self.draw_1d();
+        let u_light_2d = self.draw_2d();
+        let u_bsdf = self.draw_1d();
+        let u_bsdf_2d = self.draw_2d();
+        (u_light, u_light_2d, u_bsdf, u_bsdf_2d)
+    }
+
+    /// [`Sampler::get_camera_samples`](super::Sampler::get_camera_samples)
+    /// in one call (see [`ZSobolSampler::get_vertex_samples`]).
+    #[inline(never)]
+    pub fn get_camera_samples(&mut self) -> (Float, Point2f, Float, Point2f) {
+        let u_lambda = self.draw_1d();
+        let u_pixel = self.draw_2d();
+        let u_time = self.draw_1d();
+        let u_lens = self.draw_2d();
+        (u_lambda, u_pixel, u_time, u_lens)
+    }
+
+    #[inline(always)]
+    fn draw_1d(&mut self) -> Float {
         let index = self.cached_sample_index();
         self.dimension += 1;
         let hash = self.scramble_hash() as u32;
@@ -583,9 +617,8 @@ impl ZSobolSampler {
         sobol_sample(index, 0, scrambler(self.randomize, hash))
     }
 
-    /// The next 2-D value.
-    #[inline]
-    pub fn get_2d(&mut self) -> Point2f {
+    #[inline(always)]
+    fn draw_2d(&mut self) -> Point2f {
         let index = self.cached_sample_index();
         self.dimension += 2;
         let bits = self.scramble_hash();
