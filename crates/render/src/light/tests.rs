@@ -586,6 +586,49 @@ fn light_bounds_importance_and_union() {
     assert_eq!(LightBounds::union(&LightBounds::default(), &a), a);
 }
 
+/// The two-lane importance equals two calls of the scalar one, bit for
+/// bit, over random bounds (one- and two-sided, narrow and wide cones),
+/// points inside and outside them, and with and without a normal.
+#[test]
+fn importance2_matches_importance() {
+    let mut rng = Rng::with_sequence(5);
+    let mut r = |lo: Float, hi: Float| lo + (hi - lo) * rng.uniform_float();
+    let mut nonzero = 0;
+    for i in 0..20_000 {
+        let mut bounds = || {
+            let p0 = Point3f::new(r(-2.0, 2.0), r(-2.0, 2.0), r(-2.0, 2.0));
+            let ext = if i % 7 == 0 { 0.0 } else { 1.0 };
+            let p1 = p0 + Vector3f::new(r(0.0, ext), r(0.0, ext), r(0.0, ext));
+            let w = Vector3f::new(r(-1.0, 1.0), r(-1.0, 1.0), r(-1.0, 1.0));
+            let lb = LightBounds::new(
+                rpbrt_geometry::Bounds3f::new(p0, p1),
+                w,
+                r(0.0, 10.0),
+                r(-1.0, 1.0),
+                r(-1.0, 1.0).min(0.0),
+                i % 3 == 0,
+            );
+            PreparedLightBounds::new(&lb)
+        };
+        let (a, b) = (bounds(), bounds());
+        let p = Point3f::new(r(-4.0, 4.0), r(-4.0, 4.0), r(-4.0, 4.0));
+        let n = if i % 5 == 0 {
+            Normal3f::default()
+        } else {
+            Normal3f::new(r(-1.0, 1.0), r(-1.0, 1.0), r(-1.0, 1.0)).normalize()
+        };
+        let got = importance2(&a, &b, p, n);
+        let want = [a.importance(p, n), b.importance(p, n)];
+        assert_eq!(
+            got.map(Float::to_bits),
+            want.map(Float::to_bits),
+            "case {i}"
+        );
+        nonzero += want.iter().filter(|&&v| v > 0.0).count();
+    }
+    assert!(nonzero > 10_000, "{nonzero}");
+}
+
 #[test]
 fn light_enum_stays_small() {
     assert!(

@@ -8,7 +8,7 @@
 use rpbrt_geometry::{safe_acos, Bounds3f, Float, Point3f, PI};
 
 use super::{SampledLight, ONE_MINUS_EPSILON};
-use crate::light::{Light, LightBounds, LightSampleContext, PreparedLightBounds};
+use crate::light::{importance2, Light, LightBounds, LightSampleContext, PreparedLightBounds};
 
 /// Number of buckets per axis for the split heuristic.
 const N_BUCKETS: usize = 12;
@@ -220,8 +220,12 @@ impl BvhLightSampler {
                 return None;
             }
             let c1 = node.child_or_light as usize;
-            let ci0 = self.nodes[node_index + 1].bounds.importance(p, n);
-            let ci1 = self.nodes[c1].bounds.importance(p, n);
+            let [ci0, ci1] = importance2(
+                &self.nodes[node_index + 1].bounds,
+                &self.nodes[c1].bounds,
+                p,
+                n,
+            );
             if ci0 == 0.0 && ci1 == 0.0 {
                 return None;
             }
@@ -265,8 +269,12 @@ impl BvhLightSampler {
                 return pmf;
             }
             let c1 = node.child_or_light as usize;
-            let ci0 = self.nodes[node_index + 1].bounds.importance(p, n);
-            let ci1 = self.nodes[c1].bounds.importance(p, n);
+            let [ci0, ci1] = importance2(
+                &self.nodes[node_index + 1].bounds,
+                &self.nodes[c1].bounds,
+                p,
+                n,
+            );
             let sum = ci0 + ci1;
             if sum == 0.0 {
                 return 0.0;
