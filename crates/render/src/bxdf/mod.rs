@@ -372,6 +372,14 @@ impl BxDFMethods for BxDF {
 }
 
 impl BxDF {
+    /// True when `f` is zero for every pair of directions on opposite
+    /// sides of the shading plane: the models whose `f` starts with the
+    /// same-hemisphere test (light culling relies on it).
+    #[inline]
+    pub fn zero_across_hemispheres(&self) -> bool {
+        matches!(self, BxDF::Diffuse(_) | BxDF::Conductor(_))
+    }
+
     /// The model's name, as pbrt-v4 prints it.
     pub fn name(&self) -> &'static str {
         match self {

@@ -20,7 +20,7 @@ use crate::bxdf::BSDF;
 use crate::camera::Camera;
 use crate::film::{Film, VisibleSurface};
 use crate::filter::Filter;
-use crate::light::{Light, LightSampleContext};
+use crate::light::{Light, LightCull, LightSampleContext};
 use crate::lightsampler::LightSampler;
 use crate::material::MaterialSet;
 use crate::primitive::{PrimitiveAggregate, PrimitiveIntersection};
@@ -83,6 +83,9 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Indices of the infinite lights in `lights`.
     pub infinite_lights: Vec<u32>,
+    /// Per light, the tests that recognise samples of it that cannot
+    /// contribute (triangle emitters only; see [`LightCull`]).
+    pub light_cull: Vec<Option<LightCull>>,
     /// The light sampler chosen by the integrator.
     pub light_sampler: LightSampler,
     /// The materials, indexed by the primitives' material ids.
@@ -371,6 +374,20 @@ pub(crate) fn sample_ld(
     let Some(sampled) = sampled else {
         return SampledSpectrum::new(0.0);
     };
+    if let Some(Some(cull)) = scene.light_cull.get(sampled.light as usize) {
+        // Samples of this light would be discarded below (zero emission
+        // toward the point, or a zero BSDF): skip taking them.
+        let p = ctx.p();
+        if cull.faces_away_from(p) {
+            return SampledSpectrum::new(0.0);
+        }
+        if bsdf.bxdf.zero_across_hemispheres() {
+            let z = bsdf.shading_frame.z;
+            if cull.behind(p, z, dot(si.wo, z)) {
+                return SampledSpectrum::new(0.0);
+            }
+        }
+    }
     let light = &scene.lights[sampled.light as usize];
     let Some(ls) = light.sample_li(&ctx, u_light, lambda, true) else {
         return SampledSpectrum::new(0.0);

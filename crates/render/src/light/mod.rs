@@ -23,6 +23,7 @@ use crate::spectrum::{
 
 mod area;
 pub mod create;
+mod cull;
 mod distant;
 mod infinite;
 mod point;
@@ -32,6 +33,7 @@ mod tests;
 
 pub use area::{AreaEmission, DiffuseAreaLight};
 pub use create::{create_area_light, create_light};
+pub use cull::LightCull;
 pub use distant::DistantLight;
 pub use infinite::{ImageInfiniteLight, UniformInfiniteLight};
 pub use point::{GoniometricLight, PointLight, ProjectionLight, SpotLight};

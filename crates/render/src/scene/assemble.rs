@@ -11,7 +11,7 @@ use crate::film::{create_film, FilmOverrides};
 use crate::filter::create_filter;
 use crate::image::MIPMapCache;
 use crate::integrator::{create_integrator, Integrator, RayCounters, Scene};
-use crate::light::{create_area_light, create_light, Light, LightType};
+use crate::light::{create_area_light, create_light, Light, LightCull, LightType};
 use crate::lightsampler::create_light_sampler;
 use crate::material::create_materials;
 use crate::primitive::{
@@ -456,6 +456,7 @@ pub fn create_scene(
         sampler,
         filter,
         aggregate,
+        light_cull: lights.iter().map(LightCull::for_light).collect(),
         lights,
         infinite_lights,
         light_sampler,

@@ -483,6 +483,45 @@ impl Triangle {
         }
     }
 
+    /// The normal [`Triangle::oriented_normal`] gives at every point of the
+    /// triangle, when it is the same everywhere: always without vertex
+    /// normals; with them, when all three lie clearly (by a margin far
+    /// above rounding) on the same side of the face, so that their
+    /// interpolation cannot flip it. `None` otherwise.
+    pub fn uniform_oriented_normal(&self) -> Option<Normal3f> {
+        let [p0, p1, p2] = self.vertices();
+        let n = Normal3f::from(cross(p1 - p0, p2 - p0).normalize());
+        if !(n.x.is_finite() && n.y.is_finite() && n.z.is_finite()) {
+            return None;
+        }
+        match &self.mesh.n {
+            Some(ns) => {
+                let v = self.vertex_indices();
+                let side = |i: usize| {
+                    let m = ns[v[i]];
+                    let d = dot(n, m);
+                    let margin = 1e-3 * m.length();
+                    if d > margin {
+                        1
+                    } else if d < -margin {
+                        -1
+                    } else {
+                        0
+                    }
+                };
+                match (side(0), side(1), side(2)) {
+                    (1, 1, 1) => Some(n),
+                    (-1, -1, -1) => Some(-n),
+                    _ => None,
+                }
+            }
+            None if self.mesh.reverse_orientation ^ self.mesh.transform_swaps_handedness => {
+                Some(-n)
+            }
+            None => Some(n),
+        }
+    }
+
     /// The sample at barycentrics `b` with density `pdf`.
     #[inline(always)]
     fn sample_at(&self, b: [Float; 3], pdf: Float, time: Float) -> ShapeSample {
