@@ -28,11 +28,53 @@ use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::interaction::{CameraDifferentials, SurfaceInteraction};
-use rpbrt_geometry::ray::{spawn_ray_to_surface, Ray, RayDifferential, SHADOW_EPSILON};
+use rpbrt_geometry::ray::{
+    offset_ray_origin, spawn_ray_to_surface, Ray, RayDifferential, SHADOW_EPSILON,
+};
 use rpbrt_geometry::tuple::*;
 use rpbrt_geometry::Bounds3f;
 use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary};
 use std::sync::atomic::{AtomicU64, Ordering};
+
+/// A path vertex's ray origins, offset off the surface toward either of
+/// its sides (pbrt-v4's `OffsetRayOrigin`), each computed at most once:
+/// the light sample's reference point, the shadow ray and the next bounce
+/// usually leave by the same side. The offset depends on the direction
+/// only through that side, so a cached origin is the one a fresh
+/// computation would give.
+pub(crate) struct VertexOrigins<'a> {
+    /// The surface point.
+    pub si: &'a SurfaceInteraction,
+    /// Origins for directions with `dot(w, n) ≥ 0` and `< 0` (or NaN
+    /// tests, which count as the first side, as in `offset_ray_origin`).
+    sides: [Option<Point3f>; 2],
+}
+
+impl<'a> VertexOrigins<'a> {
+    /// No origin computed yet.
+    #[inline]
+    pub fn new(si: &'a SurfaceInteraction) -> Self {
+        VertexOrigins {
+            si,
+            sides: [None, None],
+        }
+    }
+
+    /// `si.offset_ray_origin(w)`.
+    #[inline(always)]
+    pub fn toward(&mut self, w: Vector3f) -> Point3f {
+        // The test `offset_ray_origin` makes.
+        let side = (dot(w, self.si.n) < 0.0) as usize;
+        let si = self.si;
+        *self.sides[side].get_or_insert_with(|| si.offset_ray_origin(w))
+    }
+
+    /// `si.spawn_ray(d)`.
+    #[inline]
+    pub fn spawn_ray(&mut self, d: Vector3f) -> Ray {
+        Ray::with_time(self.toward(d), d, self.si.time, None)
+    }
+}
 
 /// Counters shared by all threads (for `--stats`).
 #[derive(Debug, Default)]
@@ -127,6 +169,23 @@ impl Scene {
             c.set((closest, shadow + 1));
         });
         self.aggregate.intersect_p(ray, t_max)
+    }
+
+    /// [`Scene::unoccluded`] with the surface point's offset origin taken
+    /// from `origins` (the same ray).
+    #[inline]
+    pub(crate) fn unoccluded_from(
+        &self,
+        origins: &mut VertexOrigins,
+        to_p: Point3fi,
+        to_n: Normal3f,
+    ) -> bool {
+        let si = origins.si;
+        let p_to = to_p.midpoint();
+        let pf = origins.toward(p_to - si.p());
+        let pt = offset_ray_origin(p_to, to_p.error(), to_n, pf - p_to);
+        let r = Ray::with_time(pf, pt - pf, si.time, None);
+        !self.intersect_p(&r, 1.0 - SHADOW_EPSILON)
     }
 
     /// True when nothing blocks the segment between a surface point and a
@@ -352,23 +411,27 @@ pub fn create_integrator(
 
 /// Samples direct lighting at a surface hit with multiple importance
 /// sampling (pbrt-v4 `PathIntegrator::SampleLd`), given its two sampler
-/// draws: `u` chooses the light and `u_light` the point on it.
+/// draws: `u` chooses the light and `u_light` the point on it. `origins`
+/// holds the vertex's offset ray origins (shared with the shadow ray and
+/// the next bounce).
 #[inline]
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn sample_ld(
     scene: &Scene,
     light_sampler: &LightSampler,
-    si: &SurfaceInteraction,
+    origins: &mut VertexOrigins,
     bsdf: &BSDF,
     lambda: &SampledWavelengths,
     u: Float,
     u_light: Point2f,
 ) -> SampledSpectrum {
+    let si = origins.si;
     let mut ctx = LightSampleContext::from_si(si);
     let flags = bsdf.flags();
     if flags.is_reflective() && !flags.is_transmissive() {
-        ctx.pi = Point3fi::from(si.offset_ray_origin(si.wo));
+        ctx.pi = Point3fi::from(origins.toward(si.wo));
     } else if flags.is_transmissive() && !flags.is_reflective() {
-        ctx.pi = Point3fi::from(si.offset_ray_origin(-si.wo));
+        ctx.pi = Point3fi::from(origins.toward(-si.wo));
     }
     let sampled = light_sampler.sample(&ctx, u);
     let Some(sampled) = sampled else {
@@ -398,7 +461,7 @@ pub(crate) fn sample_ld(
     let wo = si.wo;
     let wi = ls.wi;
     let f = bsdf.f(wo, wi, crate::bxdf::TransportMode::Radiance) * abs_dot(wi, si.shading.n);
-    if f.is_black() || !scene.unoccluded(si, ls.p_light, ls.n_light) {
+    if f.is_black() || !scene.unoccluded_from(origins, ls.p_light, ls.n_light) {
         return SampledSpectrum::new(0.0);
     }
     let p_l = sampled.p * ls.pdf;

@@ -2,7 +2,7 @@
 //! estimation with multiple importance sampling, Russian roulette and
 //! optional BSDF regularization.
 
-use super::{sample_ld, skip_intersection, Scene};
+use super::{sample_ld, skip_intersection, Scene, VertexOrigins};
 use crate::bxdf::{BxDFReflTransFlags, TransportMode};
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
@@ -99,11 +99,20 @@ impl PathIntegrator {
             }
             depth += 1;
             let si = &hit.si;
+            let mut origins = VertexOrigins::new(si);
             // Sampler draws in pbrt-v4's order: the light's two, then the
             // BSDF's two (taken together when there is a light sample).
             let (u, u2) = if bsdf.flags().is_non_specular() {
                 let (u_light, u_light_2d, u, u2) = sampler.get_vertex_samples();
-                let ld = sample_ld(scene, light_sampler, si, bsdf, lambda, u_light, u_light_2d);
+                let ld = sample_ld(
+                    scene,
+                    light_sampler,
+                    &mut origins,
+                    bsdf,
+                    lambda,
+                    u_light,
+                    u_light_2d,
+                );
                 l += beta * ld;
                 (u, u2)
             } else {
@@ -127,7 +136,7 @@ impl PathIntegrator {
             if bs.is_transmission() {
                 eta_scale *= bs.eta * bs.eta;
             }
-            ray = RayDifferential::new(si.spawn_ray(bs.wi));
+            ray = RayDifferential::new(origins.spawn_ray(bs.wi));
             let rr_beta = beta * eta_scale;
             let m = rr_beta.max_component_value();
             if m < 1.0 && depth > 1 {
