@@ -65,8 +65,14 @@ impl<'a> VertexOrigins<'a> {
     pub fn toward(&mut self, w: Vector3f) -> Point3f {
         // The test `offset_ray_origin` makes.
         let side = (dot(w, self.si.n) < 0.0) as usize;
-        let si = self.si;
-        *self.sides[side].get_or_insert_with(|| si.offset_ray_origin(w))
+        match self.sides[side] {
+            Some(p) => p,
+            None => {
+                let p = self.si.offset_ray_origin(w);
+                self.sides[side] = Some(p);
+                p
+            }
+        }
     }
 
     /// `si.spawn_ray(d)`.

@@ -46,7 +46,10 @@ impl PathIntegrator {
         let mut any_non_specular = false;
         let mut prev_ctx = LightSampleContext::default();
         loop {
-            let Some(mut hit) = scene.intersect(&ray.ray, Float::INFINITY) else {
+            // Matched by reference: moving the (large) intersection out of
+            // the `Option` would copy it.
+            let mut closest = scene.intersect(&ray.ray, Float::INFINITY);
+            let Some(hit) = closest.as_mut() else {
                 // Escaped: infinite lights, weighted by MIS unless the last
                 // bounce could not have been light-sampled.
                 for &li in &scene.infinite_lights {
@@ -67,7 +70,7 @@ impl PathIntegrator {
                 break;
             };
             // Emission from an area light that was hit.
-            let le = scene.le(&hit, -ray.ray.d, lambda);
+            let le = scene.le(hit, -ray.ray.d, lambda);
             if !le.is_black() {
                 if depth == 0 || specular_bounce {
                     l += beta * le;
@@ -80,15 +83,15 @@ impl PathIntegrator {
                 }
             }
             // Borrowed in place: moving the (large) BSDF out would copy it.
-            let mut bsdf_slot = scene.get_bsdf(&mut hit, &ray, lambda, sampler);
+            let mut bsdf_slot = scene.get_bsdf(hit, &ray, lambda, sampler);
             let Some(bsdf) = bsdf_slot.as_mut() else {
                 specular_bounce = true;
-                ray = skip_intersection(&ray, &hit);
+                ray = skip_intersection(&ray, hit);
                 continue;
             };
             if depth == 0 {
                 if let Some(v) = visible.take() {
-                    *v = scene.visible_surface(&hit, bsdf);
+                    *v = scene.visible_surface(hit, bsdf);
                 }
             }
             if self.regularize && any_non_specular {
