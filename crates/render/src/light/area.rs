@@ -5,7 +5,7 @@ use rpbrt_geometry::{dot, Float, MediumId, Normal3f, Point2f, Point2i, Point3f, 
 use super::{rgb_illuminant, LightBounds, LightLiSample, LightSampleContext};
 use crate::image::{Image, WrapMode, WrapMode2D};
 use crate::rng::mix_bits;
-use crate::shape::{Shape, ShapeMethods, ShapeSampleContext};
+use crate::shape::{SampledTriangle, Shape, ShapeMethods, ShapeSampleContext};
 use crate::spectrum::{RgbColorSpace, SampledSpectrum, SampledWavelengths, Spectrum};
 use crate::texture::{FloatTextureRef, TextureEvalContext};
 
@@ -39,6 +39,9 @@ pub struct DiffuseAreaLight {
     pub medium_inside: Option<MediumId>,
     /// Medium outside the shape.
     pub medium_outside: Option<MediumId>,
+    /// For a triangle with a uniform oriented normal, its sampling data
+    /// (see [`SampledTriangle`]); built by [`DiffuseAreaLight::with_cache`].
+    pub sampled_triangle: Option<SampledTriangle>,
 }
 
 /// A deterministic hash of a point to [0, 1) (pbrt-v4 `HashFloat`'s role
@@ -110,6 +113,15 @@ impl DiffuseAreaLight {
         }
     }
 
+    /// The light with its sampling cache filled in.
+    pub fn with_cache(mut self) -> Self {
+        self.sampled_triangle = match &self.shape {
+            Shape::Triangle(t) => SampledTriangle::new(t),
+            _ => None,
+        };
+        self
+    }
+
     /// Samples a point on the shape by solid angle from `ctx`.
     pub fn sample_li(
         &self,
@@ -118,7 +130,11 @@ impl DiffuseAreaLight {
         lambda: &SampledWavelengths,
         _allow_incomplete_pdf: bool,
     ) -> Option<LightLiSample> {
-        let ss = self.shape.sample(&Self::shape_ctx(ctx), u)?;
+        let sctx = Self::shape_ctx(ctx);
+        let ss = match &self.sampled_triangle {
+            Some(t) => t.sample(&sctx, u),
+            None => self.shape.sample(&sctx, u),
+        }?;
         if ss.pdf == 0.0 || (ss.p() - ctx.p()).length_squared() == 0.0 {
             return None;
         }

@@ -610,14 +610,18 @@ pub fn create_area_light(
             scale *= power / k_e;
         }
     }
-    Ok(Light::DiffuseArea(Box::new(DiffuseAreaLight {
-        shape: shape.clone(),
-        area,
-        emission,
-        scale,
-        two_sided,
-        alpha,
-        medium_inside,
-        medium_outside,
-    })))
+    Ok(Light::DiffuseArea(Box::new(
+        DiffuseAreaLight {
+            shape: shape.clone(),
+            area,
+            emission,
+            scale,
+            two_sided,
+            alpha,
+            medium_inside,
+            medium_outside,
+            sampled_triangle: None,
+        }
+        .with_cache(),
+    )))
 }

@@ -161,16 +161,20 @@ mod tests {
             };
             let tri = Triangle::new(mesh, 0);
             let area = tri.area();
-            let light = Light::DiffuseArea(Box::new(DiffuseAreaLight {
-                shape: Shape::Triangle(tri),
-                area,
-                emission: AreaEmission::Spectrum(Spectrum::Constant(1.0)),
-                scale: 1.0,
-                two_sided: case % 5 == 0,
-                alpha: None,
-                medium_inside: None,
-                medium_outside: None,
-            }));
+            let light = Light::DiffuseArea(Box::new(
+                DiffuseAreaLight {
+                    shape: Shape::Triangle(tri),
+                    area,
+                    emission: AreaEmission::Spectrum(Spectrum::Constant(1.0)),
+                    scale: 1.0,
+                    two_sided: case % 5 == 0,
+                    alpha: None,
+                    medium_inside: None,
+                    medium_outside: None,
+                    sampled_triangle: None,
+                }
+                .with_cache(),
+            ));
             let Some(cull) = LightCull::for_light(&light) else {
                 continue;
             };

@@ -100,6 +100,7 @@ pub fn sample_spherical_triangle(
 /// to the vertices (`(v[i] - p).normalize()`, all finite) and the solid
 /// angle `area` they subtend ([`spherical_triangle_area`] of them), which
 /// the caller has already computed.
+#[inline(always)]
 pub(crate) fn sample_spherical_triangle_dirs(
     v: [Point3f; 3],
     p: Point3f,

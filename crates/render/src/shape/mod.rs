@@ -23,7 +23,7 @@ pub use disk::Disk;
 pub use hyperboloid::Hyperboloid;
 pub use paraboloid::Paraboloid;
 pub use sphere::Sphere;
-pub use triangle::{Triangle, TriangleMesh};
+pub use triangle::{SampledTriangle, Triangle, TriangleMesh};
 
 pub mod bilinear;
 pub mod cone;

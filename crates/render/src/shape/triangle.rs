@@ -453,17 +453,10 @@ impl Triangle {
         spherical_triangle_area(a, b, c)
     }
 
-    /// The unit directions from `p` to the vertices (NaN components when
-    /// `p` is a vertex), shared by the solid angle, the cos θ weights and
-    /// spherical sampling so that each is normalised once.
+    /// The unit directions from `p` to the vertices.
     #[inline]
     fn directions_from(&self, p: Point3f) -> [Vector3f; 3] {
-        let [p0, p1, p2] = self.vertices();
-        [
-            (p0 - p).normalize(),
-            (p1 - p).normalize(),
-            (p2 - p).normalize(),
-        ]
+        directions_to(self.vertices(), p)
     }
 
     /// The geometric normal at barycentrics `b`, oriented as intersections
@@ -520,38 +513,6 @@ impl Triangle {
             }
             None => Some(n),
         }
-    }
-
-    /// The sample at barycentrics `b` with density `pdf`.
-    #[inline(always)]
-    fn sample_at(&self, b: [Float; 3], pdf: Float, time: Float) -> ShapeSample {
-        let [p0, p1, p2] = self.vertices();
-        let p = p0 * b[0] + p1 * b[1] + p2 * b[2];
-        let abs_sum = (p0 * b[0]).abs() + (p1 * b[1]).abs() + (p2 * b[2]).abs();
-        let p_error = Vector3f::from(abs_sum) * gamma(6);
-        let uv = self.uvs();
-        let uv = Point2f::new(
-            b[0] * uv[0].x + b[1] * uv[1].x + b[2] * uv[2].x,
-            b[0] * uv[0].y + b[1] * uv[1].y + b[2] * uv[2].y,
-        );
-        ShapeSample {
-            pi: Point3fi::from_value_and_error(p, p_error),
-            n: self.oriented_normal(b),
-            uv,
-            time,
-            pdf,
-        }
-    }
-
-    /// The weights of the bilinear cos θ warp for spherical sampling from
-    /// `ctx`: corner (0,0) and (1,0) map to vertex 1, (0,1) to vertex 0 and
-    /// (1,1) to vertex 2, as the spherical triangle sampler lays them out.
-    /// `dirs` are the unit directions from the reference point to the
-    /// vertices.
-    fn cos_weights(ctx: &ShapeSampleContext, dirs: &[Vector3f; 3]) -> [Float; 4] {
-        let w = |d: Vector3f| abs_dot(ctx.ns, d).max(0.01);
-        let (w0, w1, w2) = (w(dirs[0]), w(dirs[1]), w(dirs[2]));
-        [w1, w1, w0, w2]
     }
 
     /// The closest hit along `ray` in (0, `t_max`) as barycentrics and
@@ -785,36 +746,12 @@ impl ShapeMethods for Triangle {
     }
 
     fn sample_area(&self, u: Point2f) -> Option<ShapeSample> {
-        let b = sample_uniform_triangle(u);
-        let pdf = 1.0 / self.area();
-        pdf.is_finite().then(|| self.sample_at(b, pdf, 0.0))
+        sample_area(self, u)
     }
 
     #[inline(always)]
     fn sample(&self, ctx: &ShapeSampleContext, u: Point2f) -> Option<ShapeSample> {
-        let dirs = self.directions_from(ctx.p());
-        let sa = spherical_triangle_area(dirs[0], dirs[1], dirs[2]);
-        if !(MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA).contains(&sa) {
-            let mut ss = self.sample_area(u)?;
-            ss.time = ctx.time;
-            return area_sample_to_solid_angle(ctx, ss);
-        }
-        // Warp u by an approximation of the cos θ factor at the reference
-        // point, then sample the spherical triangle uniformly.
-        let mut pdf = 1.0;
-        let mut u = u;
-        if ctx.ns != Normal3f::default() {
-            let w = Self::cos_weights(ctx, &dirs);
-            u = sample_bilinear(u, w);
-            pdf *= bilinear_pdf(u, w);
-        }
-        // In this branch the solid angle is finite and positive, so the
-        // directions are the ones `try_normalize` would give.
-        let (b, tri_pdf) = sample_spherical_triangle_dirs(self.vertices(), ctx.p(), dirs, sa, u)?;
-        if !(tri_pdf > 0.0) {
-            return None;
-        }
-        Some(self.sample_at(b, pdf * tri_pdf, ctx.time))
+        sample_solid_angle(self, ctx, u)
     }
 
     fn pdf(&self, ctx: &ShapeSampleContext, wi: Vector3f) -> Float {
@@ -828,12 +765,179 @@ impl ShapeMethods for Triangle {
         }
         let mut pdf = 1.0 / sa;
         if ctx.ns != Normal3f::default() {
-            let w = Self::cos_weights(ctx, &dirs);
+            let w = cos_weights(ctx, &dirs);
             let u = invert_spherical_triangle_sample_dirs(dirs, sa, wi.normalize());
             pdf *= bilinear_pdf(u, w);
         }
         pdf
     }
+}
+
+/// What sampling a point on a triangle reads: a mesh triangle's data, or
+/// an emitter's copy of it ([`SampledTriangle`]).
+trait TriangleGeometry {
+    fn corners(&self) -> [Point3f; 3];
+    fn corner_uvs(&self) -> [Point2f; 3];
+    fn normal_at(&self, b: [Float; 3]) -> Normal3f;
+    fn surface_area(&self) -> Float;
+}
+
+impl TriangleGeometry for Triangle {
+    #[inline(always)]
+    fn corners(&self) -> [Point3f; 3] {
+        Triangle::vertices(self)
+    }
+    #[inline(always)]
+    fn corner_uvs(&self) -> [Point2f; 3] {
+        Triangle::uvs(self)
+    }
+    #[inline(always)]
+    fn normal_at(&self, b: [Float; 3]) -> Normal3f {
+        Triangle::oriented_normal(self, b)
+    }
+    #[inline(always)]
+    fn surface_area(&self) -> Float {
+        ShapeMethods::area(self)
+    }
+}
+
+/// A triangle's sampling data copied out of its mesh, for an emitter whose
+/// oriented normal is the same everywhere
+/// ([`Triangle::uniform_oriented_normal`]): light samples are taken at
+/// nearly every path vertex, and reading the copy saves the index
+/// lookups and the per-sample normal computation. Samples are the ones
+/// the mesh triangle gives, bit for bit.
+#[derive(Clone, Debug)]
+pub struct SampledTriangle {
+    v: [Point3f; 3],
+    uv: [Point2f; 3],
+    n: Normal3f,
+    area: Float,
+}
+
+impl SampledTriangle {
+    /// The copy of `tri`, when its oriented normal is uniform.
+    pub fn new(tri: &Triangle) -> Option<SampledTriangle> {
+        Some(SampledTriangle {
+            n: tri.uniform_oriented_normal()?,
+            v: tri.vertices(),
+            uv: tri.uvs(),
+            area: ShapeMethods::area(tri),
+        })
+    }
+
+    /// [`ShapeMethods::sample`] of the triangle (by solid angle).
+    #[inline]
+    pub fn sample(&self, ctx: &ShapeSampleContext, u: Point2f) -> Option<ShapeSample> {
+        sample_solid_angle(self, ctx, u)
+    }
+}
+
+impl TriangleGeometry for SampledTriangle {
+    #[inline(always)]
+    fn corners(&self) -> [Point3f; 3] {
+        self.v
+    }
+    #[inline(always)]
+    fn corner_uvs(&self) -> [Point2f; 3] {
+        self.uv
+    }
+    #[inline(always)]
+    fn normal_at(&self, _b: [Float; 3]) -> Normal3f {
+        self.n
+    }
+    #[inline(always)]
+    fn surface_area(&self) -> Float {
+        self.area
+    }
+}
+
+/// The unit directions from `p` to the vertices (NaN components when `p`
+/// is a vertex), shared by the solid angle, the cos θ weights and
+/// spherical sampling so that each is normalised once.
+#[inline(always)]
+fn directions_to(v: [Point3f; 3], p: Point3f) -> [Vector3f; 3] {
+    let [p0, p1, p2] = v;
+    [
+        (p0 - p).normalize(),
+        (p1 - p).normalize(),
+        (p2 - p).normalize(),
+    ]
+}
+
+/// The weights of the bilinear cos θ warp for spherical sampling from
+/// `ctx`: corner (0,0) and (1,0) map to vertex 1, (0,1) to vertex 0 and
+/// (1,1) to vertex 2, as the spherical triangle sampler lays them out.
+/// `dirs` are the unit directions from the reference point to the
+/// vertices.
+#[inline(always)]
+fn cos_weights(ctx: &ShapeSampleContext, dirs: &[Vector3f; 3]) -> [Float; 4] {
+    let w = |d: Vector3f| abs_dot(ctx.ns, d).max(0.01);
+    let (w0, w1, w2) = (w(dirs[0]), w(dirs[1]), w(dirs[2]));
+    [w1, w1, w0, w2]
+}
+
+/// The sample at barycentrics `b` with density `pdf`.
+#[inline(always)]
+fn sample_at<T: TriangleGeometry>(t: &T, b: [Float; 3], pdf: Float, time: Float) -> ShapeSample {
+    let [p0, p1, p2] = t.corners();
+    let p = p0 * b[0] + p1 * b[1] + p2 * b[2];
+    let abs_sum = (p0 * b[0]).abs() + (p1 * b[1]).abs() + (p2 * b[2]).abs();
+    let p_error = Vector3f::from(abs_sum) * gamma(6);
+    let uv = t.corner_uvs();
+    let uv = Point2f::new(
+        b[0] * uv[0].x + b[1] * uv[1].x + b[2] * uv[2].x,
+        b[0] * uv[0].y + b[1] * uv[1].y + b[2] * uv[2].y,
+    );
+    ShapeSample {
+        pi: Point3fi::from_value_and_error(p, p_error),
+        n: t.normal_at(b),
+        uv,
+        time,
+        pdf,
+    }
+}
+
+/// A uniform sample by area.
+#[inline]
+fn sample_area<T: TriangleGeometry>(t: &T, u: Point2f) -> Option<ShapeSample> {
+    let b = sample_uniform_triangle(u);
+    let pdf = 1.0 / t.surface_area();
+    pdf.is_finite().then(|| sample_at(t, b, pdf, 0.0))
+}
+
+/// pbrt-v4's `Triangle::Sample(ctx, u)`: uniform in the solid angle the
+/// triangle subtends, warped by the cos θ approximation at the reference
+/// point; by area when the solid angle is too small or too large.
+#[inline(always)]
+fn sample_solid_angle<T: TriangleGeometry>(
+    t: &T,
+    ctx: &ShapeSampleContext,
+    u: Point2f,
+) -> Option<ShapeSample> {
+    let dirs = directions_to(t.corners(), ctx.p());
+    let sa = spherical_triangle_area(dirs[0], dirs[1], dirs[2]);
+    if !(MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA).contains(&sa) {
+        let mut ss = sample_area(t, u)?;
+        ss.time = ctx.time;
+        return area_sample_to_solid_angle(ctx, ss);
+    }
+    // Warp u by an approximation of the cos θ factor at the reference
+    // point, then sample the spherical triangle uniformly.
+    let mut pdf = 1.0;
+    let mut u = u;
+    if ctx.ns != Normal3f::default() {
+        let w = cos_weights(ctx, &dirs);
+        u = sample_bilinear(u, w);
+        pdf *= bilinear_pdf(u, w);
+    }
+    // In this branch the solid angle is finite and positive, so the
+    // directions are the ones `try_normalize` would give.
+    let (b, tri_pdf) = sample_spherical_triangle_dirs(t.corners(), ctx.p(), dirs, sa, u)?;
+    if !(tri_pdf > 0.0) {
+        return None;
+    }
+    Some(sample_at(t, b, pdf * tri_pdf, ctx.time))
 }
 
 #[cfg(test)]
