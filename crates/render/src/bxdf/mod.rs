@@ -361,7 +361,7 @@ impl BxDFMethods for BxDF {
     ) -> Float {
         dispatch!(self, b => b.pdf(wo, wi, mode, sample_flags))
     }
-    #[inline]
+    #[inline(always)]
     fn flags(&self) -> BxDFFlags {
         dispatch!(self, b => b.flags())
     }

@@ -189,7 +189,7 @@ impl TriangleMesh {
     }
 
     /// The vertex indices of triangle `i`.
-    #[inline]
+    #[inline(always)]
     fn vertex_indices(&self, i: usize) -> [usize; 3] {
         [
             self.indices[3 * i] as usize,
@@ -426,13 +426,14 @@ impl Triangle {
         self.mesh.vertices(self.tri_index as usize)
     }
 
-    #[inline]
+    #[inline(always)]
     fn vertex_indices(&self) -> [usize; 3] {
         self.mesh.vertex_indices(self.tri_index as usize)
     }
 
     /// The texture coordinates of the vertices, (0,0), (1,0), (1,1) when
     /// the mesh has none.
+    #[inline(always)]
     fn uvs(&self) -> [Point2f; 3] {
         match &self.mesh.uv {
             Some(uv) => {
