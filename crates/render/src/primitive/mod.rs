@@ -221,6 +221,19 @@ impl Primitive {
 /// triangles beside the primitives for the traversal.
 const MAX_CACHED_TRIANGLE_PRIMITIVES: usize = 1 << 22;
 
+/// The closest hit found so far by [`PrimitiveAggregate::intersect`]: an
+/// opaque triangle's barycentrics (its interaction is built once, for the
+/// closest), or another primitive's full intersection.
+enum Closest {
+    None,
+    Full(PrimitiveIntersection),
+    Triangle {
+        prim: u32,
+        b: (Float, Float, Float),
+        t_hit: Float,
+    },
+}
+
 /// Primitives under an acceleration structure (pbrt-v4's aggregates).
 #[derive(Clone, Debug)]
 pub struct PrimitiveAggregate {
@@ -284,47 +297,33 @@ impl PrimitiveAggregate {
     /// is built, at the end. The result is the same as building every
     /// hit's, as pbrt-v4 does.
     pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
-        enum Closest {
-            None,
-            Full(PrimitiveIntersection),
-            Triangle {
-                prim: u32,
-                b: (Float, Float, Float),
-                t_hit: Float,
-                ray: Ray,
-            },
-        }
         let mut closest = Closest::None;
         let tr = TriangleRay::new(ray);
-        self.accel.intersect(ray, t_max, |i, r, t| {
-            if let Some(Some([p0, p1, p2])) = self.triangle_vertices.get(i as usize) {
-                let (p0, p1, p2) = (*p0, *p1, *p2);
-                let (b0, b1, b2, t_hit) = intersect_prepared_triangle(&tr, t, p0, p1, p2)?;
-                closest = Closest::Triangle {
-                    prim: i,
-                    b: (b0, b1, b2),
-                    t_hit,
-                    ray: *r,
-                };
-                return Some(t_hit);
-            }
-            let pi = self.prims[i as usize].intersect(r, t)?;
-            let th = pi.t_hit;
-            closest = Closest::Full(pi);
-            Some(th)
-        });
+        self.accel.intersect(
+            ray,
+            t_max,
+            #[inline(always)]
+            |i, _, t| {
+                if let Some(Some([p0, p1, p2])) = self.triangle_vertices.get(i as usize) {
+                    let (p0, p1, p2) = (*p0, *p1, *p2);
+                    let (b0, b1, b2, t_hit) = intersect_prepared_triangle(&tr, t, p0, p1, p2)?;
+                    closest = Closest::Triangle {
+                        prim: i,
+                        b: (b0, b1, b2),
+                        t_hit,
+                    };
+                    return Some(t_hit);
+                }
+                self.intersect_other(i, ray, t, &mut closest)
+            },
+        );
         match closest {
             Closest::None => None,
             Closest::Full(pi) => Some(pi),
-            Closest::Triangle {
-                prim,
-                b,
-                t_hit,
-                ray,
-            } => match &self.prims[prim as usize] {
+            Closest::Triangle { prim, b, t_hit } => match &self.prims[prim as usize] {
                 Primitive::Geometric(g) => match &g.shape {
                     Shape::Triangle(tri) => Some(PrimitiveIntersection {
-                        si: tri.interaction_at_hit(b.0, b.1, b.2, &ray),
+                        si: tri.interaction_at_hit(b.0, b.1, b.2, ray),
                         t_hit,
                         material: g.material,
                         area_light: g.area_light,
@@ -336,6 +335,22 @@ impl PrimitiveAggregate {
                 _ => None,
             },
         }
+    }
+
+    /// The test of a primitive that is not an opaque triangle, out of line
+    /// so that the triangle test above inlines into the traversal.
+    #[inline(never)]
+    fn intersect_other(
+        &self,
+        i: u32,
+        ray: &Ray,
+        t_max: Float,
+        closest: &mut Closest,
+    ) -> Option<Float> {
+        let pi = self.prims[i as usize].intersect(ray, t_max)?;
+        let th = pi.t_hit;
+        *closest = Closest::Full(pi);
+        Some(th)
     }
 
     /// Whether anything is hit in (0, t_max).
