@@ -98,7 +98,7 @@ impl Sampler {
     #[inline]
     pub fn get_vertex_samples(&mut self) -> (Float, Point2f, Float, Point2f) {
         if let Sampler::ZSobol(s) = self {
-            return s.get_vertex_samples();
+            return s.get_1d_2d_1d_2d();
         }
         dispatch!(self, s => {
             let u_light = s.get_1d();
@@ -115,7 +115,7 @@ impl Sampler {
     #[inline]
     pub fn get_camera_samples(&mut self) -> (Float, Point2f, Float, Point2f) {
         if let Sampler::ZSobol(s) = self {
-            return s.get_camera_samples();
+            return s.get_1d_2d_1d_2d();
         }
         dispatch!(self, s => {
             let u_lambda = s.get_1d();

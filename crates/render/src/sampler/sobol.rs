@@ -583,27 +583,20 @@ impl ZSobolSampler {
         self.draw_2d()
     }
 
-    /// [`Sampler::get_vertex_samples`](super::Sampler::get_vertex_samples):
-    /// the four draws in one call, each inlined, so that a vertex pays one
-    /// call's overhead instead of four and their work overlaps.
+    /// A 1-D, a 2-D, a 1-D and a 2-D draw in one call, each inlined, so
+    /// that a path vertex
+    /// ([`Sampler::get_vertex_samples`](super::Sampler::get_vertex_samples))
+    /// or a camera sample
+    /// ([`Sampler::get_camera_samples`](super::Sampler::get_camera_samples))
+    /// pays one call's overhead instead of four and the draws' work
+    /// overlaps.
     #[inline(never)]
-    pub fn get_vertex_samples(&mut self) -> (Float, Point2f, Float, Point2f) {
-        let u_light = self.draw_1d();
-        let u_light_2d = self.draw_2d();
-        let u_bsdf = self.draw_1d();
-        let u_bsdf_2d = self.draw_2d();
-        (u_light, u_light_2d, u_bsdf, u_bsdf_2d)
-    }
-
-    /// [`Sampler::get_camera_samples`](super::Sampler::get_camera_samples)
-    /// in one call (see [`ZSobolSampler::get_vertex_samples`]).
-    #[inline(never)]
-    pub fn get_camera_samples(&mut self) -> (Float, Point2f, Float, Point2f) {
-        let u_lambda = self.draw_1d();
-        let u_pixel = self.draw_2d();
-        let u_time = self.draw_1d();
-        let u_lens = self.draw_2d();
-        (u_lambda, u_pixel, u_time, u_lens)
+    pub fn get_1d_2d_1d_2d(&mut self) -> (Float, Point2f, Float, Point2f) {
+        let a = self.draw_1d();
+        let b = self.draw_2d();
+        let c = self.draw_1d();
+        let d = self.draw_2d();
+        (a, b, c, d)
     }
 
     #[inline(always)]
