@@ -184,6 +184,18 @@ pub fn spawn_ray_to_surface(
     n_to: Normal3f,
 ) -> Ray {
     let pf = offset_ray_origin(p_from, err_from, n_from, p_to - p_from);
+    spawn_ray_from_origin_to_surface(pf, time, p_to, err_to, n_to)
+}
+
+/// [`spawn_ray_to_surface`] given the start point's offset origin `pf`.
+#[inline]
+pub fn spawn_ray_from_origin_to_surface(
+    pf: Point3f,
+    time: Float,
+    p_to: Point3f,
+    err_to: Vector3f,
+    n_to: Normal3f,
+) -> Ray {
     let pt = offset_ray_origin(p_to, err_to, n_to, pf - p_to);
     Ray::with_time(pf, pt - pf, time, None)
 }

@@ -29,7 +29,7 @@ use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::interaction::{CameraDifferentials, SurfaceInteraction};
 use rpbrt_geometry::ray::{
-    offset_ray_origin, spawn_ray_to_surface, Ray, RayDifferential, SHADOW_EPSILON,
+    spawn_ray_from_origin_to_surface, spawn_ray_to_surface, Ray, RayDifferential, SHADOW_EPSILON,
 };
 use rpbrt_geometry::tuple::*;
 use rpbrt_geometry::Bounds3f;
@@ -189,8 +189,7 @@ impl Scene {
         let si = origins.si;
         let p_to = to_p.midpoint();
         let pf = origins.toward(p_to - si.p());
-        let pt = offset_ray_origin(p_to, to_p.error(), to_n, pf - p_to);
-        let r = Ray::with_time(pf, pt - pf, si.time, None);
+        let r = spawn_ray_from_origin_to_surface(pf, si.time, p_to, to_p.error(), to_n);
         !self.intersect_p(&r, 1.0 - SHADOW_EPSILON)
     }
 
@@ -421,7 +420,6 @@ pub fn create_integrator(
 /// holds the vertex's offset ray origins (shared with the shadow ray and
 /// the next bounce).
 #[inline]
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn sample_ld(
     scene: &Scene,
     light_sampler: &LightSampler,

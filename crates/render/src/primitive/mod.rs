@@ -223,7 +223,9 @@ const MAX_CACHED_TRIANGLE_PRIMITIVES: usize = 1 << 22;
 
 /// The closest hit found so far by [`PrimitiveAggregate::intersect`]: an
 /// opaque triangle's barycentrics (its interaction is built once, for the
-/// closest), or another primitive's full intersection.
+/// closest), or another primitive's full intersection (kept inline:
+/// boxing it would allocate per hit).
+#[allow(clippy::large_enum_variant)]
 enum Closest {
     None,
     Full(PrimitiveIntersection),
