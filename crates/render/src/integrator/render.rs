@@ -1,7 +1,9 @@
 //! The parallel render loop (pbrt-v4 `ImageTileIntegrator::Render` and
 //! `RayIntegrator::EvaluatePixelSample`): image tiles rendered in parallel,
-//! samples taken in waves of doubling size so that progress, interruption
-//! and partial images happen between waves.
+//! samples taken in waves: pbrt-v4's doubling waves when partial images or
+//! per-wave MSE are asked for, otherwise one sample per pixel and then the
+//! rest. A thread draws the progress bar while a wave runs, and Ctrl-C is
+//! checked at every pixel.
 
 use super::{Integrator, Scene};
 use crate::camera::CameraSample;
@@ -14,7 +16,7 @@ use rpbrt_geometry::float::Float;
 use rpbrt_geometry::ray::RayDifferential;
 use rpbrt_geometry::tuple::*;
 use std::io::{IsTerminal, Write};
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
@@ -143,6 +145,42 @@ fn evaluate_pixel_sample(
     );
 }
 
+/// The samples of the wave after `[start, end)`: pbrt-v4's schedule,
+/// doubling waves of at most 64 samples, when something happens between
+/// waves (partial images, MSE against a reference); otherwise everything
+/// left in one wave. A wave revisits every pixel, and the Z-Sobol sampler's
+/// caches start over on each pixel it moves to, so fewer waves are faster;
+/// the first wave of one sample per pixel is kept either way, so that an
+/// interrupted render has every pixel.
+fn next_wave(end: i32, wave_size: i32, spp: i32, progressive: bool) -> (i32, i32) {
+    if progressive {
+        ((end + wave_size).min(spp), (2 * wave_size).min(64))
+    } else {
+        (spp, wave_size)
+    }
+}
+
+/// The progress bar line for `done` of `total` samples after `elapsed`
+/// seconds.
+fn progress_line(done: u64, total: u64, elapsed: f64) -> String {
+    let frac = done as f64 / total.max(1) as f64;
+    let eta = if frac > 0.0 {
+        elapsed / frac - elapsed
+    } else {
+        0.0
+    };
+    let width = 40;
+    let filled = ((frac * width as f64) as usize).min(width);
+    format!(
+        "\r[{}{}] {:5.1}% {:.1}s elapsed, ETA {:.1}s ",
+        "+".repeat(filled),
+        " ".repeat(width - filled),
+        frac * 100.0,
+        elapsed,
+        eta
+    )
+}
+
 /// Renders `scene` with `integrator`, writing the film's image (and partial
 /// images when asked). `metadata` is completed with timing and sample
 /// counts.
@@ -167,101 +205,119 @@ pub fn render(
     // texture filtering or bump mapping, or a G-buffer film's depth slopes.
     let differentials =
         scene.film.uses_visible_surface() || scene.materials.any_needs_differentials();
-    let mut done: u64 = 0;
+    let progressive = opts.write_partial_images || opts.mse_reference.is_some();
+    let interrupt_set = || {
+        opts.interrupt
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::Relaxed))
+    };
+    // Samples taken so far, counted by the tiles as they finish (the
+    // progress bar reads it while a wave runs).
+    let samples_done = AtomicU64::new(0);
+    let rendering = AtomicBool::new(true);
     let mut wave_start = 0;
     let mut wave_end = 1;
     let mut next_wave_size = 1;
     let mut interrupted = false;
     let mut mse_per_wave = Vec::new();
-    while wave_start < spp {
-        let results: Vec<FilmTile> = {
-            let scene_ref: &Scene = scene;
-            pool.install(|| {
-                tile_list
-                    .par_iter()
-                    .map(|&b| {
-                        let mut tile = scene_ref.film.make_tile(b);
-                        let mut sampler = scene_ref.sampler.clone();
-                        super::RayCounters::reset_local();
-                        let mut camera_rays = 0u64;
-                        for p in b.iter() {
-                            for s in wave_start..wave_end {
-                                sampler.start_pixel_sample(p, s, 0);
-                                evaluate_pixel_sample(
-                                    scene_ref,
-                                    integrator,
-                                    opts,
-                                    p,
-                                    &mut sampler,
-                                    &mut tile,
-                                    differentials,
-                                );
-                            }
-                            camera_rays += (wave_end - wave_start) as u64;
-                        }
-                        scene_ref.counters.flush_local();
-                        scene_ref
-                            .counters
-                            .camera_rays
-                            .fetch_add(camera_rays, Ordering::Relaxed);
-                        tile
-                    })
-                    .collect()
-            })
-        };
-        for t in results {
-            scene.film.merge_tile(&t);
-        }
-        done += pixels * (wave_end - wave_start) as u64;
-        wave_start = wave_end;
-        wave_end = (wave_end + next_wave_size).min(spp);
-        next_wave_size = (2 * next_wave_size).min(64);
+    let result = std::thread::scope(|threads| -> Result<(), String> {
         if show_progress {
-            let elapsed = start.elapsed().as_secs_f64();
-            let frac = done as f64 / total.max(1) as f64;
-            let eta = if frac > 0.0 {
-                elapsed / frac - elapsed
-            } else {
-                0.0
-            };
-            let width = 40;
-            let filled = (frac * width as f64) as usize;
-            eprint!(
-                "\r[{}{}] {:5.1}% {:.1}s elapsed, ETA {:.1}s ",
-                "+".repeat(filled),
-                " ".repeat(width - filled),
-                frac * 100.0,
-                elapsed,
-                eta
-            );
-            let _ = std::io::stderr().flush();
+            let (samples_done, rendering) = (&samples_done, &rendering);
+            threads.spawn(move || {
+                while rendering.load(Ordering::Relaxed) {
+                    let line = progress_line(
+                        samples_done.load(Ordering::Relaxed),
+                        total,
+                        start.elapsed().as_secs_f64(),
+                    );
+                    eprint!("{line}");
+                    let _ = std::io::stderr().flush();
+                    std::thread::sleep(Duration::from_millis(250));
+                }
+            });
         }
-        if let Some(reference) = &opts.mse_reference {
-            let mut md = ImageMetadata::default();
-            let image = scene.film.get_image(&mut md, 1.0);
-            let d = crate::image::ops::diff(&image, reference)
-                .map_err(|e| format!("--mse-reference-image: {e}"))?;
-            mse_per_wave.push((wave_start, d.mse));
-        }
-        if opts
-            .interrupt
-            .as_ref()
-            .is_some_and(|f| f.load(Ordering::Relaxed))
-        {
-            interrupted = true;
-            break;
-        }
-        if opts.write_partial_images && wave_start < spp {
-            metadata.render_time_seconds = Some(start.elapsed().as_secs_f32());
-            metadata.samples_per_pixel = Some(wave_start);
-            scene.film.write_image(metadata, 1.0)?;
-        }
-    }
+        let outcome = (|| {
+            while wave_start < spp {
+                let results: Vec<FilmTile> = {
+                    let scene_ref: &Scene = scene;
+                    let samples_done = &samples_done;
+                    pool.install(|| {
+                        tile_list
+                            .par_iter()
+                            .map(|&b| {
+                                let mut tile = scene_ref.film.make_tile(b);
+                                let mut sampler = scene_ref.sampler.clone();
+                                super::RayCounters::reset_local();
+                                let mut camera_rays = 0u64;
+                                for p in b.iter() {
+                                    // Checked per pixel: a wave can be the
+                                    // whole render.
+                                    if interrupt_set() {
+                                        break;
+                                    }
+                                    for s in wave_start..wave_end {
+                                        sampler.start_pixel_sample(p, s, 0);
+                                        evaluate_pixel_sample(
+                                            scene_ref,
+                                            integrator,
+                                            opts,
+                                            p,
+                                            &mut sampler,
+                                            &mut tile,
+                                            differentials,
+                                        );
+                                    }
+                                    camera_rays += (wave_end - wave_start) as u64;
+                                }
+                                scene_ref.counters.flush_local();
+                                scene_ref
+                                    .counters
+                                    .camera_rays
+                                    .fetch_add(camera_rays, Ordering::Relaxed);
+                                samples_done.fetch_add(camera_rays, Ordering::Relaxed);
+                                tile
+                            })
+                            .collect()
+                    })
+                };
+                for t in results {
+                    scene.film.merge_tile(&t);
+                }
+                if interrupt_set() {
+                    interrupted = true;
+                    break;
+                }
+                wave_start = wave_end;
+                (wave_end, next_wave_size) = next_wave(wave_end, next_wave_size, spp, progressive);
+                if let Some(reference) = &opts.mse_reference {
+                    let mut md = ImageMetadata::default();
+                    let image = scene.film.get_image(&mut md, 1.0);
+                    let d = crate::image::ops::diff(&image, reference)
+                        .map_err(|e| format!("--mse-reference-image: {e}"))?;
+                    mse_per_wave.push((wave_start, d.mse));
+                }
+                if opts.write_partial_images && wave_start < spp {
+                    metadata.render_time_seconds = Some(start.elapsed().as_secs_f32());
+                    metadata.samples_per_pixel = Some(wave_start);
+                    scene.film.write_image(metadata, 1.0)?;
+                }
+            }
+            Ok(())
+        })();
+        rendering.store(false, Ordering::Relaxed);
+        outcome
+    });
+    result?;
+    let done = samples_done.load(Ordering::Relaxed);
     if show_progress {
-        eprintln!();
+        eprintln!(
+            "{}",
+            progress_line(done, total, start.elapsed().as_secs_f64())
+        );
     }
     let render_time = start.elapsed();
     metadata.render_time_seconds = Some(render_time.as_secs_f32());
+    // Every pixel has at least the samples of the completed waves.
     metadata.samples_per_pixel = Some(wave_start);
     if let Some(&(_, mse)) = mse_per_wave.last() {
         metadata.mse = Some(mse as f32);
@@ -273,4 +329,42 @@ pub fn render(
         interrupted,
         mse_per_wave,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::next_wave;
+
+    /// The waves as `[start, end)` ranges for `spp` samples per pixel.
+    fn waves(spp: i32, progressive: bool) -> Vec<(i32, i32)> {
+        let (mut start, mut end, mut size) = (0, 1, 1);
+        let mut out = Vec::new();
+        while start < spp {
+            out.push((start, end));
+            start = end;
+            (end, size) = next_wave(end, size, spp, progressive);
+        }
+        out
+    }
+
+    #[test]
+    fn progressive_waves_double_as_in_pbrt_v4() {
+        assert_eq!(
+            waves(64, true),
+            [(0, 1), (1, 2), (2, 4), (4, 8), (8, 16), (16, 32), (32, 64)]
+        );
+        // At most 64 samples a wave.
+        let w = waves(300, true);
+        assert!(w.iter().all(|&(a, b)| b - a <= 64));
+        assert_eq!(w.last(), Some(&(256, 300)));
+        assert_eq!(waves(1, true), [(0, 1)]);
+    }
+
+    #[test]
+    fn other_renders_take_one_sample_then_the_rest() {
+        assert_eq!(waves(64, false), [(0, 1), (1, 64)]);
+        assert_eq!(waves(1000, false), [(0, 1), (1, 1000)]);
+        assert_eq!(waves(1, false), [(0, 1)]);
+        assert_eq!(waves(2, false), [(0, 1), (1, 2)]);
+    }
 }
