@@ -385,6 +385,32 @@ impl PixelDigitCache {
         high
     }
 
+    /// Caches, for dimension `d`, everything the lowest sample digit
+    /// (digit `odd`) takes from the index bits above it: the permuted
+    /// digits above it and its own permutation, under those bits as the
+    /// key. Needs `split > odd` (at least one sample digit above the last
+    /// bit).
+    #[inline(always)]
+    fn refresh_low(
+        &mut self,
+        morton: u64,
+        d: usize,
+        split: usize,
+        n_digits: usize,
+        odd: usize,
+        dim_mix: u64,
+    ) {
+        let key = morton >> (odd + 2);
+        // A new key whenever the pixel changes, so `high` is checked here.
+        let mut upper = self.pixel_digits(morton, d, split, n_digits, odd, dim_mix);
+        for i in odd + 1..split {
+            upper |= self.digit(morton, d, i, odd, dim_mix);
+        }
+        self.low_key[d] = key;
+        self.low_upper[d] = upper;
+        self.low_perm[d] = ZSobolSampler::digit_permutation(key, dim_mix) as u8;
+    }
+
     /// Permuted digit `i` of `morton` in place (at bit `2i - odd`), for
     /// dimension `d`, from the cache when the digits above it are the ones
     /// it was last chosen for.
@@ -532,15 +558,7 @@ impl ZSobolSampler {
             let shift = odd;
             let key = morton >> (shift + 2);
             if cache.low_key[d] != key {
-                // A new key whenever the pixel changes, so `high` is
-                // checked here.
-                let mut upper = cache.pixel_digits(morton, d, split, n_digits, odd, dim_mix);
-                for i in odd + 1..split {
-                    upper |= cache.digit(morton, d, i, odd, dim_mix);
-                }
-                cache.low_key[d] = key;
-                cache.low_upper[d] = upper;
-                cache.low_perm[d] = Self::digit_permutation(key, dim_mix) as u8;
+                cache.refresh_low(morton, d, split, n_digits, odd, dim_mix);
             }
             let digit = ((morton >> shift) & 3) as usize;
             cache.low_upper[d] | (PERMUTATIONS_4[cache.low_perm[d] as usize][digit] as u64) << shift
@@ -602,11 +620,12 @@ impl ZSobolSampler {
         (a, b, c, d)
     }
 
-    /// [`ZSobolSampler::get_1d_2d_1d_2d`] when all four draws' indices are
-    /// cached under the current key (even log2 spp, fast Owen scrambling,
-    /// cached dimensions): one test for the four instead of a branch each,
-    /// since their caches miss together (every fourth sample and on a new
-    /// pixel). The same values as the four draws.
+    /// [`ZSobolSampler::get_1d_2d_1d_2d`] for even log2 spp, fast Owen
+    /// scrambling and cached dimensions: the four draws' cache entries are
+    /// tested together (one branch instead of one each, since they miss
+    /// together: every fourth sample and on a new pixel), refreshed where
+    /// stale, and the draws computed from them. The same values as the
+    /// four single draws.
     #[inline(always)]
     fn four_cached_draws(&mut self) -> Option<(Float, Point2f, Float, Point2f)> {
         let d = self.dimension as usize;
@@ -623,14 +642,26 @@ impl ZSobolSampler {
         // sample digit); its key is everything above it.
         let morton = self.morton_index;
         let key = morton >> 2;
-        let c = &*self.cache;
+        let c = &mut *self.cache;
         let all_cached = (c.low_key[d] == key)
             & (c.low_key[d + 1] == key)
             & (c.low_key[d + 3] == key)
             & (c.low_key[d + 4] == key);
         if !all_cached {
-            return None;
+            // Refreshed here, as the single draws would (the same cache
+            // entries), without their per-draw checks.
+            let split = (self.log2_samples_per_pixel / 2) as usize;
+            if split > n_digits {
+                return None;
+            }
+            for dd in [d, d + 1, d + 3, d + 4] {
+                if c.low_key[dd] != key {
+                    let dim_mix = 0x5555_5555u64.wrapping_mul(dd as u64);
+                    c.refresh_low(morton, dd, split, n_digits, 0, dim_mix);
+                }
+            }
         }
+        let c = &*self.cache;
         let digit = (morton & 3) as usize;
         let index =
             |dd: usize| c.low_upper[dd] | PERMUTATIONS_4[c.low_perm[dd] as usize][digit] as u64;
