@@ -221,9 +221,9 @@ pub fn render(
     let mut interrupted = false;
     let mut mse_per_wave = Vec::new();
     let result = std::thread::scope(|threads| -> Result<(), String> {
-        if show_progress {
+        let reporter = if show_progress {
             let (samples_done, rendering) = (&samples_done, &rendering);
-            threads.spawn(move || {
+            Some(threads.spawn(move || {
                 while rendering.load(Ordering::Relaxed) {
                     let line = progress_line(
                         samples_done.load(Ordering::Relaxed),
@@ -232,10 +232,13 @@ pub fn render(
                     );
                     eprint!("{line}");
                     let _ = std::io::stderr().flush();
-                    std::thread::sleep(Duration::from_millis(250));
+                    // Woken early when the render ends.
+                    std::thread::park_timeout(Duration::from_millis(250));
                 }
-            });
-        }
+            }))
+        } else {
+            None
+        };
         let outcome = (|| {
             while wave_start < spp {
                 let results: Vec<FilmTile> = {
@@ -305,6 +308,9 @@ pub fn render(
             Ok(())
         })();
         rendering.store(false, Ordering::Relaxed);
+        if let Some(r) = reporter {
+            r.thread().unpark();
+        }
         outcome
     });
     result?;

@@ -504,6 +504,19 @@ impl ZSobolSampler {
         index
     }
 
+    /// The hash input that makes digit permutations differ by dimension.
+    #[inline(always)]
+    fn dim_mix(dimension: usize) -> u64 {
+        0x5555_5555u64.wrapping_mul(dimension as u64)
+    }
+
+    /// The first base-4 digit that lies in the pixel's Morton code
+    /// (digits below it come from the sample index), at most `n_digits`.
+    #[inline(always)]
+    fn split(&self, n_digits: usize) -> usize {
+        (self.log2_samples_per_pixel.div_ceil(2) as usize).min(n_digits)
+    }
+
     /// Which of the 24 permutations of a base-4 digit the digits above it
     /// (`higher`) and the dimension select.
     #[inline(always)]
@@ -528,7 +541,7 @@ impl ZSobolSampler {
     /// digits above it and the dimension.
     pub fn sample_index(&self) -> u64 {
         let last_digit = (self.log2_samples_per_pixel & 1) as i32;
-        let dim_mix = 0x5555_5555u64.wrapping_mul(self.dimension as i64 as u64);
+        let dim_mix = Self::dim_mix(self.dimension as usize);
         self.permuted_digits(last_digit, self.n_base4_digits as i32, dim_mix)
             | self.permuted_last_bit(dim_mix)
     }
@@ -544,9 +557,9 @@ impl ZSobolSampler {
         if d >= ZSOBOL_CACHED_DIMENSIONS || n_digits > ZSOBOL_CACHED_DIGITS {
             return self.sample_index();
         }
-        let split = (self.log2_samples_per_pixel.div_ceil(2) as usize).min(n_digits);
+        let split = self.split(n_digits);
         let odd = (self.log2_samples_per_pixel & 1) as usize;
-        let dim_mix = 0x5555_5555u64.wrapping_mul(self.dimension as i64 as u64);
+        let dim_mix = Self::dim_mix(d);
         let morton = self.morton_index;
         let cache = &mut *self.cache;
         let mut index = if split > odd {
@@ -642,6 +655,7 @@ impl ZSobolSampler {
         // sample digit); its key is everything above it.
         let morton = self.morton_index;
         let key = morton >> 2;
+        let split = self.split(n_digits);
         let c = &mut *self.cache;
         let all_cached = (c.low_key[d] == key)
             & (c.low_key[d + 1] == key)
@@ -650,14 +664,12 @@ impl ZSobolSampler {
         if !all_cached {
             // Refreshed here, as the single draws would (the same cache
             // entries), without their per-draw checks.
-            let split = (self.log2_samples_per_pixel / 2) as usize;
-            if split > n_digits {
+            if split == 0 {
                 return None;
             }
             for dd in [d, d + 1, d + 3, d + 4] {
                 if c.low_key[dd] != key {
-                    let dim_mix = 0x5555_5555u64.wrapping_mul(dd as u64);
-                    c.refresh_low(morton, dd, split, n_digits, 0, dim_mix);
+                    c.refresh_low(morton, dd, split, n_digits, 0, Self::dim_mix(dd));
                 }
             }
         }
