@@ -17,6 +17,7 @@ pub mod rng;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod select;
 pub mod shape;
 pub mod spectrum;
 pub mod texture;

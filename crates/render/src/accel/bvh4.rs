@@ -155,23 +155,24 @@ impl WideRay {
         for a in 0..3 {
             let inv = 1.0 / d[a];
             w.inv[a] = inv;
-            // Zero components: the nudged origins of `RayPrecomp` (lo
-            // planes against an origin one ulp up, hi planes one ulp down)
-            // so that a ray lying in a face counts as inside.
-            let (o_lo, o_hi) = if d[a] == 0.0 {
-                (next_float_up(o[a]), next_float_down(o[a]))
-            } else {
-                (o[a], o[a])
-            };
             // A negative direction (−0 included) enters through the max
             // plane. Selected, not branched on: the signs of a ray's
-            // direction are as good as random.
+            // direction are as good as random. (Only integers: a select
+            // between floats becomes a branch on x86-64.)
             let neg = inv < 0.0;
-            use std::hint::select_unpredictable as sel;
+            let sel = std::hint::select_unpredictable;
             w.near[a] = sel(neg, 3 + a, a);
             w.far[a] = sel(neg, a, 3 + a);
-            w.o_near[a] = sel(neg, o_hi, o_lo);
-            w.o_far[a] = sel(neg, o_lo, o_hi);
+            if d[a] == 0.0 {
+                // Zero components (rare, so this branch predicts well):
+                // the nudged origins of `RayPrecomp` (lo planes against an
+                // origin one ulp up, hi planes one ulp down) so that a ray
+                // lying in a face counts as inside. Elsewhere both planes
+                // use the origin itself.
+                let (o_lo, o_hi) = (next_float_up(o[a]), next_float_down(o[a]));
+                w.o_near[a] = if neg { o_hi } else { o_lo };
+                w.o_far[a] = if neg { o_lo } else { o_hi };
+            }
         }
         w
     }

@@ -9,6 +9,7 @@ use rpbrt_geometry::{safe_acos, Bounds3f, Float, Point3f, PI};
 
 use super::{SampledLight, ONE_MINUS_EPSILON};
 use crate::light::{importance2, Light, LightBounds, LightSampleContext, PreparedLightBounds};
+use crate::select::select_f32;
 
 /// Number of buckets per axis for the split heuristic.
 const N_BUCKETS: usize = 12;
@@ -234,9 +235,8 @@ impl BvhLightSampler {
             // is as random as `u`, so a branch would often mispredict.
             let first = u < p0;
             let p1 = 1.0 - p0;
-            pmf *= std::hint::select_unpredictable(first, p0, ci1 / (ci0 + ci1));
-            u = std::hint::select_unpredictable(first, u / p0, (u - p0) / p1)
-                .min(ONE_MINUS_EPSILON);
+            pmf *= select_f32(first, p0, ci1 / (ci0 + ci1));
+            u = select_f32(first, u / p0, (u - p0) / p1).min(ONE_MINUS_EPSILON);
             node_index = std::hint::select_unpredictable(first, node_index + 1, c1);
         }
     }

@@ -4,7 +4,9 @@
 //! acceleration structure over a set of primitives.
 
 use crate::accel::{AccelParams, Accelerator, Aggregate};
-use crate::shape::triangle::{intersect_prepared_triangle, triangle_is_nondegenerate, TriangleRay};
+use crate::shape::triangle::{
+    intersect_prepared_triangle, triangle_is_nondegenerate, TriangleFrame, TriangleRay,
+};
 use crate::shape::{Shape, ShapeMethods};
 use crate::texture::{FloatTextureRef, TextureEvalContext};
 use rpbrt_geometry::animated::AnimatedTransform;
@@ -221,6 +223,10 @@ impl Primitive {
 /// triangles beside the primitives for the traversal.
 const MAX_CACHED_TRIANGLE_PRIMITIVES: usize = 1 << 22;
 
+/// Aggregates with at most this many primitives also keep each triangle's
+/// [`TriangleFrame`] (at most 60 MiB).
+const MAX_TRIANGLE_FRAME_PRIMITIVES: usize = 1 << 20;
+
 /// The closest hit found so far by [`PrimitiveAggregate::intersect`]: an
 /// opaque triangle's barycentrics (its interaction is built once, for the
 /// closest), or another primitive's full intersection (kept inline:
@@ -245,6 +251,11 @@ pub struct PrimitiveAggregate {
     /// so that the traversal tests it without going through the primitive
     /// and its mesh (`None` for every other primitive).
     triangle_vertices: Vec<Option<[Point3f; 3]>>,
+    /// Per primitive, for the same triangles: the parts of the surface
+    /// interaction that are the same all over the triangle, so that a hit
+    /// builds only the rest (empty for large aggregates, default for
+    /// other primitives).
+    triangle_frames: Vec<TriangleFrame>,
 }
 
 impl PrimitiveAggregate {
@@ -255,7 +266,7 @@ impl PrimitiveAggregate {
         // 40 bytes per primitive: bounded so that huge scenes do not pay
         // gigabytes for it (they fall back to going through the mesh).
         let cache_triangles = prims.len() <= MAX_CACHED_TRIANGLE_PRIMITIVES;
-        let triangle_vertices = prims
+        let triangle_vertices: Vec<Option<[Point3f; 3]>> = prims
             .iter()
             .take(if cache_triangles { prims.len() } else { 0 })
             .map(|p| match p {
@@ -270,10 +281,27 @@ impl PrimitiveAggregate {
                 _ => None,
             })
             .collect();
+        // 60 bytes per primitive, read once per closest hit.
+        let triangle_frames = if prims.len() <= MAX_TRIANGLE_FRAME_PRIMITIVES {
+            prims
+                .iter()
+                .zip(&triangle_vertices)
+                .map(|(p, cached)| match p {
+                    Primitive::Geometric(GeometricPrimitive {
+                        shape: Shape::Triangle(tri),
+                        ..
+                    }) if cached.is_some() => tri.frame(),
+                    _ => TriangleFrame::default(),
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         PrimitiveAggregate {
             prims,
             accel,
             triangle_vertices,
+            triangle_frames,
         }
     }
 
@@ -325,7 +353,12 @@ impl PrimitiveAggregate {
             Closest::Triangle { prim, b, t_hit } => match &self.prims[prim as usize] {
                 Primitive::Geometric(g) => match &g.shape {
                     Shape::Triangle(tri) => Some(PrimitiveIntersection {
-                        si: tri.interaction_at_hit(b.0, b.1, b.2, ray),
+                        si: match self.triangle_frames.get(prim as usize) {
+                            Some(frame) => {
+                                tri.interaction_at_hit_with_frame(frame, b.0, b.1, b.2, ray)
+                            }
+                            None => tri.interaction_at_hit(b.0, b.1, b.2, ray),
+                        },
                         t_hit,
                         material: g.material,
                         area_light: g.area_light,

@@ -5,6 +5,7 @@
 pub mod spherical;
 pub mod tabulated;
 
+use crate::select::select_f32;
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;
 
@@ -18,8 +19,8 @@ pub fn sample_uniform_disk_concentric(u: Point2f) -> Point2f {
     // Both wedges computed and one selected: which one is a coin flip, so a
     // branch would mispredict half the time.
     let x_major = uo.x.abs() > uo.y.abs();
-    let r = std::hint::select_unpredictable(x_major, uo.x, uo.y);
-    let theta = std::hint::select_unpredictable(
+    let r = select_f32(x_major, uo.x, uo.y);
+    let theta = select_f32(
         x_major,
         PI_OVER_4 * (uo.y / uo.x),
         PI_OVER_2 - PI_OVER_4 * (uo.x / uo.y),

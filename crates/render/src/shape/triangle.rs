@@ -413,6 +413,24 @@ pub struct Triangle {
     pub tri_index: u32,
 }
 
+/// The parts of a triangle's surface interaction that do not depend on
+/// where it is hit: the geometric normal (oriented), dp/du and dp/dv, and
+/// dn/du and dn/dv from the vertex normals (zero without them).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TriangleFrame {
+    /// The geometric normal, flipped for reverse orientation and
+    /// handedness (before facing the shading normal).
+    pub n: Normal3f,
+    /// ∂p/∂u.
+    pub dpdu: Vector3f,
+    /// ∂p/∂v.
+    pub dpdv: Vector3f,
+    /// ∂n/∂u.
+    pub dndu: Normal3f,
+    /// ∂n/∂v.
+    pub dndv: Normal3f,
+}
+
 impl Triangle {
     /// Triangle `tri_index` of `mesh` (which must be in range; use
     /// [`triangles`] to get only the valid ones).
@@ -545,19 +563,28 @@ impl Triangle {
         b2: Float,
         ray: &Ray,
     ) -> SurfaceInteraction {
-        let wo = (-ray.d).try_normalize().unwrap_or_default();
-        self.interaction(b0, b1, b2, ray.time, wo)
+        self.interaction_at_hit_with_frame(&self.frame(), b0, b1, b2, ray)
     }
 
-    /// The full surface interaction at barycentrics (b0, b1, b2).
-    fn interaction(
+    /// [`Triangle::interaction_at_hit`] with the triangle's
+    /// [`TriangleFrame`] already computed (aggregates keep one per
+    /// triangle): the same interaction.
+    #[inline]
+    pub fn interaction_at_hit_with_frame(
         &self,
+        frame: &TriangleFrame,
         b0: Float,
         b1: Float,
         b2: Float,
-        time: Float,
-        wo: Vector3f,
+        ray: &Ray,
     ) -> SurfaceInteraction {
+        let wo = (-ray.d).try_normalize().unwrap_or_default();
+        self.interaction(frame, b0, b1, b2, ray.time, wo)
+    }
+
+    /// The parts of the surface interaction that are the same at every
+    /// point of the triangle (pbrt-v4 computes them at each hit).
+    pub fn frame(&self) -> TriangleFrame {
         let mesh = &*self.mesh;
         let v = self.vertex_indices();
         let [p0, p1, p2] = self.vertices();
@@ -599,6 +626,76 @@ impl Triangle {
             dpdv = t;
         }
 
+        // The geometric normal follows the vertex order, not dpdu × dpdv
+        // (so that one is never computed).
+        let mut n = Normal3f::from(cross(dp02, dp12).normalize());
+        if mesh.reverse_orientation ^ mesh.transform_swaps_handedness {
+            n = -n;
+        }
+
+        // dn/du and dn/dv from the vertex normals.
+        let (dndu, dndv) = match &mesh.n {
+            Some(nn) => {
+                let dn1 = nn[v[0]] - nn[v[2]];
+                let dn2 = nn[v[1]] - nn[v[2]];
+                if degenerate_uv {
+                    // Derivatives with respect to the same arbitrary
+                    // frame used for dp/du, so that reflected ray
+                    // differentials stay reasonable.
+                    let dn = cross(
+                        Vector3f::from(nn[v[2]] - nn[v[0]]),
+                        Vector3f::from(nn[v[1]] - nn[v[0]]),
+                    );
+                    match dn.try_normalize() {
+                        Some(dn) => {
+                            let (a, c) = dn.coordinate_system();
+                            (Normal3f::from(a), Normal3f::from(c))
+                        }
+                        None => (Normal3f::default(), Normal3f::default()),
+                    }
+                } else {
+                    let inv = 1.0 / determinant;
+                    (
+                        (dn1 * duv12.y - dn2 * duv02.y) * inv,
+                        (dn2 * duv02.x - dn1 * duv12.x) * inv,
+                    )
+                }
+            }
+            None => (Normal3f::default(), Normal3f::default()),
+        };
+        TriangleFrame {
+            n,
+            dpdu,
+            dpdv,
+            dndu,
+            dndv,
+        }
+    }
+
+    /// The full surface interaction at barycentrics (b0, b1, b2), given
+    /// the triangle's frame.
+    #[inline(always)]
+    fn interaction(
+        &self,
+        frame: &TriangleFrame,
+        b0: Float,
+        b1: Float,
+        b2: Float,
+        time: Float,
+        wo: Vector3f,
+    ) -> SurfaceInteraction {
+        let mesh = &*self.mesh;
+        let v = self.vertex_indices();
+        let [p0, p1, p2] = self.vertices();
+        let uv = self.uvs();
+        let TriangleFrame {
+            n,
+            dpdu,
+            dpdv,
+            dndu,
+            dndv,
+        } = *frame;
+
         let p_hit = p0 * b0 + p1 * b1 + p2 * b2;
         let uv_hit = Point2f::new(
             b0 * uv[0].x + b1 * uv[1].x + b2 * uv[2].x,
@@ -607,14 +704,8 @@ impl Triangle {
         let abs_sum = (p0 * b0).abs() + (p1 * b1).abs() + (p2 * b2).abs();
         let p_error = Vector3f::from(abs_sum) * gamma(7);
 
-        let flip = mesh.reverse_orientation ^ mesh.transform_swaps_handedness;
         // What `SurfaceInteraction::new` builds, except that the geometric
-        // normal follows the vertex order, not dpdu × dpdv (so that one is
-        // never computed).
-        let mut n = Normal3f::from(cross(dp02, dp12).normalize());
-        if flip {
-            n = -n;
-        }
+        // normal comes from the frame.
         let mut isect = SurfaceInteraction {
             pi: Point3fi::from_value_and_error(p_hit, p_error),
             time,
@@ -672,36 +763,6 @@ impl Triangle {
                 ss = a;
                 ts = c;
             }
-            // dn/du and dn/dv from the vertex normals.
-            let (dndu, dndv) = match &mesh.n {
-                Some(nn) => {
-                    let dn1 = nn[v[0]] - nn[v[2]];
-                    let dn2 = nn[v[1]] - nn[v[2]];
-                    if degenerate_uv {
-                        // Derivatives with respect to the same arbitrary
-                        // frame used for dp/du, so that reflected ray
-                        // differentials stay reasonable.
-                        let dn = cross(
-                            Vector3f::from(nn[v[2]] - nn[v[0]]),
-                            Vector3f::from(nn[v[1]] - nn[v[0]]),
-                        );
-                        match dn.try_normalize() {
-                            Some(dn) => {
-                                let (a, c) = dn.coordinate_system();
-                                (Normal3f::from(a), Normal3f::from(c))
-                            }
-                            None => (Normal3f::default(), Normal3f::default()),
-                        }
-                    } else {
-                        let inv = 1.0 / determinant;
-                        (
-                            (dn1 * duv12.y - dn2 * duv02.y) * inv,
-                            (dn2 * duv02.x - dn1 * duv12.x) * inv,
-                        )
-                    }
-                }
-                None => (Normal3f::default(), Normal3f::default()),
-            };
             isect.set_shading_geometry(ns, ss, ts, dndu, dndv, true);
         }
         isect
