@@ -784,9 +784,28 @@ impl Normal3f {
     where
         Normal3f: Dot<V>,
     {
-        // Selected, not branched on: the side is often unpredictable.
-        std::hint::select_unpredictable(self.dot(v) < 0.0, -self, self)
+        let [x, y, z] = flip_signs_if(self.dot(v) < 0.0, [self.x, self.y, self.z]);
+        Normal3f::new(x, y, z)
     }
+
+    /// True when every component is zero (of either sign), as
+    /// `self == Normal3f::default()`, but without branching on each
+    /// component in turn: which component of a normal is zero is often
+    /// as good as random along a path.
+    #[inline]
+    pub fn is_zero(self) -> bool {
+        // A float is ±0 exactly when its bits other than the sign are.
+        ((self.x.to_bits() | self.y.to_bits() | self.z.to_bits()) << 1) == 0
+    }
+}
+
+/// `v` negated (every sign bit flipped, as unary minus does) when `flip`,
+/// by integer operations: a select between floats becomes a branch on
+/// x86-64, and which side a vector lies on is often unpredictable.
+#[inline(always)]
+fn flip_signs_if(flip: bool, v: [Float; 3]) -> [Float; 3] {
+    let m = (flip as u32) << 31;
+    v.map(|c| Float::from_bits(c.to_bits() ^ m))
 }
 
 impl Vector3f {
@@ -796,8 +815,8 @@ impl Vector3f {
     where
         Vector3f: Dot<V>,
     {
-        // Selected, not branched on: the side is often unpredictable.
-        std::hint::select_unpredictable(self.dot(v) < 0.0, -self, self)
+        let [x, y, z] = flip_signs_if(self.dot(v) < 0.0, [self.x, self.y, self.z]);
+        Vector3f::new(x, y, z)
     }
 
     /// The numerically stable angle between two unit vectors.

@@ -707,7 +707,7 @@ impl ShapeMethods for BilinearPatch {
         }
         let mut pdf = 1.0;
         let mut u = u;
-        if ctx.ns != Normal3f::default() {
+        if !ctx.ns.is_zero() {
             let w = Self::cos_weights(ctx, &corners);
             u = sample_bilinear(u, w);
             pdf *= bilinear_pdf(u, w);
@@ -745,7 +745,7 @@ impl ShapeMethods for BilinearPatch {
             return if pdf.is_finite() { pdf } else { 0.0 };
         }
         let mut pdf = 1.0 / sa;
-        if ctx.ns != Normal3f::default() {
+        if !ctx.ns.is_zero() {
             let p = self.vertices();
             let w = Self::cos_weights(ctx, &corners);
             let u = invert_spherical_rectangle_sample(

@@ -826,7 +826,7 @@ impl ShapeMethods for Triangle {
             return 0.0;
         }
         let mut pdf = 1.0 / sa;
-        if ctx.ns != Normal3f::default() {
+        if !ctx.ns.is_zero() {
             let w = cos_weights(ctx, &dirs);
             let u = invert_spherical_triangle_sample_dirs(dirs, sa, wi.normalize());
             pdf *= bilinear_pdf(u, w);
@@ -988,7 +988,7 @@ fn sample_solid_angle<T: TriangleGeometry>(
     // point, then sample the spherical triangle uniformly.
     let mut pdf = 1.0;
     let mut u = u;
-    if ctx.ns != Normal3f::default() {
+    if !ctx.ns.is_zero() {
         let w = cos_weights(ctx, &dirs);
         u = sample_bilinear(u, w);
         pdf *= bilinear_pdf(u, w);
