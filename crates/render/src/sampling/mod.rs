@@ -20,12 +20,16 @@ pub fn sample_uniform_disk_concentric(u: Point2f) -> Point2f {
     // branch would mispredict half the time.
     let x_major = uo.x.abs() > uo.y.abs();
     let r = select_f32(x_major, uo.x, uo.y);
-    let theta = select_f32(
-        x_major,
-        PI_OVER_4 * (uo.y / uo.x),
-        PI_OVER_2 - PI_OVER_4 * (uo.x / uo.y),
-    );
-    Point2f::new(r * theta.cos(), r * theta.sin())
+    // θ = φ in the x-major wedges and π/2 − φ in the others, with φ in
+    // [−π/4, π/4]: the sine and cosine of φ are taken either way and
+    // swapped for the second case (cos(π/2 − φ) = sin φ), so that the
+    // library's sin/cos, which branches on whether its argument exceeds
+    // π/4, always takes the same path.
+    let phi = PI_OVER_4 * select_f32(x_major, uo.y / uo.x, uo.x / uo.y);
+    let (sin_phi, cos_phi) = phi.sin_cos();
+    let cos_theta = select_f32(x_major, cos_phi, sin_phi);
+    let sin_theta = select_f32(x_major, sin_phi, cos_phi);
+    Point2f::new(r * cos_theta, r * sin_theta)
 }
 
 /// Uniform point on the unit disk by the polar mapping.
