@@ -40,8 +40,10 @@ pub struct Bvh4Node {
     /// Leaf child: its primitive count; 0 for interior children and unused
     /// lanes.
     pub count: [u16; WIDTH],
+    /// Bit `i` set when lane `i` is a leaf child (nonzero count).
+    pub leaf_lanes: u32,
     /// Padding to 128 bytes.
-    pub pad: [u32; 2],
+    pub pad: u32,
 }
 
 impl Bvh4Node {
@@ -58,7 +60,8 @@ impl Bvh4Node {
             ],
             child: [0; WIDTH],
             count: [0; WIDTH],
-            pad: [0; 2],
+            leaf_lanes: 0,
+            pad: 0,
         }
     }
 
@@ -122,6 +125,9 @@ fn collapse(bin: &[BvhNode], root: usize, out: &mut Vec<Bvh4Node>) -> u32 {
         if n.is_leaf() {
             out[me].child[lane] = n.offset;
             out[me].count[lane] = n.count;
+            if n.count > 0 {
+                out[me].leaf_lanes |= 1 << lane;
+            }
         } else {
             let c = collapse(bin, k, out);
             out[me].child[lane] = c;
@@ -268,6 +274,7 @@ impl Bvh4 {
                 n.set_bounds(0, root);
                 n.child[0] = root.offset;
                 n.count[0] = root.count;
+                n.leaf_lanes = u32::from(root.count > 0);
                 nodes.push(n);
             } else {
                 collapse(&bnodes, 0, &mut nodes);
@@ -315,33 +322,42 @@ impl Aggregate for Bvh4 {
         let mut cur = 0u32;
         loop {
             let node = &self.nodes[cur as usize];
-            let (t0, mut mask) = w.test(node, t_max);
-            let mut next: Option<(u32, Float)> = None;
-            if mask != 0 && mask & (mask - 1) == 0 {
-                // One child hit (the common case near the leaves): no
-                // ordering to do.
-                let i = mask.trailing_zeros() as usize;
+            let (t0, mask) = w.test(node, t_max);
+            // Leaf children first, in lane order: each tests its primitives
+            // against the shrinking `t_max`, so their order does not change
+            // which are tested, and not sorting them saves branches on
+            // which children a ray happens to hit.
+            let mut leaves = mask & node.leaf_lanes;
+            while leaves != 0 {
+                let i = leaves.trailing_zeros() as usize;
+                leaves &= leaves - 1;
+                let start = node.child[i] as usize;
                 let c = node.count[i] as usize;
-                if c > 0 {
-                    let start = node.child[i] as usize;
-                    closest_in_leaf(
-                        &self.prim_indices[start..start + c],
-                        ray,
-                        &mut t_max,
-                        &mut best,
-                        &mut hit,
-                    );
-                } else {
+                closest_in_leaf(
+                    &self.prim_indices[start..start + c],
+                    ray,
+                    &mut t_max,
+                    &mut best,
+                    &mut hit,
+                );
+            }
+            let mut inner = mask & !node.leaf_lanes;
+            let mut next: Option<(u32, Float)> = None;
+            if inner != 0 && inner & (inner - 1) == 0 {
+                // One interior child hit (the common case): no ordering.
+                let i = inner.trailing_zeros() as usize;
+                if t0[i] <= t_max {
                     next = Some((node.child[i], t0[i]));
                 }
-            } else if mask != 0 {
-                // Hit children sorted near to far (at most four: insertion
-                // sort).
+            } else if inner != 0 {
+                // Hit interior children sorted near to far (at most four:
+                // insertion sort); the nearest is visited next, the others
+                // pushed far to near.
                 let mut order = [(0usize, 0.0 as Float); WIDTH];
                 let mut n = 0;
-                while mask != 0 {
-                    let i = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
+                while inner != 0 {
+                    let i = inner.trailing_zeros() as usize;
+                    inner &= inner - 1;
                     let mut j = n;
                     while j > 0 && order[j - 1].1 > t0[i] {
                         order[j] = order[j - 1];
@@ -350,24 +366,8 @@ impl Aggregate for Bvh4 {
                     order[j] = (i, t0[i]);
                     n += 1;
                 }
-                // Leaves first, near to far; they shrink `t_max`.
-                for &(i, _) in &order[..n] {
-                    let c = node.count[i] as usize;
-                    if c > 0 {
-                        let start = node.child[i] as usize;
-                        closest_in_leaf(
-                            &self.prim_indices[start..start + c],
-                            ray,
-                            &mut t_max,
-                            &mut best,
-                            &mut hit,
-                        );
-                    }
-                }
-                // Interior children: visit the nearest next, push the rest
-                // far to near.
                 for &(i, tn) in order[..n].iter().rev() {
-                    if node.count[i] == 0 && tn <= t_max {
+                    if tn <= t_max {
                         if let Some(prev) = next {
                             stack.push(prev);
                         }
