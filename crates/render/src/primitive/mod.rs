@@ -353,12 +353,20 @@ impl PrimitiveAggregate {
             Closest::Triangle { prim, b, t_hit } => match &self.prims[prim as usize] {
                 Primitive::Geometric(g) => match &g.shape {
                     Shape::Triangle(tri) => Some(PrimitiveIntersection {
-                        si: match self.triangle_frames.get(prim as usize) {
-                            Some(frame) => {
-                                tri.interaction_at_hit_with_frame(frame, b.0, b.1, b.2, ray)
-                            }
-                            None => tri.interaction_at_hit(b.0, b.1, b.2, ray),
-                        },
+                        // One construction path (not a `match` between two
+                        // calls), so that the interaction is built in place
+                        // instead of copied.
+                        si: tri.interaction_at_hit_with_frame(
+                            &self
+                                .triangle_frames
+                                .get(prim as usize)
+                                .copied()
+                                .unwrap_or_else(|| tri.frame()),
+                            b.0,
+                            b.1,
+                            b.2,
+                            ray,
+                        ),
                         t_hit,
                         material: g.material,
                         area_light: g.area_light,
