@@ -342,19 +342,14 @@ pub fn intersect_prepared_triangle(
         q.y += sy * q.z;
     }
 
-    // Edge functions; on an exact zero, redo them in double precision so
-    // that the sign test is exact for rays through edges.
-    let mut e0 = difference_of_products(p1t.x, p2t.y, p1t.y, p2t.x);
-    let mut e1 = difference_of_products(p2t.x, p0t.y, p2t.y, p0t.x);
-    let mut e2 = difference_of_products(p0t.x, p1t.y, p0t.y, p1t.x);
-    if e0 == 0.0 || e1 == 0.0 || e2 == 0.0 {
-        let f = |a: Float, b: Float, c: Float, dd: Float| {
-            (a as f64 * b as f64 - c as f64 * dd as f64) as Float
-        };
-        e0 = f(p1t.x, p2t.y, p1t.y, p2t.x);
-        e1 = f(p2t.x, p0t.y, p2t.y, p0t.x);
-        e2 = f(p0t.x, p1t.y, p0t.y, p1t.x);
-    }
+    // Edge functions. pbrt-v4 redoes them in double precision when one is
+    // exactly zero, so that the sign test is exact for rays through edges;
+    // `difference_of_products` already forms them in double precision
+    // (exact products, one rounding), so the redo would give the same
+    // values and is left out.
+    let e0 = difference_of_products(p1t.x, p2t.y, p1t.y, p2t.x);
+    let e1 = difference_of_products(p2t.x, p0t.y, p2t.y, p0t.x);
+    let e2 = difference_of_products(p0t.x, p1t.y, p0t.y, p1t.x);
     // The tests are combined with `|` and `&`, not `||` and `&&`: whether a
     // ray hits is unpredictable, and one branch mispredicts less than six.
     let mixed_signs = (e0 < 0.0 || e1 < 0.0 || e2 < 0.0) & (e0 > 0.0 || e1 > 0.0 || e2 > 0.0);
