@@ -12,6 +12,7 @@ pub mod integrator;
 pub mod light;
 pub mod lightsampler;
 pub mod material;
+pub mod params;
 pub mod primitive;
 pub mod rng;
 pub mod sampler;

@@ -146,7 +146,7 @@ fn float_of(key: &str, v: ParamValue) -> Result<Float, String> {
 
 impl AccelParams {
     /// The accelerator names [`AccelParams::new`] accepts.
-    pub const NAMES: &'static [&'static str] = &["bvh", "kdtree", "grid"];
+    pub const NAMES: &'static [&'static str] = &["bvh", "grid", "kdtree"];
 
     /// Defaults for the accelerator named `name` (`"bvh"`, `"kdtree"` or
     /// `"grid"`).

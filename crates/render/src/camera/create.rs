@@ -2,61 +2,36 @@
 //! `Camera::Create` and the cameras' `Create` functions): parameter names
 //! and defaults as pbrt-v4, with located errors for values it cannot use.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use rpbrt_geometry::{Bounds2f, Float, MediumId, Point2f};
-use rpbrt_parser::{Diagnostic, FileLoc, ParamError, ParameterDictionary};
+use rpbrt_parser::Diagnostic;
 
 use super::realistic::EXIT_PUPIL_RINGS;
+use super::CameraTransform;
 use super::{
     ApertureImage, Camera, CameraBase, FilmGeometry, OrthographicCamera, PerspectiveCamera,
     RealisticCamera, SphericalCamera, SphericalMapping,
 };
-use crate::scene::CameraSceneEntity;
+use crate::params::{unknown_type, ParamReader};
 
 /// Rays traced per ring when bounding the exit pupil (pbrt-v4: 1024²);
 /// smaller in unit tests, which build many lens systems on few cores.
 const EXIT_PUPIL_SAMPLES: usize = if cfg!(test) { 128 * 128 } else { 1024 * 1024 };
 
-/// A camera and the warnings raised making it.
-#[derive(Debug)]
-pub struct CreatedCamera {
-    /// The camera.
-    pub camera: Camera,
-    /// Located warnings (reversed shutter, clamped aperture, unused
-    /// parameters...).
-    pub warnings: Vec<Diagnostic>,
-}
+/// The camera types `Camera` accepts, sorted.
+pub const CAMERA_NAMES: &[&str] = &["orthographic", "perspective", "realistic", "spherical"];
 
-/// Creates the camera of a `Camera` directive for `film`, in no medium,
-/// discarding warnings (see [`create_camera_with`] to keep them).
+/// Creates the camera of type `name` placed by `camera_transform`, for
+/// `film`, in `medium` (pbrt-v4 `Camera::Create`); warnings go to `cp`.
 pub fn create_camera(
-    entity: &CameraSceneEntity,
-    film: &FilmGeometry,
-) -> Result<Camera, Diagnostic> {
-    create_camera_with(entity, film, None).map(|c| c.camera)
-}
-
-fn perr(e: ParamError) -> Diagnostic {
-    Diagnostic::from(e)
-}
-
-/// The location of parameter `name`, or the directive's.
-fn at(params: &ParameterDictionary, name: &str, loc: &FileLoc) -> FileLoc {
-    params.loc(name).cloned().unwrap_or_else(|| loc.clone())
-}
-
-/// Creates the camera of a `Camera` directive for `film`, in `medium`,
-/// with its warnings.
-pub fn create_camera_with(
-    entity: &CameraSceneEntity,
+    name: &str,
+    cp: &ParamReader,
+    camera_transform: &CameraTransform,
     film: &FilmGeometry,
     medium: Option<MediumId>,
-) -> Result<CreatedCamera, Diagnostic> {
-    let params = &entity.base.params;
-    let loc = &entity.base.loc;
-    let name = entity.base.name.as_str();
-    let mut warnings = Vec::new();
+) -> Result<Camera, Diagnostic> {
+    let loc = cp.loc();
 
     let res = film.full_resolution;
     if res.x <= 0 || res.y <= 0 {
@@ -65,69 +40,60 @@ pub fn create_camera_with(
             format!("film resolution {}x{} is not positive", res.x, res.y),
         ));
     }
-    if !matches!(
-        name,
-        "perspective" | "orthographic" | "spherical" | "realistic"
-    ) {
-        return Err(Diagnostic::error(
-            loc.clone(),
-            format!("\"{name}\": camera type unknown"),
-        ));
+    if !CAMERA_NAMES.contains(&name) {
+        return Err(unknown_type("camera", name, CAMERA_NAMES, loc));
     }
 
-    let shutter_open = params.get_one_float("shutteropen", 0.0).map_err(perr)?;
-    let shutter_close = params.get_one_float("shutterclose", 1.0).map_err(perr)?;
+    let shutter_open = cp.float("shutteropen", 0.0)?;
+    let shutter_close = cp.float("shutterclose", 1.0)?;
     if !(shutter_open.is_finite() && shutter_close.is_finite()) {
         return Err(Diagnostic::error(
-            at(params, "shutteropen", loc),
+            cp.param_loc("shutteropen"),
             "shutter times must be finite",
         ));
     }
     if shutter_close < shutter_open {
-        warnings.push(Diagnostic::warning(
-            at(params, "shutterclose", loc),
+        cp.warn_at(
+            "shutterclose",
             format!(
                 "shutter close time {shutter_close} < shutter open {shutter_open}; swapping them"
             ),
-        ));
+        );
     }
-    let ct = entity.camera_transform;
+    let ct = *camera_transform;
     let rfc = &ct.render_from_camera;
     if rfc.start_transform.has_scale(1e-3) || rfc.end_transform.has_scale(1e-3) {
-        warnings.push(Diagnostic::warning(
-            loc.clone(),
+        cp.warn(
             "scaling detected in the camera-from-render transformation; the renderer \
              assumes it has none, so the image may be wrong",
-        ));
+        );
     }
     let base = CameraBase::new(ct, shutter_open, shutter_close, *film, medium);
 
     let camera = match name {
         "perspective" | "orthographic" | "spherical" => {
-            let lens_radius = params.get_one_float("lensradius", 0.0).map_err(perr)?;
+            let lens_radius = cp.float("lensradius", 0.0)?;
             let default_focal = if name == "spherical" { 1e30 } else { 1e6 };
-            let focal_distance = params
-                .get_one_float("focaldistance", default_focal)
-                .map_err(perr)?;
-            let screen = screen_window(params, film, loc)?;
+            let focal_distance = cp.float("focaldistance", default_focal)?;
+            let screen = screen_window(cp, film)?;
             if !(lens_radius >= 0.0 && lens_radius.is_finite()) {
                 return Err(Diagnostic::error(
-                    at(params, "lensradius", loc),
+                    cp.param_loc("lensradius"),
                     format!("lens radius {lens_radius} must be finite and non-negative"),
                 ));
             }
             if lens_radius > 0.0 && !(focal_distance > 0.0 && focal_distance.is_finite()) {
                 return Err(Diagnostic::error(
-                    at(params, "focaldistance", loc),
+                    cp.param_loc("focaldistance"),
                     format!("focal distance {focal_distance} must be positive"),
                 ));
             }
             match name {
                 "perspective" => {
-                    let fov = params.get_one_float("fov", 90.0).map_err(perr)?;
+                    let fov = cp.float("fov", 90.0)?;
                     if !(fov > 0.0 && fov < 180.0) {
                         return Err(Diagnostic::error(
-                            at(params, "fov", loc),
+                            cp.param_loc("fov"),
                             format!("field of view {fov} must be between 0 and 180 degrees"),
                         ));
                     }
@@ -141,15 +107,13 @@ pub fn create_camera_with(
                     Camera::Orthographic(c)
                 }
                 _ => {
-                    let m = params
-                        .get_one_string("mapping", "equalarea")
-                        .map_err(perr)?;
+                    let m = cp.string("mapping", "equalarea")?;
                     let mapping = match m.as_str() {
                         "equalarea" => SphericalMapping::EqualArea,
                         "equirectangular" => SphericalMapping::EquiRectangular,
                         _ => {
                             return Err(Diagnostic::error(
-                                at(params, "mapping", loc),
+                                cp.param_loc("mapping"),
                                 format!(
                                     "\"{m}\": unknown mapping for spherical camera (must be \
                                      \"equalarea\" or \"equirectangular\")"
@@ -159,7 +123,7 @@ pub fn create_camera_with(
                     };
                     if mapping == SphericalMapping::EqualArea && res.x != res.y {
                         return Err(Diagnostic::error(
-                            at(params, "mapping", loc),
+                            cp.param_loc("mapping"),
                             format!(
                                 "the equal-area spherical mapping needs a square film; \
                                  the resolution is {}x{}",
@@ -171,26 +135,19 @@ pub fn create_camera_with(
                 }
             }
         }
-        _ => create_realistic(entity, base, &mut warnings)?,
+        _ => create_realistic(cp, base)?,
     };
-    warnings.extend(params.report_unused());
-    Ok(CreatedCamera { camera, warnings })
+    Ok(camera)
 }
 
 /// `screenwindow`, or the default from `frameaspectratio` (itself
 /// defaulting to the film's aspect): the shorter axis spans [−1, 1].
-fn screen_window(
-    params: &ParameterDictionary,
-    film: &FilmGeometry,
-    loc: &FileLoc,
-) -> Result<Bounds2f, Diagnostic> {
+fn screen_window(cp: &ParamReader, film: &FilmGeometry) -> Result<Bounds2f, Diagnostic> {
     let res = film.full_resolution;
-    let frame = params
-        .get_one_float("frameaspectratio", res.x as Float / res.y as Float)
-        .map_err(perr)?;
+    let frame = cp.float("frameaspectratio", res.x as Float / res.y as Float)?;
     if !(frame > 0.0 && frame.is_finite()) {
         return Err(Diagnostic::error(
-            at(params, "frameaspectratio", loc),
+            cp.param_loc("frameaspectratio"),
             format!("frame aspect ratio {frame} must be positive"),
         ));
     }
@@ -202,11 +159,11 @@ fn screen_window(
             Point2f::new(1.0, 1.0 / frame),
         )
     };
-    let sw = params.get_float_array("screenwindow").map_err(perr)?;
+    let sw = cp.floats("screenwindow")?;
     if !sw.is_empty() {
         if sw.len() != 4 {
             return Err(Diagnostic::error(
-                at(params, "screenwindow", loc),
+                cp.param_loc("screenwindow"),
                 format!(
                     "\"screenwindow\" should have four values; it has {}",
                     sw.len()
@@ -215,7 +172,7 @@ fn screen_window(
         }
         if !(sw.iter().all(|v| v.is_finite()) && sw[0] != sw[1] && sw[2] != sw[3]) {
             return Err(Diagnostic::error(
-                at(params, "screenwindow", loc),
+                cp.param_loc("screenwindow"),
                 "\"screenwindow\" must be finite with a nonzero extent in x and y",
             ));
         }
@@ -226,7 +183,6 @@ fn screen_window(
     Ok(screen)
 }
 
-/// Resolves a file name against the scene file's directory, as pbrt-v4's
 /// Reads an aperture image file (pbrt-v4: RGB images are averaged to one
 /// channel; the image is flipped and normalised by `ApertureImage`).
 fn read_aperture_image(path: &Path) -> Result<ApertureImage, String> {
@@ -258,23 +214,6 @@ fn read_aperture_image(path: &Path) -> Result<ApertureImage, String> {
         .ok_or_else(|| format!("{}: the aperture image is empty or black", path.display()))
 }
 
-/// `ResolveFilename`: absolute names and names not found there are kept.
-fn resolve(loc: &FileLoc, name: &str) -> PathBuf {
-    let p = Path::new(name);
-    if p.is_absolute() {
-        return p.to_path_buf();
-    }
-    let dir = Path::new(&*loc.file)
-        .parent()
-        .unwrap_or_else(|| Path::new("."));
-    let joined = dir.join(p);
-    if joined.exists() {
-        joined
-    } else {
-        p.to_path_buf()
-    }
-}
-
 /// Reads a lens description: whitespace-separated numbers, `#` comments to
 /// the end of the line (pbrt-v4 `ReadFloatFile`). Errors name the line.
 pub fn read_lens_file(path: &Path) -> Result<Vec<Float>, String> {
@@ -297,19 +236,12 @@ pub fn read_lens_file(path: &Path) -> Result<Vec<Float>, String> {
     Ok(values)
 }
 
-fn create_realistic(
-    entity: &CameraSceneEntity,
-    base: CameraBase,
-    warnings: &mut Vec<Diagnostic>,
-) -> Result<Camera, Diagnostic> {
-    let params = &entity.base.params;
-    let loc = &entity.base.loc;
-    let lens_file = params.get_one_string("lensfile", "").map_err(perr)?;
-    let aperture_diameter = params
-        .get_one_float("aperturediameter", 1.0)
-        .map_err(perr)?;
-    let focus_distance = params.get_one_float("focusdistance", 10.0).map_err(perr)?;
-    let aperture = params.get_one_string("aperture", "").map_err(perr)?;
+fn create_realistic(cp: &ParamReader, base: CameraBase) -> Result<Camera, Diagnostic> {
+    let loc = cp.loc();
+    let lens_file = cp.string("lensfile", "")?;
+    let aperture_diameter = cp.float("aperturediameter", 1.0)?;
+    let focus_distance = cp.float("focusdistance", 10.0)?;
+    let aperture = cp.string("aperture", "")?;
 
     if lens_file.is_empty() {
         return Err(Diagnostic::error(
@@ -317,20 +249,20 @@ fn create_realistic(
             "realistic camera: no lens description file supplied (\"string lensfile\")",
         ));
     }
-    let lens_loc = at(params, "lensfile", loc);
+    let lens_loc = cp.param_loc("lensfile");
     if !(aperture_diameter > 0.0 && aperture_diameter.is_finite()) {
         return Err(Diagnostic::error(
-            at(params, "aperturediameter", loc),
+            cp.param_loc("aperturediameter"),
             format!("aperture diameter {aperture_diameter} must be positive"),
         ));
     }
     if !(focus_distance > 0.0 && focus_distance.is_finite()) {
         return Err(Diagnostic::error(
-            at(params, "focusdistance", loc),
+            cp.param_loc("focusdistance"),
             format!("focus distance {focus_distance} must be positive"),
         ));
     }
-    let path = resolve(loc, &lens_file);
+    let path = cp.resolve("lensfile", &lens_file);
     let lens = read_lens_file(&path).map_err(|m| Diagnostic::error(lens_loc.clone(), m))?;
     if lens.is_empty() {
         return Err(Diagnostic::error(
@@ -350,14 +282,14 @@ fn create_realistic(
         ));
     }
     if !lens.chunks_exact(4).any(|r| r[0] == 0.0) {
-        warnings.push(Diagnostic::warning(
+        cp.warn_located(
             lens_loc.clone(),
             format!(
                 "{}: the lens has no aperture stop (a row with curvature radius 0); \
                  \"aperturediameter\" has no effect",
                 path.display()
             ),
-        ));
+        );
     }
 
     let aperture_image = if aperture.is_empty() {
@@ -366,14 +298,12 @@ fn create_realistic(
         match ApertureImage::builtin(&aperture) {
             Some(img) => Some(img),
             None => Some(
-                read_aperture_image(&resolve(&at(params, "aperture", loc), &aperture)).map_err(
-                    |m| {
-                        Diagnostic::error(
-                            at(params, "aperture", loc),
-                            format!("aperture \"{aperture}\": {m}"),
-                        )
-                    },
-                )?,
+                read_aperture_image(&cp.resolve("aperture", &aperture)).map_err(|m| {
+                    Diagnostic::error(
+                        cp.param_loc("aperture"),
+                        format!("aperture \"{aperture}\": {m}"),
+                    )
+                })?,
             ),
         }
     };
@@ -388,10 +318,8 @@ fn create_realistic(
     )
     .map_err(|m| Diagnostic::error(lens_loc.clone(), format!("{}: {m}", path.display())))?;
     debug_assert_eq!(cam.exit_pupil_bounds.len(), EXIT_PUPIL_RINGS);
-    warnings.extend(
-        warns
-            .into_iter()
-            .map(|m| Diagnostic::warning(at(params, "aperturediameter", loc), m)),
-    );
+    for m in warns {
+        cp.warn_at("aperturediameter", m);
+    }
     Ok(Camera::Realistic(Box::new(cam)))
 }

@@ -18,6 +18,7 @@ mod create;
 mod projective;
 mod realistic;
 mod spherical;
+mod transform;
 
 #[cfg(test)]
 mod tests;
@@ -28,12 +29,11 @@ use rpbrt_geometry::{
     Vector3f,
 };
 
-use crate::scene::CameraTransform;
-
-pub use create::{create_camera, create_camera_with, read_lens_file, CreatedCamera};
+pub use create::{create_camera, read_lens_file, CAMERA_NAMES};
 pub use projective::{OrthographicCamera, PerspectiveCamera, ProjectiveTransforms};
 pub use realistic::{ApertureImage, LensElementInterface, RealisticCamera};
 pub use spherical::{SphericalCamera, SphericalMapping};
+pub use transform::{CameraTransform, RenderingCoordinateSystem};
 
 /// Where on the film and lens, and when, a camera ray starts (pbrt-v4
 /// `CameraSample`).

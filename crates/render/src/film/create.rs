@@ -6,14 +6,18 @@
 use std::path::Path;
 
 use rpbrt_geometry::{AnimatedTransform, Bounds2i, Float, Point2i};
-use rpbrt_parser::{Diagnostic, FileLoc, ParamError, ParameterDictionary};
+use rpbrt_parser::{Diagnostic, FileLoc};
 
 use super::pixels::KindConfig;
 use super::sensor::{sensor_names, PixelSensor};
 use super::{Film, FilmCore, FilmParams, GBufferFilm, RgbFilm, SpectralFilm};
+use crate::camera::CameraTransform;
 use crate::filter::Filter;
-use crate::scene::{CameraTransform, SceneEntity};
-use crate::spectrum::{RgbColorSpace, LAMBDA_MAX, LAMBDA_MIN};
+use crate::params::{unknown_type, ParamReader};
+use crate::spectrum::{LAMBDA_MAX, LAMBDA_MIN};
+
+/// The film types `Film` accepts, sorted.
+pub const FILM_NAMES: &[&str] = &["gbuffer", "rgb", "spectral"];
 
 /// Largest accepted `xresolution`/`yresolution` (2^15).
 pub const MAX_RESOLUTION: i32 = 1 << 15;
@@ -34,14 +38,6 @@ pub struct FilmOverrides {
     pub pixel_bounds: Option<[i32; 4]>,
     /// Quarter the resolution.
     pub quick: bool,
-}
-
-fn at(params: &ParameterDictionary, name: &str, loc: &FileLoc) -> FileLoc {
-    params.loc(name).cloned().unwrap_or_else(|| loc.clone())
-}
-
-fn perr(e: ParamError) -> Diagnostic {
-    Diagnostic::from(e)
 }
 
 fn extension(name: &str) -> String {
@@ -113,36 +109,25 @@ fn check_pixel_bounds(pb: &[i32], full: Bounds2i, loc: FileLoc) -> Result<Bounds
 
 /// Creates the film of a `Film` directive. `exposure_time` is the camera's
 /// `shutterclose - shutteropen`; `camera_transform` places G-buffer output.
-/// Returns the film and its warnings (unused parameters, overridden
-/// settings).
+/// Warnings (overridden settings) go to `fp`.
 pub fn create_film(
-    entity: &SceneEntity,
+    name: &str,
+    fp: &ParamReader,
     filter: &Filter,
     exposure_time: Float,
     camera_transform: &CameraTransform,
     overrides: &FilmOverrides,
-) -> Result<(Film, Vec<Diagnostic>), Diagnostic> {
-    let params = &entity.params;
-    let loc = &entity.loc;
-    let mut warnings = Vec::new();
-    let name = entity.name.as_str();
-    if !matches!(name, "rgb" | "gbuffer" | "spectral") {
-        return Err(Diagnostic::error(
-            loc.clone(),
-            format!("\"{name}\": unknown film type (known: rgb, gbuffer, spectral)"),
-        ));
+) -> Result<Film, Diagnostic> {
+    let loc = fp.loc();
+    if !FILM_NAMES.contains(&name) {
+        return Err(unknown_type("film", name, FILM_NAMES, loc));
     }
-    let color_space = RgbColorSpace::get(&entity.color_space).ok_or_else(|| {
-        Diagnostic::error(
-            loc.clone(),
-            format!("\"{}\": unknown colour space", entity.color_space),
-        )
-    })?;
+    let color_space = fp.color_space();
 
     // Sensor.
-    let iso = params.get_one_float("iso", 100.0).map_err(perr)?;
-    let mut wb = params.get_one_float("whitebalance", 0.0).map_err(perr)?;
-    let sensor_name = params.get_one_string("sensor", "cie1931").map_err(perr)?;
+    let iso = fp.float("iso", 100.0)?;
+    let mut wb = fp.float("whitebalance", 0.0)?;
+    let sensor_name = fp.string("sensor", "cie1931")?;
     if sensor_name != "cie1931" && wb == 0.0 {
         wb = 6500.0;
     }
@@ -152,11 +137,11 @@ pub fn create_film(
     } else {
         match PixelSensor::camera(&sensor_name, color_space, wb, imaging_ratio) {
             Some(Ok(s)) => s,
-            Some(Err(m)) => return Err(Diagnostic::error(at(params, "sensor", loc), m)),
+            Some(Err(m)) => return Err(Diagnostic::error(fp.param_loc("sensor"), m)),
             None => {
                 let known: Vec<&str> = sensor_names().collect();
                 return Err(Diagnostic::error(
-                    at(params, "sensor", loc),
+                    fp.param_loc("sensor"),
                     format!(
                         "\"{sensor_name}\": unknown sensor type (known: {})",
                         known.join(", ")
@@ -167,14 +152,14 @@ pub fn create_film(
     };
 
     // File name.
-    let scene_filename = params.get_one_string("filename", "").map_err(perr)?;
+    let scene_filename = fp.string("filename", "")?;
     let filename = match &overrides.outfile {
         Some(f) => {
             if !scene_filename.is_empty() {
-                warnings.push(Diagnostic::warning(
-                    at(params, "filename", loc),
+                fp.warn_at(
+                    "filename",
                     format!("output filename \"{f}\" from the command line overrides \"{scene_filename}\" from the scene"),
-                ));
+                );
             }
             f.clone()
         }
@@ -182,7 +167,7 @@ pub fn create_film(
         None => scene_filename,
     };
     let ext = extension(&filename);
-    let floc = at(params, "filename", loc);
+    let floc = fp.param_loc("filename");
     if !IMAGE_EXTENSIONS.contains(&ext.as_str()) {
         return Err(Diagnostic::error(
             floc,
@@ -197,18 +182,18 @@ pub fn create_film(
     }
 
     // Resolution.
-    let xres = params.get_one_int("xresolution", 1280).map_err(perr)?;
-    let yres = params.get_one_int("yresolution", 720).map_err(perr)?;
+    let xres = fp.int("xresolution", 1280)?;
+    let yres = fp.int("yresolution", 720)?;
     for (n, v) in [("xresolution", xres), ("yresolution", yres)] {
         if v <= 0 {
             return Err(Diagnostic::error(
-                at(params, n, loc),
+                fp.param_loc(n),
                 format!("\"{n}\" must be positive (got {v})"),
             ));
         }
         if v > MAX_RESOLUTION {
             return Err(Diagnostic::error(
-                at(params, n, loc),
+                fp.param_loc(n),
                 format!("\"{n}\" {v} is larger than the supported maximum {MAX_RESOLUTION}"),
             ));
         }
@@ -221,35 +206,35 @@ pub fn create_film(
 
     // Pixel bounds and crop window, with pbrt-v4's precedence.
     let mut pixel_bounds = full_bounds;
-    let pb = params.get_int_array("pixelbounds").map_err(perr)?;
+    let pb = fp.ints("pixelbounds")?;
     if let Some(cli) = overrides.pixel_bounds {
         pixel_bounds = check_pixel_bounds(&cli, full_bounds, loc.clone())?;
     } else if !pb.is_empty() {
-        pixel_bounds = check_pixel_bounds(&pb, full_bounds, at(params, "pixelbounds", loc))?;
+        pixel_bounds = check_pixel_bounds(&pb, full_bounds, fp.param_loc("pixelbounds"))?;
     }
-    let cr = params.get_float_array("cropwindow").map_err(perr)?;
+    let cr = fp.floats("cropwindow")?;
     if let Some(c) = overrides.crop_window {
         let c = check_crop(&c, loc.clone())?;
         pixel_bounds = crop_to_pixel_bounds(full, c);
         if !cr.is_empty() {
-            warnings.push(Diagnostic::warning(
-                at(params, "cropwindow", loc),
+            fp.warn_at(
+                "cropwindow",
                 "crop window from the command line overrides the film's \"cropwindow\"",
-            ));
+            );
         }
     } else if !cr.is_empty() {
-        let c = check_crop(&cr, at(params, "cropwindow", loc))?;
+        let c = check_crop(&cr, fp.param_loc("cropwindow"))?;
         if overrides.pixel_bounds.is_some() {
-            warnings.push(Diagnostic::warning(
-                at(params, "cropwindow", loc),
+            fp.warn_at(
+                "cropwindow",
                 "ignoring \"cropwindow\" since pixel bounds were given on the command line",
-            ));
+            );
         } else {
             if !pb.is_empty() {
-                warnings.push(Diagnostic::warning(
-                    at(params, "cropwindow", loc),
+                fp.warn_at(
+                    "cropwindow",
                     "both pixel bounds and crop window were given; using the crop window",
-                ));
+                );
             }
             pixel_bounds = crop_to_pixel_bounds(full, c);
         }
@@ -276,23 +261,19 @@ pub fn create_film(
         ));
     }
 
-    let diagonal = params.get_one_float("diagonal", 35.0).map_err(perr)?;
-    let max_component_value = params
-        .get_one_float("maxcomponentvalue", Float::INFINITY)
-        .map_err(perr)?;
-    let write_fp16 = params.get_one_bool("savefp16", true).map_err(perr)?;
+    let diagonal = fp.float("diagonal", 35.0)?;
+    let max_component_value = fp.float("maxcomponentvalue", Float::INFINITY)?;
+    let write_fp16 = fp.bool("savefp16", true)?;
 
     let kind = match name {
         "gbuffer" => {
-            let cs = params
-                .get_one_string("coordinatesystem", "camera")
-                .map_err(perr)?;
+            let cs = fp.string("coordinatesystem", "camera")?;
             let (output_from_render, apply_inverse) = match cs.as_str() {
                 "camera" => (camera_transform.render_from_camera, true),
                 "world" => (AnimatedTransform::fixed(camera_transform.world_from_render), false),
                 _ => {
                     return Err(Diagnostic::error(
-                        at(params, "coordinatesystem", loc),
+                        fp.param_loc("coordinatesystem"),
                         format!("\"{cs}\": unknown coordinate system for the gbuffer film (expected \"camera\" or \"world\")"),
                     ))
                 }
@@ -304,16 +285,12 @@ pub fn create_film(
             }
         }
         "spectral" => {
-            let nb = params.get_one_int("nbuckets", 16).map_err(perr)?;
-            let lmin = params
-                .get_one_float("lambdamin", LAMBDA_MIN)
-                .map_err(perr)?;
-            let lmax = params
-                .get_one_float("lambdamax", LAMBDA_MAX)
-                .map_err(perr)?;
+            let nb = fp.int("nbuckets", 16)?;
+            let lmin = fp.float("lambdamin", LAMBDA_MIN)?;
+            let lmax = fp.float("lambdamax", LAMBDA_MAX)?;
             if !(1..=1024).contains(&nb) {
                 return Err(Diagnostic::error(
-                    at(params, "nbuckets", loc),
+                    fp.param_loc("nbuckets"),
                     format!("\"nbuckets\" must be in [1, 1024] (got {nb})"),
                 ));
             }
@@ -324,7 +301,7 @@ pub fn create_film(
                 || lmax.is_nan()
             {
                 return Err(Diagnostic::error(
-                    at(params, "lambdamin", loc),
+                    fp.param_loc("lambdamin"),
                     format!("wavelength range [{lmin}, {lmax}] must be increasing and within [{LAMBDA_MIN}, {LAMBDA_MAX}] nm"),
                 ));
             }
@@ -336,8 +313,6 @@ pub fn create_film(
         }
         _ => KindConfig::Rgb,
     };
-    warnings.extend(params.report_unused());
-
     let core = FilmCore::new(
         FilmParams {
             full_resolution: full,
@@ -357,5 +332,5 @@ pub fn create_film(
         "spectral" => Film::Spectral(SpectralFilm { core }),
         _ => Film::Rgb(RgbFilm { core }),
     };
-    Ok((film, warnings))
+    Ok(film)
 }

@@ -28,7 +28,7 @@ mod sensor;
 #[cfg(test)]
 mod tests;
 
-pub use create::{create_film, FilmOverrides, IMAGE_EXTENSIONS, MAX_RESOLUTION};
+pub use create::{create_film, FilmOverrides, FILM_NAMES, IMAGE_EXTENSIONS, MAX_RESOLUTION};
 pub use pixels::{KindConfig, Pixels, SampleConfig, VarianceEstimator};
 pub use sensor::{daylight_illuminant, sensor_names, white_balance, PixelSensor};
 

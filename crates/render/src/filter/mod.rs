@@ -7,13 +7,15 @@
 //! a [`FilterSampler`]: the filter tabulated at 32 cells per unit radius and
 //! sampled as a [`PiecewiseConstant2D`].
 
+mod create;
 #[cfg(test)]
 mod tests;
+
+pub use create::{create_filter, FILTER_NAMES};
 
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;
 use rpbrt_geometry::Bounds2f;
-use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary};
 
 use crate::sampling::sample_linear;
 use crate::sampling::tabulated::PiecewiseConstant2D;
@@ -449,77 +451,4 @@ impl Filter {
     pub fn sample(&self, u: Point2f) -> FilterSample {
         dispatch!(self, f => f.sample(u))
     }
-}
-
-fn positive(
-    params: &ParameterDictionary,
-    name: &str,
-    default: Float,
-    loc: &FileLoc,
-) -> Result<Float, Diagnostic> {
-    let v = params.get_one_float(name, default)?;
-    if !(v.is_finite() && v > 0.0) {
-        let at = params.loc(name).cloned().unwrap_or_else(|| loc.clone());
-        return Err(Diagnostic::error(
-            at,
-            format!("\"{name}\" must be a positive number, not {v}"),
-        ));
-    }
-    Ok(v)
-}
-
-fn finite(
-    params: &ParameterDictionary,
-    name: &str,
-    default: Float,
-    loc: &FileLoc,
-) -> Result<Float, Diagnostic> {
-    let v = params.get_one_float(name, default)?;
-    if !v.is_finite() {
-        let at = params.loc(name).cloned().unwrap_or_else(|| loc.clone());
-        return Err(Diagnostic::error(at, format!("\"{name}\" must be finite")));
-    }
-    Ok(v)
-}
-
-/// Creates the filter `name` ("box", "gaussian", "mitchell", "sinc",
-/// "triangle") from its parameters, with pbrt-v4's defaults.
-pub fn create_filter(
-    name: &str,
-    params: &ParameterDictionary,
-    loc: &FileLoc,
-) -> Result<Filter, Diagnostic> {
-    let radius = |d: Float| -> Result<Vector2f, Diagnostic> {
-        Ok(Vector2f::new(
-            positive(params, "xradius", d, loc)?,
-            positive(params, "yradius", d, loc)?,
-        ))
-    };
-    Ok(match name {
-        "box" => Filter::Box(BoxFilter::new(radius(0.5)?)),
-        "gaussian" => {
-            let r = radius(1.5)?;
-            Filter::Gaussian(GaussianFilter::new(r, positive(params, "sigma", 0.5, loc)?))
-        }
-        "mitchell" => {
-            let r = radius(2.0)?;
-            let b = finite(params, "B", 1.0 / 3.0, loc)?;
-            let c = finite(params, "C", 1.0 / 3.0, loc)?;
-            Filter::Mitchell(MitchellFilter::new(r, b, c))
-        }
-        "sinc" => {
-            let r = radius(4.0)?;
-            Filter::LanczosSinc(LanczosSincFilter::new(
-                r,
-                positive(params, "tau", 3.0, loc)?,
-            ))
-        }
-        "triangle" => Filter::Triangle(TriangleFilter::new(radius(2.0)?)),
-        _ => {
-            return Err(Diagnostic::error(
-                loc.clone(),
-                format!("\"{name}\": filter type unknown"),
-            ))
-        }
-    })
 }

@@ -4,13 +4,11 @@
 //! (`scale /= SpectrumToPhotometric(spectrum)`) and its `power` /
 //! `illuminance` targets, with located errors.
 
-use std::path::{Path, PathBuf};
-
 use rpbrt_geometry::{
-    equal_area_square_to_sphere, Float, Frame, MediumId, Point2f, Point2i, Point3f, SquareMatrix4,
-    Transform, Vector3f, PI,
+    equal_area_square_to_sphere, AnimatedTransform, Float, Frame, MediumId, Point2f, Point2i,
+    Point3f, SquareMatrix4, Transform, Vector3f, PI,
 };
-use rpbrt_parser::{Diagnostic, FileLoc, ParamError, ParameterDictionary};
+use rpbrt_parser::{Diagnostic, FileLoc};
 
 use super::area::AreaEmission;
 use super::{
@@ -18,85 +16,34 @@ use super::{
     Light, PointLight, PortalImageInfiniteLight, ProjectionLight, SceneSphere, SpotLight,
     UniformInfiniteLight,
 };
+use crate::camera::CameraTransform;
 use crate::image::{Image, WrapMode, WrapMode2D};
-use crate::scene::entities::{CameraTransform, LightSceneEntity, SceneEntity};
+use crate::params::{unknown_type, ParamReader};
 use crate::shape::{Shape, ShapeMethods};
-use crate::spectrum::{
-    spectrum_from_param, spectrum_to_photometric, RgbColorSpace, Spectrum, SpectrumType,
-};
+use crate::spectrum::{spectrum_to_photometric, RgbColorSpace, Spectrum, SpectrumType};
 use crate::texture::FloatTextureRef;
 
-/// The light types `LightSource` accepts.
+/// The light types `LightSource` accepts, sorted.
 pub const LIGHT_NAMES: &[&str] = &[
-    "point",
-    "spot",
-    "goniometric",
-    "projection",
     "distant",
+    "goniometric",
     "infinite",
+    "point",
+    "projection",
+    "spot",
 ];
 
-fn perr(e: ParamError) -> Diagnostic {
-    Diagnostic::from(e)
-}
-
-/// The location of parameter `name`, or the directive's.
-fn at(params: &ParameterDictionary, name: &str, loc: &FileLoc) -> FileLoc {
-    params.loc(name).cloned().unwrap_or_else(|| loc.clone())
-}
-
-/// Resolves a file name against the scene file's directory (pbrt-v4
-/// `ResolveFilename`).
-fn resolve(loc: &FileLoc, name: &str) -> PathBuf {
-    let p = Path::new(name);
-    if p.is_absolute() {
-        return p.to_path_buf();
-    }
-    let dir = Path::new(&*loc.file)
-        .parent()
-        .unwrap_or_else(|| Path::new("."));
-    let joined = dir.join(p);
-    if joined.exists() {
-        joined
-    } else {
-        p.to_path_buf()
-    }
-}
-
-fn base_dir(loc: &FileLoc) -> PathBuf {
-    Path::new(&*loc.file)
-        .parent()
-        .map(Path::to_path_buf)
-        .unwrap_or_else(|| PathBuf::from("."))
-}
-
-fn color_space(name: &str, loc: &FileLoc) -> Result<&'static RgbColorSpace, Diagnostic> {
-    RgbColorSpace::get(name)
-        .ok_or_else(|| Diagnostic::error(loc.clone(), format!("\"{name}\": unknown colour space")))
-}
-
 /// An illuminant spectrum parameter, or `None` when absent.
-fn spectrum_param(
-    params: &ParameterDictionary,
-    name: &str,
-    cs: &RgbColorSpace,
-    loc: &FileLoc,
-) -> Result<Option<Spectrum>, Diagnostic> {
-    let Some(v) = params.get_one_spectrum(name).map_err(perr)? else {
-        return Ok(None);
-    };
-    let ploc = at(params, name, loc);
-    spectrum_from_param(&v, SpectrumType::Illuminant, cs, &base_dir(&ploc))
-        .map(Some)
-        .map_err(|e| Diagnostic::error(ploc, format!("\"{name}\": {e}")))
+fn spectrum_param(lp: &ParamReader, name: &str) -> Result<Option<Spectrum>, Diagnostic> {
+    lp.spectrum(name, SpectrumType::Illuminant)
 }
 
 /// `scale`, which must not be negative.
-fn scale_param(params: &ParameterDictionary, loc: &FileLoc) -> Result<Float, Diagnostic> {
-    let s = params.get_one_float("scale", 1.0).map_err(perr)?;
+fn scale_param(lp: &ParamReader) -> Result<Float, Diagnostic> {
+    let s = lp.float("scale", 1.0)?;
     if s.is_nan() || s < 0.0 || !s.is_finite() {
-        return Err(Diagnostic::error(
-            at(params, "scale", loc),
+        return Err(lp.error_at(
+            "scale",
             format!("\"scale\" {s} must be finite and non-negative"),
         ));
     }
@@ -121,8 +68,8 @@ fn normalize_scale(
     Ok(scale / y)
 }
 
-fn point3(params: &ParameterDictionary, name: &str, def: [f32; 3]) -> Result<Point3f, Diagnostic> {
-    let p = params.get_one_point3(name, def).map_err(perr)?;
+fn point3(lp: &ParamReader, name: &str, def: [f32; 3]) -> Result<Point3f, Diagnostic> {
+    let p = lp.point3(name, def)?;
     Ok(Point3f::new(p[0], p[1], p[2]))
 }
 
@@ -141,16 +88,14 @@ fn from_axes(x: Vector3f, y: Vector3f, z: Vector3f) -> Transform {
 
 /// Reads an image, with located errors.
 fn read_image(
-    params: &ParameterDictionary,
+    lp: &ParamReader,
     filename: &str,
-    loc: &FileLoc,
 ) -> Result<(Image, &'static RgbColorSpace), Diagnostic> {
-    let floc = at(params, "filename", loc);
-    let path = resolve(&floc, filename);
-    let im =
-        Image::read(&path, None).map_err(|e| Diagnostic::error(floc.clone(), format!("{e}")))?;
-    let cs_name = im.metadata.color_space_name().to_string();
-    let cs = color_space(&cs_name, &floc)?;
+    let path = lp.resolve("filename", filename);
+    let im = Image::read(&path, None).map_err(|e| lp.error_at("filename", format!("{e}")))?;
+    let cs_name = im.metadata.color_space_name();
+    let cs = RgbColorSpace::get(cs_name)
+        .ok_or_else(|| lp.error_at("filename", format!("\"{cs_name}\": unknown colour space")))?;
     Ok((im.image, cs))
 }
 
@@ -176,33 +121,28 @@ fn rgb_image(
 /// unused-parameter warnings. `camera_transform` takes infinite-light
 /// portals, given in world space, into render space.
 pub fn create_light(
-    entity: &LightSceneEntity,
+    name: &str,
+    lp: &ParamReader,
+    render_from_light: &AnimatedTransform,
     medium: Option<MediumId>,
     camera_transform: &CameraTransform,
-) -> Result<(Light, Vec<Diagnostic>), Diagnostic> {
-    let base = &entity.base;
-    let params = &base.params;
-    let loc = &base.loc;
-    let cs = color_space(&base.color_space, loc)?;
-    let mut warnings = Vec::new();
-    if entity.render_from_object.is_animated() {
-        warnings.push(Diagnostic::warning(
-            loc.clone(),
-            "animated lights aren't supported; using the start transform",
-        ));
+) -> Result<Light, Diagnostic> {
+    let cs = lp.color_space();
+    let loc = lp.loc();
+    if render_from_light.is_animated() {
+        lp.warn("animated lights aren't supported; using the start transform");
     }
-    let render_from_light = entity.render_from_object.start_transform;
+    let render_from_light = render_from_light.start_transform;
 
-    let light = match base.name.as_str() {
+    let light = match name {
         "point" => {
-            let i =
-                spectrum_param(params, "I", cs, loc)?.unwrap_or_else(|| cs.illuminant_spectrum());
-            let mut scale = normalize_scale(scale_param(params, loc)?, &i, "\"I\"", loc)?;
-            let power = params.get_one_float("power", -1.0).map_err(perr)?;
+            let i = spectrum_param(lp, "I")?.unwrap_or_else(|| cs.illuminant_spectrum());
+            let mut scale = normalize_scale(scale_param(lp)?, &i, "\"I\"", loc)?;
+            let power = lp.float("power", -1.0)?;
             if power > 0.0 {
                 scale *= power / (4.0 * PI);
             }
-            let from = point3(params, "from", [0.0; 3])?;
+            let from = point3(lp, "from", [0.0; 3])?;
             Light::Point(PointLight {
                 render_from_light: render_from_light * Transform::translate(Vector3f::from(from)),
                 i: dense(&i),
@@ -211,16 +151,15 @@ pub fn create_light(
             })
         }
         "spot" => {
-            let i =
-                spectrum_param(params, "I", cs, loc)?.unwrap_or_else(|| cs.illuminant_spectrum());
-            let mut scale = normalize_scale(scale_param(params, loc)?, &i, "\"I\"", loc)?;
-            let coneangle = params.get_one_float("coneangle", 30.0).map_err(perr)?;
-            let conedelta = params.get_one_float("conedelta", 5.0).map_err(perr)?;
-            let from = point3(params, "from", [0.0; 3])?;
-            let to = point3(params, "to", [0.0, 0.0, 1.0])?;
+            let i = spectrum_param(lp, "I")?.unwrap_or_else(|| cs.illuminant_spectrum());
+            let mut scale = normalize_scale(scale_param(lp)?, &i, "\"I\"", loc)?;
+            let coneangle = lp.float("coneangle", 30.0)?;
+            let conedelta = lp.float("conedelta", 5.0)?;
+            let from = point3(lp, "from", [0.0; 3])?;
+            let to = point3(lp, "to", [0.0, 0.0, 1.0])?;
             let dir = (to - from).try_normalize().ok_or_else(|| {
                 Diagnostic::error(
-                    at(params, "to", loc),
+                    lp.param_loc("to"),
                     "spot light \"from\" and \"to\" coincide",
                 )
             })?;
@@ -229,7 +168,7 @@ pub fn create_light(
                 Transform::translate(Vector3f::from(from)) * from_axes(f.x, f.y, f.z);
             let cos_falloff_end = coneangle.to_radians().cos();
             let cos_falloff_start = (coneangle - conedelta).to_radians().cos();
-            let power = params.get_one_float("power", -1.0).map_err(perr)?;
+            let power = lp.float("power", -1.0)?;
             if power > 0.0 {
                 let k_e = 2.0
                     * PI
@@ -246,20 +185,19 @@ pub fn create_light(
             })
         }
         "goniometric" => {
-            let i =
-                spectrum_param(params, "I", cs, loc)?.unwrap_or_else(|| cs.illuminant_spectrum());
-            let mut scale = normalize_scale(scale_param(params, loc)?, &i, "\"I\"", loc)?;
-            let filename = params.get_one_string("filename", "").map_err(perr)?;
+            let i = spectrum_param(lp, "I")?.unwrap_or_else(|| cs.illuminant_spectrum());
+            let mut scale = normalize_scale(scale_param(lp)?, &i, "\"I\"", loc)?;
+            let filename = lp.string("filename", "")?;
             if filename.is_empty() {
                 return Err(Diagnostic::error(
                     loc.clone(),
                     "must provide \"filename\" to \"goniometric\" light source",
                 ));
             }
-            let floc = at(params, "filename", loc);
-            let (im, _) = read_image(params, &filename, loc)?;
+            let floc = lp.param_loc("filename");
+            let (im, _) = read_image(lp, &filename)?;
             let image = goniometric_image(&im, &filename, &floc)?;
-            let power = params.get_one_float("power", -1.0).map_err(perr)?;
+            let power = lp.float("power", -1.0)?;
             if power > 0.0 {
                 let res = image.resolution();
                 let wrap = WrapMode2D::new(WrapMode::OctahedralSphere, WrapMode::OctahedralSphere);
@@ -289,24 +227,24 @@ pub fn create_light(
             }))
         }
         "projection" => {
-            let scale = scale_param(params, loc)?;
-            let power = params.get_one_float("power", -1.0).map_err(perr)?;
-            let fov = params.get_one_float("fov", 90.0).map_err(perr)?;
+            let scale = scale_param(lp)?;
+            let power = lp.float("power", -1.0)?;
+            let fov = lp.float("fov", 90.0)?;
             if !(fov > 0.0 && fov < 180.0) {
                 return Err(Diagnostic::error(
-                    at(params, "fov", loc),
+                    lp.param_loc("fov"),
                     format!("\"fov\" {fov} must be in (0, 180) degrees"),
                 ));
             }
-            let filename = params.get_one_string("filename", "").map_err(perr)?;
+            let filename = lp.string("filename", "")?;
             if filename.is_empty() {
                 return Err(Diagnostic::error(
                     loc.clone(),
                     "must provide \"filename\" to \"projection\" light source",
                 ));
             }
-            let floc = at(params, "filename", loc);
-            let (im, ics) = read_image(params, &filename, loc)?;
+            let floc = lp.param_loc("filename");
+            let (im, ics) = read_image(lp, &filename)?;
             let image = rgb_image(&im, &filename, "projection", &floc)?;
             let res = image.resolution();
             if res.x <= 0 || res.y <= 0 {
@@ -339,20 +277,19 @@ pub fn create_light(
             Light::Projection(Box::new(light))
         }
         "distant" => {
-            let l =
-                spectrum_param(params, "L", cs, loc)?.unwrap_or_else(|| cs.illuminant_spectrum());
-            let mut scale = normalize_scale(scale_param(params, loc)?, &l, "\"L\"", loc)?;
-            let from = point3(params, "from", [0.0; 3])?;
-            let to = point3(params, "to", [0.0, 0.0, 1.0])?;
+            let l = spectrum_param(lp, "L")?.unwrap_or_else(|| cs.illuminant_spectrum());
+            let mut scale = normalize_scale(scale_param(lp)?, &l, "\"L\"", loc)?;
+            let from = point3(lp, "from", [0.0; 3])?;
+            let to = point3(lp, "to", [0.0, 0.0, 1.0])?;
             let w = (from - to).try_normalize().ok_or_else(|| {
                 Diagnostic::error(
-                    at(params, "to", loc),
+                    lp.param_loc("to"),
                     "distant light \"from\" and \"to\" coincide",
                 )
             })?;
             let (v1, v2) = w.coordinate_system();
             // Illuminance is measured on a surface facing the light.
-            let e_v = params.get_one_float("illuminance", -1.0).map_err(perr)?;
+            let e_v = lp.float("illuminance", -1.0)?;
             if e_v > 0.0 {
                 scale *= e_v;
             }
@@ -363,19 +300,10 @@ pub fn create_light(
                 scene: SceneSphere::default(),
             })
         }
-        "infinite" => create_infinite(params, loc, cs, render_from_light, camera_transform)?,
-        other => {
-            return Err(Diagnostic::error(
-                loc.clone(),
-                format!(
-                    "\"{other}\": light type unknown (known: {})",
-                    LIGHT_NAMES.join(", ")
-                ),
-            ))
-        }
+        "infinite" => create_infinite(lp, render_from_light, camera_transform)?,
+        other => return Err(unknown_type("light", other, LIGHT_NAMES, loc)),
     };
-    warnings.extend(params.report_unused());
-    Ok((light, warnings))
+    Ok(light)
 }
 
 /// A single-channel image from an RGB (channel average) or Y image, which
@@ -422,20 +350,20 @@ fn goniometric_image(im: &Image, filename: &str, loc: &FileLoc) -> Result<Image,
 }
 
 fn create_infinite(
-    params: &ParameterDictionary,
-    loc: &FileLoc,
-    cs: &'static RgbColorSpace,
+    lp: &ParamReader,
     render_from_light: Transform,
     camera_transform: &CameraTransform,
 ) -> Result<Light, Diagnostic> {
-    let l = spectrum_param(params, "L", cs, loc)?;
-    let scale = scale_param(params, loc)?;
-    let portal = params.get_point3_array("portal").map_err(perr)?;
-    let filename = params.get_one_string("filename", "").map_err(perr)?;
-    let e_v = params.get_one_float("illuminance", -1.0).map_err(perr)?;
+    let cs = lp.color_space();
+    let loc = lp.loc();
+    let l = spectrum_param(lp, "L")?;
+    let scale = scale_param(lp)?;
+    let portal = lp.point3s("portal")?;
+    let filename = lp.string("filename", "")?;
+    let e_v = lp.float("illuminance", -1.0)?;
     if l.is_some() && !portal.is_empty() {
         return Err(Diagnostic::error(
-            at(params, "portal", loc),
+            lp.param_loc("portal"),
             "portals are not supported for infinite lights without \"filename\"",
         ));
     }
@@ -458,8 +386,8 @@ fn create_infinite(
             scene: SceneSphere::default(),
         }));
     }
-    let floc = at(params, "filename", loc);
-    let (im, ics) = read_image(params, &filename, loc)?;
+    let floc = lp.param_loc("filename");
+    let (im, ics) = read_image(lp, &filename)?;
     let image = rgb_image(&im, &filename, "infinite", &floc)?;
     let res = image.resolution();
     if res.x != res.y || res.x <= 0 {
@@ -504,7 +432,7 @@ fn create_infinite(
         }
     }
     if !portal.is_empty() {
-        let ploc = at(params, "portal", loc);
+        let ploc = lp.param_loc("portal");
         let corners: [Point3f; 4] = match portal.as_slice() {
             [a, b, c, d] => [*a, *b, *c, *d].map(|p| {
                 camera_transform
@@ -533,13 +461,17 @@ fn create_infinite(
     ))))
 }
 
+/// The area light types `AreaLightSource` accepts.
+pub const AREA_LIGHT_NAMES: &[&str] = &["diffuse"];
+
 /// Creates the `diffuse` area light of an `AreaLightSource` directive for
 /// one shape (already in render space; `render_from_object` is the
 /// shape's placement, kept for pbrt-v4 parity). `alpha` masks emission.
 /// Unused parameters are not reported here, since one directive serves
-/// many shapes: call `entity.params.report_unused()` once afterwards.
+/// many shapes: the caller reports them once, after its last shape.
 pub fn create_area_light(
-    entity: &SceneEntity,
+    name: &str,
+    lp: &ParamReader,
     render_from_object: &Transform,
     shape: &Shape,
     alpha: Option<FloatTextureRef>,
@@ -547,23 +479,16 @@ pub fn create_area_light(
     medium_outside: Option<MediumId>,
 ) -> Result<Light, Diagnostic> {
     let _ = render_from_object;
-    let params = &entity.params;
-    let loc = &entity.loc;
-    if entity.name != "diffuse" {
-        return Err(Diagnostic::error(
-            loc.clone(),
-            format!(
-                "\"{}\": area light type unknown (known: diffuse)",
-                entity.name
-            ),
-        ));
+    let loc = lp.loc();
+    if name != "diffuse" {
+        return Err(unknown_type("area light", name, AREA_LIGHT_NAMES, loc));
     }
-    let cs = color_space(&entity.color_space, loc)?;
-    let l = spectrum_param(params, "L", cs, loc)?;
-    let scale = scale_param(params, loc)?;
-    let two_sided = params.get_one_bool("twosided", false).map_err(perr)?;
-    let filename = params.get_one_string("filename", "").map_err(perr)?;
-    let power = params.get_one_float("power", -1.0).map_err(perr)?;
+    let cs = lp.color_space();
+    let l = spectrum_param(lp, "L")?;
+    let scale = scale_param(lp)?;
+    let two_sided = lp.bool("twosided", false)?;
+    let filename = lp.string("filename", "")?;
+    let power = lp.float("power", -1.0)?;
     let area = shape.area();
 
     let (emission, norm_spectrum, image_cs) = if !filename.is_empty() {
@@ -573,8 +498,8 @@ pub fn create_area_light(
                 "both \"L\" and \"filename\" specified for diffuse area light",
             ));
         }
-        let floc = at(params, "filename", loc);
-        let (im, ics) = read_image(params, &filename, loc)?;
+        let floc = lp.param_loc("filename");
+        let (im, ics) = read_image(lp, &filename)?;
         let image = rgb_image(&im, &filename, "diffuse", &floc)?;
         if image.resolution().x <= 0 || image.resolution().y <= 0 {
             return Err(Diagnostic::error(floc, format!("{filename}: empty image")));

@@ -42,7 +42,7 @@ mod tests_create;
 pub use bump::{bump_map, normal_map, read_normal_map};
 pub use coated::{CoatedConductorMaterial, CoatedDiffuseMaterial};
 pub use conductor::{ConductorMaterial, ConductorSpectra};
-pub use create::create_materials;
+pub use create::{create_material, NormalMapCache, MATERIAL_NAMES};
 pub use data::get_medium_scattering_properties;
 pub use dielectric::{DielectricMaterial, ThinDielectricMaterial};
 pub use diffuse::{DiffuseMaterial, DiffuseTransmissionMaterial};

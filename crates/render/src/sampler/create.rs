@@ -3,35 +3,41 @@
 //! defaults and overrides as pbrt-v4, with located errors for bad values.
 
 use rpbrt_geometry::tuple::Point2i;
-use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary};
+use rpbrt_parser::Diagnostic;
 
 use super::*;
+use crate::params::{unknown_type, ParamReader};
 
-fn param_loc(params: &ParameterDictionary, name: &str, loc: &FileLoc) -> FileLoc {
-    params.loc(name).cloned().unwrap_or_else(|| loc.clone())
-}
+/// The sampler types `Sampler` accepts, sorted.
+pub const SAMPLER_NAMES: &[&str] = &[
+    "halton",
+    "independent",
+    "paddedsobol",
+    "pmj02bn",
+    "sobol",
+    "stratified",
+    "zsobol",
+];
 
 /// Reads `pixelsamples` (default `default`), applying the command-line
 /// override; counts ≤ 0 are errors.
 fn pixel_samples(
-    params: &ParameterDictionary,
+    sp: &ParamReader,
     default: i32,
     spp_override: Option<i32>,
-    loc: &FileLoc,
 ) -> Result<i32, Diagnostic> {
-    let mut n = params.get_one_int("pixelsamples", default)?;
+    let mut n = sp.int("pixelsamples", default)?;
     if n <= 0 {
         return Err(Diagnostic::error(
-            param_loc(params, "pixelsamples", loc),
+            sp.param_loc("pixelsamples"),
             format!("\"pixelsamples\" must be positive, not {n}"),
         ));
     }
     if let Some(o) = spp_override {
         if o <= 0 {
-            return Err(Diagnostic::error(
-                loc.clone(),
-                format!("samples-per-pixel override must be positive, not {o}"),
-            ));
+            return Err(sp.error(format!(
+                "samples-per-pixel override must be positive, not {o}"
+            )));
         }
         n = o;
     }
@@ -39,13 +45,12 @@ fn pixel_samples(
 }
 
 fn randomization(
-    params: &ParameterDictionary,
+    sp: &ParamReader,
     default: &str,
     sampler: &str,
-    loc: &FileLoc,
 ) -> Result<RandomizeStrategy, Diagnostic> {
-    let s = params.get_one_string("randomization", default)?;
-    let err = |msg: String| Diagnostic::error(param_loc(params, "randomization", loc), msg);
+    let s = sp.string("randomization", default)?;
+    let err = |msg: String| sp.error_at("randomization", msg);
     match s.as_str() {
         "none" => Ok(RandomizeStrategy::None),
         "permutedigits" => Ok(RandomizeStrategy::PermuteDigits),
@@ -61,11 +66,10 @@ fn randomization(
     }
 }
 
-fn warn_not_pow2(n: i32, name: &str, loc: &FileLoc, warnings: &mut Vec<Diagnostic>) {
+fn warn_not_pow2(n: i32, name: &str, sp: &ParamReader) {
     if n & (n - 1) != 0 {
-        warnings.push(Diagnostic::warning(
-            loc.clone(),
-            format!("{name}: non power-of-two sample counts ({n}) are sub-optimal"),
+        sp.warn(format!(
+            "{name}: non power-of-two sample counts ({n}) are sub-optimal"
         ));
     }
 }
@@ -75,38 +79,34 @@ fn warn_not_pow2(n: i32, name: &str, loc: &FileLoc, warnings: &mut Vec<Diagnosti
 /// `full_resolution` from its parameters. `spp_override` and
 /// `seed_override` are the command-line `--spp` and `--seed` (the seed
 /// default for the `seed` parameter; pbrt's default 0). Warnings (such as
-/// a non-power-of-two count for a Sobol' sampler) go to `warnings`.
+/// a non-power-of-two count for a Sobol' sampler) go to `sp`.
 pub fn create_sampler(
     name: &str,
-    params: &ParameterDictionary,
+    sp: &ParamReader,
     full_resolution: Point2i,
     spp_override: Option<i32>,
     seed_override: Option<i32>,
-    loc: &FileLoc,
-    warnings: &mut Vec<Diagnostic>,
 ) -> Result<Sampler, Diagnostic> {
+    let loc = sp.loc();
     let options_seed = seed_override.unwrap_or(0);
     let sampler = match name {
         "zsobol" => {
-            let n = pixel_samples(params, 16, spp_override, loc)?;
-            let seed = params.get_one_int("seed", options_seed)?;
-            let r = randomization(params, "fastowen", name, loc)?;
+            let n = pixel_samples(sp, 16, spp_override)?;
+            let seed = sp.int("seed", options_seed)?;
+            let r = randomization(sp, "fastowen", name)?;
             if n & (n - 1) != 0 {
                 let used = 1 << (31 - (n as u32).leading_zeros());
-                warnings.push(Diagnostic::warning(
-                    loc.clone(),
-                    format!(
-                        "zsobol: non power-of-two sample counts are sub-optimal; \
-                         using {used} samples per pixel instead of {n}"
-                    ),
+                sp.warn(format!(
+                    "zsobol: non power-of-two sample counts are sub-optimal; \
+                     using {used} samples per pixel instead of {n}"
                 ));
             }
             Sampler::ZSobol(ZSobolSampler::new(n, full_resolution, r, seed))
         }
         "sobol" => {
-            let n = pixel_samples(params, 16, spp_override, loc)?;
-            let r = randomization(params, "fastowen", name, loc)?;
-            warn_not_pow2(n, name, loc, warnings);
+            let n = pixel_samples(sp, 16, spp_override)?;
+            let r = randomization(sp, "fastowen", name)?;
+            warn_not_pow2(n, name, sp);
             let res = full_resolution.x.max(full_resolution.y).max(1) as u64;
             let log2_scale = res.next_power_of_two().trailing_zeros();
             let log2_spp = (n as u64).next_power_of_two().trailing_zeros();
@@ -127,45 +127,43 @@ pub fn create_sampler(
             Sampler::Sobol(SobolSampler::new(n, full_resolution, r, options_seed))
         }
         "paddedsobol" => {
-            let n = pixel_samples(params, 16, spp_override, loc)?;
-            let seed = params.get_one_int("seed", options_seed)?;
-            let r = randomization(params, "fastowen", name, loc)?;
-            warn_not_pow2(n, name, loc, warnings);
+            let n = pixel_samples(sp, 16, spp_override)?;
+            let seed = sp.int("seed", options_seed)?;
+            let r = randomization(sp, "fastowen", name)?;
+            warn_not_pow2(n, name, sp);
             Sampler::PaddedSobol(PaddedSobolSampler::new(n, r, seed))
         }
         "halton" => {
-            let n = pixel_samples(params, 16, spp_override, loc)?;
-            let seed = params.get_one_int("seed", options_seed)?;
-            let r = randomization(params, "permutedigits", name, loc)?;
+            let n = pixel_samples(sp, 16, spp_override)?;
+            let seed = sp.int("seed", options_seed)?;
+            let r = randomization(sp, "permutedigits", name)?;
             Sampler::Halton(HaltonSampler::new(n, full_resolution, r, seed))
         }
         "pmj02bn" => {
-            let n = pixel_samples(params, 16, spp_override, loc)?;
-            let seed = params.get_one_int("seed", options_seed)?;
+            let n = pixel_samples(sp, 16, spp_override)?;
+            let seed = sp.int("seed", options_seed)?;
             let log2 = 31 - (n as u32).leading_zeros();
             if n & (n - 1) != 0 || log2 % 2 != 0 {
-                warnings.push(Diagnostic::warning(
-                    loc.clone(),
+                sp.warn(
                     "pmj02bn: results are best with power-of-4 samples per pixel (1, 4, 16, 64, ...)",
-                ));
+                );
             }
-            let s = Pmj02bnSampler::new(n, seed)
-                .map_err(|e| Diagnostic::error(param_loc(params, "pixelsamples", loc), e))?;
+            let s = Pmj02bnSampler::new(n, seed).map_err(|e| sp.error_at("pixelsamples", e))?;
             Sampler::Pmj02bn(s)
         }
         "independent" => {
-            let n = pixel_samples(params, 4, spp_override, loc)?;
-            let seed = params.get_one_int("seed", options_seed)?;
+            let n = pixel_samples(sp, 4, spp_override)?;
+            let seed = sp.int("seed", options_seed)?;
             Sampler::Independent(IndependentSampler::new(n, seed))
         }
         "stratified" => {
-            let jitter = params.get_one_bool("jitter", true)?;
-            let mut xs = params.get_one_int("xsamples", 4)?;
-            let mut ys = params.get_one_int("ysamples", 4)?;
+            let jitter = sp.bool("jitter", true)?;
+            let mut xs = sp.int("xsamples", 4)?;
+            let mut ys = sp.int("ysamples", 4)?;
             for (v, pname) in [(xs, "xsamples"), (ys, "ysamples")] {
                 if v <= 0 {
                     return Err(Diagnostic::error(
-                        param_loc(params, pname, loc),
+                        sp.param_loc(pname),
                         format!("\"{pname}\" must be positive, not {v}"),
                     ));
                 }
@@ -185,15 +183,10 @@ pub fn create_sampler(
                 xs = n / div;
                 ys = n / xs;
             }
-            let seed = params.get_one_int("seed", options_seed)?;
+            let seed = sp.int("seed", options_seed)?;
             Sampler::Stratified(StratifiedSampler::new(xs, ys, jitter, seed))
         }
-        _ => {
-            return Err(Diagnostic::error(
-                loc.clone(),
-                format!("\"{name}\": sampler type unknown"),
-            ))
-        }
+        _ => return Err(unknown_type("sampler", name, SAMPLER_NAMES, loc)),
     };
     Ok(sampler)
 }

@@ -21,7 +21,7 @@ mod tests;
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::tuple::{Point2f, Point2i};
 
-pub use create::create_sampler;
+pub use create::{create_sampler, SAMPLER_NAMES};
 pub use halton::HaltonSampler;
 pub use independent::IndependentSampler;
 pub use lowdiscrepancy::RandomizeStrategy;

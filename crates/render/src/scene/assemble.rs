@@ -1,29 +1,30 @@
 //! From a scene description to a render-ready [`Scene`] (pbrt-v4
 //! `BasicScene`'s `Create*` phase): film, camera, sampler, filter,
 //! textures, materials, lights, primitives, the aggregate and the
-//! integrator, with every problem reported at its directive.
+//! integrator. Each entity's parameters are read through one
+//! [`ParamReader`] by its module's `create`; every problem is reported at
+//! its directive, and parameters nothing read are warned about.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use rpbrt_parser::Diagnostic;
 
 use super::entities::*;
-use super::shapes::create_entity_shapes;
+use super::materials::{create_materials, create_textures};
+use super::shapes::{at_origin, create_primitives, ShapeContext};
 use crate::accel::{AccelParams, ParamValue};
-use crate::camera::create_camera_with;
+use crate::camera::create_camera;
 use crate::film::{create_film, FilmOverrides};
 use crate::filter::create_filter;
 use crate::image::MIPMapCache;
 use crate::integrator::{create_integrator, Integrator, RayCounters, Scene};
-use crate::light::{create_area_light, create_light, Light, LightCull, LightType};
+use crate::light::{create_light, Light, LightCull, LightType};
 use crate::lightsampler::create_light_sampler;
-use crate::material::create_materials;
-use crate::primitive::{
-    Alpha, AnimatedPrimitive, GeometricPrimitive, Primitive, PrimitiveAggregate,
-    TransformedPrimitive,
-};
+use crate::params::ParamReader;
+use crate::primitive::{AnimatedPrimitive, Primitive, PrimitiveAggregate, TransformedPrimitive};
 use crate::sampler::create_sampler;
-use crate::texture::{create_textures, get_float_texture_opt, NamedTextures, TextureOptions};
-use rpbrt_geometry::transform::Transform;
-use rpbrt_parser::{Diagnostic, ParameterDictionary};
-use std::collections::HashMap;
-use std::sync::Arc;
+use crate::texture::TextureOptions;
 
 /// Command-line settings that change how the scene is created.
 #[derive(Clone, Debug, Default)]
@@ -50,10 +51,58 @@ pub struct CreatedScene {
     pub warnings: Vec<Diagnostic>,
 }
 
+/// The errors and warnings of scene creation: the one place creators'
+/// diagnostics go.
+#[derive(Debug, Default)]
+pub(super) struct Problems {
+    /// Errors: the scene is not rendered.
+    pub errors: Vec<Diagnostic>,
+    /// Warnings, including unused parameters.
+    pub warnings: Vec<Diagnostic>,
+}
+
+impl Problems {
+    /// The value, or `None` with the error kept.
+    pub fn take<T>(&mut self, r: Result<T, Diagnostic>) -> Option<T> {
+        r.map_err(|e| self.errors.push(e)).ok()
+    }
+
+    /// The value of a creator that read `reader`: its warnings are kept,
+    /// with the unused-parameter ones when it succeeded.
+    pub fn finish<T>(&mut self, reader: ParamReader, r: Result<T, Diagnostic>) -> Option<T> {
+        match r {
+            Ok(v) => {
+                self.warnings.extend(reader.finish());
+                Some(v)
+            }
+            Err(e) => {
+                self.errors.push(e);
+                self.warnings.extend(reader.take_warnings());
+                None
+            }
+        }
+    }
+
+    /// A step of a creator that goes on reading `reader`: on an error, the
+    /// error and the warnings so far are kept.
+    pub fn keep_going<T>(&mut self, reader: &ParamReader, r: Result<T, Diagnostic>) -> Option<T> {
+        r.map_err(|e| {
+            self.errors.push(e);
+            self.warnings.extend(reader.take_warnings());
+        })
+        .ok()
+    }
+}
+
+/// A directive's parameter reader in its colour space.
+fn reader(e: &SceneEntity) -> Result<ParamReader<'_>, Diagnostic> {
+    ParamReader::new(&e.params, &e.loc, &e.color_space)
+}
+
 /// Reads an `Accelerator` directive's parameters.
-fn accel_params(e: &SceneEntity) -> Result<AccelParams, Diagnostic> {
-    let mut p = AccelParams::new(&e.name).map_err(|m| Diagnostic::error(e.loc.clone(), m))?;
-    for param in e.params.params() {
+fn accel_params(name: &str, ap: &ParamReader) -> Result<AccelParams, Diagnostic> {
+    let mut p = AccelParams::new(name).map_err(|m| ap.error(m))?;
+    for param in ap.dict().params() {
         let v = match param.canonical_type() {
             "integer" if param.ints.len() == 1 => ParamValue::Int(param.ints[0]),
             "float" if param.floats.len() == 1 => ParamValue::Float(param.floats[0]),
@@ -75,267 +124,137 @@ fn accel_params(e: &SceneEntity) -> Result<AccelParams, Diagnostic> {
     Ok(p)
 }
 
-fn alpha_of(params: &ParameterDictionary, textures: &NamedTextures) -> Result<Alpha, Diagnostic> {
-    match get_float_texture_opt(params, "alpha", textures)? {
-        None => Ok(Alpha::Opaque),
-        Some(t) => match &*t {
-            crate::texture::FloatTexture::Constant(a) if *a >= 1.0 => Ok(Alpha::Opaque),
-            crate::texture::FloatTexture::Constant(a) => Ok(Alpha::Constant(*a)),
-            _ => Ok(Alpha::Texture(t)),
-        },
-    }
-}
-
-fn one<T>(r: Result<T, Diagnostic>, errors: &mut Vec<Diagnostic>) -> Option<T> {
-    match r {
-        Ok(v) => Some(v),
-        Err(e) => {
-            errors.push(e);
-            None
-        }
-    }
-}
-
 /// Builds the render-ready scene.
 pub fn create_scene(
     desc: &SceneDescription,
     opts: &CreateOptions,
 ) -> Result<CreatedScene, Vec<Diagnostic>> {
-    let mut warnings: Vec<Diagnostic> = Vec::new();
-    let mut errors: Vec<Diagnostic> = Vec::new();
+    let mut problems = Problems::default();
+    let p = &mut problems;
 
     // Participating media are not built yet: refuse scenes that use them.
     if let Some(m) = desc.media.first() {
-        errors.push(Diagnostic::error(
+        p.errors.push(Diagnostic::error(
             m.base.loc.clone(),
             "participating media are not supported yet",
         ));
     }
 
     // Filter, film, camera, sampler.
-    let filter = one(
-        create_filter(&desc.filter.name, &desc.filter.params, &desc.filter.loc),
-        &mut errors,
-    );
-    let cam_params = &desc.camera.base.params;
-    let exposure = cam_params.get_one_float("shutterclose", 1.0).unwrap_or(1.0)
-        - cam_params.get_one_float("shutteropen", 0.0).unwrap_or(0.0);
-    let film = filter.as_ref().and_then(|f| {
-        one(
-            create_film(
-                &desc.film,
-                f,
-                exposure,
-                &desc.camera.camera_transform,
-                &opts.film,
-            )
-            .map(|(film, w)| {
-                warnings.extend(w);
-                film
-            }),
-            &mut errors,
-        )
+    let filter = p.take(reader(&desc.filter)).and_then(|r| {
+        let f = create_filter(&desc.filter.name, &r);
+        p.finish(r, f)
+    });
+    let camera_entity = &desc.camera;
+    let Some(camera_reader) = p.take(reader(&camera_entity.base)) else {
+        return Err(problems.errors);
+    };
+    let exposure = camera_reader.float("shutterclose", 1.0).unwrap_or(1.0)
+        - camera_reader.float("shutteropen", 0.0).unwrap_or(0.0);
+    let camera_transform = &camera_entity.camera_transform;
+    let film = filter.as_ref().and_then(|filter| {
+        let r = p.take(reader(&desc.film))?;
+        let f = create_film(
+            &desc.film.name,
+            &r,
+            filter,
+            exposure,
+            camera_transform,
+            &opts.film,
+        );
+        p.finish(r, f)
     });
     let Some((filter, film)) = filter.zip(film) else {
-        return Err(errors);
+        return Err(problems.errors);
     };
     let geometry = film.geometry();
-    let camera = match create_camera_with(&desc.camera, &geometry, None) {
-        Ok(c) => {
-            warnings.extend(c.warnings);
-            c.camera
-        }
-        Err(e) => {
-            errors.push(e);
-            return Err(errors);
-        }
+    let camera = create_camera(
+        &camera_entity.base.name,
+        &camera_reader,
+        camera_transform,
+        &geometry,
+        None,
+    );
+    let Some(camera) = p.finish(camera_reader, camera) else {
+        return Err(problems.errors);
     };
-    let mut sampler_warnings = Vec::new();
-    let sampler = one(
-        create_sampler(
+    let sampler = p.take(reader(&desc.sampler)).and_then(|r| {
+        let s = create_sampler(
             &desc.sampler.name,
-            &desc.sampler.params,
+            &r,
             geometry.full_resolution,
             opts.spp,
             opts.seed,
-            &desc.sampler.loc,
-            &mut sampler_warnings,
-        ),
-        &mut errors,
-    );
-    warnings.extend(sampler_warnings);
+        );
+        p.finish(r, s)
+    });
 
     // Textures and materials.
     let cache = MIPMapCache::new();
-    let textures = match create_textures(
+    let texture_options = TextureOptions {
+        disable_texture_filtering: opts.disable_texture_filtering,
+    };
+    let Some(textures) = create_textures(
         &desc.float_textures,
         &desc.spectrum_textures,
         &cache,
-        &TextureOptions {
-            disable_texture_filtering: opts.disable_texture_filtering,
-        },
-    ) {
-        Ok((t, w)) => {
-            warnings.extend(w);
-            t
-        }
-        Err(e) => {
-            errors.extend(e);
-            return Err(errors);
-        }
+        &texture_options,
+        p,
+    ) else {
+        return Err(problems.errors);
     };
-    let (materials, named_material_ids) =
-        match create_materials(&desc.materials, &desc.named_materials, &textures) {
-            Ok((m, ids, w)) => {
-                warnings.extend(w);
-                (m, ids)
-            }
-            Err(e) => {
-                errors.extend(e);
-                return Err(errors);
-            }
-        };
+    let Some((materials, named_material_ids)) =
+        create_materials(&desc.materials, &desc.named_materials, &textures, p)
+    else {
+        return Err(problems.errors);
+    };
     if let Some((_, loc)) = materials.first_subsurface() {
         let loc = loc.cloned().unwrap_or_else(|| desc.integrator.loc.clone());
-        errors.push(Diagnostic::error(
+        p.errors.push(Diagnostic::error(
             loc,
             "subsurface scattering is not supported yet: no rpbrt integrator renders BSSRDFs",
         ));
     }
-    let material_id = |r: &MaterialRef| -> Option<u32> {
-        match r {
-            MaterialRef::Index(i) => Some(*i as u32),
-            MaterialRef::Named(n) => named_material_ids.get(n).copied(),
-        }
-    };
 
     // Lights.
-    let camera_transform = &desc.camera.camera_transform;
     let mut lights: Vec<Light> = Vec::new();
     for l in &desc.lights {
-        match create_light(l, None, camera_transform) {
-            Ok((light, w)) => {
-                warnings.extend(w);
-                lights.push(light);
-            }
-            Err(e) => errors.push(e),
+        let Some(r) = p.take(reader(&l.base)) else {
+            continue;
+        };
+        let light = create_light(
+            &l.base.name,
+            &r,
+            &l.render_from_object,
+            None,
+            camera_transform,
+        );
+        if let Some(light) = p.finish(r, light) {
+            lights.push(light);
         }
     }
 
     // Primitives, with area lights per shape.
-    let mut prims: Vec<Primitive> = Vec::new();
-    let make_prims = |s: &ShapeSceneEntity,
-                      lights: &mut Vec<Light>,
-                      errors: &mut Vec<Diagnostic>,
-                      warnings: &mut Vec<Diagnostic>,
-                      out: &mut Vec<Primitive>| {
-        let created = match create_entity_shapes(
-            &s.base,
-            &s.render_from_object,
-            s.attributes.reverse_orientation,
-        ) {
-            Ok(c) => c,
-            Err(e) => {
-                errors.push(e);
-                return;
-            }
-        };
-        warnings.extend(created.warnings);
-        let alpha = match alpha_of(&s.base.params, &textures) {
-            Ok(a) => a,
-            Err(e) => {
-                errors.push(e);
-                return;
-            }
-        };
-        let material = match &s.attributes.material {
-            MaterialRef::Named(n) if n.is_empty() || n == "none" || n == "interface" => None,
-            r => match material_id(r) {
-                Some(id) => Some(id),
-                None => {
-                    errors.push(Diagnostic::error(
-                        s.base.loc.clone(),
-                        format!("material {r:?} is not defined"),
-                    ));
-                    return;
-                }
-            },
-        };
-        for shape in created.shapes {
-            let area_light = match (s.attributes.light_index, material) {
-                (Some(li), Some(_)) => {
-                    let al = &desc.area_lights[li];
-                    let alpha_tex = match &alpha {
-                        Alpha::Texture(t) => Some(t.clone()),
-                        Alpha::Constant(a) => {
-                            Some(Arc::new(crate::texture::FloatTexture::Constant(*a)))
-                        }
-                        Alpha::Opaque => None,
-                    };
-                    match create_area_light(
-                        al,
-                        &s.render_from_object,
-                        &shape,
-                        alpha_tex,
-                        None,
-                        None,
-                    ) {
-                        Ok(light) => {
-                            lights.push(light);
-                            Some((lights.len() - 1) as u32)
-                        }
-                        Err(e) => {
-                            errors.push(e);
-                            None
-                        }
-                    }
-                }
-                (Some(li), None) => {
-                    warnings.push(Diagnostic::warning(
-                        desc.area_lights[li].loc.clone(),
-                        "ignoring the area light of a shape with an interface material",
-                    ));
-                    None
-                }
-                _ => None,
-            };
-            out.push(Primitive::Geometric(GeometricPrimitive {
-                shape,
-                material,
-                area_light,
-                medium_interface: None,
-                alpha: alpha.clone(),
-            }));
-        }
-        for d in s.base.params.report_unused() {
-            if !super::shapes::LATER_SHAPE_PARAMS
-                .iter()
-                .any(|p| d.message.contains(&format!("\"{p}\"")))
-            {
-                warnings.push(d);
-            }
-        }
+    let cx = ShapeContext {
+        desc,
+        textures: &textures,
+        named_material_ids: &named_material_ids,
     };
-    for s in &desc.shapes {
-        make_prims(s, &mut lights, &mut errors, &mut warnings, &mut prims);
-    }
     let default_accel = AccelParams::default();
+    let mut prims: Vec<Primitive> = Vec::new();
+    for s in &desc.shapes {
+        create_primitives(&cx, s, &mut lights, p, &mut prims);
+    }
     for s in &desc.animated_shapes {
         if s.attributes.light_index.is_some() {
-            errors.push(Diagnostic::error(
+            p.errors.push(Diagnostic::error(
                 s.base.loc.clone(),
                 "area lights on animated shapes are not supported (as in pbrt-v4)",
             ));
             continue;
         }
-        let fixed = ShapeSceneEntity {
-            base: s.base.clone(),
-            render_from_object: Transform::identity(),
-            object_from_render: Transform::identity(),
-            attributes: s.attributes.clone(),
-        };
         let mut inner = Vec::new();
-        make_prims(&fixed, &mut lights, &mut errors, &mut warnings, &mut inner);
+        create_primitives(&cx, &at_origin(s), &mut lights, p, &mut inner);
         if !inner.is_empty() {
             prims.push(Primitive::Animated(Box::new(AnimatedPrimitive {
                 primitive: Arc::new(PrimitiveAggregate::new(inner, &default_accel)),
@@ -349,23 +268,17 @@ pub fn create_scene(
         let mut inner = Vec::new();
         for s in &def.shapes {
             if s.attributes.light_index.is_some() {
-                errors.push(Diagnostic::error(
+                p.errors.push(Diagnostic::error(
                     s.base.loc.clone(),
                     "area lights inside object definitions are not supported (as in pbrt-v4)",
                 ));
                 continue;
             }
-            make_prims(s, &mut lights, &mut errors, &mut warnings, &mut inner);
+            create_primitives(&cx, s, &mut lights, p, &mut inner);
         }
         for s in &def.animated_shapes {
-            let fixed = ShapeSceneEntity {
-                base: s.base.clone(),
-                render_from_object: Transform::identity(),
-                object_from_render: Transform::identity(),
-                attributes: s.attributes.clone(),
-            };
             let mut shapes = Vec::new();
-            make_prims(&fixed, &mut lights, &mut errors, &mut warnings, &mut shapes);
+            create_primitives(&cx, &at_origin(s), &mut lights, p, &mut shapes);
             if !shapes.is_empty() {
                 inner.push(Primitive::Animated(Box::new(AnimatedPrimitive {
                     primitive: Arc::new(PrimitiveAggregate::new(shapes, &default_accel)),
@@ -380,7 +293,7 @@ pub fn create_scene(
     }
     for inst in &desc.instances {
         let Some(def) = definitions.get(inst.name.as_str()) else {
-            errors.push(Diagnostic::error(
+            p.errors.push(Diagnostic::error(
                 inst.loc.clone(),
                 format!("object \"{}\" is not defined", inst.name),
             ));
@@ -401,36 +314,27 @@ pub fn create_scene(
         });
     }
 
-    let accel = match accel_params(&desc.accelerator) {
-        Ok(a) => a,
-        Err(e) => {
-            errors.push(e);
-            AccelParams::default()
-        }
-    };
-    let integrator = one(
-        create_integrator(
+    let accel = p
+        .take(reader(&desc.accelerator))
+        .and_then(|r| {
+            let a = accel_params(&desc.accelerator.name, &r);
+            p.finish(r, a)
+        })
+        .unwrap_or_default();
+    let integrator = p.take(reader(&desc.integrator)).and_then(|r| {
+        let i = create_integrator(
             &desc.integrator.name,
-            &desc.integrator.params,
-            &desc.integrator.loc,
+            r.dict(),
+            r.loc(),
             !desc.media.is_empty(),
-        ),
-        &mut errors,
-    );
-    for e in [
-        &desc.film,
-        &desc.sampler,
-        &desc.filter,
-        &desc.integrator,
-        &desc.camera.base,
-    ] {
-        warnings.extend(e.params.report_unused());
-    }
-    if !errors.is_empty() {
-        return Err(errors);
+        );
+        p.finish(r, i)
+    });
+    if !problems.errors.is_empty() {
+        return Err(problems.errors);
     }
     let (Some(sampler), Some(integrator)) = (sampler, integrator) else {
-        return Err(errors);
+        return Err(problems.errors);
     };
     let aggregate = PrimitiveAggregate::new(prims, &accel);
     let bounds = aggregate.bounds();
@@ -470,6 +374,6 @@ pub fn create_scene(
     Ok(CreatedScene {
         scene,
         integrator,
-        warnings,
+        warnings: problems.warnings,
     })
 }

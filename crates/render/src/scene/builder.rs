@@ -24,6 +24,9 @@ use rpbrt_parser::{
 use super::entities::*;
 use super::names::*;
 use super::state::*;
+use crate::camera::{CameraTransform, RenderingCoordinateSystem};
+use crate::params::unknown_type;
+use crate::spectrum::RgbColorSpace;
 
 /// A pbrt-v3 → pbrt-v4 mapping of the parser crate.
 type UpgradeFn = fn(&str, Vec<ParsedParameter>, &FileLoc) -> Upgraded;
@@ -409,21 +412,16 @@ impl ParserTarget for SceneBuilder {
 
     fn color_space(&mut self, name: &str, loc: FileLoc) -> DirectiveResult {
         let lower = name.to_ascii_lowercase();
-        match COLOR_SPACES.iter().find(|&&c| c == lower) {
+        match RgbColorSpace::NAMES.iter().find(|&&c| c == lower) {
             Some(c) => {
                 self.state.color_space = c;
                 Ok(())
             }
-            None => Err(Diagnostic::error(
-                loc,
-                format!(
-                    "\"{name}\": unknown color space; expected one of {}",
-                    COLOR_SPACES
-                        .iter()
-                        .map(|c| format!("\"{c}\""))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ),
+            None => Err(unknown_type(
+                "color space",
+                name,
+                RgbColorSpace::NAMES,
+                &loc,
             )),
         }
     }

@@ -3,7 +3,7 @@
 //! (pbrt-v4 `scene.h`: `SceneEntity`, `TransformedSceneEntity`,
 //! `CameraSceneEntity`, `ShapeSceneEntity`, `AnimatedShapeSceneEntity`,
 //! `LightSceneEntity`, `InstanceDefinitionSceneEntity`,
-//! `InstanceSceneEntity`; `cameras.h`: `CameraTransform`).
+//! `InstanceSceneEntity`).
 //!
 //! Nothing here is a render object yet: parameters are kept as written (after
 //! the pbrt-v3 upgrade) and are read when the renderer creates the objects.
@@ -11,10 +11,10 @@
 use std::fmt::Write as _;
 use std::sync::Arc;
 
-use rpbrt_geometry::{AnimatedTransform, Float, Point3f, Transform, Vector3f};
+use rpbrt_geometry::{AnimatedTransform, Float, Transform};
 use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary, ParsedParameter};
 
-use super::names::RenderingCoordinateSystem;
+use crate::camera::{CameraTransform, RenderingCoordinateSystem};
 
 /// The location given to entities that stand for a default (no directive).
 pub fn default_loc() -> FileLoc {
@@ -63,63 +63,6 @@ pub struct TransformedSceneEntity {
     pub base: SceneEntity,
     /// From the entity's own space to render space.
     pub render_from_object: AnimatedTransform,
-}
-
-/// The camera's placement (pbrt-v4 `CameraTransform`): where render space
-/// is with respect to the world, and the camera with respect to it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CameraTransform {
-    /// From camera space to render space, over the shutter interval.
-    pub render_from_camera: AnimatedTransform,
-    /// From render space to world space.
-    pub world_from_render: Transform,
-}
-
-impl Default for CameraTransform {
-    fn default() -> Self {
-        CameraTransform {
-            render_from_camera: AnimatedTransform::fixed(Transform::identity()),
-            world_from_render: Transform::identity(),
-        }
-    }
-}
-
-impl CameraTransform {
-    /// Chooses render space for a camera placed by `world_from_camera`.
-    /// The camera and camera-world choices use the camera's placement at
-    /// the middle of the transformation times.
-    pub fn new(world_from_camera: &AnimatedTransform, space: RenderingCoordinateSystem) -> Self {
-        let t_mid = (world_from_camera.start_time + world_from_camera.end_time) / 2.0;
-        let world_from_render = match space {
-            RenderingCoordinateSystem::Camera => world_from_camera.interpolate(t_mid),
-            RenderingCoordinateSystem::CameraWorld => {
-                let p = world_from_camera.apply_point(Point3f::new(0.0, 0.0, 0.0), t_mid);
-                Transform::translate(Vector3f::from(p))
-            }
-            RenderingCoordinateSystem::World => Transform::identity(),
-        };
-        let render_from_world = world_from_render.inverse();
-        let render_from_camera = AnimatedTransform::new(
-            render_from_world * world_from_camera.start_transform,
-            world_from_camera.start_time,
-            render_from_world * world_from_camera.end_transform,
-            world_from_camera.end_time,
-        );
-        CameraTransform {
-            render_from_camera,
-            world_from_render,
-        }
-    }
-
-    /// From world space to render space.
-    pub fn render_from_world(&self) -> Transform {
-        self.world_from_render.inverse()
-    }
-
-    /// From render space to camera space at `time`.
-    pub fn camera_from_render(&self, time: Float) -> Transform {
-        self.render_from_camera.interpolate(time).inverse()
-    }
 }
 
 /// The `Camera` directive.
@@ -571,32 +514,5 @@ mod tests {
         assert_eq!(s.camera.base.name, "perspective");
         assert_eq!(s.materials[0].name, "diffuse");
         assert_eq!(s.film.color_space, "srgb");
-    }
-
-    #[test]
-    fn camera_world_render_space_is_translated_world() {
-        let world_from_camera = Transform::translate(Vector3f::new(1.0, 2.0, 3.0))
-            * Transform::rotate(30.0, Vector3f::new(0.0, 1.0, 0.0));
-        let a = AnimatedTransform::fixed(world_from_camera);
-        let ct = CameraTransform::new(&a, RenderingCoordinateSystem::CameraWorld);
-        let p = ct
-            .world_from_render
-            .apply_point(Point3f::new(0.0, 0.0, 0.0));
-        assert!((Vector3f::from(p) - Vector3f::new(1.0, 2.0, 3.0)).length() < 1e-5);
-        let ct = CameraTransform::new(&a, RenderingCoordinateSystem::Camera);
-        assert!(
-            ct.render_from_camera.start_transform.is_identity()
-                || ct
-                    .render_from_camera
-                    .start_transform
-                    .matrix()
-                    .m
-                    .iter()
-                    .flatten()
-                    .zip(Transform::identity().matrix().m.iter().flatten())
-                    .all(|(a, b)| (a - b).abs() < 1e-5)
-        );
-        let ct = CameraTransform::new(&a, RenderingCoordinateSystem::World);
-        assert!(ct.world_from_render.is_identity());
     }
 }

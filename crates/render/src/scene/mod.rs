@@ -10,6 +10,7 @@
 pub mod assemble;
 pub mod builder;
 pub mod entities;
+mod materials;
 pub mod names;
 pub mod options;
 pub mod shapes;
@@ -20,9 +21,11 @@ use std::sync::Arc;
 
 use rpbrt_parser::{Diagnostics, ParseOptions, Parser};
 
+use crate::camera::RenderingCoordinateSystem;
+
 pub use builder::SceneBuilder;
 pub use entities::*;
-pub use names::{EntityKind, RenderingCoordinateSystem, COLOR_SPACES};
+pub use names::EntityKind;
 
 /// Settings for [`build_scene`].
 #[derive(Clone, Debug, Default)]

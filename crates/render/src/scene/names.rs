@@ -5,6 +5,7 @@
 //! The builder only checks that a name is one of these; whether the renderer
 //! implements each is checked when the entity is turned into a render object.
 
+use crate::params::unknown_type;
 use rpbrt_parser::{Diagnostic, FileLoc};
 
 /// The kinds of named entity whose type name the builder validates.
@@ -37,86 +38,22 @@ pub enum EntityKind {
 }
 
 impl EntityKind {
-    /// The pbrt-v4 type names of this kind, sorted.
+    /// The type names of this kind, sorted; each module that creates the
+    /// objects owns its list.
     pub fn known_names(self) -> &'static [&'static str] {
         match self {
-            EntityKind::Shape => &[
-                "bilinearmesh",
-                "cone",
-                "curve",
-                "cylinder",
-                "disk",
-                "hyperboloid",
-                "loopsubdiv",
-                "paraboloid",
-                "plymesh",
-                "sphere",
-                "trianglemesh",
-            ],
-            EntityKind::Material => &[
-                "coatedconductor",
-                "coateddiffuse",
-                "conductor",
-                "dielectric",
-                "diffuse",
-                "diffusetransmission",
-                "hair",
-                "interface",
-                "measured",
-                "mix",
-                "subsurface",
-                "thindielectric",
-            ],
-            EntityKind::Light => &[
-                "distant",
-                "goniometric",
-                "infinite",
-                "point",
-                "projection",
-                "spot",
-            ],
-            EntityKind::AreaLight => &["diffuse"],
-            EntityKind::Texture => &[
-                "bilerp",
-                "checkerboard",
-                "constant",
-                "directionmix",
-                "dots",
-                "fbm",
-                "imagemap",
-                "marble",
-                "mix",
-                "ptex",
-                "scale",
-                "windy",
-                "wrinkled",
-            ],
-            EntityKind::Film => &["gbuffer", "rgb", "spectral"],
-            EntityKind::Sampler => &[
-                "halton",
-                "independent",
-                "paddedsobol",
-                "pmj02bn",
-                "sobol",
-                "stratified",
-                "zsobol",
-            ],
-            EntityKind::Filter => &["box", "gaussian", "mitchell", "sinc", "triangle"],
-            EntityKind::Integrator => &[
-                "ambientocclusion",
-                "bdpt",
-                "lightpath",
-                "mlt",
-                "path",
-                "randomwalk",
-                "simplepath",
-                "simplevolpath",
-                "sppm",
-                "volpath",
-            ],
-            EntityKind::Accelerator => &["bvh", "grid", "kdtree"],
-            EntityKind::Camera => &["orthographic", "perspective", "realistic", "spherical"],
-            EntityKind::Medium => &["cloud", "homogeneous", "nanovdb", "rgbgrid", "uniformgrid"],
+            EntityKind::Shape => crate::shape::create::SHAPE_NAMES,
+            EntityKind::Material => crate::material::MATERIAL_NAMES,
+            EntityKind::Light => crate::light::LIGHT_NAMES,
+            EntityKind::AreaLight => crate::light::AREA_LIGHT_NAMES,
+            EntityKind::Texture => crate::texture::TEXTURE_NAMES,
+            EntityKind::Film => crate::film::FILM_NAMES,
+            EntityKind::Sampler => crate::sampler::SAMPLER_NAMES,
+            EntityKind::Filter => crate::filter::FILTER_NAMES,
+            EntityKind::Integrator => crate::integrator::INTEGRATOR_NAMES,
+            EntityKind::Accelerator => crate::accel::AccelParams::NAMES,
+            EntityKind::Camera => crate::camera::CAMERA_NAMES,
+            EntityKind::Medium => MEDIUM_NAMES,
         }
     }
 
@@ -150,59 +87,14 @@ impl EntityKind {
         if self.is_known(name) {
             return Ok(());
         }
-        let list = self
-            .known_names()
-            .iter()
-            .map(|n| format!("\"{n}\""))
-            .collect::<Vec<_>>()
-            .join(", ");
-        Err(Diagnostic::error(
-            loc.clone(),
-            format!(
-                "\"{name}\": unknown {} type; expected one of {list}",
-                self.describe()
-            ),
-        ))
+        Err(unknown_type(self.describe(), name, self.known_names(), loc))
     }
 }
 
-/// The RGB color spaces `ColorSpace` accepts (pbrt-v4 `RGBColorSpace::GetNamed`).
-pub const COLOR_SPACES: [&str; 4] = ["srgb", "rec2020", "aces2065-1", "dci-p3"];
-
-/// The space in which rendering computations happen (pbrt-v4
-/// `RenderingCoordinateSystem`, `options.h`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum RenderingCoordinateSystem {
-    /// Camera space: the camera sits at the origin looking down +z.
-    Camera,
-    /// World space translated so that the camera is at the origin, with the
-    /// world's orientation (pbrt-v4's default).
-    #[default]
-    CameraWorld,
-    /// World space.
-    World,
-}
-
-impl RenderingCoordinateSystem {
-    /// Parses `camera`, `cameraworld` or `world`.
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "camera" => Some(Self::Camera),
-            "cameraworld" => Some(Self::CameraWorld),
-            "world" => Some(Self::World),
-            _ => None,
-        }
-    }
-
-    /// The name as written in scene files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Camera => "camera",
-            Self::CameraWorld => "cameraworld",
-            Self::World => "world",
-        }
-    }
-}
+/// The medium types `MakeNamedMedium` accepts (pbrt-v4 `Medium::Create`).
+/// rpbrt does not render participating media yet: the scene refuses them
+/// when it is created.
+pub const MEDIUM_NAMES: &[&str] = &["cloud", "homogeneous", "nanovdb", "rgbgrid", "uniformgrid"];
 
 /// The type of an `Option` setting's value.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -302,9 +194,5 @@ mod tests {
         );
         assert_eq!(option_type("seed"), Some(OptionType::Int));
         assert_eq!(option_type("bogus"), None);
-        assert_eq!(
-            RenderingCoordinateSystem::from_name("world"),
-            Some(RenderingCoordinateSystem::World)
-        );
     }
 }

@@ -5,9 +5,8 @@ use rpbrt_parser::params::canonical_type;
 use rpbrt_parser::{Diagnostic, FileLoc};
 
 use super::entities::{OptionValue, SceneOption};
-use super::names::{
-    normalize_option_name, option_type, OptionType, RenderingCoordinateSystem, KNOWN_OPTIONS,
-};
+use super::names::{normalize_option_name, option_type, OptionType, KNOWN_OPTIONS};
+use crate::camera::RenderingCoordinateSystem;
 
 /// The contents of a quoted option value, or `None` for a bare word.
 fn unquote(value: &str) -> Option<String> {

@@ -1,37 +1,159 @@
-//! Turning the shape entities of a scene description into [`Shape`]s
+//! Turning the shape entities of a scene description into primitives
 //! (pbrt-v4 `BasicScene::CreateAggregate`'s shape half): every `Shape`
-//! directive, inside object definitions too, with its located errors and
-//! warnings.
+//! directive with its material, alpha mask and area lights, with located
+//! errors and warnings.
 
-use super::entities::{SceneDescription, SceneEntity};
-use crate::shape::create::{create_shapes, CreatedShapes};
-use crate::shape::Shape;
-use rpbrt_geometry::transform::Transform;
+use std::collections::HashMap;
+use std::sync::Arc;
+
 use rpbrt_parser::Diagnostic;
-use std::path::Path;
 
-/// Shape parameters read by later stages (primitives and area lights), so
-/// they are not reported as unused when the shapes are created.
-pub const LATER_SHAPE_PARAMS: &[&str] = &["alpha", "emissionfilename"];
+use super::assemble::Problems;
+use super::entities::{
+    AnimatedShapeSceneEntity, MaterialRef, SceneDescription, SceneEntity, ShapeSceneEntity,
+};
+use crate::light::{create_area_light, Light};
+use crate::params::ParamReader;
+use crate::primitive::{Alpha, GeometricPrimitive, Primitive};
+use crate::shape::create::create_shapes;
+use crate::shape::Shape;
+use crate::texture::{FloatTexture, NamedTextures, TextureParams};
+use rpbrt_geometry::transform::Transform;
 
-/// Creates the shapes of one entity; file names resolve against the
-/// directory of the scene file the directive is in.
-pub fn create_entity_shapes(
-    base: &SceneEntity,
-    render_from_object: &Transform,
-    reverse_orientation: bool,
-) -> Result<CreatedShapes, Diagnostic> {
-    let dir = Path::new(&*base.loc.file)
-        .parent()
-        .unwrap_or_else(|| Path::new("."));
-    create_shapes(
-        &base.name,
-        &base.params,
-        render_from_object,
-        reverse_orientation,
-        dir,
-        &base.loc,
-    )
+/// What shapes are turned into primitives with.
+pub(super) struct ShapeContext<'a> {
+    /// The scene (for its area lights).
+    pub desc: &'a SceneDescription,
+    /// The named textures (for alpha masks).
+    pub textures: &'a NamedTextures,
+    /// Named materials' indices.
+    pub named_material_ids: &'a HashMap<String, u32>,
+}
+
+/// A shape entity's reader (shapes have no colours of their own).
+fn reader(e: &SceneEntity) -> ParamReader<'_> {
+    ParamReader::plain(&e.params, &e.loc)
+}
+
+/// pbrt-v4's alpha: a float texture or constant; 1 (the default) is opaque.
+fn alpha_of(tp: &TextureParams) -> Result<Alpha, Diagnostic> {
+    match tp.float_texture_opt("alpha")? {
+        None => Ok(Alpha::Opaque),
+        Some(t) => match &*t {
+            FloatTexture::Constant(a) if *a >= 1.0 => Ok(Alpha::Opaque),
+            FloatTexture::Constant(a) => Ok(Alpha::Constant(*a)),
+            _ => Ok(Alpha::Texture(t)),
+        },
+    }
+}
+
+/// The fixed-transformation view of an animated shape: its shapes are
+/// made in its own space and moved by an animated primitive.
+pub(super) fn at_origin(s: &AnimatedShapeSceneEntity) -> ShapeSceneEntity {
+    ShapeSceneEntity {
+        base: s.base.clone(),
+        render_from_object: Transform::identity(),
+        object_from_render: Transform::identity(),
+        attributes: s.attributes.clone(),
+    }
+}
+
+/// Creates the primitives of one shape entity into `out`, with its area
+/// lights appended to `lights`.
+pub(super) fn create_primitives(
+    cx: &ShapeContext,
+    s: &ShapeSceneEntity,
+    lights: &mut Vec<Light>,
+    problems: &mut Problems,
+    out: &mut Vec<Primitive>,
+) {
+    let tp = TextureParams::new(reader(&s.base), cx.textures);
+    let shapes = create_shapes(
+        &s.base.name,
+        &tp,
+        &s.render_from_object,
+        s.attributes.reverse_orientation,
+    );
+    let Some(shapes) = problems.keep_going(&tp, shapes) else {
+        return;
+    };
+    let Some(alpha) = problems.keep_going(&tp, alpha_of(&tp)) else {
+        return;
+    };
+    let material = match &s.attributes.material {
+        MaterialRef::Named(n) if n.is_empty() || n == "none" || n == "interface" => None,
+        MaterialRef::Index(i) => Some(*i as u32),
+        MaterialRef::Named(n) => match cx.named_material_ids.get(n) {
+            Some(&id) => Some(id),
+            None => {
+                problems.errors.push(Diagnostic::error(
+                    s.base.loc.clone(),
+                    format!("material {:?} is not defined", s.attributes.material),
+                ));
+                problems.warnings.extend(tp.take_warnings());
+                return;
+            }
+        },
+    };
+    let area_light = s.attributes.light_index.map(|li| &cx.desc.area_lights[li]);
+    let area = match (area_light, material) {
+        (Some(al), Some(_)) => match ParamReader::new(&al.params, &al.loc, &al.color_space) {
+            Ok(r) => Some((al, r)),
+            Err(e) => {
+                problems.errors.push(e);
+                None
+            }
+        },
+        (Some(al), None) => {
+            problems.warnings.push(Diagnostic::warning(
+                al.loc.clone(),
+                "ignoring the area light of a shape with an interface material",
+            ));
+            None
+        }
+        _ => None,
+    };
+    let alpha_tex = match &alpha {
+        Alpha::Texture(t) => Some(t.clone()),
+        Alpha::Constant(a) => Some(Arc::new(FloatTexture::Constant(*a))),
+        Alpha::Opaque => None,
+    };
+    for shape in shapes {
+        let area_light = area.as_ref().and_then(|(al, r)| {
+            let light = create_area_light(
+                &al.name,
+                r,
+                &s.render_from_object,
+                &shape,
+                alpha_tex.clone(),
+                None,
+                None,
+            );
+            match light {
+                Ok(light) => {
+                    lights.push(light);
+                    Some((lights.len() - 1) as u32)
+                }
+                Err(e) => {
+                    problems.errors.push(e);
+                    None
+                }
+            }
+        });
+        out.push(Primitive::Geometric(GeometricPrimitive {
+            shape,
+            material,
+            area_light,
+            medium_interface: None,
+            alpha: alpha.clone(),
+        }));
+    }
+    // One `AreaLightSource` serves every shape of the entity: its unused
+    // parameters are reported once.
+    if let Some((_, r)) = area {
+        problems.warnings.extend(r.finish());
+    }
+    problems.warnings.extend(tp.finish());
 }
 
 /// Every shape of a scene, in directive order (instance definitions last),
@@ -45,54 +167,41 @@ pub struct SceneShapes {
     pub diagnostics: Vec<Diagnostic>,
 }
 
-/// Creates every shape in `desc`. Animated shapes are created at their
-/// start transformation (motion is the primitives' business).
+/// Creates every shape in `desc` without materials or lights (for tools
+/// and tests that look at geometry alone). Animated shapes are created at
+/// their start transformation.
 pub fn create_scene_shapes(desc: &SceneDescription) -> SceneShapes {
     let mut out = SceneShapes::default();
     let mut add = |base: &SceneEntity, xf: &Transform, ro: bool| {
-        match create_entity_shapes(base, xf, ro) {
-            Ok(c) => {
-                out.shapes.extend(c.shapes);
-                out.diagnostics.extend(c.warnings);
-            }
+        let r = reader(base);
+        match create_shapes(&base.name, &r, xf, ro) {
+            Ok(shapes) => out.shapes.extend(shapes),
             Err(e) => out.diagnostics.push(e),
         }
-        out.diagnostics
-            .extend(base.params.report_unused().into_iter().filter(|d| {
-                !LATER_SHAPE_PARAMS
-                    .iter()
-                    .any(|p| d.message.contains(&format!("\"{p}\"")))
-            }));
+        out.diagnostics.extend(r.take_warnings());
     };
-    for s in &desc.shapes {
+    let fixed = desc
+        .shapes
+        .iter()
+        .chain(desc.instance_definitions.iter().flat_map(|d| &d.shapes));
+    let animated = desc.animated_shapes.iter().chain(
+        desc.instance_definitions
+            .iter()
+            .flat_map(|d| &d.animated_shapes),
+    );
+    for s in fixed {
         add(
             &s.base,
             &s.render_from_object,
             s.attributes.reverse_orientation,
         );
     }
-    for s in &desc.animated_shapes {
+    for s in animated {
         add(
             &s.base,
             &s.render_from_object.start_transform,
             s.attributes.reverse_orientation,
         );
-    }
-    for def in &desc.instance_definitions {
-        for s in &def.shapes {
-            add(
-                &s.base,
-                &s.render_from_object,
-                s.attributes.reverse_orientation,
-            );
-        }
-        for s in &def.animated_shapes {
-            add(
-                &s.base,
-                &s.render_from_object.start_transform,
-                s.attributes.reverse_orientation,
-            );
-        }
     }
     out
 }

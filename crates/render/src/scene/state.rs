@@ -8,7 +8,6 @@ use rpbrt_geometry::{Float, Transform};
 use rpbrt_parser::{FileLoc, ParsedParameter};
 
 use super::entities::{MaterialRef, SceneEntity};
-use super::names::COLOR_SPACES;
 
 /// Bit of [`GraphicsState::active`] for the start-time transformation.
 pub(super) const START_BIT: u8 = 1;
@@ -56,7 +55,7 @@ impl Default for GraphicsState {
             medium_attributes: Arc::default(),
             texture_attributes: Arc::default(),
             reverse_orientation: false,
-            color_space: COLOR_SPACES[0],
+            color_space: "srgb",
             ctm: [Transform::identity(); 2],
             active: ALL_BITS,
             start_time: 0.0,

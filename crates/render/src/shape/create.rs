@@ -8,11 +8,11 @@ use super::curve::create_curves;
 use super::loopsubdiv::loop_subdivide;
 use super::triangle::{self, TriangleMesh};
 use super::{Cone, Cylinder, Disk, Hyperboloid, Paraboloid, Shape, ShapeError, Sphere};
+use crate::params::{unknown_type, ParamReader};
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::transform::Transform;
 use rpbrt_geometry::tuple::*;
-use rpbrt_parser::{Diagnostic, FileLoc, ParamError, ParameterDictionary};
-use std::path::Path;
+use rpbrt_parser::{Diagnostic, FileLoc};
 
 /// The shape type names rpbrt knows.
 pub const SHAPE_NAMES: &[&str] = &[
@@ -28,19 +28,6 @@ pub const SHAPE_NAMES: &[&str] = &[
     "sphere",
     "trianglemesh",
 ];
-
-/// Shapes created from one `Shape` directive, and the warnings it raised.
-#[derive(Debug, Default)]
-pub struct CreatedShapes {
-    /// The shapes (a mesh gives one per triangle or patch).
-    pub shapes: Vec<Shape>,
-    /// Located warnings (skipped degenerate elements, unused parameters...).
-    pub warnings: Vec<Diagnostic>,
-}
-
-fn perr(e: ParamError) -> Diagnostic {
-    Diagnostic::from(e)
-}
 
 fn serr(loc: &FileLoc, name: &str, e: ShapeError) -> Diagnostic {
     let msg = e.to_string();
@@ -59,41 +46,31 @@ fn n3(v: Vec<[f32; 3]>) -> Vec<Normal3f> {
     v.into_iter().map(Normal3f::from).collect()
 }
 
-fn indices(
-    params: &ParameterDictionary,
-    name: &str,
-    loc: &FileLoc,
-) -> Result<Vec<u32>, Diagnostic> {
-    let raw = params.get_int_array(name).map_err(perr)?;
+fn indices(sp: &ParamReader, name: &str) -> Result<Vec<u32>, Diagnostic> {
+    let raw = sp.ints(name)?;
     raw.iter()
         .map(|&i| {
-            u32::try_from(i).map_err(|_| {
-                Diagnostic::error(
-                    params.loc(name).cloned().unwrap_or_else(|| loc.clone()),
-                    format!("vertex index {i} is negative"),
-                )
-            })
+            u32::try_from(i).map_err(|_| sp.error_at(name, format!("vertex index {i} is negative")))
         })
         .collect()
 }
 
-/// Creates the shapes of one `Shape "name" ...` directive. `base_dir` is the
-/// directory of the scene file, against which file names resolve. Unused
-/// parameters are reported as warnings, except those the caller still
-/// reads (`alpha`, `emissionfilename`, displacement settings), which it
-/// passes in `reserved`.
+/// Creates the shapes of one `Shape "name" ...` directive (a mesh gives
+/// one per triangle or patch); file names resolve against the scene file
+/// they were written in. Warnings (skipped degenerate elements...) go to
+/// `sp`; unused parameters are the caller's to report, since primitives
+/// and area lights read some of the same parameters.
 pub fn create_shapes(
     name: &str,
-    params: &ParameterDictionary,
+    sp: &ParamReader,
     render_from_object: &Transform,
     reverse_orientation: bool,
-    base_dir: &Path,
-    loc: &FileLoc,
-) -> Result<CreatedShapes, Diagnostic> {
-    let mut out = CreatedShapes::default();
+) -> Result<Vec<Shape>, Diagnostic> {
+    let loc = sp.loc();
+    let mut out = Vec::new();
     let rfo = *render_from_object;
     let ro = reverse_orientation;
-    let f = |n: &str, d: Float| params.get_one_float(n, d).map_err(perr);
+    let f = |n: &str, d: Float| sp.float(n, d);
     match name {
         "sphere" => {
             let radius = f("radius", 1.0)?;
@@ -106,7 +83,7 @@ pub fn create_shapes(
                 f("phimax", 360.0)?,
             )
             .map_err(|e| serr(loc, name, e))?;
-            out.shapes.push(Shape::Sphere(Box::new(s)));
+            out.push(Shape::Sphere(Box::new(s)));
         }
         "cylinder" => {
             let s = Cylinder::new(
@@ -118,7 +95,7 @@ pub fn create_shapes(
                 f("phimax", 360.0)?,
             )
             .map_err(|e| serr(loc, name, e))?;
-            out.shapes.push(Shape::Cylinder(Box::new(s)));
+            out.push(Shape::Cylinder(Box::new(s)));
         }
         "disk" => {
             let s = Disk::new(
@@ -130,7 +107,7 @@ pub fn create_shapes(
                 f("phimax", 360.0)?,
             )
             .map_err(|e| serr(loc, name, e))?;
-            out.shapes.push(Shape::Disk(Box::new(s)));
+            out.push(Shape::Disk(Box::new(s)));
         }
         "cone" => {
             let s = Cone::new(
@@ -141,7 +118,7 @@ pub fn create_shapes(
                 f("phimax", 360.0)?,
             )
             .map_err(|e| serr(loc, name, e))?;
-            out.shapes.push(Shape::Cone(Box::new(s)));
+            out.push(Shape::Cone(Box::new(s)));
         }
         "paraboloid" => {
             let s = Paraboloid::new(
@@ -153,11 +130,11 @@ pub fn create_shapes(
                 f("phimax", 360.0)?,
             )
             .map_err(|e| serr(loc, name, e))?;
-            out.shapes.push(Shape::Paraboloid(Box::new(s)));
+            out.push(Shape::Paraboloid(Box::new(s)));
         }
         "hyperboloid" => {
-            let p1 = params.get_one_point3("p1", [0.0, 0.0, 0.0]).map_err(perr)?;
-            let p2 = params.get_one_point3("p2", [1.0, 1.0, 1.0]).map_err(perr)?;
+            let p1 = sp.point3("p1", [0.0, 0.0, 0.0])?;
+            let p2 = sp.point3("p2", [1.0, 1.0, 1.0])?;
             let s = Hyperboloid::new(
                 rfo,
                 ro,
@@ -166,11 +143,11 @@ pub fn create_shapes(
                 f("phimax", 360.0)?,
             )
             .map_err(|e| serr(loc, name, e))?;
-            out.shapes.push(Shape::Hyperboloid(Box::new(s)));
+            out.push(Shape::Hyperboloid(Box::new(s)));
         }
         "trianglemesh" => {
-            let p = p3(params.get_point3_array("P").map_err(perr)?);
-            let mut idx = indices(params, "indices", loc)?;
+            let p = p3(sp.point3s("P")?);
+            let mut idx = indices(sp, "indices")?;
             if idx.is_empty() {
                 if p.len() == 3 {
                     idx = vec![0, 1, 2];
@@ -178,47 +155,31 @@ pub fn create_shapes(
                     return Err(Diagnostic::error(loc.clone(), "\"trianglemesh\" shape: \"indices\" is required unless exactly three vertices are given"));
                 }
             }
-            let n = n3(params.get_normal3_array("N").map_err(perr)?);
-            let s: Vec<Vector3f> = params
-                .get_vector3_array("S")
-                .map_err(perr)?
-                .into_iter()
-                .map(Vector3f::from)
-                .collect();
-            let uv: Vec<Point2f> = params
-                .get_point2_array("uv")
-                .map_err(perr)?
-                .into_iter()
-                .map(Point2f::from)
-                .collect();
-            let fi = params.get_int_array("faceIndices").map_err(perr)?;
-            push_triangles(&mut out, &rfo, ro, idx, p, s, n, uv, fi, loc, name)?;
+            let n = n3(sp.normals("N")?);
+            let s: Vec<Vector3f> = sp.vector3s("S")?.into_iter().map(Vector3f::from).collect();
+            let uv: Vec<Point2f> = sp.point2s("uv")?.into_iter().map(Point2f::from).collect();
+            let fi = sp.ints("faceIndices")?;
+            push_triangles(&mut out, sp, &rfo, ro, idx, p, s, n, uv, fi, name)?;
         }
         "plymesh" => {
-            let file = params.get_one_string("filename", "").map_err(perr)?;
+            let file = sp.string("filename", "")?;
             if file.is_empty() {
                 return Err(Diagnostic::error(
                     loc.clone(),
                     "\"plymesh\" shape: \"filename\" is required",
                 ));
             }
-            if let Some(d) = params.get_texture("displacement").map_err(perr)? {
-                return Err(Diagnostic::error(
-                    params
-                        .loc("displacement")
-                        .cloned()
-                        .unwrap_or_else(|| loc.clone()),
+            if let Some(d) = sp.texture_name("displacement")? {
+                return Err(sp.error_at(
+                    "displacement",
                     format!("\"plymesh\" shape: displacement texture \"{d}\" is not supported yet"),
                 ));
             }
-            let path = base_dir.join(&file);
+            let path = sp.resolve("filename", &file);
             let mesh = rpbrt_parser::ply::read_ply(&path)
                 .map_err(|e| Diagnostic::error(loc.clone(), format!("\"plymesh\" shape: {e}")))?;
             for w in &mesh.warnings {
-                out.warnings.push(Diagnostic::warning(
-                    loc.clone(),
-                    format!("{}: {w}", path.display()),
-                ));
+                sp.warn(format!("{}: {w}", path.display()));
             }
             let p: Vec<Point3f> = mesh.positions.iter().map(|&a| Point3f::from(a)).collect();
             let n: Vec<Normal3f> = mesh.normals.iter().map(|&a| Normal3f::from(a)).collect();
@@ -236,6 +197,7 @@ pub fn create_shapes(
             if !mesh.tri_indices.is_empty() {
                 push_triangles(
                     &mut out,
+                    sp,
                     &rfo,
                     ro,
                     mesh.tri_indices.clone(),
@@ -244,13 +206,13 @@ pub fn create_shapes(
                     n.clone(),
                     uv.clone(),
                     tri_fi,
-                    loc,
                     name,
                 )?;
             }
             if !mesh.quad_indices.is_empty() {
                 push_patches(
                     &mut out,
+                    sp,
                     &rfo,
                     ro,
                     mesh.quad_indices.clone(),
@@ -258,14 +220,13 @@ pub fn create_shapes(
                     n,
                     uv,
                     quad_fi,
-                    loc,
                     name,
                 )?;
             }
         }
         "bilinearmesh" => {
-            let p = p3(params.get_point3_array("P").map_err(perr)?);
-            let mut idx = indices(params, "indices", loc)?;
+            let p = p3(sp.point3s("P")?);
+            let mut idx = indices(sp, "indices")?;
             if idx.is_empty() {
                 if p.len() == 4 {
                     idx = vec![0, 1, 2, 3];
@@ -273,20 +234,15 @@ pub fn create_shapes(
                     return Err(Diagnostic::error(loc.clone(), "\"bilinearmesh\" shape: \"indices\" is required unless exactly four vertices are given"));
                 }
             }
-            let n = n3(params.get_normal3_array("N").map_err(perr)?);
-            let uv: Vec<Point2f> = params
-                .get_point2_array("uv")
-                .map_err(perr)?
-                .into_iter()
-                .map(Point2f::from)
-                .collect();
-            let fi = params.get_int_array("faceIndices").map_err(perr)?;
-            push_patches(&mut out, &rfo, ro, idx, p, n, uv, fi, loc, name)?;
+            let n = n3(sp.normals("N")?);
+            let uv: Vec<Point2f> = sp.point2s("uv")?.into_iter().map(Point2f::from).collect();
+            let fi = sp.ints("faceIndices")?;
+            push_patches(&mut out, sp, &rfo, ro, idx, p, n, uv, fi, name)?;
         }
         "loopsubdiv" => {
-            let levels = params.get_one_int("levels", 3).map_err(perr)?;
-            let idx = indices(params, "indices", loc)?;
-            let p = p3(params.get_point3_array("P").map_err(perr)?);
+            let levels = sp.int("levels", 3)?;
+            let idx = indices(sp, "indices")?;
+            let p = p3(sp.point3s("P")?);
             if idx.is_empty() || p.is_empty() {
                 return Err(Diagnostic::error(
                     loc.clone(),
@@ -296,6 +252,7 @@ pub fn create_shapes(
             let r = loop_subdivide(levels, &idx, &p).map_err(|e| serr(loc, name, e))?;
             push_triangles(
                 &mut out,
+                sp,
                 &rfo,
                 ro,
                 r.indices,
@@ -304,20 +261,19 @@ pub fn create_shapes(
                 r.n,
                 Vec::new(),
                 Vec::new(),
-                loc,
                 name,
             )?;
         }
         "curve" => {
-            let p = p3(params.get_point3_array("P").map_err(perr)?);
-            let basis = params.get_one_string("basis", "bezier").map_err(perr)?;
-            let degree = params.get_one_int("degree", 3).map_err(perr)?;
-            let ty = params.get_one_string("type", "flat").map_err(perr)?;
-            let n = n3(params.get_normal3_array("N").map_err(perr)?);
+            let p = p3(sp.point3s("P")?);
+            let basis = sp.string("basis", "bezier")?;
+            let degree = sp.int("degree", 3)?;
+            let ty = sp.string("type", "flat")?;
+            let n = n3(sp.normals("N")?);
             let width = f("width", 1.0)?;
             let width0 = f("width0", width)?;
             let width1 = f("width1", width)?;
-            let split_depth = params.get_one_int("splitdepth", 3).map_err(perr)?;
+            let split_depth = sp.int("splitdepth", 3)?;
             let (curves, warnings) = create_curves(
                 &rfo,
                 ro,
@@ -331,30 +287,20 @@ pub fn create_shapes(
                 split_depth,
             )
             .map_err(|e| serr(loc, name, e))?;
-            out.warnings.extend(
-                warnings
-                    .into_iter()
-                    .map(|w| Diagnostic::warning(loc.clone(), format!("\"curve\" shape: {w}"))),
-            );
-            out.shapes
-                .extend(curves.into_iter().map(|c| Shape::Curve(c)));
+            for w in warnings {
+                sp.warn(format!("\"curve\" shape: {w}"));
+            }
+            out.extend(curves.into_iter().map(|c| Shape::Curve(c)));
         }
-        _ => {
-            return Err(Diagnostic::error(
-                loc.clone(),
-                format!(
-                    "unknown shape type \"{name}\"; known types: {}",
-                    SHAPE_NAMES.join(", ")
-                ),
-            ));
-        }
+        _ => return Err(unknown_type("shape", name, SHAPE_NAMES, loc)),
     }
     Ok(out)
 }
 
 #[allow(clippy::too_many_arguments)]
 fn push_triangles(
-    out: &mut CreatedShapes,
+    out: &mut Vec<Shape>,
+    sp: &ParamReader,
     rfo: &Transform,
     ro: bool,
     idx: Vec<u32>,
@@ -363,24 +309,22 @@ fn push_triangles(
     n: Vec<Normal3f>,
     uv: Vec<Point2f>,
     fi: Vec<i32>,
-    loc: &FileLoc,
     name: &str,
 ) -> Result<(), Diagnostic> {
+    let loc = sp.loc();
     let (mesh, warnings) =
         TriangleMesh::new(rfo, ro, idx, p, s, n, uv, fi).map_err(|e| serr(loc, name, e))?;
-    out.warnings.extend(
-        warnings
-            .into_iter()
-            .map(|w| Diagnostic::warning(loc.clone(), format!("\"{name}\" shape: {w}"))),
-    );
-    out.shapes
-        .extend(triangle::triangles(&mesh).into_iter().map(Shape::Triangle));
+    for w in warnings {
+        sp.warn(format!("\"{name}\" shape: {w}"));
+    }
+    out.extend(triangle::triangles(&mesh).into_iter().map(Shape::Triangle));
     Ok(())
 }
 
 #[allow(clippy::too_many_arguments)]
 fn push_patches(
-    out: &mut CreatedShapes,
+    out: &mut Vec<Shape>,
+    sp: &ParamReader,
     rfo: &Transform,
     ro: bool,
     idx: Vec<u32>,
@@ -388,17 +332,15 @@ fn push_patches(
     n: Vec<Normal3f>,
     uv: Vec<Point2f>,
     fi: Vec<i32>,
-    loc: &FileLoc,
     name: &str,
 ) -> Result<(), Diagnostic> {
+    let loc = sp.loc();
     let (mesh, warnings) =
         BilinearPatchMesh::new(rfo, ro, idx, p, n, uv, fi).map_err(|e| serr(loc, name, e))?;
-    out.warnings.extend(
-        warnings
-            .into_iter()
-            .map(|w| Diagnostic::warning(loc.clone(), format!("\"{name}\" shape: {w}"))),
-    );
-    out.shapes.extend(
+    for w in warnings {
+        sp.warn(format!("\"{name}\" shape: {w}"));
+    }
+    out.extend(
         bilinear::patches(&mesh)
             .into_iter()
             .map(Shape::BilinearPatch),

@@ -211,6 +211,10 @@ impl RgbColorSpace {
         Spectrum::DenselySampled(self.illuminant.clone())
     }
 
+    /// The names of the built-in colour spaces (pbrt-v4
+    /// `RGBColorSpace::GetNamed`), as `ColorSpace` accepts them.
+    pub const NAMES: &'static [&'static str] = &["aces2065-1", "dci-p3", "rec2020", "srgb"];
+
     /// One of the built-in colour spaces by pbrt-v4's name: `srgb`,
     /// `rec2020`, `aces2065-1` or `dci-p3`.
     pub fn get(name: &str) -> Option<&'static RgbColorSpace> {

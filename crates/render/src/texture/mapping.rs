@@ -6,11 +6,12 @@
 //! coordinates, which the texture filters use as the footprint.
 
 use super::TextureEvalContext;
+use crate::params::ParamReader;
 use rpbrt_geometry::float::{Float, INV_2PI, INV_PI, PI};
 use rpbrt_geometry::spherical::{spherical_phi, spherical_theta};
 use rpbrt_geometry::transform::Transform;
 use rpbrt_geometry::tuple::*;
-use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary};
+use rpbrt_parser::Diagnostic;
 
 /// 2-D texture coordinates and their derivatives per pixel (pbrt-v4
 /// `TexCoord2D`).
@@ -170,18 +171,17 @@ impl TextureMapping2D {
     /// "spherical", "cylindrical", "planar"), `uscale`, `vscale`, `udelta`,
     /// `vdelta`, `v1`, `v2`, as pbrt-v4's `TextureMapping2D::Create`.
     pub fn create(
-        params: &ParameterDictionary,
+        params: &ParamReader,
         render_from_texture: &Transform,
-        loc: &FileLoc,
     ) -> Result<TextureMapping2D, Diagnostic> {
-        let kind = params.get_one_string("mapping", "uv")?;
+        let kind = params.string("mapping", "uv")?;
         let texture_from_render = render_from_texture.inverse();
         Ok(match kind.as_str() {
             "uv" => TextureMapping2D::UV {
-                su: params.get_one_float("uscale", 1.0)?,
-                sv: params.get_one_float("vscale", 1.0)?,
-                du: params.get_one_float("udelta", 0.0)?,
-                dv: params.get_one_float("vdelta", 0.0)?,
+                su: params.float("uscale", 1.0)?,
+                sv: params.float("vscale", 1.0)?,
+                du: params.float("udelta", 0.0)?,
+                dv: params.float("vdelta", 0.0)?,
             },
             "spherical" => TextureMapping2D::Spherical {
                 texture_from_render,
@@ -190,23 +190,19 @@ impl TextureMapping2D {
                 texture_from_render,
             },
             "planar" => {
-                let v1 = params.get_one_vector3("v1", [1.0, 0.0, 0.0])?;
-                let v2 = params.get_one_vector3("v2", [0.0, 1.0, 0.0])?;
+                let v1 = params.vector3("v1", [1.0, 0.0, 0.0])?;
+                let v2 = params.vector3("v2", [0.0, 1.0, 0.0])?;
                 TextureMapping2D::Planar {
                     texture_from_render,
                     vs: Vector3f::new(v1[0], v1[1], v1[2]),
                     vt: Vector3f::new(v2[0], v2[1], v2[2]),
-                    ds: params.get_one_float("udelta", 0.0)?,
-                    dt: params.get_one_float("vdelta", 0.0)?,
+                    ds: params.float("udelta", 0.0)?,
+                    dt: params.float("vdelta", 0.0)?,
                 }
             }
             other => {
-                let at = params
-                    .loc("mapping")
-                    .cloned()
-                    .unwrap_or_else(|| loc.clone());
-                return Err(Diagnostic::error(
-                    at,
+                return Err(params.error_at(
+                    "mapping",
                     format!(
                         "2D texture mapping \"{other}\" unknown (known: {})",
                         MAPPING_NAMES.join(", ")

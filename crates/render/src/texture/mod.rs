@@ -9,24 +9,27 @@
 //! Submodules: [`mapping`] (texture coordinates, 10.2), [`noise`] (Perlin
 //! noise, FBm, turbulence, 10.6), [`procedural`] (the basic and procedural
 //! textures, 10.3 and 10.5), [`imagemap`] (10.4), [`ptex`] (per-face Ptex
-//! textures, with our own Ptex reader) and [`create`] (textures from scene
-//! entities, and the parameter lookups materials use).
+//! textures, with our own Ptex reader), [`create`] (textures from their
+//! directives' parameters) and [`params`] (texture-or-value parameter
+//! lookups for materials, lights and textures).
 
 pub mod create;
 pub mod imagemap;
 pub mod mapping;
 pub mod noise;
+pub mod params;
 pub mod procedural;
 pub mod ptex;
 #[cfg(test)]
 mod tests;
 
 pub use create::{
-    create_float_texture, create_spectrum_texture, create_textures, get_float_texture,
-    get_float_texture_opt, get_spectrum_texture, NamedTextures, TextureOptions,
+    create_float_texture, create_spectrum_texture, NamedTextures, TextureDef, TextureOptions,
+    FLOAT_TEXTURE_NAMES, SPECTRUM_TEXTURE_NAMES, TEXTURE_NAMES,
 };
 pub use imagemap::{FloatImageTexture, ImageTextureBase, SpectrumImageTexture};
 pub use mapping::{TexCoord2D, TexCoord3D, TextureMapping2D, TextureMapping3D};
+pub use params::TextureParams;
 pub use procedural::*;
 pub use ptex::{FloatPtexTexture, PtexTextureBase, SpectrumPtexTexture};
 
