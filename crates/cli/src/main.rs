@@ -7,13 +7,12 @@ mod imgtool;
 
 use rpbrt_parser::{parse_files, FormattingTarget};
 use rpbrt_render::accel::Aggregate;
+use rpbrt_render::camera::RenderingCoordinateSystem;
 use rpbrt_render::film::FilmOverrides;
 use rpbrt_render::image::ImageMetadata;
 use rpbrt_render::integrator::{render, RenderOptions};
 use rpbrt_render::scene::assemble::{create_scene, CreateOptions};
-use rpbrt_render::scene::{
-    build_scene, BuildOptions, OptionValue, RenderingCoordinateSystem, SceneDescription,
-};
+use rpbrt_render::scene::{build_scene, BuildOptions, OptionValue, SceneDescription};
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;

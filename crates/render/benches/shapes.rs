@@ -9,11 +9,11 @@ use rpbrt_geometry::transform::Transform;
 use rpbrt_geometry::tuple::*;
 use rpbrt_geometry::Ray;
 use rpbrt_parser::{FileLoc, ParameterDictionary, ParsedParameter};
+use rpbrt_render::params::ParamReader;
 use rpbrt_render::rng::Rng;
 use rpbrt_render::shape::create::create_shapes;
 use rpbrt_render::shape::{Shape, ShapeMethods};
 use std::hint::black_box;
-use std::path::Path;
 use std::time::Instant;
 
 fn loc() -> FileLoc {
@@ -33,8 +33,9 @@ fn ints(name: &str, v: &[i32]) -> ParsedParameter {
 fn make(name: &str, params: Vec<ParsedParameter>) -> Vec<Shape> {
     let xf = Transform::rotate(30.0, Vector3f::new(1.0, 1.0, 0.0));
     let dict = ParameterDictionary::new(params);
-    match create_shapes(name, &dict, &xf, false, Path::new("."), &loc()) {
-        Ok(c) => c.shapes,
+    let at = loc();
+    match create_shapes(name, &ParamReader::plain(&dict, &at), &xf, false) {
+        Ok(shapes) => shapes,
         Err(e) => panic!("benchmark shape {name}: {}", e.message),
     }
 }

@@ -4,11 +4,9 @@ use rpbrt_geometry::{AnimatedTransform, Float, Point2f, Point3f, Ray, Transform,
 use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary, ParsedParameter};
 
 use super::*;
+use crate::params::ParamReader;
 use crate::rng::Rng;
-use crate::scene::{
-    build_scene_from_str, BuildOptions, CameraSceneEntity, CameraTransform,
-    RenderingCoordinateSystem, SceneEntity,
-};
+use rpbrt_geometry::MediumId;
 
 fn loc(line: u32) -> FileLoc {
     FileLoc::new(Arc::from("cams.pbrt"), line, 5)
@@ -20,7 +18,38 @@ enum P<'a> {
     S(&'a str, &'a str),
 }
 
-fn entity_with(name: &str, params: &[P], ct: CameraTransform) -> CameraSceneEntity {
+/// A `Camera` directive's parts.
+struct CamEntity {
+    name: String,
+    params: ParameterDictionary,
+    ct: CameraTransform,
+}
+
+/// A camera and the warnings its creation raised.
+struct Made {
+    camera: Camera,
+    warnings: Vec<Diagnostic>,
+}
+
+fn create_camera_with(
+    e: &CamEntity,
+    film: &FilmGeometry,
+    medium: Option<MediumId>,
+) -> Result<Made, Diagnostic> {
+    let at = loc(1);
+    let r = ParamReader::plain(&e.params, &at);
+    let camera = super::create_camera(&e.name, &r, &e.ct, film, medium)?;
+    Ok(Made {
+        camera,
+        warnings: r.finish(),
+    })
+}
+
+fn create_camera(e: &CamEntity, film: &FilmGeometry) -> Result<Camera, Diagnostic> {
+    create_camera_with(e, film, None).map(|m| m.camera)
+}
+
+fn entity_with(name: &str, params: &[P], ct: CameraTransform) -> CamEntity {
     let list = params
         .iter()
         .enumerate()
@@ -31,14 +60,14 @@ fn entity_with(name: &str, params: &[P], ct: CameraTransform) -> CameraSceneEnti
             }
         })
         .collect();
-    CameraSceneEntity {
-        base: SceneEntity::new(name, ParameterDictionary::new(list), loc(1), "srgb"),
-        camera_transform: ct,
-        medium: String::new(),
+    CamEntity {
+        name: name.to_string(),
+        params: ParameterDictionary::new(list),
+        ct,
     }
 }
 
-fn entity(name: &str, params: &[P]) -> CameraSceneEntity {
+fn entity(name: &str, params: &[P]) -> CamEntity {
     entity_with(name, params, CameraTransform::default())
 }
 
@@ -161,35 +190,6 @@ fn fov_applies_to_the_shorter_axis() {
     );
     let d = ray(&c, 0.0, 10.0).d;
     assert!(close(d, Vector3f::new(0.0, 0.0, 1.0), 1e-5), "{d:?}");
-}
-
-#[test]
-fn look_at_centre_ray_hits_the_origin_in_cameraworld_space() {
-    let text = "LookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 45\n\
-                Film \"rgb\" \"integer xresolution\" 40 \"integer yresolution\" 30\n\
-                WorldBegin\n";
-    let opts = BuildOptions {
-        render_coord_sys: RenderingCoordinateSystem::CameraWorld,
-        ..Default::default()
-    };
-    let (scene, _) = build_scene_from_str(text, &opts).expect("scene");
-    let c = create_camera(&scene.camera, &FilmGeometry::new(40, 30)).expect("camera");
-    let r = ray(&c, 20.0, 15.0);
-    let target = scene
-        .camera
-        .camera_transform
-        .render_from_world()
-        .apply_point(Point3f::new(0.0, 0.0, 0.0));
-    // In camera-world space the camera sits at the render-space origin.
-    assert!(closep(r.o, Point3f::new(0.0, 0.0, 0.0), 1e-5), "{:?}", r.o);
-    assert!(
-        closep(target, Point3f::new(0.0, 0.0, 5.0), 1e-5),
-        "{target:?}"
-    );
-    let t = (target - r.o).length();
-    assert!(closep(r.at(t), target, 1e-4), "{:?}", r.at(t));
-    // Up is still +y: the top of the image looks up.
-    assert!(ray(&c, 20.0, 0.0).d.y > 0.0);
 }
 
 #[test]

@@ -4,12 +4,14 @@ use rpbrt_geometry::{Bounds2i, Float, Point2i, Vector2f};
 use rpbrt_parser::{FileLoc, ParameterDictionary, ParsedParameter};
 
 use super::*;
+use crate::camera::CameraTransform;
 use crate::filter::{BoxFilter, Filter};
+use crate::params::ParamReader;
 use crate::rng::Rng;
-use crate::scene::{CameraTransform, SceneEntity};
 use crate::spectrum::{
     cie, named_spectrum, RgbColorSpace, RgbIlluminantSpectrum, Spectrum, CIE_Y_INTEGRAL, RGB, XYZ,
 };
+use rpbrt_parser::Diagnostic;
 
 fn loc(line: u32) -> FileLoc {
     FileLoc::new(Arc::from("film.pbrt"), line, 3)
@@ -21,7 +23,27 @@ enum P<'a> {
     S(&'a str, &'a str),
 }
 
-fn entity(name: &str, params: &[P]) -> SceneEntity {
+/// A `Film` directive's type and parameters.
+struct FilmEntity {
+    name: String,
+    params: ParameterDictionary,
+}
+
+/// The film and its warnings, unused parameters included.
+fn create_film(
+    e: &FilmEntity,
+    filter: &Filter,
+    exposure_time: Float,
+    ct: &CameraTransform,
+    ov: &FilmOverrides,
+) -> Result<(Film, Vec<Diagnostic>), Diagnostic> {
+    let at = loc(1);
+    let r = ParamReader::plain(&e.params, &at);
+    let film = super::create_film(&e.name, &r, filter, exposure_time, ct, ov)?;
+    Ok((film, r.finish()))
+}
+
+fn entity(name: &str, params: &[P]) -> FilmEntity {
     let list = params
         .iter()
         .enumerate()
@@ -38,7 +60,10 @@ fn entity(name: &str, params: &[P]) -> SceneEntity {
             }
         })
         .collect();
-    SceneEntity::new(name, ParameterDictionary::new(list), loc(1), "srgb")
+    FilmEntity {
+        name: name.to_string(),
+        params: ParameterDictionary::new(list),
+    }
 }
 
 fn box_filter() -> Filter {

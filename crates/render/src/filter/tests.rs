@@ -2,7 +2,19 @@
 //! importance sampling, analytic samplers inside the radius.
 
 use super::*;
+use crate::params::ParamReader;
 use crate::rng::Rng;
+use rpbrt_geometry::float::Float;
+use rpbrt_geometry::tuple::Vector2f;
+use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary};
+
+fn create_filter(
+    name: &str,
+    params: &ParameterDictionary,
+    loc: &FileLoc,
+) -> Result<Filter, Diagnostic> {
+    super::create_filter(name, &ParamReader::plain(params, loc))
+}
 
 fn name(f: &Filter) -> &'static str {
     match f {

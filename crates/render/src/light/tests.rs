@@ -8,18 +8,59 @@ use rpbrt_geometry::{
     equal_area_square_to_sphere, AnimatedTransform, Float, Normal3f, Point2f, Point2i, Point3f,
     Ray, Transform, Vector3f, PI,
 };
-use rpbrt_parser::{FileLoc, ParameterDictionary, ParsedParameter};
+use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary, ParsedParameter};
 
 use super::*;
+use crate::camera::CameraTransform;
 use crate::image::Image;
+use crate::params::ParamReader;
 use crate::rng::Rng;
 use crate::sampling::sample_uniform_sphere;
-use crate::scene::entities::{CameraTransform, LightSceneEntity, SceneEntity};
 use crate::shape::{Disk, Shape, ShapeMethods};
 use crate::spectrum::{spectrum_to_photometric, RgbColorSpace, SampledWavelengths};
 
+/// Where the light directive is.
 fn loc() -> FileLoc {
     FileLoc::new(Arc::from("test.pbrt"), 1, 1)
+}
+
+thread_local! {
+    static NEXT_LINE: std::cell::Cell<u32> = const { std::cell::Cell::new(10) };
+}
+
+/// A fresh location for a parameter: each parameter of a test is on a
+/// line of its own, so that error locations are checked for real.
+fn ploc() -> FileLoc {
+    let line = NEXT_LINE.with(|n| {
+        let l = n.get();
+        n.set(l + 1);
+        l
+    });
+    FileLoc::new(Arc::from("test.pbrt"), line, 3)
+}
+
+/// The line an error or warning points at.
+fn line_of(d: &Diagnostic) -> Option<u32> {
+    d.loc.as_ref().map(|l| l.line)
+}
+
+/// A `LightSource` directive's parts.
+pub(crate) struct LightEntity {
+    pub name: String,
+    pub params: ParameterDictionary,
+    pub render_from_object: AnimatedTransform,
+}
+
+/// A light and its warnings, unused parameters included.
+pub(crate) fn create_light(
+    e: &LightEntity,
+    medium: Option<rpbrt_geometry::MediumId>,
+    ct: &CameraTransform,
+) -> Result<(Light, Vec<Diagnostic>), Diagnostic> {
+    let at = FileLoc::new(Arc::from("test.pbrt"), 1, 1);
+    let r = ParamReader::plain(&e.params, &at);
+    let light = super::create_light(&e.name, &r, &e.render_from_object, medium, ct)?;
+    Ok((light, r.finish()))
 }
 
 fn floats(name: &str, v: &[f32]) -> ParsedParameter {
@@ -28,14 +69,14 @@ fn floats(name: &str, v: &[f32]) -> ParsedParameter {
         3 => "rgb",
         _ => "float",
     };
-    ParsedParameter::with_floats(ty, name, loc(), v.to_vec())
+    ParsedParameter::with_floats(ty, name, ploc(), v.to_vec())
 }
 
-fn entity(name: &str, params: Vec<ParsedParameter>) -> LightSceneEntity {
-    LightSceneEntity {
-        base: SceneEntity::new(name, ParameterDictionary::new(params), loc(), "srgb"),
+fn entity(name: &str, params: Vec<ParsedParameter>) -> LightEntity {
+    LightEntity {
+        name: name.to_string(),
+        params: ParameterDictionary::new(params),
         render_from_object: AnimatedTransform::fixed(Transform::identity()),
-        medium: String::new(),
     }
 }
 
@@ -257,15 +298,18 @@ fn disk_light(two_sided: bool, power: Option<f32>, render_from_object: Transform
     if two_sided {
         params.push(ParsedParameter {
             bools: vec![true],
-            ..ParsedParameter::new("bool", "twosided", loc())
+            ..ParsedParameter::new("bool", "twosided", ploc())
         });
     }
     if let Some(p) = power {
         params.push(floats("power", &[p]));
     }
-    let e = SceneEntity::new("diffuse", ParameterDictionary::new(params), loc(), "srgb");
-    let l = create_area_light(&e, &render_from_object, &shape, None, None, None).unwrap();
-    assert!(e.params.report_unused().is_empty());
+    let params = ParameterDictionary::new(params);
+    let at = loc();
+    let r = ParamReader::plain(&params, &at);
+    let l =
+        create_area_light("diffuse", &r, &render_from_object, &shape, None, None, None).unwrap();
+    assert!(r.finish().is_empty());
     l
 }
 
@@ -519,38 +563,58 @@ fn creation_errors_are_located() {
     let bad = |name: &str, params: Vec<ParsedParameter>| {
         create_light(&entity(name, params), None, &CameraTransform::default()).unwrap_err()
     };
+    // Unknown types and missing parameters point at the directive.
     let e = bad("nosuch", vec![]);
-    assert!(format!("{e:?}").contains("point"));
-    let e = bad("point", vec![floats("scale", &[-1.0])]);
-    assert!(format!("{e:?}").contains("scale"));
+    assert!(e.message.contains("\"point\""), "{}", e.message);
+    assert_eq!(line_of(&e), Some(1));
     let e = bad("goniometric", vec![]);
-    assert!(format!("{e:?}").contains("filename"));
+    assert!(e.message.contains("filename"), "{}", e.message);
+    assert_eq!(line_of(&e), Some(1));
+    // Bad values point at their parameter.
+    let scale = floats("scale", &[-1.0]);
+    let e = bad(
+        "point",
+        vec![floats("from", &[0.0, 0.0, 0.0]), scale.clone()],
+    );
+    assert!(e.message.contains("scale"), "{}", e.message);
+    assert_eq!(e.loc.as_ref(), Some(&scale.loc));
+    let to = floats("to", &[1.0, 2.0, 3.0]);
+    let e = bad("spot", vec![floats("from", &[1.0, 2.0, 3.0]), to.clone()]);
+    assert!(e.message.contains("coincide"), "{}", e.message);
+    assert_eq!(e.loc.as_ref(), Some(&to.loc));
+    let fov = floats("fov", &[200.0]);
+    let e = bad("projection", vec![floats("scale", &[1.0]), fov.clone()]);
+    assert_eq!(e.loc.as_ref(), Some(&fov.loc), "{e:?}");
+    let file = ParsedParameter::with_strings(
+        "string",
+        "filename",
+        ploc(),
+        vec!["/nonexistent/env.exr".into()],
+    );
+    let e = bad("infinite", vec![floats("scale", &[1.0]), file.clone()]);
+    assert!(e.message.contains("env.exr"), "{}", e.message);
+    assert_eq!(e.loc.as_ref(), Some(&file.loc));
+    let portal = ParsedParameter::with_floats("point3", "portal", ploc(), vec![0.0; 12]);
     let e = bad(
         "infinite",
-        vec![ParsedParameter::with_strings(
-            "string",
-            "filename",
-            loc(),
-            vec!["/nonexistent/env.exr".into()],
-        )],
+        vec![floats("L", &[1.0, 1.0, 1.0]), portal.clone()],
     );
-    assert!(format!("{e:?}").contains("env.exr"));
-    let e = bad(
-        "infinite",
-        vec![
-            floats("L", &[1.0, 1.0, 1.0]),
-            ParsedParameter::with_floats("point3", "portal", loc(), vec![0.0; 12]),
-        ],
+    assert!(
+        e.message.contains("portals are not supported"),
+        "{}",
+        e.message
     );
-    assert!(format!("{e:?}").contains("portals are not supported"));
-    // Unused parameters are warned about.
+    assert_eq!(e.loc.as_ref(), Some(&portal.loc));
+    // Unused parameters are warned about, at the parameter.
+    let bogus = floats("bogus", &[1.0]);
     let (_, w) = create_light(
-        &entity("point", vec![floats("bogus", &[1.0])]),
+        &entity("point", vec![bogus.clone()]),
         None,
         &CameraTransform::default(),
     )
     .unwrap();
     assert_eq!(w.len(), 1);
+    assert_eq!(w[0].loc.as_ref(), Some(&bogus.loc));
 }
 
 #[test]
@@ -647,7 +711,7 @@ fn image_infinite_from_file_illuminance_and_square_check() {
         .write(&square, &Default::default())
         .unwrap();
     let file = |p: &std::path::Path| {
-        ParsedParameter::with_strings("string", "filename", loc(), vec![p.display().to_string()])
+        ParsedParameter::with_strings("string", "filename", ploc(), vec![p.display().to_string()])
     };
     let l = make(
         "infinite",

@@ -11,8 +11,8 @@ use super::*;
 use crate::light::{
     create_area_light, Light, LightSampleContext, PointLight, UniformInfiniteLight,
 };
+use crate::params::ParamReader;
 use crate::rng::Rng;
-use crate::scene::entities::SceneEntity;
 use crate::shape::{Disk, Shape};
 use crate::spectrum::{RgbColorSpace, Spectrum};
 
@@ -22,18 +22,14 @@ fn disk(at: Vector3f, rot_x: Float, radius: Float) -> Light {
         Disk::new(xf, false, 0.0, radius, 0.0, 360.0).unwrap(),
     ));
     let loc = FileLoc::new(Arc::from("t.pbrt"), 1, 1);
-    let e = SceneEntity::new(
-        "diffuse",
-        ParameterDictionary::new(vec![ParsedParameter::with_floats(
-            "float",
-            "scale",
-            loc.clone(),
-            vec![radius],
-        )]),
-        loc,
-        "srgb",
-    );
-    create_area_light(&e, &xf, &shape, None, None, None).unwrap()
+    let params = ParameterDictionary::new(vec![ParsedParameter::with_floats(
+        "float",
+        "scale",
+        loc.clone(),
+        vec![radius],
+    )]);
+    let r = ParamReader::plain(&params, &loc);
+    create_area_light("diffuse", &r, &xf, &shape, None, None, None).unwrap()
 }
 
 fn point(p: Point3f, scale: Float) -> Light {

@@ -36,8 +36,6 @@ mod mix;
 mod subsurface;
 #[cfg(test)]
 mod tests;
-#[cfg(test)]
-mod tests_create;
 
 pub use bump::{bump_map, normal_map, read_normal_map};
 pub use coated::{CoatedConductorMaterial, CoatedDiffuseMaterial};

@@ -5,7 +5,24 @@
 use super::lowdiscrepancy::radical_inverse;
 use super::pmj02bn::{pmj02bn_set, N_PMJ02BN_SAMPLES};
 use super::*;
-use rpbrt_parser::{FileLoc, ParameterDictionary, ParsedParameter};
+use crate::params::ParamReader;
+use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary, ParsedParameter};
+
+/// The sampler, with the warnings creating it raised added to `warnings`.
+fn create_sampler(
+    name: &str,
+    params: &ParameterDictionary,
+    res: Point2i,
+    spp: Option<i32>,
+    seed: Option<i32>,
+    loc: &FileLoc,
+    warnings: &mut Vec<Diagnostic>,
+) -> Result<Sampler, Diagnostic> {
+    let r = ParamReader::plain(params, loc);
+    let s = super::create_sampler(name, &r, res, spp, seed);
+    warnings.extend(r.take_warnings());
+    s
+}
 
 fn int_param(name: &str, v: i32) -> ParsedParameter {
     let mut p = ParsedParameter::new("integer", name, FileLoc::new("test.pbrt".into(), 1, 1));

@@ -950,5 +950,4 @@ impl ParserTarget for SceneBuilder {
 }
 
 #[cfg(test)]
-#[path = "builder_tests.rs"]
 mod tests;

@@ -15,6 +15,8 @@ pub mod names;
 pub mod options;
 pub mod shapes;
 mod state;
+#[cfg(test)]
+mod tests;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

@@ -11,13 +11,12 @@ use rpbrt_geometry::{
 };
 use rpbrt_parser::{FileLoc, ParameterDictionary, ParsedParameter};
 
-use super::super::{
-    create_light, ImageInfiniteLight, Light, LightSampleContext, PortalImageInfiniteLight,
-};
+use super::super::{ImageInfiniteLight, Light, LightSampleContext, PortalImageInfiniteLight};
+use crate::camera::CameraTransform;
 use crate::image::Image;
+use crate::light::tests::{create_light, LightEntity};
 use crate::rng::Rng;
 use crate::sampling::sample_uniform_sphere;
-use crate::scene::entities::{CameraTransform, LightSceneEntity, SceneEntity};
 use crate::spectrum::{RgbColorSpace, SampledWavelengths};
 
 /// A tilted 2a × 2b rectangle centred at `c`, with the environment on the
@@ -348,16 +347,11 @@ fn portal_param(pts: &[[Float; 3]]) -> ParsedParameter {
     )
 }
 
-fn entity(params: Vec<ParsedParameter>) -> LightSceneEntity {
-    LightSceneEntity {
-        base: SceneEntity::new(
-            "infinite",
-            ParameterDictionary::new(params),
-            loc_at(2),
-            "srgb",
-        ),
+fn entity(params: Vec<ParsedParameter>) -> LightEntity {
+    LightEntity {
+        name: "infinite".to_string(),
+        params: ParameterDictionary::new(params),
         render_from_object: AnimatedTransform::fixed(Transform::identity()),
-        medium: String::new(),
     }
 }
 

@@ -4,7 +4,6 @@
 use super::reader::*;
 use super::*;
 use crate::rng::Rng;
-use crate::texture::tests::create;
 use crate::texture::{FloatTexture, SpectrumTexture, TextureEvalContext};
 use half::f16;
 use rpbrt_geometry::tuple::*;
@@ -552,13 +551,59 @@ fn textures_from_scene() {
     let faces = test_faces(3);
     let path = dir.join("c.ptx");
     std::fs::write(&path, write_ptex(&faces, PtexDataType::U8, 3, [0, 0])).unwrap();
-    let text = format!(
-        "Texture \"f\" \"float\" \"ptex\" \"string filename\" \"{p}\" \"float scale\" 2\n\
-         Texture \"s\" \"spectrum\" \"ptex\" \"string filename\" \"{p}\" \"string encoding\" \"linear\"\n",
-        p = path.display()
-    );
-    let (named, warnings) = create(&text).unwrap();
-    assert!(warnings.is_empty(), "{warnings:?}");
+    // What `Texture "f" "float" "ptex" "string filename" ... "float scale" 2`
+    // and `Texture "s" "spectrum" "ptex" ... "string encoding" "linear"`
+    // give.
+    let l = rpbrt_parser::FileLoc::new(Arc::from("t.pbrt"), 1, 1);
+    let file = || {
+        rpbrt_parser::ParsedParameter::with_strings(
+            "string",
+            "filename",
+            l.clone(),
+            vec![path.display().to_string()],
+        )
+    };
+    let fparams = rpbrt_parser::ParameterDictionary::new(vec![
+        file(),
+        rpbrt_parser::ParsedParameter::with_floats("float", "scale", l.clone(), vec![2.0]),
+    ]);
+    let sparams = rpbrt_parser::ParameterDictionary::new(vec![
+        file(),
+        rpbrt_parser::ParsedParameter::with_strings(
+            "string",
+            "encoding",
+            l.clone(),
+            vec!["linear".into()],
+        ),
+    ]);
+    let cache = crate::image::MIPMapCache::new();
+    let options = crate::texture::TextureOptions::default();
+    let mut named = crate::texture::NamedTextures::default();
+    let def = |name| crate::texture::TextureDef {
+        name,
+        class: "ptex",
+        render_from_texture: rpbrt_geometry::transform::Transform::identity(),
+    };
+    let tp =
+        crate::texture::TextureParams::new(crate::params::ParamReader::plain(&fparams, &l), &named);
+    let f = crate::texture::create_float_texture(&def("f"), &tp, &cache, &options).unwrap();
+    assert!(tp.finish().is_empty());
+    let mut spectra = Vec::new();
+    let tp =
+        crate::texture::TextureParams::new(crate::params::ParamReader::plain(&sparams, &l), &named);
+    for ty in [
+        SpectrumType::Albedo,
+        SpectrumType::Unbounded,
+        SpectrumType::Illuminant,
+    ] {
+        let s = crate::texture::create_spectrum_texture(&def("s"), ty, &tp, &cache, &options);
+        spectra.push((ty, s.unwrap()));
+    }
+    assert!(tp.finish().is_empty());
+    named.float.insert("f".into(), f);
+    for (ty, s) in spectra {
+        named.spectrum_mut(ty).insert("s".into(), s);
+    }
     let ctx = TextureEvalContext {
         uv: Point2f::new(0.5, 0.5),
         face_index: 1,

@@ -9,36 +9,20 @@ use rpbrt_geometry::interaction::SurfaceInteraction;
 use rpbrt_geometry::tuple::*;
 use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary, ParsedParameter};
 
-use super::*;
+use super::{build, create_materials, create_textures_of};
 use crate::bxdf::{BxDF, TransportMode};
-use crate::image::{Image, ImageMetadata, MIPMapCache};
+use crate::image::{Image, ImageMetadata};
+use crate::material::*;
 use crate::scene::entities::SceneEntity;
-use crate::scene::{build_scene_from_str, BuildOptions, SceneDescription};
+use crate::scene::{build_scene_from_str, BuildOptions};
 use crate::spectrum::SampledWavelengths;
-use crate::texture::{
-    create_textures, FloatBilerpTexture, FloatTexture, TextureMapping2D, TextureOptions,
-};
-
-fn scene(text: &str) -> SceneDescription {
-    // Line numbers in the tests count from the line after `WorldBegin`.
-    let full = format!("WorldBegin\n{text}");
-    match build_scene_from_str(&full, &BuildOptions::default()) {
-        Ok((s, _)) => s,
-        Err(d) => panic!("{}", d.render()),
-    }
-}
+use crate::texture::{FloatBilerpTexture, FloatTexture, FloatTextureRef, TextureMapping2D};
 
 type Created = (MaterialSet, HashMap<String, u32>, Vec<Diagnostic>);
 
 fn create(text: &str) -> Result<Created, Vec<Diagnostic>> {
-    let s = scene(text);
-    let (named, _) = create_textures(
-        &s.float_textures,
-        &s.spectrum_textures,
-        &MIPMapCache::new(),
-        &TextureOptions::default(),
-    )
-    .unwrap_or_else(|d| panic!("{d:?}"));
+    let s = build(text);
+    let (named, _) = create_textures_of(&s).unwrap_or_else(|d| panic!("{d:?}"));
     create_materials(&s.materials, &s.named_materials, &named)
 }
 
