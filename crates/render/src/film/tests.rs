@@ -353,7 +353,12 @@ fn bad_parameters_are_located_errors() {
     let e = make("rgb", &[P::S("sensor", "nikon_d1")], &ov).expect_err("sensor");
     assert!(e.message.contains("sony_ilce_9") && e.message.contains("cie1931"));
     let e = make("film35", &[], &ov).expect_err("type");
-    assert!(e.message.contains("rgb, gbuffer, spectral"));
+    assert!(
+        e.message
+            .contains("unknown film type; expected one of \"gbuffer\", \"rgb\", \"spectral\""),
+        "{}",
+        e.message
+    );
     let o = FilmOverrides {
         outfile: Some("out.jpg".into()),
         ..Default::default()

@@ -28,7 +28,8 @@ pub struct MediumInterface {
 }
 
 impl MediumInterface {
-    /// True when both sides have the same medium.
+    /// True when the two sides have different media: crossing the surface
+    /// changes the medium a ray travels in (pbrt-v4 `IsMediumTransition`).
     #[inline]
     pub fn is_transition(&self) -> bool {
         self.inside != self.outside

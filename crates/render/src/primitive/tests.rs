@@ -192,3 +192,12 @@ fn primitive_enum_stays_small() {
         std::mem::size_of::<Primitive>()
     );
 }
+
+#[test]
+fn a_medium_transition_has_different_media_on_its_sides() {
+    let mi = |inside, outside| MediumInterface { inside, outside };
+    assert!(!mi(Some(1), Some(1)).is_transition());
+    assert!(!mi(None, None).is_transition());
+    assert!(mi(Some(1), None).is_transition());
+    assert!(mi(Some(0), Some(2)).is_transition());
+}

@@ -415,7 +415,7 @@ fn located_errors() {
         ("Accelerator \"octree\"\nWorldBegin\n", "<string>:1:1:", "unknown accelerator type; expected one of \"bvh\", \"grid\", \"kdtree\""),
         ("Camera \"pinhole\"\nWorldBegin\n", "<string>:1:1:", "unknown camera type"),
         ("MakeNamedMedium \"m\" \"string type\" \"fog\"\nWorldBegin\n", "<string>:1:21:", "unknown medium type"),
-        ("ColorSpace \"adobe\"\nWorldBegin\n", "<string>:1:1:", "\"adobe\": unknown color space; expected one of \"srgb\", \"rec2020\", \"aces2065-1\", \"dci-p3\""),
+        ("ColorSpace \"adobe\"\nWorldBegin\n", "<string>:1:1:", "\"adobe\": unknown color space type; expected one of \"aces2065-1\", \"dci-p3\", \"rec2020\", \"srgb\""),
         ("Option \"bogus\" true\nWorldBegin\n", "<string>:1:1:", "unknown option"),
         ("Option \"seed\" \"x\"\nWorldBegin\n", "<string>:1:1:", "expected an integer"),
         ("WorldBegin\nAttributeEnd\n", "<string>:2:1:", "unmatched AttributeEnd"),
@@ -558,15 +558,17 @@ fn pbrt_files(dir: &std::path::Path, out: &mut Vec<PathBuf>) {
     }
 }
 
+/// Needs the third-party scenes in `../shared/scenes` beside the project,
+/// which a fresh clone does not have: `.ci/run` runs it with `--ignored`.
 #[test]
+#[ignore = "needs ../shared/scenes beside the project; .ci/run runs it"]
 fn shared_scenes_build_without_errors() {
-    let mut roots = vec![PathBuf::from("/work/shared/scenes")];
-    let manifest = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
-    roots.push(manifest.join("../../../shared/scenes"));
-    let Some(root) = roots.into_iter().find(|r| r.is_dir()) else {
-        eprintln!("no shared scenes; skipping");
-        return;
-    };
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
+    assert!(
+        root.is_dir(),
+        "{} is missing: this test needs the shared scenes",
+        root.display()
+    );
     let mut files = Vec::new();
     if let Ok(dirs) = std::fs::read_dir(&root) {
         for d in dirs.flatten() {
