@@ -1026,5 +1026,4 @@ impl<'a> Run<'a> {
 }
 
 #[cfg(test)]
-#[path = "driver_tests.rs"]
 mod tests;
