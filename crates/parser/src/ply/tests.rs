@@ -1,4 +1,7 @@
+use super::header::Format;
+use super::read::{is_gzip, UV_NAMES};
 use super::*;
+use std::io::Write;
 
 /// Writes PLY bodies value by value in any of the three formats.
 struct Body {
