@@ -48,6 +48,26 @@ enum Inner {
 pub struct FileReader {
     inner: Inner,
     file_len: Option<u64>,
+    gzip_hint: Option<u64>,
+}
+
+/// The most a gzip trailer's size is believed, as a multiple of the
+/// compressed size.
+const MAX_HINT_RATIO: u64 = 16;
+
+/// The uncompressed size a gzip file's trailer records (ISIZE: the size of its
+/// last member, modulo 2^32), capped at [`MAX_HINT_RATIO`] times the file
+/// size. Only a hint: it may be forged, wrap, or miss earlier members.
+fn file_gzip_size_hint(file: &mut File, file_len: u64) -> Option<u64> {
+    use std::io::{Seek, SeekFrom};
+    // A gzip member has at least a 10-byte header and an 8-byte trailer.
+    if file_len < 18 {
+        return None;
+    }
+    let mut isize = [0u8; 4];
+    file.seek(SeekFrom::Start(file_len - 4)).ok()?;
+    file.read_exact(&mut isize).ok()?;
+    Some(u64::from(u32::from_le_bytes(isize)).min(file_len.saturating_mul(MAX_HINT_RATIO)))
 }
 
 impl FileReader {
@@ -72,13 +92,23 @@ impl FileReader {
             .take(GZIP_MAGIC.len() as u64)
             .read_to_end(&mut head)?;
         let gzip = force_gzip || is_gzip(&head);
+        let gzip_hint = match (gzip, file_len) {
+            (true, Some(len)) => File::open(path)
+                .ok()
+                .and_then(|mut f| file_gzip_size_hint(&mut f, len)),
+            _ => None,
+        };
         let raw = BufReader::with_capacity(BUFFER_SIZE, io::Cursor::new(head).chain(file));
         let inner = if gzip {
             Inner::Gzip(Box::new(flate2::read::MultiGzDecoder::new(raw)))
         } else {
             Inner::Plain(raw)
         };
-        Ok(FileReader { inner, file_len })
+        Ok(FileReader {
+            inner,
+            file_len,
+            gzip_hint,
+        })
     }
 
     /// True when the contents are being decompressed.
@@ -99,6 +129,17 @@ impl FileReader {
             Inner::Gzip(_) => None,
         }
     }
+
+    /// A guess at the number of bytes [`Read`] will yield, for sizing
+    /// buffers: [`content_len`](Self::content_len) for plain files; for gzip
+    /// files the size the gzip trailer records, believed up to 16 times the
+    /// compressed size. Not a bound: the data may be shorter or longer.
+    pub fn size_hint(&self) -> Option<u64> {
+        match self.inner {
+            Inner::Plain(_) => self.file_len,
+            Inner::Gzip(_) => self.gzip_hint,
+        }
+    }
 }
 
 impl Read for FileReader {
@@ -108,6 +149,16 @@ impl Read for FileReader {
             Inner::Gzip(r) => r.read(buf),
         }
     }
+}
+
+/// The uncompressed size that gzip data held in memory records in its
+/// trailer, believed up to 16 times the compressed size (see
+/// [`FileReader::size_hint`]); `None` when `bytes` is too short to be gzip.
+pub fn gzip_size_hint(bytes: &[u8]) -> Option<u64> {
+    let len = bytes.len() as u64;
+    let tail = bytes.len().checked_sub(4).filter(|_| len >= 18)?;
+    let isize = u32::from_le_bytes(bytes[tail..].try_into().ok()?);
+    Some(u64::from(isize).min(len.saturating_mul(MAX_HINT_RATIO)))
 }
 
 /// Reads all of `reader` into memory, failing when it yields more than `limit`
@@ -150,7 +201,9 @@ pub fn read_file_limited(path: impl AsRef<Path>, limit: u64) -> io::Result<Vec<u
             read_to_end_limited(reader, limit, len, "file size")
         }
         None => {
-            let hint = reader.file_len().unwrap_or(0).saturating_mul(4);
+            // One more byte than expected, so that a correct hint needs no
+            // reallocation to find the end.
+            let hint = reader.size_hint().unwrap_or(0).saturating_add(1);
             read_to_end_limited(reader, limit, hint, "decompressed size")
         }
     }
@@ -183,6 +236,8 @@ mod tests {
             let mut r = FileReader::open(path).unwrap();
             assert_eq!(r.is_gzip(), is_gz);
             assert_eq!(r.content_len().is_some(), !is_gz);
+            let hint = r.size_hint().unwrap();
+            assert!(hint > 0 && hint <= text.len() as u64, "{hint}");
             let mut out = Vec::new();
             r.read_to_end(&mut out).unwrap();
             assert_eq!(out, text);

@@ -2,6 +2,8 @@
 //! declarations that describe the body (the PLY format of Turk's "The PLY
 //! Polygon File Format", as read by pbrt-v4's `plymesh` via rply).
 
+use std::io::{self, BufRead, Read};
+
 use super::PlyErrorKind;
 
 /// A PLY scalar type.
@@ -104,22 +106,45 @@ pub(super) enum Format {
 pub(super) struct Header {
     pub(super) format: Format,
     pub(super) elements: Vec<Element>,
-    /// Offset of the first body byte.
+    /// Size of the header in bytes: the offset of the first body byte.
     pub(super) data_start: usize,
 }
 
-/// Returns the next `\n`-terminated line (without `\r\n`) and advances `pos`.
-pub(super) fn next_line<'a>(bytes: &'a [u8], pos: &mut usize) -> Option<&'a [u8]> {
-    let rest = bytes.get(*pos..)?;
-    if rest.is_empty() {
-        return None;
+/// The longest header line accepted, in bytes (the body is read as a stream,
+/// so a file without line breaks must not be read whole into one line).
+pub(super) const MAX_LINE: usize = 1 << 20;
+
+/// One header line.
+enum Line {
+    /// The line, without its `\n` or `\r\n`.
+    Text,
+    /// Longer than [`MAX_LINE`].
+    TooLong,
+    /// The data ended.
+    End,
+}
+
+/// Reads the next `\n`-terminated line into `buf` (without `\r\n`), adding
+/// the bytes consumed to `pos`.
+fn next_line<R: BufRead>(r: &mut R, buf: &mut Vec<u8>, pos: &mut usize) -> io::Result<Line> {
+    buf.clear();
+    let n = r
+        .by_ref()
+        .take(MAX_LINE as u64 + 1)
+        .read_until(b'\n', buf)?;
+    *pos += n;
+    if n == 0 {
+        return Ok(Line::End);
     }
-    let (line, advance) = match rest.iter().position(|&b| b == b'\n') {
-        Some(i) => (&rest[..i], i + 1),
-        None => (rest, rest.len()),
-    };
-    *pos += advance;
-    Some(line.strip_suffix(b"\r").unwrap_or(line))
+    if buf.last() == Some(&b'\n') {
+        buf.pop();
+    } else if buf.len() > MAX_LINE {
+        return Ok(Line::TooLong);
+    }
+    if buf.last() == Some(&b'\r') {
+        buf.pop();
+    }
+    Ok(Line::Text)
 }
 
 pub(super) fn lossy(bytes: &[u8]) -> String {
@@ -132,22 +157,34 @@ pub(super) fn lossy(bytes: &[u8]) -> String {
     }
 }
 
-pub(super) fn parse_header(bytes: &[u8]) -> Result<Header, PlyErrorKind> {
+/// Reads the header from the start of `r`, leaving `r` at the first body byte.
+pub(super) fn parse_header<R: BufRead>(r: &mut R) -> Result<Header, PlyErrorKind> {
     let mut pos = 0;
-    match next_line(bytes, &mut pos) {
-        Some(l) if l.trim_ascii() == b"ply" => {}
+    let mut buf = Vec::new();
+    match next_line(r, &mut buf, &mut pos).map_err(PlyErrorKind::Io)? {
+        Line::Text if buf.trim_ascii() == b"ply" => {}
         _ => return Err(PlyErrorKind::BadMagic),
     }
     let mut line_no = 1;
     let mut format = None;
     let mut elements: Vec<Element> = Vec::new();
     loop {
-        let Some(line) = next_line(bytes, &mut pos) else {
-            return Err(PlyErrorKind::Header {
-                line: line_no,
-                message: "missing 'end_header'".into(),
-            });
-        };
+        match next_line(r, &mut buf, &mut pos).map_err(PlyErrorKind::Io)? {
+            Line::Text => {}
+            Line::TooLong => {
+                return Err(PlyErrorKind::Header {
+                    line: line_no + 1,
+                    message: format!("line longer than {MAX_LINE} bytes"),
+                })
+            }
+            Line::End => {
+                return Err(PlyErrorKind::Header {
+                    line: line_no,
+                    message: "missing 'end_header'".into(),
+                })
+            }
+        }
+        let line = &buf[..];
         line_no += 1;
         let err = |message: String| PlyErrorKind::Header {
             line: line_no,

@@ -2,9 +2,10 @@
 //! binary records exporters write, and a general property-by-property decoder
 //! for everything else (ASCII, lists, unusual types).
 
-use std::io::Read;
+use std::io::{BufRead, BufReader};
 
-use super::header::{lossy, parse_header, Element, Format, Header, PropKind, Scalar};
+use super::header::{parse_header, Element, Format, Header, PropKind, Scalar};
+use super::stream::{decode_f32, decode_num, AsciiSource, BinarySource, Input, ReadErr, Source};
 use super::{PlyErrorKind, PlyMesh};
 
 // ---------------------------------------------------------------------------
@@ -112,190 +113,29 @@ fn face_layout(el: &Element) -> Result<FaceLayout, PlyErrorKind> {
 }
 
 // ---------------------------------------------------------------------------
-// Decoding values
-
-/// Why a value could not be read; turned into a [`PlyErrorKind`] by the
-/// element loop, which knows the element and record.
-enum ReadErr {
-    Eof,
-    Bad(String),
-    Index(i64),
-}
-
-#[inline(always)]
-fn array_at<const N: usize>(b: &[u8], off: usize) -> [u8; N] {
-    let mut a = [0u8; N];
-    a.copy_from_slice(&b[off..off + N]);
-    a
-}
-
-macro_rules! decode_num {
-    ($t:ty, $n:literal, $be:expr, $b:expr, $off:expr) => {{
-        let a = array_at::<$n>($b, $off);
-        if $be {
-            <$t>::from_be_bytes(a)
-        } else {
-            <$t>::from_le_bytes(a)
-        }
-    }};
-}
-
-/// Decodes a scalar at `off` (which the caller has bounds-checked) as `f32`.
-#[inline(always)]
-fn decode_f32<const BE: bool>(ty: Scalar, b: &[u8], off: usize) -> f32 {
-    match ty {
-        Scalar::I8 => f32::from(b[off] as i8),
-        Scalar::U8 => f32::from(b[off]),
-        Scalar::I16 => f32::from(decode_num!(i16, 2, BE, b, off)),
-        Scalar::U16 => f32::from(decode_num!(u16, 2, BE, b, off)),
-        Scalar::I32 => decode_num!(i32, 4, BE, b, off) as f32,
-        Scalar::U32 => decode_num!(u32, 4, BE, b, off) as f32,
-        Scalar::F32 => decode_num!(f32, 4, BE, b, off),
-        Scalar::F64 => decode_num!(f64, 8, BE, b, off) as f32,
-    }
-}
-
-fn float_to_int(f: f64) -> Result<i64, ReadErr> {
-    if f.is_finite() && f.fract() == 0.0 && f.abs() < 9.0e15 {
-        Ok(f as i64)
-    } else {
-        Err(ReadErr::Bad(format!("expected an integer, found {f}")))
-    }
-}
-
-/// Decodes a scalar at `off` (which the caller has bounds-checked) as an integer.
-#[inline(always)]
-fn decode_int<const BE: bool>(ty: Scalar, b: &[u8], off: usize) -> Result<i64, ReadErr> {
-    Ok(match ty {
-        Scalar::I8 => i64::from(b[off] as i8),
-        Scalar::U8 => i64::from(b[off]),
-        Scalar::I16 => i64::from(decode_num!(i16, 2, BE, b, off)),
-        Scalar::U16 => i64::from(decode_num!(u16, 2, BE, b, off)),
-        Scalar::I32 => i64::from(decode_num!(i32, 4, BE, b, off)),
-        Scalar::U32 => i64::from(decode_num!(u32, 4, BE, b, off)),
-        Scalar::F32 => return float_to_int(f64::from(decode_num!(f32, 4, BE, b, off))),
-        Scalar::F64 => return float_to_int(decode_num!(f64, 8, BE, b, off)),
-    })
-}
-
-/// A stream of property values: a binary slice or ASCII tokens.
-trait Source {
-    fn remaining(&self) -> usize;
-    /// A lower bound on the bytes one record of `el` occupies.
-    fn min_record_size(&self, el: &Element) -> usize;
-    fn read_f32(&mut self, ty: Scalar) -> Result<f32, ReadErr>;
-    fn read_int(&mut self, ty: Scalar) -> Result<i64, ReadErr>;
-    fn skip(&mut self, ty: Scalar, n: u64) -> Result<(), ReadErr>;
-}
-
-struct BinarySource<'a, const BE: bool> {
-    data: &'a [u8],
-    pos: usize,
-}
-
-impl<'a, const BE: bool> BinarySource<'a, BE> {
-    #[inline(always)]
-    fn take(&mut self, n: usize) -> Result<&'a [u8], ReadErr> {
-        let end = self.pos.checked_add(n).ok_or(ReadErr::Eof)?;
-        let s = self.data.get(self.pos..end).ok_or(ReadErr::Eof)?;
-        self.pos = end;
-        Ok(s)
-    }
-}
-
-impl<const BE: bool> Source for BinarySource<'_, BE> {
-    fn remaining(&self) -> usize {
-        self.data.len().saturating_sub(self.pos)
-    }
-
-    fn min_record_size(&self, el: &Element) -> usize {
-        el.min_binary_size()
-    }
-
-    fn read_f32(&mut self, ty: Scalar) -> Result<f32, ReadErr> {
-        let b = self.take(ty.size())?;
-        Ok(decode_f32::<BE>(ty, b, 0))
-    }
-
-    fn read_int(&mut self, ty: Scalar) -> Result<i64, ReadErr> {
-        let b = self.take(ty.size())?;
-        decode_int::<BE>(ty, b, 0)
-    }
-
-    fn skip(&mut self, ty: Scalar, n: u64) -> Result<(), ReadErr> {
-        let bytes = n
-            .checked_mul(ty.size() as u64)
-            .and_then(|b| usize::try_from(b).ok())
-            .ok_or(ReadErr::Eof)?;
-        self.take(bytes).map(|_| ())
-    }
-}
-
-struct AsciiSource<'a> {
-    data: &'a [u8],
-    pos: usize,
-}
-
-impl<'a> AsciiSource<'a> {
-    fn token(&mut self) -> Option<&'a [u8]> {
-        let rest = self.data.get(self.pos..)?;
-        let start = rest.iter().position(|b| !b.is_ascii_whitespace())?;
-        let rest = &rest[start..];
-        let len = rest
-            .iter()
-            .position(|b| b.is_ascii_whitespace())
-            .unwrap_or(rest.len());
-        self.pos += start + len;
-        Some(&rest[..len])
-    }
-
-    fn text(&mut self) -> Result<&'a str, ReadErr> {
-        let tok = self.token().ok_or(ReadErr::Eof)?;
-        std::str::from_utf8(tok)
-            .map_err(|_| ReadErr::Bad(format!("invalid number '{}'", lossy(tok))))
-    }
-}
-
-impl Source for AsciiSource<'_> {
-    fn remaining(&self) -> usize {
-        self.data.len().saturating_sub(self.pos)
-    }
-
-    fn min_record_size(&self, el: &Element) -> usize {
-        // Every value is at least one character plus a separator.
-        el.props.len()
-    }
-
-    fn read_f32(&mut self, _ty: Scalar) -> Result<f32, ReadErr> {
-        let s = self.text()?;
-        s.parse::<f32>()
-            .map_err(|_| ReadErr::Bad(format!("invalid number '{}'", lossy(s.as_bytes()))))
-    }
-
-    fn read_int(&mut self, _ty: Scalar) -> Result<i64, ReadErr> {
-        let s = self.text()?;
-        match s.parse::<i64>() {
-            Ok(i) => Ok(i),
-            Err(_) => match s.parse::<f64>() {
-                Ok(f) => float_to_int(f),
-                Err(_) => Err(ReadErr::Bad(format!(
-                    "invalid integer '{}'",
-                    lossy(s.as_bytes())
-                ))),
-            },
-        }
-    }
-
-    fn skip(&mut self, _ty: Scalar, n: u64) -> Result<(), ReadErr> {
-        for _ in 0..n {
-            self.token().ok_or(ReadErr::Eof)?;
-        }
-        Ok(())
-    }
-}
-
-// ---------------------------------------------------------------------------
 // Assembling the mesh
+
+/// Bytes of decompressed data decoded at a time when reading a gzip stream.
+const WINDOW: usize = 256 * 1024;
+
+/// The first reservation, in elements, for an array whose final size is not
+/// yet backed by data (a gzip body, whose size is unknown until read).
+const FIRST_RESERVE: usize = 4096;
+
+/// Makes room for `n` more elements in `v`, growing geometrically (from
+/// [`FIRST_RESERVE`]) but never past `total` elements in all unless `n`
+/// itself needs it. Callers pass the records actually present in the data as
+/// `n` and the header's count as `total`, so a lying count never drives an
+/// allocation, and a truthful one ends with no excess capacity.
+#[inline]
+fn reserve_upto<T>(v: &mut Vec<T>, n: usize, total: usize) {
+    if v.capacity() - v.len() >= n {
+        return;
+    }
+    let grow = v.capacity().max(FIRST_RESERVE);
+    let room = total.saturating_sub(v.len());
+    v.reserve_exact(grow.min(room).max(n));
+}
 
 struct Builder {
     vertex_count: u64,
@@ -324,6 +164,8 @@ impl Builder {
         }
     }
 
+    /// Reserves room for `n` vertices, a number the data has been checked to
+    /// hold.
     fn reserve_vertices(&mut self, n: usize, layout: &VertexLayout) {
         self.positions.reserve(n);
         if layout.normals {
@@ -331,6 +173,18 @@ impl Builder {
         }
         if layout.uvs {
             self.uvs.reserve(n);
+        }
+    }
+
+    /// Makes room for `n` more vertices (see [`reserve_upto`]).
+    #[inline]
+    fn grow_vertices(&mut self, n: usize, total: usize, layout: &VertexLayout) {
+        reserve_upto(&mut self.positions, n, total);
+        if layout.normals {
+            reserve_upto(&mut self.normals, n, total);
+        }
+        if layout.uvs {
+            reserve_upto(&mut self.uvs, n, total);
         }
     }
 
@@ -383,14 +237,14 @@ fn map_err(e: ReadErr, el: &Element, record: u64, vertex_count: u64) -> PlyError
             index,
             vertex_count,
         },
+        ReadErr::Io(e) => PlyErrorKind::Io(e),
     }
 }
 
-/// How many records of `el` can possibly fit in what `src` has left: caps
-/// reservations so that a lying count never drives an allocation.
-fn plausible_records<S: Source>(src: &S, el: &Element) -> usize {
-    let cap = src.remaining() / src.min_record_size(el).max(1);
-    usize::try_from(el.count).unwrap_or(usize::MAX).min(cap)
+/// The header's count of `el` as a `usize` (saturating), for capping
+/// reservations.
+fn count_usize(el: &Element) -> usize {
+    usize::try_from(el.count).unwrap_or(usize::MAX)
 }
 
 fn skip_property<S: Source>(src: &mut S, kind: PropKind) -> Result<(), ReadErr> {
@@ -425,7 +279,10 @@ fn read_vertices_general<S: Source>(
     layout: &VertexLayout,
     b: &mut Builder,
 ) -> Result<(), PlyErrorKind> {
-    b.reserve_vertices(plausible_records(src, el), layout);
+    if let Some(n) = src.plausible_records(el) {
+        b.reserve_vertices(n, layout);
+    }
+    let total = count_usize(el);
     for rec in 0..el.count {
         let mut v = [0.0f32; SLOT_COUNT];
         for (p, slot) in el.props.iter().zip(&layout.slots) {
@@ -435,6 +292,7 @@ fn read_vertices_general<S: Source>(
             };
             r.map_err(|e| map_err(e, el, rec, 0))?;
         }
+        b.grow_vertices(1, total, layout);
         b.push_vertex(&v, layout.normals, layout.uvs);
     }
     Ok(())
@@ -480,83 +338,130 @@ fn read_faces_general<S: Source>(
     layout: &FaceLayout,
     b: &mut Builder,
 ) -> Result<(), PlyErrorKind> {
-    b.tris.reserve(plausible_records(src, el).saturating_mul(3));
+    if let Some(n) = src.plausible_records(el) {
+        b.tris.reserve(n.saturating_mul(3));
+    }
+    let total = count_usize(el).saturating_mul(3);
     for rec in 0..el.count {
+        reserve_upto(&mut b.tris, 3, total);
         read_face_record(src, el, layout, b).map_err(|e| map_err(e, el, rec, b.vertex_count))?;
     }
     Ok(())
 }
 
-/// Fixed-size binary vertex records: decode each field at its offset.
-fn read_vertices_fixed<const BE: bool>(
-    data: &[u8],
-    pos: &mut usize,
+/// Where the fixed-size vertex fast path finds each of x y z nx ny nz u v.
+struct VertexFields {
+    /// (offset, type) of each slot; unused slots read field 0 harmlessly.
+    fields: [(usize, Scalar); SLOT_COUNT],
+    /// Every needed field is an `f32`.
+    all_f32: bool,
+    normals: bool,
+    uvs: bool,
+}
+
+impl VertexFields {
+    fn new(el: &Element, layout: &VertexLayout) -> VertexFields {
+        let mut fields = [(0usize, Scalar::U8); SLOT_COUNT];
+        let mut offset = 0;
+        for (p, slot) in el.props.iter().zip(&layout.slots) {
+            if let PropKind::Scalar(t) = p.kind {
+                if let Some(s) = slot {
+                    fields[*s] = (offset, t);
+                }
+                offset += t.size();
+            }
+        }
+        let mut needed = vec![0, 1, 2];
+        if layout.normals {
+            needed.extend([3, 4, 5]);
+        }
+        if layout.uvs {
+            needed.extend([6, 7]);
+        }
+        let all_f32 = needed.iter().all(|&s| fields[s].1 == Scalar::F32);
+        VertexFields {
+            fields,
+            all_f32,
+            normals: layout.normals,
+            uvs: layout.uvs,
+        }
+    }
+
+    /// Decodes the whole records in `body` (a multiple of `record_size`).
+    #[inline]
+    fn decode<const BE: bool>(&self, body: &[u8], record_size: usize, b: &mut Builder) {
+        let (fields, normals, uvs) = (&self.fields, self.normals, self.uvs);
+        if self.all_f32 {
+            let f = |rec: &[u8], s: usize| decode_num!(f32, 4, BE, rec, fields[s].0);
+            for rec in body.chunks_exact(record_size) {
+                b.positions.push([f(rec, 0), f(rec, 1), f(rec, 2)]);
+                if normals {
+                    b.normals.push([f(rec, 3), f(rec, 4), f(rec, 5)]);
+                }
+                if uvs {
+                    b.uvs.push([f(rec, 6), f(rec, 7)]);
+                }
+            }
+        } else {
+            let f = |rec: &[u8], s: usize| decode_f32::<BE>(fields[s].1, rec, fields[s].0);
+            for rec in body.chunks_exact(record_size) {
+                b.positions.push([f(rec, 0), f(rec, 1), f(rec, 2)]);
+                if normals {
+                    b.normals.push([f(rec, 3), f(rec, 4), f(rec, 5)]);
+                }
+                if uvs {
+                    b.uvs.push([f(rec, 6), f(rec, 7)]);
+                }
+            }
+        }
+    }
+}
+
+/// Fixed-size binary vertex records: decode each field at its offset, a
+/// window of records at a time.
+fn read_vertices_fixed<R: BufRead, const BE: bool>(
+    input: &mut Input<R>,
     el: &Element,
     layout: &VertexLayout,
     record_size: usize,
     b: &mut Builder,
 ) -> Result<(), PlyErrorKind> {
-    let remaining = data.len().saturating_sub(*pos);
-    let truncated = || PlyErrorKind::Truncated {
+    let truncated = |read: u64| PlyErrorKind::Truncated {
         element: el.name.clone(),
         expected: el.count,
-        read: (remaining / record_size.max(1)) as u64,
+        read,
     };
-    let bytes = usize::try_from(el.count)
-        .ok()
-        .and_then(|n| n.checked_mul(record_size))
-        .filter(|&n| n <= remaining)
-        .ok_or_else(truncated)?;
-    let count = bytes / record_size.max(1);
-    let body = &data[*pos..*pos + bytes];
-    *pos += bytes;
-    b.reserve_vertices(count, layout);
+    if let Some(n) = input.fits_exactly(el.count, record_size) {
+        // The body's size is known: a short one fails before decoding.
+        if (n as u64) < el.count {
+            return Err(truncated(n as u64));
+        }
+    }
+    if let Some(n) = input.fits(el.count, record_size) {
+        b.reserve_vertices(n, layout);
+    }
     if record_size == 0 {
         return Ok(());
     }
-
-    // (offset, type) of each slot; unused slots read field 0 harmlessly.
-    let mut fields = [(0usize, Scalar::U8); SLOT_COUNT];
-    let mut offset = 0;
-    for (p, slot) in el.props.iter().zip(&layout.slots) {
-        if let PropKind::Scalar(t) = p.kind {
-            if let Some(s) = slot {
-                fields[*s] = (offset, t);
-            }
-            offset += t.size();
-        }
-    }
-    let mut needed = vec![0, 1, 2];
-    if layout.normals {
-        needed.extend([3, 4, 5]);
-    }
-    if layout.uvs {
-        needed.extend([6, 7]);
-    }
-    let all_f32 = needed.iter().all(|&s| fields[s].1 == Scalar::F32);
-
-    let (normals, uvs) = (layout.normals, layout.uvs);
-    if all_f32 {
-        let f = |rec: &[u8], s: usize| decode_num!(f32, 4, BE, rec, fields[s].0);
-        for rec in body.chunks_exact(record_size) {
-            b.positions.push([f(rec, 0), f(rec, 1), f(rec, 2)]);
-            if normals {
-                b.normals.push([f(rec, 3), f(rec, 4), f(rec, 5)]);
-            }
-            if uvs {
-                b.uvs.push([f(rec, 6), f(rec, 7)]);
-            }
-        }
-    } else {
-        let f = |rec: &[u8], s: usize| decode_f32::<BE>(fields[s].1, rec, fields[s].0);
-        for rec in body.chunks_exact(record_size) {
-            b.positions.push([f(rec, 0), f(rec, 1), f(rec, 2)]);
-            if normals {
-                b.normals.push([f(rec, 3), f(rec, 4), f(rec, 5)]);
-            }
-            if uvs {
-                b.uvs.push([f(rec, 6), f(rec, 7)]);
-            }
+    let fields = VertexFields::new(el, layout);
+    let total = count_usize(el);
+    let mut read = 0u64;
+    while read < el.count {
+        let buf = input.window().map_err(|e| map_err(e, el, read, 0))?;
+        let left = usize::try_from(el.count - read).unwrap_or(usize::MAX);
+        let n = (buf.len() / record_size).min(left);
+        if n > 0 {
+            b.grow_vertices(n, total, layout);
+            fields.decode::<BE>(&buf[..n * record_size], record_size, b);
+            input.consume(n * record_size);
+            read += n as u64;
+        } else {
+            // One record straddles the end of the window (or the data ends).
+            b.grow_vertices(1, total, layout);
+            input
+                .with_bytes(record_size, |rec| fields.decode::<BE>(rec, record_size, b))
+                .map_err(|e| map_err(e, el, read, 0))?;
+            read += 1;
         }
     }
     Ok(())
@@ -590,9 +495,11 @@ fn fast_face_layout(el: &Element, layout: &FaceLayout) -> Option<(bool, bool)> {
     }
 }
 
-fn read_faces_fast<const BE: bool>(
-    data: &[u8],
-    pos: &mut usize,
+/// Faces in the layout of [`fast_face_layout`]: triangles and quads decoded
+/// straight from the window; anything else (other vertex counts, a record
+/// that straddles two windows) goes through [`read_face_record`].
+fn read_faces_fast<R: BufRead, const BE: bool>(
+    input: &mut Input<R>,
     el: &Element,
     layout: &FaceLayout,
     signed: bool,
@@ -602,13 +509,13 @@ fn read_faces_fast<const BE: bool>(
     let fi_len = if with_face_index { 4 } else { 0 };
     let tri_len = 13 + fi_len;
     let quad_len = 17 + fi_len;
-    let plausible = usize::try_from(el.count)
-        .unwrap_or(usize::MAX)
-        .min(data.len().saturating_sub(*pos) / tri_len);
-    b.tris.reserve(plausible.saturating_mul(3));
-    if with_face_index {
-        b.tri_faces.reserve(plausible);
+    if let Some(plausible) = input.fits(el.count, tri_len) {
+        b.tris.reserve(plausible.saturating_mul(3));
+        if with_face_index {
+            b.tri_faces.reserve(plausible);
+        }
     }
+    let total = count_usize(el);
     // Valid indices are below `limit`; a negative `int` read as `u32` is at
     // least 2^31 and so fails the same comparison.
     let limit = if signed {
@@ -624,9 +531,10 @@ fn read_faces_fast<const BE: bool>(
         };
         ReadErr::Index(index)
     };
+    let signed_fi = signed_face_index(el);
     let face_index = |rec: &[u8], off: usize| -> Result<i32, ReadErr> {
         let raw = decode_num!(u32, 4, BE, rec, off);
-        if signed_face_index(el) {
+        if signed_fi {
             Ok(raw as i32)
         } else {
             i32::try_from(raw)
@@ -635,56 +543,74 @@ fn read_faces_fast<const BE: bool>(
     };
     let mut rec = 0u64;
     while rec < el.count {
-        let rest = &data[*pos..];
-        let r: Result<(), ReadErr> = match rest.first() {
-            Some(3) if rest.len() >= tri_len => {
-                let i = [
-                    decode_num!(u32, 4, BE, rest, 1),
-                    decode_num!(u32, 4, BE, rest, 5),
-                    decode_num!(u32, 4, BE, rest, 9),
-                ];
-                match i.iter().find(|&&v| u64::from(v) >= limit) {
-                    Some(&bad) => Err(index_err(bad)),
-                    None => {
-                        b.tris.extend_from_slice(&i);
-                        if with_face_index {
-                            face_index(rest, 13).map(|f| b.tri_faces.push(f))
-                        } else {
-                            Ok(())
+        let buf = input
+            .window()
+            .map_err(|e| map_err(e, el, rec, b.vertex_count))?;
+        // At most this many triangles start in the window.
+        let in_window = (buf.len() / tri_len).min(total);
+        reserve_upto(
+            &mut b.tris,
+            in_window.saturating_mul(3),
+            total.saturating_mul(3),
+        );
+        if with_face_index {
+            reserve_upto(&mut b.tri_faces, in_window, total);
+        }
+        let mut pos = 0;
+        while rec < el.count {
+            let rest = &buf[pos..];
+            let r: Result<(), ReadErr> = match rest.first() {
+                Some(3) if rest.len() >= tri_len => {
+                    let i = [
+                        decode_num!(u32, 4, BE, rest, 1),
+                        decode_num!(u32, 4, BE, rest, 5),
+                        decode_num!(u32, 4, BE, rest, 9),
+                    ];
+                    match i.iter().find(|&&v| u64::from(v) >= limit) {
+                        Some(&bad) => Err(index_err(bad)),
+                        None => {
+                            b.tris.extend_from_slice(&i);
+                            if with_face_index {
+                                face_index(rest, 13).map(|f| b.tri_faces.push(f))
+                            } else {
+                                Ok(())
+                            }
                         }
                     }
+                    .map(|()| pos += tri_len)
                 }
-                .map(|()| *pos += tri_len)
-            }
-            Some(4) if rest.len() >= quad_len => {
-                let i = [
-                    decode_num!(u32, 4, BE, rest, 1),
-                    decode_num!(u32, 4, BE, rest, 5),
-                    decode_num!(u32, 4, BE, rest, 9),
-                    decode_num!(u32, 4, BE, rest, 13),
-                ];
-                match i.iter().find(|&&v| u64::from(v) >= limit) {
-                    Some(&bad) => Err(index_err(bad)),
-                    None => {
-                        b.quads.extend_from_slice(&[i[0], i[1], i[3], i[2]]);
-                        if with_face_index {
-                            face_index(rest, 17).map(|f| b.quad_faces.push(f))
-                        } else {
-                            Ok(())
+                Some(4) if rest.len() >= quad_len => {
+                    let i = [
+                        decode_num!(u32, 4, BE, rest, 1),
+                        decode_num!(u32, 4, BE, rest, 5),
+                        decode_num!(u32, 4, BE, rest, 9),
+                        decode_num!(u32, 4, BE, rest, 13),
+                    ];
+                    match i.iter().find(|&&v| u64::from(v) >= limit) {
+                        Some(&bad) => Err(index_err(bad)),
+                        None => {
+                            b.quads.extend_from_slice(&[i[0], i[1], i[3], i[2]]);
+                            if with_face_index {
+                                face_index(rest, 17).map(|f| b.quad_faces.push(f))
+                            } else {
+                                Ok(())
+                            }
                         }
                     }
+                    .map(|()| pos += quad_len)
                 }
-                .map(|()| *pos += quad_len)
-            }
-            _ => {
-                let mut src = BinarySource::<BE> { data, pos: *pos };
-                let r = read_face_record(&mut src, el, layout, b);
-                *pos = src.pos;
-                r
-            }
-        };
-        r.map_err(|e| map_err(e, el, rec, b.vertex_count))?;
-        rec += 1;
+                _ => break,
+            };
+            r.map_err(|e| map_err(e, el, rec, b.vertex_count))?;
+            rec += 1;
+        }
+        input.consume(pos);
+        if rec < el.count && pos == 0 {
+            // Not a triangle or quad, or one that straddles the window's end.
+            let r = read_face_record(&mut BinarySource::<R, BE>(input), el, layout, b);
+            r.map_err(|e| map_err(e, el, rec, b.vertex_count))?;
+            rec += 1;
+        }
     }
     Ok(())
 }
@@ -715,38 +641,37 @@ fn plan(header: &Header) -> Result<Plan, PlyErrorKind> {
     })
 }
 
-fn read_binary<const BE: bool>(
-    data: &[u8],
+/// Reads a binary body; returns the number of bytes after the last element.
+fn read_binary<R: BufRead, const BE: bool>(
+    input: &mut Input<R>,
     header: &Header,
     plan: &Plan,
     b: &mut Builder,
-) -> Result<usize, PlyErrorKind> {
-    let mut pos = 0;
+) -> Result<u64, PlyErrorKind> {
     for (i, el) in header.elements.iter().enumerate() {
         if i == plan.vertex {
             if let Some(size) = el.fixed_size() {
-                read_vertices_fixed::<BE>(data, &mut pos, el, &plan.vertex_layout, size, b)?;
+                read_vertices_fixed::<R, BE>(input, el, &plan.vertex_layout, size, b)?;
                 continue;
             }
         } else if i == plan.face {
             if let Some((signed, fi)) = fast_face_layout(el, &plan.face_layout) {
-                read_faces_fast::<BE>(data, &mut pos, el, &plan.face_layout, signed, fi, b)?;
+                read_faces_fast::<R, BE>(input, el, &plan.face_layout, signed, fi, b)?;
                 continue;
             }
         } else if let Some(size) = el.fixed_size() {
-            let skip = usize::try_from(el.count)
-                .ok()
-                .and_then(|n| n.checked_mul(size))
-                .filter(|&n| n <= data.len() - pos)
-                .ok_or_else(|| PlyErrorKind::Truncated {
+            let bytes = el.count.saturating_mul(size as u64);
+            let skipped = input.skip(bytes).map_err(|e| map_err(e, el, 0, 0))?;
+            if skipped < bytes {
+                return Err(PlyErrorKind::Truncated {
                     element: el.name.clone(),
                     expected: el.count,
-                    read: ((data.len() - pos) / size.max(1)) as u64,
-                })?;
-            pos += skip;
+                    read: skipped / size.max(1) as u64,
+                });
+            }
             continue;
         }
-        let mut src = BinarySource::<BE> { data, pos };
+        let mut src = BinarySource::<R, BE>(input);
         if i == plan.vertex {
             read_vertices_general(&mut src, el, &plan.vertex_layout, b)?;
         } else if i == plan.face {
@@ -754,18 +679,18 @@ fn read_binary<const BE: bool>(
         } else {
             skip_element(&mut src, el)?;
         }
-        pos = src.pos;
     }
-    Ok(data.len() - pos)
+    input.drain().map_err(io_kind)
 }
 
-fn read_ascii(
-    data: &[u8],
+/// Reads an ASCII body; returns whether anything follows the last element.
+fn read_ascii<R: BufRead>(
+    input: &mut Input<R>,
     header: &Header,
     plan: &Plan,
     b: &mut Builder,
 ) -> Result<bool, PlyErrorKind> {
-    let mut src = AsciiSource { data, pos: 0 };
+    let mut src = AsciiSource(input);
     for (i, el) in header.elements.iter().enumerate() {
         if i == plan.vertex {
             read_vertices_general(&mut src, el, &plan.vertex_layout, b)?;
@@ -775,33 +700,35 @@ fn read_ascii(
             skip_element(&mut src, el)?;
         }
     }
-    Ok(src.token().is_some())
+    let trailing = input.token(|_| ()).map_err(io_kind)?.is_some();
+    input.drain().map_err(io_kind)?;
+    Ok(trailing)
 }
 
-fn gunzip(bytes: &[u8]) -> Result<Vec<u8>, PlyErrorKind> {
-    // The trailer's ISIZE (uncompressed size mod 2^32) is a capacity hint;
-    // capped at a modest ratio so that a forged trailer cannot drive the
-    // allocation.
-    let hint = bytes
-        .len()
-        .checked_sub(4)
-        .and_then(|i| bytes.get(i..))
-        .map_or(0, |t| u32::from_le_bytes([t[0], t[1], t[2], t[3]]) as usize);
-    let mut out = Vec::with_capacity(hint.min(bytes.len().saturating_mul(16)));
-    flate2::read::MultiGzDecoder::new(bytes)
-        .read_to_end(&mut out)
-        .map_err(PlyErrorKind::Gzip)?;
-    Ok(out)
+/// A stream error outside any element (only [`ReadErr::Io`] can occur).
+fn io_kind(e: ReadErr) -> PlyErrorKind {
+    match e {
+        ReadErr::Io(e) => PlyErrorKind::Io(e),
+        ReadErr::Eof => PlyErrorKind::Io(std::io::ErrorKind::UnexpectedEof.into()),
+        ReadErr::Bad(m) => PlyErrorKind::Io(std::io::Error::other(m)),
+        ReadErr::Index(i) => PlyErrorKind::Io(std::io::Error::other(format!("index {i}"))),
+    }
 }
 
-pub(super) fn is_gzip(bytes: &[u8]) -> bool {
-    bytes.starts_with(&[0x1f, 0x8b])
-}
-
-fn parse_uncompressed(bytes: &[u8]) -> Result<PlyMesh, PlyErrorKind> {
-    let header = parse_header(bytes)?;
+/// Parses a whole PLY file from `r`, decoding the body as it is read.
+/// `total` is the size of the data when known (`exact`) or guessed without
+/// reading it; it sizes reservations, and an exact one lets a short body be
+/// reported before it is read. Errors from `r` come back as
+/// [`PlyErrorKind::Io`].
+pub(super) fn parse_reader<R: BufRead>(
+    mut r: R,
+    total: Option<u64>,
+    exact: bool,
+) -> Result<PlyMesh, PlyErrorKind> {
+    let header = parse_header(&mut r)?;
     let plan = plan(&header)?;
-    let data = bytes.get(header.data_start..).unwrap_or(&[]);
+    let body = total.map(|t| t.saturating_sub(header.data_start as u64));
+    let mut input = Input::new(r, body, exact);
     let mut b = Builder {
         vertex_count: header.elements[plan.vertex].count,
         positions: Vec::new(),
@@ -818,15 +745,15 @@ fn parse_uncompressed(bytes: &[u8]) -> Result<PlyMesh, PlyErrorKind> {
     let mut warnings = Vec::new();
     match header.format {
         Format::Ascii => {
-            if read_ascii(data, &header, &plan, &mut b)? {
+            if read_ascii(&mut input, &header, &plan, &mut b)? {
                 warnings.push("ignored trailing data after the last element".to_string());
             }
         }
         Format::BinaryLittleEndian | Format::BinaryBigEndian => {
             let trailing = if header.format == Format::BinaryBigEndian {
-                read_binary::<true>(data, &header, &plan, &mut b)?
+                read_binary::<R, true>(&mut input, &header, &plan, &mut b)?
             } else {
-                read_binary::<false>(data, &header, &plan, &mut b)?
+                read_binary::<R, false>(&mut input, &header, &plan, &mut b)?
             };
             if trailing > 0 {
                 warnings.push(format!(
@@ -873,10 +800,31 @@ fn parse_uncompressed(bytes: &[u8]) -> Result<PlyMesh, PlyErrorKind> {
     })
 }
 
-pub(super) fn parse_any(bytes: &[u8], gzip: bool) -> Result<PlyMesh, PlyErrorKind> {
-    if gzip || is_gzip(bytes) {
-        parse_uncompressed(&gunzip(bytes)?)
+/// Parses a gzip-compressed PLY file held in memory, inflating it as it is
+/// decoded. Errors from the decompressor come back as [`PlyErrorKind::Gzip`].
+pub(super) fn parse_gzip(bytes: &[u8]) -> Result<PlyMesh, PlyErrorKind> {
+    let hint = crate::input::gzip_size_hint(bytes);
+    let r = BufReader::with_capacity(WINDOW, flate2::read::MultiGzDecoder::new(bytes));
+    parse_reader(r, hint, false).map_err(gzip_kind)
+}
+
+/// Parses a PLY stream from a file (see [`crate::input::FileReader`]).
+pub(super) fn parse_file(reader: crate::input::FileReader) -> Result<PlyMesh, PlyErrorKind> {
+    let gzip = reader.is_gzip();
+    let total = reader.size_hint();
+    let r = BufReader::with_capacity(WINDOW, reader);
+    let mesh = parse_reader(r, total, !gzip);
+    if gzip {
+        mesh.map_err(gzip_kind)
     } else {
-        parse_uncompressed(bytes)
+        mesh
+    }
+}
+
+/// Read errors on a gzip stream are decompression errors.
+fn gzip_kind(kind: PlyErrorKind) -> PlyErrorKind {
+    match kind {
+        PlyErrorKind::Io(e) => PlyErrorKind::Gzip(e),
+        k => k,
     }
 }
