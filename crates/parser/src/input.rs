@@ -30,6 +30,14 @@ pub fn is_gzip(bytes: &[u8]) -> bool {
     bytes.starts_with(&GZIP_MAGIC)
 }
 
+/// True when `path` ends in `.gz` (any case): a name that promises gzip
+/// data, for callers that open such files with [`FileReader::open_gzip`] or
+/// compress what they write.
+pub fn has_gz_extension(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gz"))
+}
+
 /// The first bytes of a file, read to sniff its format, followed by the rest.
 type Raw = io::Chain<io::Cursor<Vec<u8>>, File>;
 

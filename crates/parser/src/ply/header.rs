@@ -4,7 +4,7 @@
 
 use std::io::{self, BufRead, Read};
 
-use super::PlyErrorKind;
+use super::types::PlyErrorKind;
 
 /// A PLY scalar type.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -6,7 +6,7 @@ use std::io::{BufRead, BufReader};
 
 use super::header::{parse_header, Element, Format, Header, PropKind, Scalar};
 use super::stream::{decode_f32, decode_num, AsciiSource, BinarySource, Input, ReadErr, Source};
-use super::{PlyErrorKind, PlyMesh};
+use super::types::{PlyErrorKind, PlyMesh};
 
 // ---------------------------------------------------------------------------
 // What to extract from the vertex and face elements

@@ -10,7 +10,7 @@ use std::io::{self, BufRead};
 
 use super::header::{lossy, Element, Scalar};
 
-/// Why a value could not be read; turned into a [`PlyErrorKind`] by the
+/// Why a value could not be read; turned into a [`PlyErrorKind`](super::PlyErrorKind) by the
 /// element loop, which knows the element and record.
 pub(super) enum ReadErr {
     /// The data ended.

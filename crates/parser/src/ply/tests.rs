@@ -3,6 +3,7 @@ use super::read::UV_NAMES;
 use super::*;
 use crate::input::is_gzip;
 use std::io::Write;
+use std::path::PathBuf;
 
 /// Writes PLY bodies value by value in any of the three formats.
 struct Body {

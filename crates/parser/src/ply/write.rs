@@ -4,7 +4,8 @@
 use std::io::Write;
 use std::path::Path;
 
-use super::{has_gz_extension, PlyError, PlyErrorKind, PlyMesh};
+use super::types::{PlyError, PlyErrorKind, PlyMesh};
+use crate::input::has_gz_extension;
 
 // ---------------------------------------------------------------------------
 // Writing
@@ -53,7 +54,7 @@ fn check_mesh(mesh: &PlyMesh) -> Result<(), String> {
 /// [`write_ply`] writes (before any compression).
 ///
 /// Quads are written in PLY polygon order (undoing the bilinear-patch order
-/// of [`PlyMesh::quad_indices`]), so [`parse_ply`] reads back an identical mesh.
+/// of [`PlyMesh::quad_indices`]), so [`parse_ply`](super::parse_ply) reads back an identical mesh.
 pub fn encode_ply(mesh: &PlyMesh) -> Result<Vec<u8>, PlyError> {
     check_mesh(mesh).map_err(|m| PlyError::new(None, PlyErrorKind::InvalidMesh(m)))?;
     let nv = mesh.positions.len();
@@ -130,7 +131,7 @@ pub fn encode_ply(mesh: &PlyMesh) -> Result<Vec<u8>, PlyError> {
 }
 
 /// Writes `mesh` as a `binary_little_endian` PLY file (gzip-compressed when
-/// `path` ends in `.gz`) that [`read_ply`] reads back identically.
+/// `path` ends in `.gz`) that [`read_ply`](super::read_ply) reads back identically.
 pub fn write_ply(path: &Path, mesh: &PlyMesh) -> Result<(), PlyError> {
     let err = |kind| PlyError::new(Some(path), kind);
     let bytes = encode_ply(mesh).map_err(|e| err(e.kind))?;
