@@ -93,7 +93,13 @@ impl FileReader {
 
     fn open_impl(path: &Path, force_gzip: bool) -> io::Result<FileReader> {
         let mut file = File::open(path)?;
-        let file_len = file.metadata().ok().map(|m| m.len());
+        // Only a regular file's size says how much there is to read (a pipe
+        // reports 0).
+        let file_len = file
+            .metadata()
+            .ok()
+            .filter(|m| m.is_file())
+            .map(|m| m.len());
         // Read the magic bytes without seeking, so pipes work too.
         let mut head = Vec::with_capacity(GZIP_MAGIC.len());
         (&mut file)
@@ -124,7 +130,8 @@ impl FileReader {
         matches!(self.inner, Inner::Gzip(_))
     }
 
-    /// Size of the file on disk (compressed size for gzip files), when known.
+    /// Size of the file on disk (compressed size for gzip files), when it is
+    /// a regular file.
     pub fn file_len(&self) -> Option<u64> {
         self.file_len
     }
