@@ -5,11 +5,13 @@
 #![deny(missing_docs)]
 
 pub mod animated;
+pub mod bilinear;
 pub mod bounds;
 pub mod float;
 pub mod frame;
 pub mod interaction;
 pub mod interval;
+pub mod pointfi;
 pub mod quaternion;
 pub mod ray;
 pub mod spherical;

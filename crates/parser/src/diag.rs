@@ -6,6 +6,7 @@ use std::collections::HashMap;
 use std::fmt;
 use std::sync::Arc;
 
+use crate::input;
 use crate::loc::FileLoc;
 
 /// How serious a [`Diagnostic`] is.
@@ -228,7 +229,9 @@ impl Diagnostics {
                     Some(s) => Some(s),
                     None => reread
                         .entry(loc.file.clone())
-                        .or_insert_with(|| crate::driver::read_scene_file(&*loc.file).ok())
+                        .or_insert_with(|| {
+                            input::read_file_limited(&*loc.file, input::DEFAULT_MAX_FILE_BYTES).ok()
+                        })
                         .as_deref(),
                 },
             };

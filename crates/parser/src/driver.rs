@@ -9,11 +9,11 @@
 //! [`ParseOptions::max_errors`] errors.
 
 use std::collections::HashSet;
-use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::diag::{Diagnostic, Diagnostics, Severity};
+use crate::input;
 use crate::loc::FileLoc;
 use crate::params::{split_declaration, value_kind, ParsedParameter, ValueKind};
 use crate::target::{IncludeKind, ParserTarget};
@@ -41,37 +41,16 @@ impl Default for ParseOptions {
             max_warnings: 1000,
             max_include_depth: 64,
             max_values: 1 << 30,
-            max_file_bytes: 1 << 36,
+            max_file_bytes: input::DEFAULT_MAX_FILE_BYTES,
         }
     }
 }
 
 /// Reads a scene file, decompressing it when it starts with the gzip magic
-/// bytes (whatever its extension).
+/// bytes (whatever its extension), with the default size limit
+/// ([`input::DEFAULT_MAX_FILE_BYTES`]).
 pub fn read_scene_file(path: impl AsRef<Path>) -> std::io::Result<Vec<u8>> {
-    read_limited(path.as_ref(), ParseOptions::default().max_file_bytes)
-}
-
-fn read_limited(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
-    let raw = std::fs::read(path)?;
-    if raw.starts_with(&[0x1f, 0x8b]) {
-        let mut out = Vec::with_capacity(raw.len() * 4);
-        flate2::read::MultiGzDecoder::new(&raw[..])
-            .take(limit.saturating_add(1))
-            .read_to_end(&mut out)?;
-        if out.len() as u64 > limit {
-            return Err(std::io::Error::other(format!(
-                "decompressed size exceeds the limit of {limit} bytes"
-            )));
-        }
-        Ok(out)
-    } else if raw.len() as u64 > limit {
-        Err(std::io::Error::other(format!(
-            "file size exceeds the limit of {limit} bytes"
-        )))
-    } else {
-        Ok(raw)
-    }
+    input::read_file_limited(path, input::DEFAULT_MAX_FILE_BYTES)
 }
 
 /// Parses the given files in order, then calls `end_of_files`.
@@ -401,7 +380,7 @@ impl<'a> Run<'a> {
     }
 
     fn open(&self, path: &Path) -> Result<Source, String> {
-        let data = read_limited(path, self.opts.max_file_bytes)
+        let data = input::read_file_limited(path, self.opts.max_file_bytes)
             .map_err(|e| format!("{}: {e}", path.display()))?;
         let dir = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
@@ -1047,5 +1026,4 @@ impl<'a> Run<'a> {
 }
 
 #[cfg(test)]
-#[path = "driver_tests.rs"]
 mod tests;

@@ -576,5 +576,4 @@ impl ParserTarget for FormattingTarget {
 }
 
 #[cfg(test)]
-#[path = "format_tests.rs"]
 mod tests;

@@ -9,6 +9,8 @@
 //!   [`parse_string`] drive it, following `Include`/`Import`.
 //! - [`Diagnostic`] / [`Diagnostics`]: located errors and warnings, rendered
 //!   with the source line and a caret.
+//! - [`input`]: opening files, with transparent gzip decompression, as a
+//!   stream ([`input::FileReader`]) or whole ([`input::read_file_limited`]).
 //! - [`FormattingTarget`]: prints a scene back as canonical pbrt-v4 text,
 //!   optionally upgrading pbrt-v3 constructs with the mappings in [`upgrade`].
 #![forbid(unsafe_code)]
@@ -17,6 +19,7 @@
 pub mod diag;
 pub mod driver;
 pub mod format;
+pub mod input;
 pub mod loc;
 pub mod params;
 pub mod ply;

@@ -682,5 +682,4 @@ pub fn upgrade_shape(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) ->
 }
 
 #[cfg(test)]
-#[path = "upgrade_tests.rs"]
 mod tests;

@@ -1,4 +1,9 @@
+use super::header::Format;
+use super::read::UV_NAMES;
 use super::*;
+use crate::input::is_gzip;
+use std::io::Write;
+use std::path::PathBuf;
 
 /// Writes PLY bodies value by value in any of the three formats.
 struct Body {
@@ -877,4 +882,70 @@ fn real_scene_files_if_present() {
         assert_eq!(m.triangle_count(), 102938);
     }
     eprintln!("checked {checked} shared PLY files");
+}
+
+/// Parses `bytes` through a reader with `window`-byte refills and no known
+/// size, the way files and gzip streams are read.
+fn parse_windowed(bytes: &[u8], window: usize) -> Result<PlyMesh, String> {
+    read::parse_reader(
+        std::io::BufReader::with_capacity(window, bytes),
+        None,
+        false,
+    )
+    .map_err(|k| format!("{k:?}"))
+}
+
+#[test]
+fn small_windows_read_the_same_as_memory() {
+    let mut files: Vec<Vec<u8>> = FORMATS.iter().map(|&f| rich_file(f)).collect();
+    let mut odd = sample_mesh();
+    odd.face_indices.clear();
+    files.push(encode_ply(&odd).unwrap());
+    for bytes in &files {
+        let whole = parse_ply(bytes).map_err(|e| format!("{:?}", e.kind));
+        for window in [1, 2, 3, 5, 7, 13, 16, 64, 1 << 16] {
+            assert_eq!(parse_windowed(bytes, window), whole, "window {window}");
+        }
+        let header_len = bytes
+            .windows(11)
+            .position(|w| w == b"end_header\n")
+            .unwrap()
+            + 11;
+        for cut in header_len..bytes.len() {
+            let whole = parse_ply(&bytes[..cut]).map_err(|e| format!("{:?}", e.kind));
+            for window in [1, 4, 9] {
+                assert_eq!(
+                    parse_windowed(&bytes[..cut], window),
+                    whole,
+                    "cut {cut} window {window}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn gzip_files_stream_with_the_same_errors() {
+    let bytes = encode_ply(&sample_mesh()).unwrap();
+    let gz = {
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+        enc.write_all(&bytes).unwrap();
+        enc.finish().unwrap()
+    };
+    let path = temp_path("stream.ply.gz");
+    std::fs::write(&path, &gz).unwrap();
+    assert_eq!(read_ply(&path).unwrap(), sample_mesh());
+    // Every cut of the compressed stream is a gzip error, never a panic or a
+    // PLY truncation.
+    for cut in 0..gz.len() {
+        std::fs::write(&path, &gz[..cut]).unwrap();
+        match read_ply(&path) {
+            Err(PlyError {
+                kind: PlyErrorKind::Gzip(_),
+                ..
+            }) => {}
+            other => panic!("cut {cut}: {other:?}"),
+        }
+    }
+    std::fs::remove_file(&path).unwrap();
 }
