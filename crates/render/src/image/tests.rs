@@ -871,3 +871,36 @@ fn reads_shared_scene_images() {
     }
     let _ = f16::ONE;
 }
+
+#[test]
+fn writes_replace_the_file_whole_and_leave_no_temporary_files() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-atomic-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("out.pfm");
+    let image = |v: f32| Image::from_f32(vec![v; 2 * 2 * 3], Point2i::new(2, 2), &["R", "G", "B"]);
+    image(1.0)
+        .unwrap()
+        .write(&path, &Default::default())
+        .unwrap();
+    image(2.0)
+        .unwrap()
+        .write(&path, &Default::default())
+        .unwrap();
+    let back = Image::read(&path, None).unwrap().image;
+    assert_eq!(back.to_f32_vec(), vec![2.0; 12]);
+    // A target that cannot be replaced (a directory) is an error that
+    // leaves no temporary file behind.
+    let sub = dir.join("sub.pfm");
+    std::fs::create_dir_all(&sub).unwrap();
+    assert!(image(3.0)
+        .unwrap()
+        .write(&sub, &Default::default())
+        .is_err());
+    let mut names: Vec<String> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["out.pfm", "sub.pfm"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

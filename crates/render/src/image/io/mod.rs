@@ -100,6 +100,29 @@ pub struct ImageAndMetadata {
     pub metadata: ImageMetadata,
 }
 
+/// Writes `bytes` to `path` through a temporary file in the same directory
+/// (same file system) that is renamed over `path` once complete.
+pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    use std::io::Write;
+    let file_name = path
+        .file_name()
+        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file name"))?;
+    let mut tmp_name = std::ffi::OsString::from(".");
+    tmp_name.push(file_name);
+    tmp_name.push(format!(".{}.tmp", std::process::id()));
+    let tmp = path.with_file_name(tmp_name);
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
 /// Result type of the format modules: a message without the file name.
 type FmtResult<T> = Result<T, String>;
 
@@ -121,11 +144,19 @@ impl Image {
     ) -> Result<ImageAndMetadata, ImageError> {
         let path = path.as_ref();
         let name = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|source| ImageError::Io {
+        // The project's one file reader (gzip-compressed images are
+        // inflated as they are read).
+        let bytes = rpbrt_parser::input::read_file_limited(
+            path,
+            rpbrt_parser::input::DEFAULT_MAX_FILE_BYTES,
+        )
+        .map_err(|source| ImageError::Io {
             path: name.clone(),
             source,
         })?;
-        Self::read_from_bytes(&bytes, &name, encoding)
+        // A `.gz` suffix is not the image's extension.
+        let format_name = name.strip_suffix(".gz").unwrap_or(&name);
+        Self::read_from_bytes(&bytes, format_name, encoding)
     }
 
     /// Decodes an in-memory file; `name` supplies the extension and the error messages.
@@ -153,6 +184,9 @@ impl Image {
     }
 
     /// Writes the image to a file chosen by extension: exr, pfm, png, qoi.
+    /// The file is written beside its target under a temporary name and
+    /// renamed into place, so a failed or interrupted write leaves any
+    /// earlier image of that name as it was.
     pub fn write(
         &self,
         path: impl AsRef<Path>,
@@ -161,7 +195,7 @@ impl Image {
         let path = path.as_ref();
         let name = path.display().to_string();
         let bytes = self.encode(&name, metadata)?;
-        std::fs::write(path, bytes).map_err(|source| ImageError::Io { path: name, source })
+        write_atomically(path, &bytes).map_err(|source| ImageError::Io { path: name, source })
     }
 
     /// Encodes the image in the format `name`'s extension names.
