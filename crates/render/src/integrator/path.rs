@@ -2,7 +2,7 @@
 //! estimation with multiple importance sampling, Russian roulette and
 //! optional BSDF regularization.
 
-use super::{sample_ld, skip_intersection, Scene, VertexOrigins};
+use super::{sample_ld, skip_intersection, RayIntegrator, Scene, VertexOrigins};
 use crate::bxdf::{BxDFReflTransFlags, TransportMode};
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
@@ -25,9 +25,8 @@ pub struct PathIntegrator {
     pub regularize: bool,
 }
 
-impl PathIntegrator {
-    /// The radiance arriving along `ray`.
-    pub fn li(
+impl RayIntegrator for PathIntegrator {
+    fn li(
         &self,
         scene: &Scene,
         ray: RayDifferential,
