@@ -317,11 +317,10 @@ fn render_errors_are_typed() {
     assert!(matches!(err, RenderError::MseReference(_)), "{err:?}");
     assert!(std::error::Error::source(&err).is_some());
 
-    let text = emitting_sphere("unwritable", "orthographic", "independent", "path", 1)
-        .replace(
-            &out_path("unwritable").display().to_string(),
-            "/nonexistent-rpbrt-dir/x.exr",
-        );
+    let text = emitting_sphere("unwritable", "orthographic", "independent", "path", 1).replace(
+        &out_path("unwritable").display().to_string(),
+        "/nonexistent-rpbrt-dir/x.exr",
+    );
     let c = created(&text);
     let mut scene = c.scene;
     let err = c
@@ -337,5 +336,8 @@ fn render_errors_are_typed() {
         RenderError::WriteImage { path, .. } => assert_eq!(path, "/nonexistent-rpbrt-dir/x.exr"),
         e => panic!("{e:?}"),
     }
-    assert!(err.to_string().contains("/nonexistent-rpbrt-dir/x.exr"), "{err}");
+    assert!(
+        err.to_string().contains("/nonexistent-rpbrt-dir/x.exr"),
+        "{err}"
+    );
 }

@@ -142,9 +142,12 @@ fn run_one(name: &str, bytes: &[u8], dir: &Path) {
                         nthreads: 1,
                         ..Default::default()
                     };
-                    let _ =
-                        c.integrator
-                            .render(&mut scene, &ro, &mut ImageMetadata::default(), &|_| {});
+                    let _ = c.integrator.render(
+                        &mut scene,
+                        &ro,
+                        &mut ImageMetadata::default(),
+                        &|_| {},
+                    );
                 }
             }
         }

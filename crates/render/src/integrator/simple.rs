@@ -3,8 +3,8 @@
 //! as references for the path tracer and for debugging scenes.
 
 use super::{skip_intersection, RayIntegrator, Scene};
-use crate::film::VisibleSurface;
 use crate::bxdf::{BxDFReflTransFlags, TransportMode};
+use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
 use crate::sampler::Sampler;
 use crate::sampling::*;
