@@ -295,3 +295,28 @@ fn progress_line(p: Progress) -> String {
 fn desc_flag(desc: &SceneDescription, name: &str) -> bool {
     matches!(desc.option(name), Some(OptionValue::Bool(true)))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::progress_line;
+    use rpbrt_render::integrator::Progress;
+    use std::time::Duration;
+
+    #[test]
+    fn progress_line_draws_the_fraction_done() {
+        let line = progress_line(Progress {
+            done: 50,
+            total: 200,
+            elapsed: Duration::from_secs(2),
+        });
+        assert!(line.starts_with('\r'), "{line:?}");
+        assert!(line.contains(&format!("[{}{}]", "+".repeat(10), " ".repeat(30))));
+        assert!(line.contains(" 25.0% 2.0s elapsed, ETA 6.0s"), "{line:?}");
+        let done = progress_line(Progress {
+            done: 7,
+            total: 7,
+            elapsed: Duration::from_millis(500),
+        });
+        assert!(done.contains(&format!("[{}]", "+".repeat(40))) && done.contains("100.0%"));
+    }
+}
