@@ -10,10 +10,10 @@ use rpbrt_render::accel::Aggregate;
 use rpbrt_render::camera::RenderingCoordinateSystem;
 use rpbrt_render::film::FilmOverrides;
 use rpbrt_render::image::ImageMetadata;
-use rpbrt_render::integrator::{render, RenderOptions};
+use rpbrt_render::integrator::{Progress, RenderOptions};
 use rpbrt_render::scene::assemble::{create_scene, CreateOptions};
 use rpbrt_render::scene::{build_scene, BuildOptions, OptionValue, SceneDescription};
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -176,7 +176,6 @@ fn render_command(opts: &args::Options) -> ExitCode {
     }
     let render_opts = RenderOptions {
         nthreads: opts.nthreads.unwrap_or(0),
-        quiet: opts.quiet,
         write_partial_images: opts.write_partial_images,
         disable_pixel_jitter: opts.disable_pixel_jitter || desc_flag(&desc, "disablepixeljitter"),
         disable_wavelength_jitter: opts.disable_wavelength_jitter
@@ -185,7 +184,20 @@ fn render_command(opts: &args::Options) -> ExitCode {
         mse_reference,
     };
     let mut metadata = ImageMetadata::default();
-    let stats = match render(&mut scene, &integrator, &render_opts, &mut metadata) {
+    // The progress bar, redrawn in place on each report.
+    let show_progress = !opts.quiet && std::io::stderr().is_terminal();
+    let draw_progress = |p: Progress| {
+        if show_progress {
+            eprint!("{}", progress_line(p));
+            let _ = std::io::stderr().flush();
+        }
+    };
+    let result = integrator.render(&mut scene, &render_opts, &mut metadata, &draw_progress);
+    if show_progress {
+        // Below the bar's last state.
+        eprintln!();
+    }
+    let stats = match result {
         Ok(s) => s,
         Err(e) => {
             eprintln!("rpbrt: error: {e}");
@@ -257,7 +269,53 @@ fn render_command(opts: &args::Options) -> ExitCode {
     ExitCode::SUCCESS
 }
 
+/// The progress bar line for a progress report.
+fn progress_line(p: Progress) -> String {
+    let elapsed = p.elapsed.as_secs_f64();
+    let frac = p.done as f64 / p.total.max(1) as f64;
+    let eta = if frac > 0.0 {
+        elapsed / frac - elapsed
+    } else {
+        0.0
+    };
+    let width = 40;
+    let filled = ((frac * width as f64) as usize).min(width);
+    format!(
+        "\r[{}{}] {:5.1}% {:.1}s elapsed, ETA {:.1}s ",
+        "+".repeat(filled),
+        " ".repeat(width - filled),
+        frac * 100.0,
+        elapsed,
+        eta
+    )
+}
+
 /// A boolean `Option` from the scene file.
 fn desc_flag(desc: &SceneDescription, name: &str) -> bool {
     matches!(desc.option(name), Some(OptionValue::Bool(true)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::progress_line;
+    use rpbrt_render::integrator::Progress;
+    use std::time::Duration;
+
+    #[test]
+    fn progress_line_draws_the_fraction_done() {
+        let line = progress_line(Progress {
+            done: 50,
+            total: 200,
+            elapsed: Duration::from_secs(2),
+        });
+        assert!(line.starts_with('\r'), "{line:?}");
+        assert!(line.contains(&format!("[{}{}]", "+".repeat(10), " ".repeat(30))));
+        assert!(line.contains(" 25.0% 2.0s elapsed, ETA 6.0s"), "{line:?}");
+        let done = progress_line(Progress {
+            done: 7,
+            total: 7,
+            elapsed: Duration::from_millis(500),
+        });
+        assert!(done.contains(&format!("[{}]", "+".repeat(40))) && done.contains("100.0%"));
+    }
 }

@@ -4,7 +4,7 @@
 //! camera. Plus determinism across thread counts.
 
 use rpbrt_render::image::{Image, ImageMetadata};
-use rpbrt_render::integrator::{render, RenderOptions};
+use rpbrt_render::integrator::RenderOptions;
 use rpbrt_render::scene::assemble::{create_scene, CreateOptions};
 use rpbrt_render::scene::{build_scene_from_str, BuildOptions};
 use std::path::PathBuf;
@@ -29,11 +29,13 @@ fn render_scene(text: &str, threads: usize) -> Image {
     let mut scene = created.scene;
     let opts = RenderOptions {
         nthreads: threads,
-        quiet: true,
         ..Default::default()
     };
     let mut md = ImageMetadata::default();
-    render(&mut scene, &created.integrator, &opts, &mut md).unwrap();
+    created
+        .integrator
+        .render(&mut scene, &opts, &mut md, &|_| {})
+        .unwrap();
     let path = scene.film.filename().to_string();
     Image::read(std::path::Path::new(&path), None)
         .unwrap()
@@ -217,16 +219,10 @@ fn force_diffuse_replaces_materials() {
     });
     let mut scene = created.scene;
     let mut md = ImageMetadata::default();
-    render(
-        &mut scene,
-        &created.integrator,
-        &RenderOptions {
-            quiet: true,
-            ..Default::default()
-        },
-        &mut md,
-    )
-    .unwrap();
+    created
+        .integrator
+        .render(&mut scene, &RenderOptions::default(), &mut md, &|_| {})
+        .unwrap();
     let im = Image::read(std::path::Path::new(scene.film.filename()), None)
         .unwrap()
         .image;
@@ -236,5 +232,112 @@ fn force_diffuse_replaces_materials() {
     assert!(
         (m - 0.5 / std::f64::consts::PI).abs() < 0.03 * m,
         "mean {m}"
+    );
+}
+
+/// Creates the scene of `text` (a tiny emitting sphere).
+fn created(text: &str) -> rpbrt_render::scene::assemble::CreatedScene {
+    let (desc, _) = build_scene_from_str(text, &BuildOptions::default())
+        .unwrap_or_else(|d| panic!("{}", d.render()));
+    create_scene(&desc, &CreateOptions::default()).unwrap_or_else(|e| {
+        panic!(
+            "{:?}",
+            e.iter().map(|d| d.message.clone()).collect::<Vec<_>>()
+        )
+    })
+}
+
+/// `Integrator::render` reports progress to its callback, last with every
+/// sample done, for each integrator.
+#[test]
+fn render_reports_progress_to_the_callback() {
+    for integrator in ["path", "simplepath", "ambientocclusion", "randomwalk"] {
+        let tag = format!("progress-{integrator}");
+        let c = created(&emitting_sphere(
+            &tag,
+            "orthographic",
+            "independent",
+            integrator,
+            4,
+        ));
+        let mut scene = c.scene;
+        let reports = std::sync::Mutex::new(Vec::new());
+        let stats = c
+            .integrator
+            .render(
+                &mut scene,
+                &RenderOptions::default(),
+                &mut ImageMetadata::default(),
+                &|p| reports.lock().unwrap().push(p),
+            )
+            .unwrap();
+        let reports = reports.into_inner().unwrap();
+        let last = reports.last().expect("no progress reported");
+        // A 16×16 film at 4 samples per pixel.
+        assert_eq!(last.total, 16 * 16 * 4, "{integrator}");
+        assert_eq!(last.done, last.total, "{integrator}");
+        assert_eq!(stats.samples, last.total, "{integrator}");
+        // Reports never go backwards.
+        assert!(
+            reports
+                .windows(2)
+                .all(|w| w[0].done <= w[1].done && w[0].elapsed <= w[1].elapsed),
+            "{integrator}: {reports:?}"
+        );
+    }
+}
+
+/// A render fails with a typed error: an MSE reference image of another
+/// resolution, and an image file that cannot be written.
+#[test]
+fn render_errors_are_typed() {
+    use rpbrt_render::integrator::RenderError;
+    let c = created(&emitting_sphere(
+        "mse-mismatch",
+        "orthographic",
+        "independent",
+        "path",
+        1,
+    ));
+    let mut scene = c.scene;
+    let reference = Image::new(
+        rpbrt_render::image::PixelFormat::Float,
+        rpbrt_geometry::Point2i::new(3, 5),
+        &["R", "G", "B"],
+        rpbrt_render::image::ColorEncoding::Linear,
+    );
+    let opts = RenderOptions {
+        mse_reference: Some(reference),
+        ..Default::default()
+    };
+    let err = c
+        .integrator
+        .render(&mut scene, &opts, &mut ImageMetadata::default(), &|_| {})
+        .unwrap_err();
+    assert!(matches!(err, RenderError::MseReference(_)), "{err:?}");
+    assert!(std::error::Error::source(&err).is_some());
+
+    let text = emitting_sphere("unwritable", "orthographic", "independent", "path", 1).replace(
+        &out_path("unwritable").display().to_string(),
+        "/nonexistent-rpbrt-dir/x.exr",
+    );
+    let c = created(&text);
+    let mut scene = c.scene;
+    let err = c
+        .integrator
+        .render(
+            &mut scene,
+            &RenderOptions::default(),
+            &mut ImageMetadata::default(),
+            &|_| {},
+        )
+        .unwrap_err();
+    match &err {
+        RenderError::WriteImage { path, .. } => assert_eq!(path, "/nonexistent-rpbrt-dir/x.exr"),
+        e => panic!("{e:?}"),
+    }
+    assert!(
+        err.to_string().contains("/nonexistent-rpbrt-dir/x.exr"),
+        "{err}"
     );
 }

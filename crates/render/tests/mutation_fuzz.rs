@@ -11,7 +11,7 @@
 
 use rpbrt_render::film::FilmOverrides;
 use rpbrt_render::image::ImageMetadata;
-use rpbrt_render::integrator::{render, RenderOptions};
+use rpbrt_render::integrator::RenderOptions;
 use rpbrt_render::rng::Rng;
 use rpbrt_render::scene::assemble::{create_scene, CreateOptions};
 use rpbrt_render::scene::shapes::create_scene_shapes;
@@ -140,14 +140,13 @@ fn run_one(name: &str, bytes: &[u8], dir: &Path) {
                     let mut scene = c.scene;
                     let ro = RenderOptions {
                         nthreads: 1,
-                        quiet: true,
                         ..Default::default()
                     };
-                    let _ = render(
+                    let _ = c.integrator.render(
                         &mut scene,
-                        &c.integrator,
                         &ro,
                         &mut ImageMetadata::default(),
+                        &|_| {},
                     );
                 }
             }

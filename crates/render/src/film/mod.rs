@@ -533,10 +533,14 @@ impl Film {
         self.core().get_image(metadata, splat_scale)
     }
     /// Writes the final image to [`Film::filename`] (format by extension).
-    pub fn write_image(&self, metadata: &ImageMetadata, splat_scale: Float) -> Result<(), String> {
+    pub fn write_image(
+        &self,
+        metadata: &ImageMetadata,
+        splat_scale: Float,
+    ) -> Result<(), crate::image::ImageError> {
         let mut md = metadata.clone();
         let image = self.get_image(&mut md, splat_scale);
-        image.write(self.filename(), &md).map_err(|e| e.to_string())
+        image.write(self.filename(), &md)
     }
 
     /// A tile accumulating samples for `bounds` (clipped to the film).

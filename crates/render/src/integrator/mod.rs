@@ -1,314 +1,44 @@
 //! Integrators (book chapters 13–14; pbrt-v4 `cpu/integrators.h/.cpp`):
-//! the light-transport algorithms, the render-ready [`Scene`] they query,
-//! and the parallel render loop.
+//! the light-transport algorithms and how each renders a [`Scene`].
 //!
-//! Every integrator here is a pbrt-v4 `RayIntegrator`: it estimates the
-//! radiance along one camera ray, and [`render`] drives it over image tiles
-//! in parallel. Results never depend on the thread count: each pixel's
-//! samples come from a sampler seeded by the pixel and sample index, and
-//! each pixel belongs to exactly one tile.
+//! [`Integrator::render`] is the one entry point: each integrator owns its
+//! render loop. Every integrator here is a pbrt-v4 `RayIntegrator`
+//! ([`RayIntegrator`]): it estimates the radiance along one camera ray, and
+//! the shared tile loop ([`tile`]) drives it over image tiles in parallel.
+//! An integrator that needs a loop of its own (MLT, SPPM) gets a match arm
+//! in [`Integrator::render`] calling its own function, which reports
+//! progress through the same callback ([`Progress`]) and fails with the
+//! same [`RenderError`].
+//!
+//! Results never depend on the thread count: each pixel's samples come
+//! from a sampler seeded by the pixel and sample index, and each pixel
+//! belongs to exactly one tile.
+//!
+//! The files: [`scene`], the render-ready scene and its ray queries;
+//! `create`, creation from the scene description; `direct`, direct
+//! lighting; [`render`], what render loops share (options, statistics,
+//! errors, progress); [`tile`], the per-ray tile loop; `path` and
+//! `simple`, the integrators.
 
+mod create;
+mod direct;
 mod path;
-mod render;
+pub mod render;
+pub mod scene;
 mod simple;
+pub mod tile;
 
+pub use create::{create_integrator, INTEGRATOR_NAMES};
 pub use path::PathIntegrator;
-pub use render::{render, RenderOptions, RenderStats};
+pub use render::{Progress, ProgressFn, RenderError, RenderOptions, RenderStats};
+pub use scene::{RayCounters, Scene};
 pub use simple::{AmbientOcclusionIntegrator, RandomWalkIntegrator, SimplePathIntegrator};
+pub use tile::RayIntegrator;
 
-use crate::bxdf::BSDF;
-use crate::camera::Camera;
-use crate::film::{Film, VisibleSurface};
-use crate::filter::Filter;
-use crate::light::{Light, LightCull, LightSampleContext};
-use crate::lightsampler::LightSampler;
-use crate::material::MaterialSet;
-use crate::primitive::{PrimitiveAggregate, PrimitiveIntersection};
-use crate::sampler::Sampler;
-use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use rpbrt_geometry::float::Float;
-use rpbrt_geometry::interaction::{CameraDifferentials, SurfaceInteraction};
-use rpbrt_geometry::ray::{
-    spawn_ray_from_origin_to_surface, spawn_ray_to_surface, Ray, RayDifferential, SHADOW_EPSILON,
-};
-use rpbrt_geometry::tuple::*;
-use rpbrt_geometry::Bounds3f;
-use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary};
-use std::sync::atomic::{AtomicU64, Ordering};
+pub(crate) use direct::{sample_ld, VertexOrigins};
+pub(crate) use scene::skip_intersection;
 
-/// A path vertex's ray origins, offset off the surface toward either of
-/// its sides (pbrt-v4's `OffsetRayOrigin`), each computed at most once:
-/// the light sample's reference point, the shadow ray and the next bounce
-/// usually leave by the same side. The offset depends on the direction
-/// only through that side, so a cached origin is the one a fresh
-/// computation would give.
-pub(crate) struct VertexOrigins<'a> {
-    /// The surface point.
-    pub si: &'a SurfaceInteraction,
-    /// Origins for directions with `dot(w, n) ≥ 0` and `< 0` (or NaN
-    /// tests, which count as the first side, as in `offset_ray_origin`).
-    sides: [Option<Point3f>; 2],
-}
-
-impl<'a> VertexOrigins<'a> {
-    /// No origin computed yet.
-    #[inline]
-    pub fn new(si: &'a SurfaceInteraction) -> Self {
-        VertexOrigins {
-            si,
-            sides: [None, None],
-        }
-    }
-
-    /// `si.offset_ray_origin(w)`.
-    #[inline(always)]
-    pub fn toward(&mut self, w: Vector3f) -> Point3f {
-        // The test `offset_ray_origin` makes.
-        let side = (dot(w, self.si.n) < 0.0) as usize;
-        match self.sides[side] {
-            Some(p) => p,
-            None => {
-                let p = self.si.offset_ray_origin(w);
-                self.sides[side] = Some(p);
-                p
-            }
-        }
-    }
-
-    /// `si.spawn_ray(d)`.
-    #[inline]
-    pub fn spawn_ray(&mut self, d: Vector3f) -> Ray {
-        Ray::with_time(self.toward(d), d, self.si.time, None)
-    }
-}
-
-/// Counters shared by all threads (for `--stats`).
-#[derive(Debug, Default)]
-pub struct RayCounters {
-    /// Camera rays generated.
-    pub camera_rays: AtomicU64,
-    /// Closest-hit queries (camera and indirect rays).
-    pub intersection_rays: AtomicU64,
-    /// Shadow (any-hit) queries.
-    pub shadow_rays: AtomicU64,
-}
-
-thread_local! {
-    /// This thread's closest-hit and shadow query counts not yet added to
-    /// a scene's shared [`RayCounters`]: counting in shared atomics would
-    /// bounce their cache line between threads on every ray.
-    static LOCAL_RAY_COUNTS: std::cell::Cell<(u64, u64)> = const { std::cell::Cell::new((0, 0)) };
-}
-
-impl RayCounters {
-    /// Forgets the calling thread's pending counts (at the start of a
-    /// unit of work whose counts [`RayCounters::flush_local`] will add).
-    pub(crate) fn reset_local() {
-        LOCAL_RAY_COUNTS.with(|c| c.set((0, 0)));
-    }
-
-    /// Adds the calling thread's pending counts to these counters.
-    pub(crate) fn flush_local(&self) {
-        let (closest, shadow) = LOCAL_RAY_COUNTS.with(|c| c.replace((0, 0)));
-        self.intersection_rays.fetch_add(closest, Ordering::Relaxed);
-        self.shadow_rays.fetch_add(shadow, Ordering::Relaxed);
-    }
-}
-
-/// Everything an integrator needs to trace rays and shade hits.
-pub struct Scene {
-    /// The camera.
-    pub camera: Camera,
-    /// The film (written by the render loop).
-    pub film: Film,
-    /// The sampler prototype (cloned per tile).
-    pub sampler: Sampler,
-    /// The pixel filter.
-    pub filter: Filter,
-    /// All geometry under its acceleration structure.
-    pub aggregate: PrimitiveAggregate,
-    /// All lights; area lights are referenced by index from primitives.
-    pub lights: Vec<Light>,
-    /// Indices of the infinite lights in `lights`.
-    pub infinite_lights: Vec<u32>,
-    /// Per light, the tests that recognise samples of it that cannot
-    /// contribute (triangle emitters only; see [`LightCull`]).
-    pub light_cull: Vec<Option<LightCull>>,
-    /// The light sampler chosen by the integrator.
-    pub light_sampler: LightSampler,
-    /// The materials, indexed by the primitives' material ids.
-    pub materials: MaterialSet,
-    /// Camera information for texture-filtering footprints of rays without
-    /// differentials.
-    pub camera_differentials: CameraDifferentials,
-    /// Samples per pixel (for the footprint scale).
-    pub samples_per_pixel: i32,
-    /// `--disable-texture-filtering`.
-    pub disable_texture_filtering: bool,
-    /// `--force-diffuse`.
-    pub force_diffuse: bool,
-    /// Ray counters.
-    pub counters: RayCounters,
-}
-
-impl Scene {
-    /// The bounds of the geometry.
-    pub fn bounds(&self) -> Bounds3f {
-        self.aggregate.bounds()
-    }
-
-    /// The closest hit along `ray` in (0, t_max).
-    #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
-        LOCAL_RAY_COUNTS.with(|c| {
-            let (closest, shadow) = c.get();
-            c.set((closest + 1, shadow));
-        });
-        self.aggregate.intersect(ray, t_max)
-    }
-
-    /// Whether anything blocks `ray` in (0, t_max).
-    #[inline]
-    pub fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
-        LOCAL_RAY_COUNTS.with(|c| {
-            let (closest, shadow) = c.get();
-            c.set((closest, shadow + 1));
-        });
-        self.aggregate.intersect_p(ray, t_max)
-    }
-
-    /// [`Scene::unoccluded`] with the surface point's offset origin taken
-    /// from `origins` (the same ray).
-    #[inline]
-    pub(crate) fn unoccluded_from(
-        &self,
-        origins: &mut VertexOrigins,
-        to_p: Point3fi,
-        to_n: Normal3f,
-    ) -> bool {
-        let si = origins.si;
-        let p_to = to_p.midpoint();
-        let pf = origins.toward(p_to - si.p());
-        let r = spawn_ray_from_origin_to_surface(pf, si.time, p_to, to_p.error(), to_n);
-        !self.intersect_p(&r, 1.0 - SHADOW_EPSILON)
-    }
-
-    /// True when nothing blocks the segment between a surface point and a
-    /// point on a light (pbrt-v4 `Integrator::Unoccluded`).
-    #[inline]
-    pub fn unoccluded(&self, from: &SurfaceInteraction, to_p: Point3fi, to_n: Normal3f) -> bool {
-        let r = spawn_ray_to_surface(
-            from.p(),
-            from.p_error(),
-            from.n,
-            from.time,
-            to_p.midpoint(),
-            to_p.error(),
-            to_n,
-        );
-        !self.intersect_p(&r, 1.0 - SHADOW_EPSILON)
-    }
-
-    /// Emitted radiance of the surface hit by a ray, toward `w`.
-    #[inline]
-    pub fn le(
-        &self,
-        hit: &PrimitiveIntersection,
-        w: Vector3f,
-        lambda: &SampledWavelengths,
-    ) -> SampledSpectrum {
-        match hit.area_light {
-            Some(l) => self.lights[l as usize].l(hit.si.p(), hit.si.n, hit.si.uv, w, lambda),
-            None => SampledSpectrum::new(0.0),
-        }
-    }
-
-    /// pbrt-v4's `SurfaceInteraction::GetBSDF`: computes the screen-space
-    /// differentials (when the material can use them), then asks the material for its BSDF (`None` for
-    /// interfaces between media, which the ray passes through).
-    pub fn get_bsdf(
-        &self,
-        hit: &mut PrimitiveIntersection,
-        ray: &RayDifferential,
-        lambda: &mut SampledWavelengths,
-        sampler: &mut Sampler,
-    ) -> Option<BSDF> {
-        let material = hit.material?;
-        // The differentials only feed texture filtering and bump mapping;
-        // materials that do neither get the same BSDF without them.
-        if self.materials.needs_differentials(material) {
-            let spp_scale = (1.0 / (self.samples_per_pixel.max(1) as Float).sqrt()).max(0.125);
-            hit.si.compute_differentials(
-                ray,
-                Some(&self.camera_differentials),
-                spp_scale,
-                self.disable_texture_filtering,
-            );
-        }
-        // Returned as is (not unwrapped and rewrapped): the BSDF is large
-        // and this lets it be built in the caller's slot.
-        let bsdf = self.materials.get_bsdf(material, &mut hit.si, lambda);
-        if self.force_diffuse {
-            // pbrt-v4's --force-diffuse: a diffuse BSDF with the material's
-            // estimated albedo (two extra sampler dimensions, as pbrt-v4).
-            let bsdf = bsdf?;
-            let uc = sampler.get_1d();
-            let u = sampler.get_2d();
-            return Some(MaterialSet::force_diffuse(&bsdf, &hit.si, uc, u));
-        }
-        bsdf
-    }
-
-    /// The first visible surface of a camera path, for G-buffer films
-    /// (pbrt-v4 `VisibleSurface`, with the BSDF's albedo estimated from 16
-    /// fixed stratified samples).
-    pub fn visible_surface(&self, hit: &PrimitiveIntersection, bsdf: &BSDF) -> VisibleSurface {
-        const N: usize = 16;
-        let mut uc = [0.0; N];
-        let mut u = [Point2f::default(); N];
-        for i in 0..N {
-            // A (0,2)-net: Hammersley points with a shifted 1-D dimension.
-            uc[i] = ((i as Float + 0.5) / N as Float + 0.37).fract();
-            u[i] = Point2f::new(
-                (i as Float + 0.5) / N as Float,
-                (i as u32).reverse_bits() as Float / 4_294_967_296.0 + 0.5 / N as Float,
-            );
-        }
-        let si = &hit.si;
-        VisibleSurface {
-            p: si.p(),
-            n: si.n.face_forward(si.wo),
-            ns: si.shading.n.face_forward(si.wo),
-            uv: si.uv,
-            time: si.time,
-            dpdx: si.dpdx,
-            dpdy: si.dpdy,
-            albedo: bsdf.rho_hd(si.wo, &uc, &u),
-            set: true,
-        }
-    }
-}
-
-/// Continues a ray through a surface without scattering (pbrt-v4
-/// `SurfaceInteraction::SkipIntersection`): a new ray from the hit in the
-/// same direction, its differentials advanced to the surface.
-#[inline]
-pub(crate) fn skip_intersection(
-    ray: &RayDifferential,
-    hit: &PrimitiveIntersection,
-) -> RayDifferential {
-    let mut next = RayDifferential::new(hit.si.spawn_ray(ray.ray.d));
-    next.ray.medium = ray.ray.medium;
-    if ray.has_differentials {
-        let t = hit.t_hit;
-        next.has_differentials = true;
-        next.rx_origin = ray.rx_origin + ray.rx_direction * t;
-        next.ry_origin = ray.ry_origin + ray.ry_direction * t;
-        next.rx_direction = ray.rx_direction;
-        next.ry_direction = ray.ry_direction;
-    }
-    next
-}
+use crate::image::ImageMetadata;
 
 /// The closed set of integrators.
 pub enum Integrator {
@@ -323,20 +53,27 @@ pub enum Integrator {
 }
 
 impl Integrator {
-    /// The radiance arriving along `ray` for the sampled wavelengths.
-    pub fn li(
+    /// Renders `scene` and writes the film's image (and partial images
+    /// when `opts` asks for them), pbrt-v4 `Integrator::Render`.
+    /// `metadata` is completed with timing and sample counts; `progress`
+    /// is called from a reporting thread about every 250 ms while the
+    /// render runs and once at its end.
+    pub fn render(
         &self,
-        scene: &Scene,
-        ray: RayDifferential,
-        lambda: &mut SampledWavelengths,
-        sampler: &mut Sampler,
-        visible: Option<&mut VisibleSurface>,
-    ) -> SampledSpectrum {
+        scene: &mut Scene,
+        opts: &RenderOptions,
+        metadata: &mut ImageMetadata,
+        progress: ProgressFn,
+    ) -> Result<RenderStats, RenderError> {
+        // One match per render: each arm runs a loop built for its
+        // integrator (no dispatch per ray).
         match self {
-            Integrator::Path(i) => i.li(scene, ray, lambda, sampler, visible),
-            Integrator::SimplePath(i) => i.li(scene, ray, lambda, sampler),
-            Integrator::AmbientOcclusion(i) => i.li(scene, ray, lambda, sampler),
-            Integrator::RandomWalk(i) => i.li(scene, ray, lambda, sampler),
+            Integrator::Path(i) => tile::render_tiles(i, scene, opts, metadata, progress),
+            Integrator::SimplePath(i) => tile::render_tiles(i, scene, opts, metadata, progress),
+            Integrator::AmbientOcclusion(i) => {
+                tile::render_tiles(i, scene, opts, metadata, progress)
+            }
+            Integrator::RandomWalk(i) => tile::render_tiles(i, scene, opts, metadata, progress),
         }
     }
 
@@ -347,137 +84,4 @@ impl Integrator {
             _ => None,
         }
     }
-}
-
-/// Integrator names rpbrt knows, and those it renders.
-pub const INTEGRATOR_NAMES: &[&str] = &[
-    "ambientocclusion",
-    "bdpt",
-    "lightpath",
-    "mlt",
-    "path",
-    "randomwalk",
-    "simplepath",
-    "simplevolpath",
-    "sppm",
-    "volpath",
-];
-
-/// Creates the integrator of an `Integrator` directive. The light sampler
-/// it needs is created by the caller (it needs the lights).
-pub fn create_integrator(
-    name: &str,
-    params: &ParameterDictionary,
-    loc: &FileLoc,
-    scene_has_media: bool,
-) -> Result<Integrator, Diagnostic> {
-    let perr = Diagnostic::from;
-    let max_depth = params.get_one_int("maxdepth", 5).map_err(perr)?;
-    if max_depth < 0 {
-        return Err(Diagnostic::error(
-            params
-                .loc("maxdepth")
-                .cloned()
-                .unwrap_or_else(|| loc.clone()),
-            format!("\"maxdepth\" must not be negative, got {max_depth}"),
-        ));
-    }
-    match name {
-        "path" | "volpath" => {
-            if name == "volpath" && scene_has_media {
-                return Err(Diagnostic::error(loc.clone(), "participating media are not supported yet: the \"volpath\" integrator renders only scenes without media"));
-            }
-            Ok(Integrator::Path(PathIntegrator {
-                max_depth,
-                light_sampler_name: params.get_one_string("lightsampler", "bvh").map_err(perr)?,
-                regularize: params.get_one_bool("regularize", false).map_err(perr)?,
-            }))
-        }
-        "simplepath" => Ok(Integrator::SimplePath(SimplePathIntegrator {
-            max_depth,
-            sample_lights: params.get_one_bool("samplelights", true).map_err(perr)?,
-            sample_bsdf: params.get_one_bool("samplebsdf", true).map_err(perr)?,
-        })),
-        "ambientocclusion" => {
-            let max_distance = params.get_one_float("maxdistance", Float::INFINITY).map_err(perr)?;
-            if !(max_distance > 0.0) {
-                return Err(Diagnostic::error(params.loc("maxdistance").cloned().unwrap_or_else(|| loc.clone()), "\"maxdistance\" must be positive"));
-            }
-            Ok(Integrator::AmbientOcclusion(AmbientOcclusionIntegrator { cos_sample: params.get_one_bool("cossample", true).map_err(perr)?, max_distance }))
-        }
-        "randomwalk" => Ok(Integrator::RandomWalk(RandomWalkIntegrator { max_depth })),
-        "bdpt" | "lightpath" | "mlt" | "simplevolpath" | "sppm" => Err(Diagnostic::error(
-            loc.clone(),
-            format!("the \"{name}\" integrator is not supported yet; rpbrt renders with \"path\", \"volpath\" (without media), \"simplepath\", \"ambientocclusion\" and \"randomwalk\""),
-        )),
-        _ => Err(Diagnostic::error(loc.clone(), format!("unknown integrator \"{name}\"; known integrators: {}", INTEGRATOR_NAMES.join(", ")))),
-    }
-}
-
-/// Samples direct lighting at a surface hit with multiple importance
-/// sampling (pbrt-v4 `PathIntegrator::SampleLd`), given its two sampler
-/// draws: `u` chooses the light and `u_light` the point on it. `origins`
-/// holds the vertex's offset ray origins (shared with the shadow ray and
-/// the next bounce).
-#[inline]
-pub(crate) fn sample_ld(
-    scene: &Scene,
-    light_sampler: &LightSampler,
-    origins: &mut VertexOrigins,
-    bsdf: &BSDF,
-    lambda: &SampledWavelengths,
-    u: Float,
-    u_light: Point2f,
-) -> SampledSpectrum {
-    let si = origins.si;
-    let mut ctx = LightSampleContext::from_si(si);
-    let flags = bsdf.flags();
-    if flags.is_reflective() && !flags.is_transmissive() {
-        ctx.pi = Point3fi::from(origins.toward(si.wo));
-    } else if flags.is_transmissive() && !flags.is_reflective() {
-        ctx.pi = Point3fi::from(origins.toward(-si.wo));
-    }
-    let sampled = light_sampler.sample(&ctx, u);
-    let Some(sampled) = sampled else {
-        return SampledSpectrum::new(0.0);
-    };
-    if let Some(Some(cull)) = scene.light_cull.get(sampled.light as usize) {
-        // Samples of this light would be discarded below (zero emission
-        // toward the point, or a zero BSDF): skip taking them.
-        let p = ctx.p();
-        if cull.faces_away_from(p) {
-            return SampledSpectrum::new(0.0);
-        }
-        if bsdf.bxdf.zero_across_hemispheres() {
-            let z = bsdf.shading_frame.z;
-            if cull.behind(p, z, dot(si.wo, z)) {
-                return SampledSpectrum::new(0.0);
-            }
-        }
-    }
-    let light = &scene.lights[sampled.light as usize];
-    let Some(ls) = light.sample_li(&ctx, u_light, lambda, true) else {
-        return SampledSpectrum::new(0.0);
-    };
-    if ls.l.is_black() || ls.pdf == 0.0 {
-        return SampledSpectrum::new(0.0);
-    }
-    let wo = si.wo;
-    let wi = ls.wi;
-    let f = bsdf.f(wo, wi, crate::bxdf::TransportMode::Radiance) * abs_dot(wi, si.shading.n);
-    if f.is_black() || !scene.unoccluded_from(origins, ls.p_light, ls.n_light) {
-        return SampledSpectrum::new(0.0);
-    }
-    let p_l = sampled.p * ls.pdf;
-    if light.light_type().is_delta() {
-        return ls.l * f / p_l;
-    }
-    let p_b = bsdf.pdf(
-        wo,
-        wi,
-        crate::bxdf::TransportMode::Radiance,
-        crate::bxdf::BxDFReflTransFlags::ALL,
-    );
-    let w_l = crate::sampling::power_heuristic(1.0, p_l, 1.0, p_b);
-    ls.l * f * (w_l / p_l)
 }

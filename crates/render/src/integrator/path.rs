@@ -2,7 +2,7 @@
 //! estimation with multiple importance sampling, Russian roulette and
 //! optional BSDF regularization.
 
-use super::{sample_ld, skip_intersection, Scene, VertexOrigins};
+use super::{sample_ld, skip_intersection, RayIntegrator, Scene, VertexOrigins};
 use crate::bxdf::{BxDFReflTransFlags, TransportMode};
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
@@ -13,6 +13,53 @@ use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::ray::RayDifferential;
 use rpbrt_geometry::tuple::*;
+
+/// The state of a path being traced: the locals of pbrt-v4's
+/// `PathIntegrator::Li` (and the path fields of its wavefront
+/// `RayWorkItem`), updated at every vertex.
+pub(crate) struct PathState {
+    /// The ray leaving the last vertex (the camera ray at first).
+    pub(crate) ray: RayDifferential,
+    /// The radiance gathered so far.
+    pub(crate) l: SampledSpectrum,
+    /// The path throughput: the product of BSDF values and cosines over
+    /// sampling probabilities, and Russian roulette's weights.
+    pub(crate) beta: SampledSpectrum,
+    /// Scattering events so far.
+    pub(crate) depth: i32,
+    /// The BSDF sampling density of the last bounce's direction, for MIS
+    /// weights of emission the ray hits.
+    pub(crate) p_b: Float,
+    /// The product of the squared relative indices of refraction crossed,
+    /// taken out of `beta` for Russian roulette.
+    pub(crate) eta_scale: Float,
+    /// The last bounce was specular (or passed through an interface): hit
+    /// emission is not MIS-weighted against light sampling.
+    pub(crate) specular_bounce: bool,
+    /// Some bounce so far was not specular (for BSDF regularization).
+    pub(crate) any_non_specular: bool,
+    /// The last scattering vertex, for the light sampler's MIS density of
+    /// emission the ray hits.
+    pub(crate) prev_ctx: LightSampleContext,
+}
+
+impl PathState {
+    /// The state of a path starting with a camera ray.
+    #[inline(always)]
+    pub(crate) fn new(ray: RayDifferential) -> Self {
+        PathState {
+            ray,
+            l: SampledSpectrum::new(0.0),
+            beta: SampledSpectrum::new(1.0),
+            depth: 0,
+            p_b: 1.0,
+            eta_scale: 1.0,
+            specular_bounce: false,
+            any_non_specular: false,
+            prev_ctx: LightSampleContext::default(),
+        }
+    }
+}
 
 /// pbrt-v4's `path` integrator.
 #[derive(Clone, Debug)]
@@ -25,9 +72,8 @@ pub struct PathIntegrator {
     pub regularize: bool,
 }
 
-impl PathIntegrator {
-    /// The radiance arriving along `ray`.
-    pub fn li(
+impl RayIntegrator for PathIntegrator {
+    fn li(
         &self,
         scene: &Scene,
         ray: RayDifferential,
@@ -36,71 +82,63 @@ impl PathIntegrator {
         mut visible: Option<&mut VisibleSurface>,
     ) -> SampledSpectrum {
         let light_sampler: &LightSampler = &scene.light_sampler;
-        let mut ray = ray;
-        let mut l = SampledSpectrum::new(0.0);
-        let mut beta = SampledSpectrum::new(1.0);
-        let mut depth = 0;
-        let mut p_b: Float = 1.0;
-        let mut eta_scale: Float = 1.0;
-        let mut specular_bounce = false;
-        let mut any_non_specular = false;
-        let mut prev_ctx = LightSampleContext::default();
+        let mut s = PathState::new(ray);
         loop {
             // Matched by reference: moving the (large) intersection out of
             // the `Option` would copy it.
-            let mut closest = scene.intersect(&ray.ray, Float::INFINITY);
+            let mut closest = scene.intersect(&s.ray.ray, Float::INFINITY);
             let Some(hit) = closest.as_mut() else {
                 // Escaped: infinite lights, weighted by MIS unless the last
                 // bounce could not have been light-sampled.
                 for &li in &scene.infinite_lights {
                     let light = &scene.lights[li as usize];
-                    let le = light.le(&ray.ray, lambda);
+                    let le = light.le(&s.ray.ray, lambda);
                     if le.is_black() {
                         continue;
                     }
-                    if depth == 0 || specular_bounce {
-                        l += beta * le;
+                    if s.depth == 0 || s.specular_bounce {
+                        s.l += s.beta * le;
                     } else {
-                        let p_l = light_sampler.pmf(&prev_ctx, li)
-                            * light.pdf_li(&prev_ctx, ray.ray.d, true);
-                        let w_b = power_heuristic(1.0, p_b, 1.0, p_l);
-                        l += beta * le * w_b;
+                        let p_l = light_sampler.pmf(&s.prev_ctx, li)
+                            * light.pdf_li(&s.prev_ctx, s.ray.ray.d, true);
+                        let w_b = power_heuristic(1.0, s.p_b, 1.0, p_l);
+                        s.l += s.beta * le * w_b;
                     }
                 }
                 break;
             };
             // Emission from an area light that was hit.
-            let le = scene.le(hit, -ray.ray.d, lambda);
+            let le = scene.le(hit, -s.ray.ray.d, lambda);
             if !le.is_black() {
-                if depth == 0 || specular_bounce {
-                    l += beta * le;
+                if s.depth == 0 || s.specular_bounce {
+                    s.l += s.beta * le;
                 } else if let Some(al) = hit.area_light {
                     let light = &scene.lights[al as usize];
-                    let p_l =
-                        light_sampler.pmf(&prev_ctx, al) * light.pdf_li(&prev_ctx, ray.ray.d, true);
-                    let w_l = power_heuristic(1.0, p_b, 1.0, p_l);
-                    l += beta * le * w_l;
+                    let p_l = light_sampler.pmf(&s.prev_ctx, al)
+                        * light.pdf_li(&s.prev_ctx, s.ray.ray.d, true);
+                    let w_l = power_heuristic(1.0, s.p_b, 1.0, p_l);
+                    s.l += s.beta * le * w_l;
                 }
             }
             // Borrowed in place: moving the (large) BSDF out would copy it.
-            let mut bsdf_slot = scene.get_bsdf(hit, &ray, lambda, sampler);
+            let mut bsdf_slot = scene.get_bsdf(hit, &s.ray, lambda, sampler);
             let Some(bsdf) = bsdf_slot.as_mut() else {
-                specular_bounce = true;
-                ray = skip_intersection(&ray, hit);
+                s.specular_bounce = true;
+                s.ray = skip_intersection(&s.ray, hit);
                 continue;
             };
-            if depth == 0 {
+            if s.depth == 0 {
                 if let Some(v) = visible.take() {
                     *v = scene.visible_surface(hit, bsdf);
                 }
             }
-            if self.regularize && any_non_specular {
+            if self.regularize && s.any_non_specular {
                 bsdf.regularize();
             }
-            if depth == self.max_depth {
+            if s.depth == self.max_depth {
                 break;
             }
-            depth += 1;
+            s.depth += 1;
             let si = &hit.si;
             let mut origins = VertexOrigins::new(si);
             // Sampler draws in pbrt-v4's order: the light's two, then the
@@ -116,43 +154,43 @@ impl PathIntegrator {
                     u_light,
                     u_light_2d,
                 );
-                l += beta * ld;
+                s.l += s.beta * ld;
                 (u, u2)
             } else {
                 (sampler.get_1d(), sampler.get_2d())
             };
-            prev_ctx = LightSampleContext::from_si(si);
-            let wo = -ray.ray.d;
+            s.prev_ctx = LightSampleContext::from_si(si);
+            let wo = -s.ray.ray.d;
             let Some(bs) =
                 bsdf.sample_f(wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL)
             else {
                 break;
             };
-            beta *= bs.f * (abs_dot(bs.wi, si.shading.n) / bs.pdf);
-            p_b = if bs.pdf_is_proportional {
+            s.beta *= bs.f * (abs_dot(bs.wi, si.shading.n) / bs.pdf);
+            s.p_b = if bs.pdf_is_proportional {
                 bsdf.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL)
             } else {
                 bs.pdf
             };
-            specular_bounce = bs.is_specular();
-            any_non_specular |= !bs.is_specular();
+            s.specular_bounce = bs.is_specular();
+            s.any_non_specular |= !bs.is_specular();
             if bs.is_transmission() {
-                eta_scale *= bs.eta * bs.eta;
+                s.eta_scale *= bs.eta * bs.eta;
             }
-            ray = RayDifferential::new(origins.spawn_ray(bs.wi));
-            let rr_beta = beta * eta_scale;
+            s.ray = RayDifferential::new(origins.spawn_ray(bs.wi));
+            let rr_beta = s.beta * s.eta_scale;
             let m = rr_beta.max_component_value();
-            if m < 1.0 && depth > 1 {
+            if m < 1.0 && s.depth > 1 {
                 let q = (1.0 - m).max(0.0);
                 if sampler.get_1d() < q {
                     break;
                 }
-                beta /= 1.0 - q;
+                s.beta /= 1.0 - q;
             }
-            if beta.is_black() {
+            if s.beta.is_black() {
                 break;
             }
         }
-        l
+        s.l
     }
 }

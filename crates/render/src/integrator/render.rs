@@ -1,21 +1,10 @@
-//! The parallel render loop (pbrt-v4 `ImageTileIntegrator::Render` and
-//! `RayIntegrator::EvaluatePixelSample`): image tiles rendered in parallel,
-//! samples taken in waves: pbrt-v4's doubling waves when partial images or
-//! per-wave MSE are asked for, otherwise one sample per pixel and then the
-//! rest. A thread draws the progress bar while a wave runs, and Ctrl-C is
-//! checked at every pixel.
+//! What every render loop shares (pbrt-v4 `Integrator::Render`'s contract,
+//! `cpu/integrators.h`): the options a render runs under, the statistics it
+//! returns, its typed errors, and progress reported to a caller-supplied
+//! callback. The library never writes to the terminal: the command line
+//! draws the progress bar from [`Progress`] reports.
 
-use super::{Integrator, Scene};
-use crate::camera::CameraSample;
-use crate::film::{FilmTile, VisibleSurface};
-use crate::image::ImageMetadata;
-use crate::sampler::Sampler;
-use rayon::prelude::*;
-use rpbrt_geometry::bounds::Bounds2i;
-use rpbrt_geometry::float::Float;
-use rpbrt_geometry::ray::RayDifferential;
-use rpbrt_geometry::tuple::*;
-use std::io::{IsTerminal, Write};
+use crate::image::ImageError;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -25,8 +14,6 @@ use std::time::{Duration, Instant};
 pub struct RenderOptions {
     /// Worker threads (0: all cores).
     pub nthreads: usize,
-    /// No progress bar.
-    pub quiet: bool,
     /// Write the image after every wave of samples.
     pub write_partial_images: bool,
     /// Sample pixel centres only.
@@ -39,6 +26,16 @@ pub struct RenderOptions {
     /// `--mse-reference-image`: after every wave of samples, the image's
     /// MSE against this reference is recorded.
     pub mse_reference: Option<crate::image::Image>,
+}
+
+impl RenderOptions {
+    /// True once the interrupt flag is set.
+    #[inline]
+    pub(crate) fn interrupted(&self) -> bool {
+        self.interrupt
+            .as_ref()
+            .is_some_and(|f| f.load(Ordering::Relaxed))
+    }
 }
 
 /// What a render measured (for `--stats`).
@@ -55,322 +52,112 @@ pub struct RenderStats {
     pub mse_per_wave: Vec<(i32, f64)>,
 }
 
-/// Side of the square tiles the image is split into.
-const TILE_SIZE: i32 = 16;
-
-fn tiles(bounds: Bounds2i) -> Vec<Bounds2i> {
-    let mut out = Vec::new();
-    let mut y = bounds.p_min.y;
-    while y < bounds.p_max.y {
-        let mut x = bounds.p_min.x;
-        while x < bounds.p_max.x {
-            out.push(Bounds2i::new(
-                Point2i::new(x, y),
-                Point2i::new(
-                    (x + TILE_SIZE).min(bounds.p_max.x),
-                    (y + TILE_SIZE).min(bounds.p_max.y),
-                ),
-            ));
-            x += TILE_SIZE;
-        }
-        y += TILE_SIZE;
-    }
-    out
+/// How far a render has come, reported to the caller's progress callback.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Progress {
+    /// Units of work done (camera samples, for the per-ray integrators).
+    pub done: u64,
+    /// Units of work in the whole render.
+    pub total: u64,
+    /// Time since the render started.
+    pub elapsed: Duration,
 }
 
-/// One camera sample through one pixel (pbrt-v4 `EvaluatePixelSample`).
-fn evaluate_pixel_sample(
-    scene: &Scene,
-    integrator: &Integrator,
-    opts: &RenderOptions,
-    p_pixel: Point2i,
-    sampler: &mut Sampler,
-    tile: &mut FilmTile,
-    differentials: bool,
-) {
-    let (mut lu, u_pixel, time, p_lens) = sampler.get_camera_samples();
-    if opts.disable_wavelength_jitter {
-        lu = 0.5;
+/// Why a render failed.
+#[derive(Debug)]
+#[non_exhaustive]
+pub enum RenderError {
+    /// The worker thread pool could not be started.
+    ThreadPool(rayon::ThreadPoolBuildError),
+    /// The image could not be compared with the MSE reference image (a
+    /// different resolution or channels).
+    MseReference(ImageError),
+    /// The (partial or final) image could not be written.
+    WriteImage {
+        /// The file.
+        path: String,
+        /// Why.
+        source: ImageError,
+    },
+}
+
+impl std::fmt::Display for RenderError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RenderError::ThreadPool(e) => write!(f, "cannot start worker threads: {e}"),
+            RenderError::MseReference(e) => write!(f, "--mse-reference-image: {e}"),
+            // The image errors that name a file name this one.
+            RenderError::WriteImage { path, source } => match source {
+                ImageError::Io { .. } | ImageError::Format { .. } => write!(f, "{source}"),
+                ImageError::Invalid(m) => write!(f, "{path}: {m}"),
+            },
+        }
     }
-    let mut lambda = scene.film.sample_wavelengths(lu);
-    let mut fs = scene.filter.sample(u_pixel);
-    if opts.disable_pixel_jitter {
-        fs.p = Point2f::new(0.0, 0.0);
-        fs.weight = 1.0;
+}
+
+impl std::error::Error for RenderError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            RenderError::ThreadPool(e) => Some(e),
+            RenderError::MseReference(e) => Some(e),
+            RenderError::WriteImage { source, .. } => Some(source),
+        }
     }
-    let cs = CameraSample {
-        p_film: Point2f::new(
-            p_pixel.x as Float + fs.p.x + 0.5,
-            p_pixel.y as Float + fs.p.y + 0.5,
-        ),
-        p_lens,
-        time,
-        filter_weight: fs.weight,
-    };
-    let mut l = crate::spectrum::SampledSpectrum::new(0.0);
-    // Only G-buffer films record the first visible surface.
-    let mut visible: Option<VisibleSurface> = if scene.film.uses_visible_surface() {
-        Some(VisibleSurface::default())
-    } else {
-        None
-    };
-    let camera_ray = if differentials {
-        scene.camera.generate_ray_differential(&cs).map(|mut cr| {
-            if !opts.disable_pixel_jitter {
-                let scale = (1.0 / (sampler.samples_per_pixel() as Float).sqrt()).max(0.125);
-                cr.ray.scale_differentials(scale);
-            }
-            (cr.ray, cr.weight)
+}
+
+/// The progress callback's type: called from a reporting thread, so `Sync`.
+pub type ProgressFn<'a> = &'a (dyn Fn(Progress) + Sync);
+
+/// How often the reporting thread calls the progress callback.
+const PROGRESS_INTERVAL: Duration = Duration::from_millis(250);
+
+/// Runs `work` while a thread reports its progress to `progress` every
+/// [`PROGRESS_INTERVAL`] (from the start) and once more after it returns.
+/// `work` counts the units it finishes in the counter it is given, out of
+/// `total`; the last report has the count it reached (`total` unless it
+/// stopped early). Any render loop can use it: the tile loop counts camera
+/// samples, a loop of its own counts its own units.
+pub(crate) fn with_progress<R>(
+    total: u64,
+    start: Instant,
+    progress: ProgressFn,
+    work: impl FnOnce(&AtomicU64) -> R,
+) -> R {
+    let done = AtomicU64::new(0);
+    let running = AtomicBool::new(true);
+    let report = |done: &AtomicU64| {
+        progress(Progress {
+            done: done.load(Ordering::Relaxed),
+            total,
+            elapsed: start.elapsed(),
         })
-    } else {
-        // Nothing reads them: the same main ray without its offset rays.
-        scene
-            .camera
-            .generate_ray(&cs)
-            .map(|cr| (RayDifferential::new(cr.ray), cr.weight))
     };
-    if let Some((ray, weight)) = camera_ray {
-        l = integrator.li(scene, ray, &mut lambda, sampler, visible.as_mut()) * weight;
-        if l.has_nan() || !l.y(&lambda).is_finite() {
-            // pbrt-v4 drops such samples (and logs them).
-            l = crate::spectrum::SampledSpectrum::new(0.0);
-        }
-    }
-    tile.add_sample(
-        p_pixel,
-        l,
-        &lambda,
-        visible.as_ref().filter(|v| v.set),
-        cs.filter_weight,
-    );
-}
-
-/// The samples of the wave after `[start, end)`: pbrt-v4's schedule,
-/// doubling waves of at most 64 samples, when something happens between
-/// waves (partial images, MSE against a reference); otherwise everything
-/// left in one wave. A wave revisits every pixel, and the Z-Sobol sampler's
-/// caches start over on each pixel it moves to, so fewer waves are faster;
-/// the first wave of one sample per pixel is kept either way, so that an
-/// interrupted render has every pixel.
-fn next_wave(end: i32, wave_size: i32, spp: i32, progressive: bool) -> (i32, i32) {
-    if progressive {
-        ((end + wave_size).min(spp), (2 * wave_size).min(64))
-    } else {
-        (spp, wave_size)
-    }
-}
-
-/// The progress bar line for `done` of `total` samples after `elapsed`
-/// seconds.
-fn progress_line(done: u64, total: u64, elapsed: f64) -> String {
-    let frac = done as f64 / total.max(1) as f64;
-    let eta = if frac > 0.0 {
-        elapsed / frac - elapsed
-    } else {
-        0.0
-    };
-    let width = 40;
-    let filled = ((frac * width as f64) as usize).min(width);
-    format!(
-        "\r[{}{}] {:5.1}% {:.1}s elapsed, ETA {:.1}s ",
-        "+".repeat(filled),
-        " ".repeat(width - filled),
-        frac * 100.0,
-        elapsed,
-        eta
-    )
-}
-
-/// Renders `scene` with `integrator`, writing the film's image (and partial
-/// images when asked). `metadata` is completed with timing and sample
-/// counts.
-pub fn render(
-    scene: &mut Scene,
-    integrator: &Integrator,
-    opts: &RenderOptions,
-    metadata: &mut ImageMetadata,
-) -> Result<RenderStats, String> {
-    let start = Instant::now();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.nthreads)
-        .build()
-        .map_err(|e| format!("cannot start worker threads: {e}"))?;
-    let spp = scene.sampler.samples_per_pixel().max(1);
-    let pixel_bounds = scene.film.pixel_bounds();
-    let tile_list = tiles(pixel_bounds);
-    let pixels = pixel_bounds.area().max(0) as u64;
-    let total = pixels * spp as u64;
-    let show_progress = !opts.quiet && std::io::stderr().is_terminal();
-    // Camera rays carry differentials only when something reads them:
-    // texture filtering or bump mapping, or a G-buffer film's depth slopes.
-    let differentials =
-        scene.film.uses_visible_surface() || scene.materials.any_needs_differentials();
-    let progressive = opts.write_partial_images || opts.mse_reference.is_some();
-    let interrupt_set = || {
-        opts.interrupt
-            .as_ref()
-            .is_some_and(|f| f.load(Ordering::Relaxed))
-    };
-    // Samples taken so far, counted by the tiles as they finish (the
-    // progress bar reads it while a wave runs).
-    let samples_done = AtomicU64::new(0);
-    let rendering = AtomicBool::new(true);
-    let mut wave_start = 0;
-    let mut wave_end = 1;
-    let mut next_wave_size = 1;
-    let mut interrupted = false;
-    let mut mse_per_wave = Vec::new();
-    let result = std::thread::scope(|threads| -> Result<(), String> {
-        let reporter = if show_progress {
-            let (samples_done, rendering) = (&samples_done, &rendering);
-            Some(threads.spawn(move || {
-                while rendering.load(Ordering::Relaxed) {
-                    let line = progress_line(
-                        samples_done.load(Ordering::Relaxed),
-                        total,
-                        start.elapsed().as_secs_f64(),
-                    );
-                    eprint!("{line}");
-                    let _ = std::io::stderr().flush();
-                    // Woken early when the render ends.
-                    std::thread::park_timeout(Duration::from_millis(250));
-                }
-            }))
-        } else {
-            None
-        };
-        let outcome = (|| {
-            while wave_start < spp {
-                let results: Vec<FilmTile> = {
-                    let scene_ref: &Scene = scene;
-                    let samples_done = &samples_done;
-                    pool.install(|| {
-                        tile_list
-                            .par_iter()
-                            .map(|&b| {
-                                let mut tile = scene_ref.film.make_tile(b);
-                                let mut sampler = scene_ref.sampler.clone();
-                                super::RayCounters::reset_local();
-                                let mut camera_rays = 0u64;
-                                for p in b.iter() {
-                                    // Checked per pixel: a wave can be the
-                                    // whole render.
-                                    if interrupt_set() {
-                                        break;
-                                    }
-                                    for s in wave_start..wave_end {
-                                        sampler.start_pixel_sample(p, s, 0);
-                                        evaluate_pixel_sample(
-                                            scene_ref,
-                                            integrator,
-                                            opts,
-                                            p,
-                                            &mut sampler,
-                                            &mut tile,
-                                            differentials,
-                                        );
-                                    }
-                                    camera_rays += (wave_end - wave_start) as u64;
-                                }
-                                scene_ref.counters.flush_local();
-                                scene_ref
-                                    .counters
-                                    .camera_rays
-                                    .fetch_add(camera_rays, Ordering::Relaxed);
-                                samples_done.fetch_add(camera_rays, Ordering::Relaxed);
-                                tile
-                            })
-                            .collect()
-                    })
-                };
-                for t in results {
-                    scene.film.merge_tile(&t);
-                }
-                if interrupt_set() {
-                    interrupted = true;
-                    break;
-                }
-                wave_start = wave_end;
-                (wave_end, next_wave_size) = next_wave(wave_end, next_wave_size, spp, progressive);
-                if let Some(reference) = &opts.mse_reference {
-                    let mut md = ImageMetadata::default();
-                    let image = scene.film.get_image(&mut md, 1.0);
-                    let d = crate::image::ops::diff(&image, reference)
-                        .map_err(|e| format!("--mse-reference-image: {e}"))?;
-                    mse_per_wave.push((wave_start, d.mse));
-                }
-                if opts.write_partial_images && wave_start < spp {
-                    metadata.render_time_seconds = Some(start.elapsed().as_secs_f32());
-                    metadata.samples_per_pixel = Some(wave_start);
-                    scene.film.write_image(metadata, 1.0)?;
-                }
+    let result = std::thread::scope(|threads| {
+        let reporter = threads.spawn(|| {
+            while running.load(Ordering::Relaxed) {
+                report(&done);
+                // Woken early when the work ends.
+                std::thread::park_timeout(PROGRESS_INTERVAL);
             }
-            Ok(())
-        })();
-        rendering.store(false, Ordering::Relaxed);
-        if let Some(r) = reporter {
-            r.thread().unpark();
-        }
-        outcome
+        });
+        let result = work(&done);
+        running.store(false, Ordering::Relaxed);
+        reporter.thread().unpark();
+        result
     });
-    result?;
-    let done = samples_done.load(Ordering::Relaxed);
-    if show_progress {
-        eprintln!(
-            "{}",
-            progress_line(done, total, start.elapsed().as_secs_f64())
-        );
-    }
-    let render_time = start.elapsed();
-    metadata.render_time_seconds = Some(render_time.as_secs_f32());
-    // Every pixel has at least the samples of the completed waves.
-    metadata.samples_per_pixel = Some(wave_start);
-    if let Some(&(_, mse)) = mse_per_wave.last() {
-        metadata.mse = Some(mse as f32);
-    }
-    scene.film.write_image(metadata, 1.0)?;
-    Ok(RenderStats {
-        render_time,
-        samples: done,
-        interrupted,
-        mse_per_wave,
-    })
+    // After the reporter has ended: this report is the last.
+    report(&done);
+    result
 }
 
-#[cfg(test)]
-mod tests {
-    use super::next_wave;
-
-    /// The waves as `[start, end)` ranges for `spp` samples per pixel.
-    fn waves(spp: i32, progressive: bool) -> Vec<(i32, i32)> {
-        let (mut start, mut end, mut size) = (0, 1, 1);
-        let mut out = Vec::new();
-        while start < spp {
-            out.push((start, end));
-            start = end;
-            (end, size) = next_wave(end, size, spp, progressive);
-        }
-        out
-    }
-
-    #[test]
-    fn progressive_waves_double_as_in_pbrt_v4() {
-        assert_eq!(
-            waves(64, true),
-            [(0, 1), (1, 2), (2, 4), (4, 8), (8, 16), (16, 32), (32, 64)]
-        );
-        // At most 64 samples a wave.
-        let w = waves(300, true);
-        assert!(w.iter().all(|&(a, b)| b - a <= 64));
-        assert_eq!(w.last(), Some(&(256, 300)));
-        assert_eq!(waves(1, true), [(0, 1)]);
-    }
-
-    #[test]
-    fn other_renders_take_one_sample_then_the_rest() {
-        assert_eq!(waves(64, false), [(0, 1), (1, 64)]);
-        assert_eq!(waves(1000, false), [(0, 1), (1, 1000)]);
-        assert_eq!(waves(1, false), [(0, 1)]);
-        assert_eq!(waves(2, false), [(0, 1), (1, 2)]);
-    }
+/// Writes the film's image to its file (pbrt-v4 `Film::WriteImage`).
+pub(crate) fn write_film(
+    film: &crate::film::Film,
+    metadata: &crate::image::ImageMetadata,
+) -> Result<(), RenderError> {
+    film.write_image(metadata, 1.0)
+        .map_err(|source| RenderError::WriteImage {
+            path: film.filename().to_string(),
+            source,
+        })
 }

@@ -2,8 +2,9 @@
 //! `AOIntegrator`, `RandomWalkIntegrator`; book sections 13.1–13.3): useful
 //! as references for the path tracer and for debugging scenes.
 
-use super::{skip_intersection, Scene};
+use super::{skip_intersection, RayIntegrator, Scene};
 use crate::bxdf::{BxDFReflTransFlags, TransportMode};
+use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
 use crate::sampler::Sampler;
 use crate::sampling::*;
@@ -25,14 +26,15 @@ pub struct SimplePathIntegrator {
     pub sample_bsdf: bool,
 }
 
-impl SimplePathIntegrator {
+impl RayIntegrator for SimplePathIntegrator {
     /// The radiance arriving along `ray`.
-    pub fn li(
+    fn li(
         &self,
         scene: &Scene,
         ray: RayDifferential,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
+        _visible: Option<&mut VisibleSurface>,
     ) -> SampledSpectrum {
         let mut ray = ray;
         let mut l = SampledSpectrum::new(0.0);
@@ -129,14 +131,15 @@ pub struct AmbientOcclusionIntegrator {
     pub max_distance: Float,
 }
 
-impl AmbientOcclusionIntegrator {
+impl RayIntegrator for AmbientOcclusionIntegrator {
     /// The AO estimate along `ray`.
-    pub fn li(
+    fn li(
         &self,
         scene: &Scene,
         ray: RayDifferential,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
+        _visible: Option<&mut VisibleSurface>,
     ) -> SampledSpectrum {
         let mut ray = ray;
         // Interfaces are skipped; bound the number of them.
@@ -188,14 +191,15 @@ pub struct RandomWalkIntegrator {
     pub max_depth: i32,
 }
 
-impl RandomWalkIntegrator {
+impl RayIntegrator for RandomWalkIntegrator {
     /// The radiance arriving along `ray`.
-    pub fn li(
+    fn li(
         &self,
         scene: &Scene,
         ray: RayDifferential,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
+        _visible: Option<&mut VisibleSurface>,
     ) -> SampledSpectrum {
         let mut ray = ray;
         let mut l = SampledSpectrum::new(0.0);

@@ -243,6 +243,34 @@ enum Closest {
     },
 }
 
+/// A ray's closest hit in an aggregate, before its interaction is built
+/// (the first of the two steps of [`PrimitiveAggregate::intersect`]; the
+/// second is [`PrimitiveAggregate::interaction`]): small and `Copy`, so
+/// that a batch of rays can be intersected first and shaded later.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HitRecord {
+    /// The primitive hit, an index into [`PrimitiveAggregate::primitives`].
+    pub primitive: u32,
+    /// The ray parameter of the hit.
+    pub t_hit: Float,
+    /// What builds the interaction.
+    kind: HitKind,
+}
+
+/// How [`PrimitiveAggregate::interaction`] builds a hit's interaction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum HitKind {
+    /// An opaque triangle's barycentrics.
+    Triangle(Float, Float, Float),
+    /// Another primitive, hit by its own test with this bound on the ray
+    /// parameter: the test is deterministic, so testing again with the
+    /// same bound gives the same interaction.
+    Other {
+        /// The bound the hit was found with.
+        t_max: Float,
+    },
+}
+
 /// Primitives under an acceleration structure (pbrt-v4's aggregates).
 #[derive(Clone, Debug)]
 pub struct PrimitiveAggregate {
@@ -326,7 +354,10 @@ impl PrimitiveAggregate {
     /// Opaque triangles (nearly all primitives in practice) are tested
     /// without building their surface interaction; only the closest hit's
     /// is built, at the end. The result is the same as building every
-    /// hit's, as pbrt-v4 does.
+    /// hit's, as pbrt-v4 does, and the same as the two steps
+    /// [`PrimitiveAggregate::intersect_record`] and
+    /// [`PrimitiveAggregate::interaction`] (fused here: a non-triangle's
+    /// interaction is kept from its test rather than built again).
     pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
         let mut closest = Closest::None;
         let tr = TriangleRay::new(ray);
@@ -351,33 +382,95 @@ impl PrimitiveAggregate {
         match closest {
             Closest::None => None,
             Closest::Full(pi) => Some(pi),
-            Closest::Triangle { prim, b, t_hit } => match &self.prims[prim as usize] {
-                Primitive::Geometric(g) => match &g.shape {
-                    Shape::Triangle(tri) => Some(PrimitiveIntersection {
-                        // One construction path (not a `match` between two
-                        // calls), so that the interaction is built in place
-                        // instead of copied.
-                        si: tri.interaction_at_hit_with_frame(
-                            &self
-                                .triangle_frames
-                                .get(prim as usize)
-                                .copied()
-                                .unwrap_or_else(|| tri.frame()),
-                            b.0,
-                            b.1,
-                            b.2,
-                            ray,
-                        ),
+            Closest::Triangle { prim, b, t_hit } => self.triangle_interaction(prim, b, t_hit, ray),
+        }
+    }
+
+    /// The closest hit in (0, t_max) without its interaction (the first
+    /// step of [`PrimitiveAggregate::intersect`]; the same primitives are
+    /// tested in the same order, so the hit is the one it finds).
+    pub fn intersect_record(&self, ray: &Ray, t_max: Float) -> Option<HitRecord> {
+        let mut closest = None;
+        let tr = TriangleRay::new(ray);
+        self.accel.intersect(
+            ray,
+            t_max,
+            #[inline(always)]
+            |i, _, t| {
+                if let Some(Some([p0, p1, p2])) = self.triangle_vertices.get(i as usize) {
+                    let (p0, p1, p2) = (*p0, *p1, *p2);
+                    let (b0, b1, b2, t_hit) = intersect_prepared_triangle(&tr, t, p0, p1, p2)?;
+                    closest = Some(HitRecord {
+                        primitive: i,
                         t_hit,
-                        material: g.material,
-                        area_light: g.area_light,
-                        medium_interface: g.medium_interface,
-                    }),
-                    // `triangle_vertices` holds only triangles.
-                    _ => None,
-                },
+                        kind: HitKind::Triangle(b0, b1, b2),
+                    });
+                    return Some(t_hit);
+                }
+                let t_hit = self.prims[i as usize].intersect(ray, t)?.t_hit;
+                closest = Some(HitRecord {
+                    primitive: i,
+                    t_hit,
+                    kind: HitKind::Other { t_max: t },
+                });
+                Some(t_hit)
+            },
+        );
+        closest
+    }
+
+    /// The interaction of a hit that [`PrimitiveAggregate::intersect_record`]
+    /// found for the same ray (the second step of
+    /// [`PrimitiveAggregate::intersect`]): bit for bit the one `intersect`
+    /// returns. `None` only for a record of another aggregate.
+    pub fn interaction(&self, ray: &Ray, hit: &HitRecord) -> Option<PrimitiveIntersection> {
+        if hit.primitive as usize >= self.prims.len() {
+            return None;
+        }
+        match hit.kind {
+            HitKind::Triangle(b0, b1, b2) => {
+                self.triangle_interaction(hit.primitive, (b0, b1, b2), hit.t_hit, ray)
+            }
+            HitKind::Other { t_max } => self.prims[hit.primitive as usize].intersect(ray, t_max),
+        }
+    }
+
+    /// The interaction of a hit on the opaque triangle `prim` (one in
+    /// `triangle_vertices`) at barycentrics `b`.
+    #[inline(always)]
+    fn triangle_interaction(
+        &self,
+        prim: u32,
+        b: (Float, Float, Float),
+        t_hit: Float,
+        ray: &Ray,
+    ) -> Option<PrimitiveIntersection> {
+        match &self.prims[prim as usize] {
+            Primitive::Geometric(g) => match &g.shape {
+                Shape::Triangle(tri) => Some(PrimitiveIntersection {
+                    // One construction path (not a `match` between two
+                    // calls), so that the interaction is built in place
+                    // instead of copied.
+                    si: tri.interaction_at_hit_with_frame(
+                        &self
+                            .triangle_frames
+                            .get(prim as usize)
+                            .copied()
+                            .unwrap_or_else(|| tri.frame()),
+                        b.0,
+                        b.1,
+                        b.2,
+                        ray,
+                    ),
+                    t_hit,
+                    material: g.material,
+                    area_light: g.area_light,
+                    medium_interface: g.medium_interface,
+                }),
+                // `triangle_vertices` holds only triangles.
                 _ => None,
             },
+            _ => None,
         }
     }
 

@@ -201,3 +201,63 @@ fn a_medium_transition_has_different_media_on_its_sides() {
     assert!(mi(Some(1), None).is_transition());
     assert!(mi(Some(0), Some(2)).is_transition());
 }
+
+/// `intersect` is the two steps `intersect_record` and `interaction`
+/// composed, bit for bit: triangles, spheres, an instance and an
+/// alpha-masked sphere.
+#[test]
+fn intersect_is_record_then_interaction() {
+    let mut rng = Rng::new(7, 0);
+    let mut prims = random_triangles(&mut rng, 300, &Transform::identity());
+    prims.push(sphere_prim(
+        Transform::translate(Vector3f::new(1.0, 0.5, -1.0)),
+        1.2,
+    ));
+    prims.push(sphere_prim(
+        Transform::translate(Vector3f::new(-1.5, -1.0, 0.5)),
+        0.7,
+    ));
+    let inner = Arc::new(PrimitiveAggregate::new(
+        random_triangles(&mut rng, 50, &Transform::identity()),
+        &AccelParams::default(),
+    ));
+    prims.push(Primitive::Transformed(Box::new(TransformedPrimitive {
+        primitive: inner,
+        render_from_primitive: Transform::translate(Vector3f::new(0.0, 2.0, 2.0))
+            * Transform::scale(0.5, 0.5, 0.5),
+    })));
+    let Primitive::Geometric(mut masked) =
+        sphere_prim(Transform::translate(Vector3f::new(0.0, -2.0, -2.0)), 1.0)
+    else {
+        unreachable!()
+    };
+    masked.alpha = Alpha::Constant(0.5);
+    prims.push(Primitive::Geometric(masked));
+    let agg = PrimitiveAggregate::new(prims, &AccelParams::default());
+    let mut rng = Rng::new(8, 0);
+    let (mut triangles, mut others) = (0, 0);
+    for _ in 0..5000 {
+        let r = random_ray(&mut rng);
+        let t_max = if rng.uniform_float() < 0.2 {
+            12.0
+        } else {
+            Float::INFINITY
+        };
+        let fused = agg.intersect(&r, t_max);
+        let record = agg.intersect_record(&r, t_max);
+        let two_steps = record.and_then(|h| agg.interaction(&r, &h));
+        // Debug output shows every bit of the floats (and -0).
+        assert_eq!(format!("{fused:?}"), format!("{two_steps:?}"));
+        if let (Some(f), Some(h)) = (fused, record) {
+            assert_eq!(f.t_hit.to_bits(), h.t_hit.to_bits());
+            if matches!(h.kind, HitKind::Triangle(..)) {
+                triangles += 1;
+            } else {
+                others += 1;
+            }
+        } else {
+            assert!(record.is_none());
+        }
+    }
+    assert!(triangles > 500 && others > 200, "{triangles} {others}");
+}

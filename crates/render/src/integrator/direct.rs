@@ -1,0 +1,129 @@
+//! Direct lighting at a path vertex (pbrt-v4 `PathIntegrator::SampleLd`;
+//! book section 13.4.3): a light chosen by the light sampler, a point on it,
+//! and a shadow ray, weighted against BSDF sampling by multiple importance
+//! sampling; plus the vertex's cached offset ray origins the light sample,
+//! the shadow ray and the next bounce share.
+
+use super::Scene;
+use crate::bxdf::BSDF;
+use crate::light::LightSampleContext;
+use crate::lightsampler::LightSampler;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use rpbrt_geometry::float::Float;
+use rpbrt_geometry::interaction::SurfaceInteraction;
+use rpbrt_geometry::ray::Ray;
+use rpbrt_geometry::tuple::*;
+
+/// A path vertex's ray origins, offset off the surface toward either of
+/// its sides (pbrt-v4's `OffsetRayOrigin`), each computed at most once:
+/// the light sample's reference point, the shadow ray and the next bounce
+/// usually leave by the same side. The offset depends on the direction
+/// only through that side, so a cached origin is the one a fresh
+/// computation would give.
+pub(crate) struct VertexOrigins<'a> {
+    /// The surface point.
+    pub si: &'a SurfaceInteraction,
+    /// Origins for directions with `dot(w, n) ≥ 0` and `< 0` (or NaN
+    /// tests, which count as the first side, as in `offset_ray_origin`).
+    sides: [Option<Point3f>; 2],
+}
+
+impl<'a> VertexOrigins<'a> {
+    /// No origin computed yet.
+    #[inline]
+    pub fn new(si: &'a SurfaceInteraction) -> Self {
+        VertexOrigins {
+            si,
+            sides: [None, None],
+        }
+    }
+
+    /// `si.offset_ray_origin(w)`.
+    #[inline(always)]
+    pub fn toward(&mut self, w: Vector3f) -> Point3f {
+        // The test `offset_ray_origin` makes.
+        let side = (dot(w, self.si.n) < 0.0) as usize;
+        match self.sides[side] {
+            Some(p) => p,
+            None => {
+                let p = self.si.offset_ray_origin(w);
+                self.sides[side] = Some(p);
+                p
+            }
+        }
+    }
+
+    /// `si.spawn_ray(d)`.
+    #[inline]
+    pub fn spawn_ray(&mut self, d: Vector3f) -> Ray {
+        Ray::with_time(self.toward(d), d, self.si.time, None)
+    }
+}
+
+/// Samples direct lighting at a surface hit with multiple importance
+/// sampling (pbrt-v4 `PathIntegrator::SampleLd`), given its two sampler
+/// draws: `u` chooses the light and `u_light` the point on it. `origins`
+/// holds the vertex's offset ray origins (shared with the shadow ray and
+/// the next bounce).
+#[inline]
+pub(crate) fn sample_ld(
+    scene: &Scene,
+    light_sampler: &LightSampler,
+    origins: &mut VertexOrigins,
+    bsdf: &BSDF,
+    lambda: &SampledWavelengths,
+    u: Float,
+    u_light: Point2f,
+) -> SampledSpectrum {
+    let si = origins.si;
+    let mut ctx = LightSampleContext::from_si(si);
+    let flags = bsdf.flags();
+    if flags.is_reflective() && !flags.is_transmissive() {
+        ctx.pi = Point3fi::from(origins.toward(si.wo));
+    } else if flags.is_transmissive() && !flags.is_reflective() {
+        ctx.pi = Point3fi::from(origins.toward(-si.wo));
+    }
+    let sampled = light_sampler.sample(&ctx, u);
+    let Some(sampled) = sampled else {
+        return SampledSpectrum::new(0.0);
+    };
+    if let Some(Some(cull)) = scene.light_cull.get(sampled.light as usize) {
+        // Samples of this light would be discarded below (zero emission
+        // toward the point, or a zero BSDF): skip taking them.
+        let p = ctx.p();
+        if cull.faces_away_from(p) {
+            return SampledSpectrum::new(0.0);
+        }
+        if bsdf.bxdf.zero_across_hemispheres() {
+            let z = bsdf.shading_frame.z;
+            if cull.behind(p, z, dot(si.wo, z)) {
+                return SampledSpectrum::new(0.0);
+            }
+        }
+    }
+    let light = &scene.lights[sampled.light as usize];
+    let Some(ls) = light.sample_li(&ctx, u_light, lambda, true) else {
+        return SampledSpectrum::new(0.0);
+    };
+    if ls.l.is_black() || ls.pdf == 0.0 {
+        return SampledSpectrum::new(0.0);
+    }
+    let wo = si.wo;
+    let wi = ls.wi;
+    let f = bsdf.f(wo, wi, crate::bxdf::TransportMode::Radiance) * abs_dot(wi, si.shading.n);
+    if f.is_black() || !scene.unoccluded_from(origins, ls.p_light, ls.n_light) {
+        return SampledSpectrum::new(0.0);
+    }
+    let p_l = sampled.p * ls.pdf;
+    if light.light_type().is_delta() {
+        return ls.l * f / p_l;
+    }
+    let p_b = bsdf.pdf(
+        wo,
+        wi,
+        crate::bxdf::TransportMode::Radiance,
+        crate::bxdf::BxDFReflTransFlags::ALL,
+    );
+    let w_l = crate::sampling::power_heuristic(1.0, p_l, 1.0, p_b);
+    ls.l * f * (w_l / p_l)
+}

@@ -1,0 +1,301 @@
+//! The tile loop of the per-ray integrators (pbrt-v4 `ImageTileIntegrator::Render`
+//! and `RayIntegrator::EvaluatePixelSample`, `cpu/integrators.cpp`; book
+//! section 1.3.4): image tiles rendered in parallel, samples taken in waves:
+//! pbrt-v4's doubling waves when partial images or per-wave MSE are asked
+//! for, otherwise one sample per pixel and then the rest. Ctrl-C is checked
+//! at every pixel; progress is counted per tile.
+//!
+//! The loop is generic over the [`RayIntegrator`]: each integrator gets its
+//! own copy, with its radiance estimate called directly per sample.
+
+use super::render::{
+    with_progress, write_film, ProgressFn, RenderError, RenderOptions, RenderStats,
+};
+use super::Scene;
+use crate::camera::CameraSample;
+use crate::film::{FilmTile, VisibleSurface};
+use crate::image::ImageMetadata;
+use crate::sampler::Sampler;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use rayon::prelude::*;
+use rpbrt_geometry::bounds::Bounds2i;
+use rpbrt_geometry::float::Float;
+use rpbrt_geometry::ray::RayDifferential;
+use rpbrt_geometry::tuple::*;
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+
+/// An integrator that estimates the radiance along one camera ray at a
+/// time (pbrt-v4 `RayIntegrator`), rendered by [`render_tiles`].
+pub trait RayIntegrator: Sync {
+    /// The radiance arriving along `ray` for the sampled wavelengths
+    /// (pbrt-v4 `RayIntegrator::Li`). `visible`, when given, receives the
+    /// first visible surface (for G-buffer films); integrators that do not
+    /// record it leave it unset.
+    fn li(
+        &self,
+        scene: &Scene,
+        ray: RayDifferential,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+        visible: Option<&mut VisibleSurface>,
+    ) -> SampledSpectrum;
+}
+
+/// Side of the square tiles the image is split into.
+const TILE_SIZE: i32 = 16;
+
+fn tiles(bounds: Bounds2i) -> Vec<Bounds2i> {
+    let mut out = Vec::new();
+    let mut y = bounds.p_min.y;
+    while y < bounds.p_max.y {
+        let mut x = bounds.p_min.x;
+        while x < bounds.p_max.x {
+            out.push(Bounds2i::new(
+                Point2i::new(x, y),
+                Point2i::new(
+                    (x + TILE_SIZE).min(bounds.p_max.x),
+                    (y + TILE_SIZE).min(bounds.p_max.y),
+                ),
+            ));
+            x += TILE_SIZE;
+        }
+        y += TILE_SIZE;
+    }
+    out
+}
+
+/// One camera sample through one pixel (pbrt-v4 `EvaluatePixelSample`).
+fn evaluate_pixel_sample<I: RayIntegrator>(
+    scene: &Scene,
+    integrator: &I,
+    opts: &RenderOptions,
+    p_pixel: Point2i,
+    sampler: &mut Sampler,
+    tile: &mut FilmTile,
+    differentials: bool,
+) {
+    let (mut lu, u_pixel, time, p_lens) = sampler.get_camera_samples();
+    if opts.disable_wavelength_jitter {
+        lu = 0.5;
+    }
+    let mut lambda = scene.film.sample_wavelengths(lu);
+    let mut fs = scene.filter.sample(u_pixel);
+    if opts.disable_pixel_jitter {
+        fs.p = Point2f::new(0.0, 0.0);
+        fs.weight = 1.0;
+    }
+    let cs = CameraSample {
+        p_film: Point2f::new(
+            p_pixel.x as Float + fs.p.x + 0.5,
+            p_pixel.y as Float + fs.p.y + 0.5,
+        ),
+        p_lens,
+        time,
+        filter_weight: fs.weight,
+    };
+    let mut l = SampledSpectrum::new(0.0);
+    // Only G-buffer films record the first visible surface.
+    let mut visible: Option<VisibleSurface> = if scene.film.uses_visible_surface() {
+        Some(VisibleSurface::default())
+    } else {
+        None
+    };
+    let camera_ray = if differentials {
+        scene.camera.generate_ray_differential(&cs).map(|mut cr| {
+            if !opts.disable_pixel_jitter {
+                let scale = (1.0 / (sampler.samples_per_pixel() as Float).sqrt()).max(0.125);
+                cr.ray.scale_differentials(scale);
+            }
+            (cr.ray, cr.weight)
+        })
+    } else {
+        // Nothing reads them: the same main ray without its offset rays.
+        scene
+            .camera
+            .generate_ray(&cs)
+            .map(|cr| (RayDifferential::new(cr.ray), cr.weight))
+    };
+    if let Some((ray, weight)) = camera_ray {
+        l = integrator.li(scene, ray, &mut lambda, sampler, visible.as_mut()) * weight;
+        if l.has_nan() || !l.y(&lambda).is_finite() {
+            // pbrt-v4 drops such samples (and logs them).
+            l = SampledSpectrum::new(0.0);
+        }
+    }
+    tile.add_sample(
+        p_pixel,
+        l,
+        &lambda,
+        visible.as_ref().filter(|v| v.set),
+        cs.filter_weight,
+    );
+}
+
+/// The samples of the wave after `[start, end)`: pbrt-v4's schedule,
+/// doubling waves of at most 64 samples, when something happens between
+/// waves (partial images, MSE against a reference); otherwise everything
+/// left in one wave. A wave revisits every pixel, and the Z-Sobol sampler's
+/// caches start over on each pixel it moves to, so fewer waves are faster;
+/// the first wave of one sample per pixel is kept either way, so that an
+/// interrupted render has every pixel.
+fn next_wave(end: i32, wave_size: i32, spp: i32, progressive: bool) -> (i32, i32) {
+    if progressive {
+        ((end + wave_size).min(spp), (2 * wave_size).min(64))
+    } else {
+        (spp, wave_size)
+    }
+}
+
+/// Renders `scene` with `integrator` tile by tile, writing the film's image
+/// (and partial images when asked). `metadata` is completed with timing and
+/// sample counts; `progress` hears of the camera samples taken.
+pub(crate) fn render_tiles<I: RayIntegrator>(
+    integrator: &I,
+    scene: &mut Scene,
+    opts: &RenderOptions,
+    metadata: &mut ImageMetadata,
+    progress: ProgressFn,
+) -> Result<RenderStats, RenderError> {
+    let start = Instant::now();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.nthreads)
+        .build()
+        .map_err(RenderError::ThreadPool)?;
+    let spp = scene.sampler.samples_per_pixel().max(1);
+    let pixel_bounds = scene.film.pixel_bounds();
+    let tile_list = tiles(pixel_bounds);
+    let pixels = pixel_bounds.area().max(0) as u64;
+    let total = pixels * spp as u64;
+    // Camera rays carry differentials only when something reads them:
+    // texture filtering or bump mapping, or a G-buffer film's depth slopes.
+    let differentials =
+        scene.film.uses_visible_surface() || scene.materials.any_needs_differentials();
+    let progressive = opts.write_partial_images || opts.mse_reference.is_some();
+    let mut wave_start = 0;
+    let mut wave_end = 1;
+    let mut next_wave_size = 1;
+    let mut interrupted = false;
+    let mut mse_per_wave = Vec::new();
+    // `samples_done`: samples taken so far, counted by the tiles as they
+    // finish (the progress reporter reads it while a wave runs).
+    let done = with_progress(total, start, progress, |samples_done| {
+        while wave_start < spp {
+            let results: Vec<FilmTile> = {
+                let scene_ref: &Scene = scene;
+                pool.install(|| {
+                    tile_list
+                        .par_iter()
+                        .map(|&b| {
+                            let mut tile = scene_ref.film.make_tile(b);
+                            let mut sampler = scene_ref.sampler.clone();
+                            super::RayCounters::reset_local();
+                            let mut camera_rays = 0u64;
+                            for p in b.iter() {
+                                // Checked per pixel: a wave can be the
+                                // whole render.
+                                if opts.interrupted() {
+                                    break;
+                                }
+                                for s in wave_start..wave_end {
+                                    sampler.start_pixel_sample(p, s, 0);
+                                    evaluate_pixel_sample(
+                                        scene_ref,
+                                        integrator,
+                                        opts,
+                                        p,
+                                        &mut sampler,
+                                        &mut tile,
+                                        differentials,
+                                    );
+                                }
+                                camera_rays += (wave_end - wave_start) as u64;
+                            }
+                            scene_ref.counters.flush_local();
+                            scene_ref
+                                .counters
+                                .camera_rays
+                                .fetch_add(camera_rays, Ordering::Relaxed);
+                            samples_done.fetch_add(camera_rays, Ordering::Relaxed);
+                            tile
+                        })
+                        .collect()
+                })
+            };
+            for t in results {
+                scene.film.merge_tile(&t);
+            }
+            if opts.interrupted() {
+                interrupted = true;
+                break;
+            }
+            wave_start = wave_end;
+            (wave_end, next_wave_size) = next_wave(wave_end, next_wave_size, spp, progressive);
+            if let Some(reference) = &opts.mse_reference {
+                let mut md = ImageMetadata::default();
+                let image = scene.film.get_image(&mut md, 1.0);
+                let d = crate::image::ops::diff(&image, reference)
+                    .map_err(RenderError::MseReference)?;
+                mse_per_wave.push((wave_start, d.mse));
+            }
+            if opts.write_partial_images && wave_start < spp {
+                metadata.render_time_seconds = Some(start.elapsed().as_secs_f32());
+                metadata.samples_per_pixel = Some(wave_start);
+                write_film(&scene.film, metadata)?;
+            }
+        }
+        Ok(samples_done.load(Ordering::Relaxed))
+    })?;
+    let render_time = start.elapsed();
+    metadata.render_time_seconds = Some(render_time.as_secs_f32());
+    // Every pixel has at least the samples of the completed waves.
+    metadata.samples_per_pixel = Some(wave_start);
+    if let Some(&(_, mse)) = mse_per_wave.last() {
+        metadata.mse = Some(mse as f32);
+    }
+    write_film(&scene.film, metadata)?;
+    Ok(RenderStats {
+        render_time,
+        samples: done,
+        interrupted,
+        mse_per_wave,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::next_wave;
+
+    /// The waves as `[start, end)` ranges for `spp` samples per pixel.
+    fn waves(spp: i32, progressive: bool) -> Vec<(i32, i32)> {
+        let (mut start, mut end, mut size) = (0, 1, 1);
+        let mut out = Vec::new();
+        while start < spp {
+            out.push((start, end));
+            start = end;
+            (end, size) = next_wave(end, size, spp, progressive);
+        }
+        out
+    }
+
+    #[test]
+    fn progressive_waves_double_as_in_pbrt_v4() {
+        assert_eq!(
+            waves(64, true),
+            [(0, 1), (1, 2), (2, 4), (4, 8), (8, 16), (16, 32), (32, 64)]
+        );
+        // At most 64 samples a wave.
+        let w = waves(300, true);
+        assert!(w.iter().all(|&(a, b)| b - a <= 64));
+        assert_eq!(w.last(), Some(&(256, 300)));
+        assert_eq!(waves(1, true), [(0, 1)]);
+    }
+
+    #[test]
+    fn other_renders_take_one_sample_then_the_rest() {
+        assert_eq!(waves(64, false), [(0, 1), (1, 64)]);
+        assert_eq!(waves(1000, false), [(0, 1), (1, 1000)]);
+        assert_eq!(waves(1, false), [(0, 1)]);
+        assert_eq!(waves(2, false), [(0, 1), (1, 2)]);
+    }
+}
