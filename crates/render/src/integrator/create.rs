@@ -6,8 +6,9 @@ use super::{
     AmbientOcclusionIntegrator, Integrator, PathIntegrator, RandomWalkIntegrator,
     SimplePathIntegrator,
 };
+use crate::params::{unknown_type, ParamReader};
 use rpbrt_geometry::float::Float;
-use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary};
+use rpbrt_parser::Diagnostic;
 
 /// Integrator names rpbrt knows, and those it renders.
 pub const INTEGRATOR_NAMES: &[&str] = &[
@@ -27,18 +28,14 @@ pub const INTEGRATOR_NAMES: &[&str] = &[
 /// it needs is created by the caller (it needs the lights).
 pub fn create_integrator(
     name: &str,
-    params: &ParameterDictionary,
-    loc: &FileLoc,
+    ip: &ParamReader,
     scene_has_media: bool,
 ) -> Result<Integrator, Diagnostic> {
-    let perr = Diagnostic::from;
-    let max_depth = params.get_one_int("maxdepth", 5).map_err(perr)?;
+    let loc = ip.loc();
+    let max_depth = ip.int("maxdepth", 5)?;
     if max_depth < 0 {
-        return Err(Diagnostic::error(
-            params
-                .loc("maxdepth")
-                .cloned()
-                .unwrap_or_else(|| loc.clone()),
+        return Err(ip.error_at(
+            "maxdepth",
             format!("\"maxdepth\" must not be negative, got {max_depth}"),
         ));
     }
@@ -49,27 +46,27 @@ pub fn create_integrator(
             }
             Ok(Integrator::Path(PathIntegrator {
                 max_depth,
-                light_sampler_name: params.get_one_string("lightsampler", "bvh").map_err(perr)?,
-                regularize: params.get_one_bool("regularize", false).map_err(perr)?,
+                light_sampler_name: ip.string("lightsampler", "bvh")?,
+                regularize: ip.bool("regularize", false)?,
             }))
         }
         "simplepath" => Ok(Integrator::SimplePath(SimplePathIntegrator {
             max_depth,
-            sample_lights: params.get_one_bool("samplelights", true).map_err(perr)?,
-            sample_bsdf: params.get_one_bool("samplebsdf", true).map_err(perr)?,
+            sample_lights: ip.bool("samplelights", true)?,
+            sample_bsdf: ip.bool("samplebsdf", true)?,
         })),
         "ambientocclusion" => {
-            let max_distance = params.get_one_float("maxdistance", Float::INFINITY).map_err(perr)?;
+            let max_distance = ip.float("maxdistance", Float::INFINITY)?;
             if !(max_distance > 0.0) {
-                return Err(Diagnostic::error(params.loc("maxdistance").cloned().unwrap_or_else(|| loc.clone()), "\"maxdistance\" must be positive"));
+                return Err(ip.error_at("maxdistance", "\"maxdistance\" must be positive"));
             }
-            Ok(Integrator::AmbientOcclusion(AmbientOcclusionIntegrator { cos_sample: params.get_one_bool("cossample", true).map_err(perr)?, max_distance }))
+            Ok(Integrator::AmbientOcclusion(AmbientOcclusionIntegrator { cos_sample: ip.bool("cossample", true)?, max_distance }))
         }
         "randomwalk" => Ok(Integrator::RandomWalk(RandomWalkIntegrator { max_depth })),
         "bdpt" | "lightpath" | "mlt" | "simplevolpath" | "sppm" => Err(Diagnostic::error(
             loc.clone(),
             format!("the \"{name}\" integrator is not supported yet; rpbrt renders with \"path\", \"volpath\" (without media), \"simplepath\", \"ambientocclusion\" and \"randomwalk\""),
         )),
-        _ => Err(Diagnostic::error(loc.clone(), format!("unknown integrator \"{name}\"; known integrators: {}", INTEGRATOR_NAMES.join(", ")))),
+        _ => Err(unknown_type("integrator", name, INTEGRATOR_NAMES, loc)),
     }
 }

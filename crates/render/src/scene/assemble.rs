@@ -322,12 +322,7 @@ pub fn create_scene(
         })
         .unwrap_or_default();
     let integrator = p.take(reader(&desc.integrator)).and_then(|r| {
-        let i = create_integrator(
-            &desc.integrator.name,
-            r.dict(),
-            r.loc(),
-            !desc.media.is_empty(),
-        );
+        let i = create_integrator(&desc.integrator.name, &r, !desc.media.is_empty());
         p.finish(r, i)
     });
     if !problems.errors.is_empty() {
