@@ -290,7 +290,7 @@ pub fn create_shapes(
             for w in warnings {
                 sp.warn(format!("\"curve\" shape: {w}"));
             }
-            out.extend(curves.into_iter().map(|c| Shape::Curve(c)));
+            out.extend(curves.into_iter().map(Shape::Curve));
         }
         _ => return Err(unknown_type("shape", name, SHAPE_NAMES, loc)),
     }
