@@ -21,7 +21,7 @@ use crate::image::MIPMapCache;
 use crate::integrator::{create_integrator, Integrator, RayCounters, Scene};
 use crate::light::{create_light, Light, LightCull, LightType};
 use crate::lightsampler::create_light_sampler;
-use crate::params::ParamReader;
+use crate::params::{unknown_type, ParamReader};
 use crate::primitive::{AnimatedPrimitive, Primitive, PrimitiveAggregate, TransformedPrimitive};
 use crate::sampler::create_sampler;
 use crate::texture::TextureOptions;
@@ -95,13 +95,14 @@ impl Problems {
 }
 
 /// A directive's parameter reader in its colour space.
-fn reader(e: &SceneEntity) -> Result<ParamReader<'_>, Diagnostic> {
+pub(super) fn reader(e: &SceneEntity) -> Result<ParamReader<'_>, Diagnostic> {
     ParamReader::new(&e.params, &e.loc, &e.color_space)
 }
 
 /// Reads an `Accelerator` directive's parameters.
 fn accel_params(name: &str, ap: &ParamReader) -> Result<AccelParams, Diagnostic> {
-    let mut p = AccelParams::new(name).map_err(|m| ap.error(m))?;
+    let mut p = AccelParams::new(name)
+        .map_err(|_| unknown_type("accelerator", name, AccelParams::NAMES, ap.loc()))?;
     for param in ap.dict().params() {
         let v = match param.canonical_type() {
             "integer" if param.ints.len() == 1 => ParamValue::Int(param.ints[0]),

@@ -15,20 +15,15 @@ use std::collections::{HashMap, HashSet};
 
 use rpbrt_parser::Diagnostic;
 
-use super::assemble::Problems;
+use super::assemble::{reader, Problems};
 use super::entities::{SceneEntity, TextureKind, TextureSceneEntity};
 use crate::image::MIPMapCache;
 use crate::material::{create_material, Material, MaterialSet, NormalMapCache};
-use crate::params::ParamReader;
 use crate::spectrum::SpectrumType;
 use crate::texture::{
     create_float_texture, create_spectrum_texture, NamedTextures, TextureDef, TextureOptions,
     TextureParams,
 };
-
-fn reader(e: &SceneEntity) -> Result<ParamReader<'_>, Diagnostic> {
-    ParamReader::new(&e.params, &e.loc, &e.color_space)
-}
 
 fn texture_def(e: &TextureSceneEntity) -> TextureDef<'_> {
     TextureDef {
