@@ -10,6 +10,7 @@ pub mod filter;
 pub mod image;
 pub mod integrator;
 pub mod light;
+pub mod medium;
 pub mod lightsampler;
 pub mod material;
 pub mod params;
