@@ -14,7 +14,8 @@ usage: rpbrt imgtool <command> [options] <files...>
 commands:
   diff [--reference <ref>] <image> [<ref>]
       Compare an image with a reference: MSE, relative MSE ((a-b)^2/(b^2+0.01)),
-      relative MSE with the worst 0.1% of pixels dropped, means, and NaN/Inf counts.
+      relative MSE with the worst 0.1% of pixels dropped, means (also with both images
+      clamped at the reference's 99.9th-percentile value), and NaN/Inf counts.
   info <images...>
       Resolution, channels, per-channel min/max/average, NaN and Inf counts.
   convert [--exposure <stops>] [--clamp <max>] [--flipy] <input> <output>
@@ -90,6 +91,17 @@ fn cmd_diff(args: &[String]) -> Result<(), String> {
         s.mean_b,
         if s.mean_b != 0.0 {
             s.mean_a / s.mean_b
+        } else {
+            f64::NAN
+        }
+    );
+    println!(
+        "mean clamped at the reference's 99.9th percentile ({:.6}): {:.6} (reference {:.6}, ratio {:.4})",
+        s.clamp_value,
+        s.clamped_mean_a,
+        s.clamped_mean_b,
+        if s.clamped_mean_b != 0.0 {
+            s.clamped_mean_a / s.clamped_mean_b
         } else {
             f64::NAN
         }

@@ -30,6 +30,13 @@ pub struct DiffStats {
     pub differing_pixels: usize,
     /// Channel values where a term was NaN or infinite (left out of the sums).
     pub non_finite: usize,
+    /// The reference's value at [`CLAMP_PERCENTILE`], where both images
+    /// are clamped for the means below.
+    pub clamp_value: f64,
+    /// Mean of the image with every value clamped at `clamp_value`.
+    pub clamped_mean_a: f64,
+    /// Mean of the reference clamped the same way.
+    pub clamped_mean_b: f64,
 }
 
 /// Fraction of pixels dropped by the trimmed relative MSE.
@@ -102,6 +109,22 @@ pub fn rel_mse_trimmed(a: &Image, b: &Image, fraction: f64) -> Result<f64, Image
     ))
 }
 
+/// The percentile of the reference's values at which [`diff`] clamps
+/// both images for its firefly-insensitive means.
+pub const CLAMP_PERCENTILE: f64 = 99.9;
+
+/// The `p`-th percentile (0–100) of the finite values of `v`, by the
+/// nearest rank (0 for no finite value).
+pub fn percentile(v: &[f32], p: f64) -> f64 {
+    let mut f: Vec<f32> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if f.is_empty() {
+        return 0.0;
+    }
+    f.sort_by(f32::total_cmp);
+    let rank = ((p / 100.0) * f.len() as f64).ceil() as usize;
+    f[rank.clamp(1, f.len()) - 1] as f64
+}
+
 /// Compares `a` with the reference `b` over `a`'s channels.
 pub fn diff(a: &Image, b: &Image) -> Result<DiffStats, ImageError> {
     let (names, va, vb) = paired(a, b)?;
@@ -130,7 +153,18 @@ pub fn diff(a: &Image, b: &Image) -> Result<DiffStats, ImageError> {
         }
     }
     let n = va.len().max(1) as f64;
+    let clamp = percentile(&vb, CLAMP_PERCENTILE);
+    let clamped_mean = |v: &[f32]| {
+        v.iter()
+            .filter(|x| x.is_finite())
+            .map(|&x| (x as f64).min(clamp))
+            .sum::<f64>()
+            / n
+    };
     Ok(DiffStats {
+        clamp_value: clamp,
+        clamped_mean_a: clamped_mean(&va),
+        clamped_mean_b: clamped_mean(&vb),
         rel_mse_trimmed: trimmed_mean(per_pixel_rel(&va, &vb, nc), TRIM_FRACTION),
         channels: names,
         mse: se / n,

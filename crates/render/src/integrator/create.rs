@@ -4,7 +4,7 @@
 
 use super::{
     AmbientOcclusionIntegrator, Integrator, PathIntegrator, RandomWalkIntegrator,
-    SimplePathIntegrator,
+    SimplePathIntegrator, SimpleVolPathIntegrator, VolPathIntegrator,
 };
 use crate::params::{unknown_type, ParamReader};
 use rpbrt_geometry::float::Float;
@@ -29,7 +29,6 @@ pub const INTEGRATOR_NAMES: &[&str] = &[
 pub fn create_integrator(
     name: &str,
     ip: &ParamReader,
-    scene_has_media: bool,
 ) -> Result<Integrator, Diagnostic> {
     let loc = ip.loc();
     let max_depth = ip.int("maxdepth", 5)?;
@@ -40,16 +39,17 @@ pub fn create_integrator(
         ));
     }
     match name {
-        "path" | "volpath" => {
-            if name == "volpath" && scene_has_media {
-                return Err(Diagnostic::error(loc.clone(), "participating media are not supported yet: the \"volpath\" integrator renders only scenes without media"));
-            }
-            Ok(Integrator::Path(PathIntegrator {
-                max_depth,
-                light_sampler_name: ip.string("lightsampler", "bvh")?,
-                regularize: ip.bool("regularize", false)?,
-            }))
-        }
+        "path" => Ok(Integrator::Path(PathIntegrator {
+            max_depth,
+            light_sampler_name: ip.string("lightsampler", "bvh")?,
+            regularize: ip.bool("regularize", false)?,
+        })),
+        "volpath" => Ok(Integrator::VolPath(VolPathIntegrator {
+            max_depth,
+            light_sampler_name: ip.string("lightsampler", "bvh")?,
+            regularize: ip.bool("regularize", false)?,
+        })),
+        "simplevolpath" => Ok(Integrator::SimpleVolPath(SimpleVolPathIntegrator { max_depth })),
         "simplepath" => Ok(Integrator::SimplePath(SimplePathIntegrator {
             max_depth,
             sample_lights: ip.bool("samplelights", true)?,
@@ -63,9 +63,9 @@ pub fn create_integrator(
             Ok(Integrator::AmbientOcclusion(AmbientOcclusionIntegrator { cos_sample: ip.bool("cossample", true)?, max_distance }))
         }
         "randomwalk" => Ok(Integrator::RandomWalk(RandomWalkIntegrator { max_depth })),
-        "bdpt" | "lightpath" | "mlt" | "simplevolpath" | "sppm" => Err(Diagnostic::error(
+        "bdpt" | "lightpath" | "mlt" | "sppm" => Err(Diagnostic::error(
             loc.clone(),
-            format!("the \"{name}\" integrator is not supported yet; rpbrt renders with \"path\", \"volpath\" (without media), \"simplepath\", \"ambientocclusion\" and \"randomwalk\""),
+            format!("the \"{name}\" integrator is not supported yet; rpbrt renders with \"path\", \"volpath\", \"simplevolpath\", \"simplepath\", \"ambientocclusion\" and \"randomwalk\""),
         )),
         _ => Err(unknown_type("integrator", name, INTEGRATOR_NAMES, loc)),
     }

@@ -87,19 +87,8 @@ pub(crate) fn sample_ld(
     let Some(sampled) = sampled else {
         return SampledSpectrum::new(0.0);
     };
-    if let Some(Some(cull)) = scene.light_cull.get(sampled.light as usize) {
-        // Samples of this light would be discarded below (zero emission
-        // toward the point, or a zero BSDF): skip taking them.
-        let p = ctx.p();
-        if cull.faces_away_from(p) {
-            return SampledSpectrum::new(0.0);
-        }
-        if bsdf.bxdf.zero_across_hemispheres() {
-            let z = bsdf.shading_frame.z;
-            if cull.behind(p, z, dot(si.wo, z)) {
-                return SampledSpectrum::new(0.0);
-            }
-        }
+    if light_sample_culled(scene, sampled.light, ctx.p(), bsdf, si) {
+        return SampledSpectrum::new(0.0);
     }
     let light = &scene.lights[sampled.light as usize];
     let Some(ls) = light.sample_li(&ctx, u_light, lambda, true) else {
@@ -126,4 +115,31 @@ pub(crate) fn sample_ld(
     );
     let w_l = crate::sampling::power_heuristic(1.0, p_l, 1.0, p_b);
     ls.l * f * (w_l / p_l)
+}
+
+/// True when a sample of light `light` cannot contribute at the surface
+/// point `si` seen from the light-sampling point `p`: the light emits
+/// nothing toward it, or it lies wholly behind a BSDF that is zero across
+/// hemispheres (triangle emitters only; see [`crate::light::LightCull`]).
+#[inline]
+pub(crate) fn light_sample_culled(
+    scene: &Scene,
+    light: u32,
+    p: Point3f,
+    bsdf: &BSDF,
+    si: &SurfaceInteraction,
+) -> bool {
+    let Some(Some(cull)) = scene.light_cull.get(light as usize) else {
+        return false;
+    };
+    if cull.faces_away_from(p) {
+        return true;
+    }
+    if bsdf.bxdf.zero_across_hemispheres() {
+        let z = bsdf.shading_frame.z;
+        if cull.behind(p, z, dot(si.wo, z)) {
+            return true;
+        }
+    }
+    false
 }

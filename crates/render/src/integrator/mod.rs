@@ -18,7 +18,8 @@
 //! `create`, creation from the scene description; `direct`, direct
 //! lighting; [`render`], what render loops share (options, statistics,
 //! errors, progress); [`tile`], the per-ray tile loop; `path` and
-//! `simple`, the integrators.
+//! `simple`, the integrators; `volume`, what the volumetric ones share;
+//! `volpath` and `simplevolpath`, pbrt-v4's volumetric path tracers.
 
 mod create;
 mod direct;
@@ -26,6 +27,9 @@ mod path;
 pub mod render;
 pub mod scene;
 mod simple;
+mod simplevolpath;
+mod volpath;
+mod volume;
 pub mod tile;
 
 pub use create::{create_integrator, INTEGRATOR_NAMES};
@@ -34,6 +38,8 @@ pub use render::{Progress, ProgressFn, RenderError, RenderOptions, RenderStats};
 pub use scene::{RayCounters, Scene};
 pub use simple::{AmbientOcclusionIntegrator, RandomWalkIntegrator, SimplePathIntegrator};
 pub use tile::RayIntegrator;
+pub use simplevolpath::SimpleVolPathIntegrator;
+pub use volpath::VolPathIntegrator;
 
 pub(crate) use direct::{sample_ld, VertexOrigins};
 pub(crate) use scene::skip_intersection;
@@ -50,6 +56,10 @@ pub enum Integrator {
     AmbientOcclusion(AmbientOcclusionIntegrator),
     /// `randomwalk`.
     RandomWalk(RandomWalkIntegrator),
+    /// `volpath`.
+    VolPath(VolPathIntegrator),
+    /// `simplevolpath`.
+    SimpleVolPath(SimpleVolPathIntegrator),
 }
 
 impl Integrator {
@@ -74,6 +84,8 @@ impl Integrator {
                 tile::render_tiles(i, scene, opts, metadata, progress)
             }
             Integrator::RandomWalk(i) => tile::render_tiles(i, scene, opts, metadata, progress),
+            Integrator::VolPath(i) => tile::render_tiles(i, scene, opts, metadata, progress),
+            Integrator::SimpleVolPath(i) => tile::render_tiles(i, scene, opts, metadata, progress),
         }
     }
 
@@ -81,6 +93,7 @@ impl Integrator {
     pub fn light_sampler_name(&self) -> Option<&str> {
         match self {
             Integrator::Path(i) => Some(&i.light_sampler_name),
+            Integrator::VolPath(i) => Some(&i.light_sampler_name),
             _ => None,
         }
     }

@@ -12,6 +12,7 @@ use crate::filter::Filter;
 use crate::light::{Light, LightCull};
 use crate::lightsampler::LightSampler;
 use crate::material::MaterialSet;
+use crate::medium::Medium;
 use crate::primitive::{PrimitiveAggregate, PrimitiveIntersection};
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -80,6 +81,12 @@ pub struct Scene {
     pub light_sampler: LightSampler,
     /// The materials, indexed by the primitives' material ids.
     pub materials: MaterialSet,
+    /// The participating media, indexed by the rays' and primitives'
+    /// medium ids.
+    pub media: Vec<Medium>,
+    /// True when the scene has media or `interface` surfaces: shadow rays
+    /// must then pass through interfaces and be attenuated by media.
+    pub has_volumes: bool,
     /// Camera information for texture-filtering footprints of rays without
     /// differentials.
     pub camera_differentials: CameraDifferentials,
@@ -240,7 +247,7 @@ pub(crate) fn skip_intersection(
     hit: &PrimitiveIntersection,
 ) -> RayDifferential {
     let mut next = RayDifferential::new(hit.si.spawn_ray(ray.ray.d));
-    next.ray.medium = ray.ray.medium;
+    next.ray.medium = super::volume::hit_medium_toward(hit, ray.ray.medium, ray.ray.d);
     if ray.has_differentials {
         let t = hit.t_hit;
         next.has_differentials = true;

@@ -316,6 +316,21 @@ impl MaterialSet {
         Some((i as u32, self.loc(i as u32)))
     }
 
+    /// The location of the first material whose surfaces scatter light
+    /// (anything but `interface` and a constant black `diffuse`), for
+    /// integrators that handle media alone; `Some(None)` when it has no
+    /// recorded location.
+    pub fn first_scattering(&self) -> Option<Option<&FileLoc>> {
+        use crate::texture::SpectrumTexture;
+        let i = self.materials.iter().position(|m| match m {
+            Material::Interface => false,
+            Material::Diffuse(d) => !matches!(&*d.reflectance,
+                SpectrumTexture::Constant(s) if s.max_value() == 0.0),
+            _ => true,
+        })?;
+        Some(self.loc(i as u32))
+    }
+
     /// Sets pbrt-v4's `--seed`, mixed into layered BxDFs' random walks.
     pub fn with_seed(mut self, seed: i32) -> Self {
         self.seed = seed;
@@ -425,6 +440,29 @@ impl MaterialSet {
         let ctx = MaterialEvalContext::from_si(si);
         let bxdf = m.get_bxdf(&ctx, lambda, self.seed)?;
         Some(BSDF::new(ctx.ns, ctx.dpdus, bxdf))
+    }
+
+    /// The BSSRDF of the material at `material` (after resolving mixes at
+    /// this point), for a hit whose shading geometry `get_bsdf` has already
+    /// perturbed (pbrt-v4 `SurfaceInteraction::GetBSSRDF`); `None` for
+    /// materials without subsurface scattering.
+    pub fn get_bssrdf(
+        &self,
+        material: u32,
+        si: &SurfaceInteraction,
+        lambda: &SampledWavelengths,
+    ) -> Option<crate::bssrdf::TabulatedBssrdf<'static>> {
+        match self.resolve(material, si)? {
+            (_, Material::Subsurface(m)) => {
+                Some(m.get_bssrdf(&MaterialEvalContext::from_si(si), lambda))
+            }
+            _ => None,
+        }
+    }
+
+    /// True when some material of the set is an `interface`.
+    pub fn any_interface(&self) -> bool {
+        self.materials.iter().any(Material::is_interface)
     }
 
     /// pbrt-v4's `--force-diffuse`: a Lambertian BSDF whose reflectance is

@@ -20,6 +20,8 @@ use crate::filter::create_filter;
 use crate::image::MIPMapCache;
 use crate::integrator::{create_integrator, Integrator, RayCounters, Scene};
 use crate::light::{create_light, Light, LightCull, LightType};
+use crate::material::MaterialSet;
+use crate::medium::{create_medium, Medium};
 use crate::lightsampler::create_light_sampler;
 use crate::params::{unknown_type, ParamReader};
 use crate::primitive::{AnimatedPrimitive, Primitive, PrimitiveAggregate, TransformedPrimitive};
@@ -125,6 +127,79 @@ fn accel_params(name: &str, ap: &ParamReader) -> Result<AccelParams, Diagnostic>
     Ok(p)
 }
 
+/// Creates the named media (pbrt-v4 `BasicScene::CreateMedia`), each
+/// under the transformation in effect at its `MakeNamedMedium` (the start
+/// of an animated one, with a warning as in pbrt-v4), and their ids by name.
+fn create_media(desc: &SceneDescription, p: &mut Problems) -> (Vec<Medium>, HashMap<String, u32>) {
+    let mut media = Vec::new();
+    let mut ids = HashMap::new();
+    for m in &desc.media {
+        let Some(r) = p.take(reader(&m.base)) else {
+            continue;
+        };
+        if m.render_from_object.is_animated() {
+            r.warn(
+                "animated transformation provided for medium; only the start transform will be used",
+            );
+        }
+        let medium = create_medium(&m.base.name, &r, &m.render_from_object.start_transform);
+        if let Some(medium) = p.finish(r, medium) {
+            ids.insert(m.name.clone(), media.len() as u32);
+            media.push(medium);
+        }
+    }
+    (media, ids)
+}
+
+/// What pbrt-v4 says when an integrator cannot render part of a scene:
+/// warnings for media and subsurface scattering that the integrator
+/// ignores, and errors for what `simplevolpath` refuses (delta lights,
+/// surfaces that scatter).
+fn check_integrator_support(
+    desc: &SceneDescription,
+    integrator: &Integrator,
+    media: &[Medium],
+    materials: &MaterialSet,
+    lights: &[Light],
+    p: &mut Problems,
+) {
+    let name = desc.integrator.name.as_str();
+    let loc = &desc.integrator.loc;
+    let volumetric = matches!(integrator, Integrator::VolPath(_) | Integrator::SimpleVolPath(_));
+    if !media.is_empty() && !volumetric {
+        p.warnings.push(Diagnostic::warning(
+            loc.clone(),
+            format!("scene has scattering media but the \"{name}\" integrator doesn't support volume scattering; consider using \"volpath\" or \"simplevolpath\""),
+        ));
+    }
+    if materials.any_subsurface() && !matches!(integrator, Integrator::VolPath(_)) {
+        p.warnings.push(Diagnostic::warning(
+            loc.clone(),
+            format!("some objects in the scene have subsurface scattering, which is not supported by the \"{name}\" integrator; use the \"volpath\" integrator to render them correctly"),
+        ));
+    }
+    if let Integrator::SimpleVolPath(_) = integrator {
+        for (l, e) in lights.iter().zip(&desc.lights) {
+            if l.light_type().is_delta() {
+                p.errors.push(Diagnostic::error(
+                    e.base.loc.clone(),
+                    "the \"simplevolpath\" integrator only supports area and infinite light sources",
+                ));
+            }
+        }
+        if let Some(loc) = materials.first_scattering() {
+            p.errors.push(Diagnostic::error(
+                loc.cloned().unwrap_or_else(|| loc_of(desc)),
+                "the \"simplevolpath\" integrator doesn't support surface scattering (only \"interface\" and black \"diffuse\" emitter surfaces)",
+            ));
+        }
+    }
+}
+
+fn loc_of(desc: &SceneDescription) -> rpbrt_parser::FileLoc {
+    desc.integrator.loc.clone()
+}
+
 /// Builds the render-ready scene.
 pub fn create_scene(
     desc: &SceneDescription,
@@ -133,13 +208,9 @@ pub fn create_scene(
     let mut problems = Problems::default();
     let p = &mut problems;
 
-    // Participating media are not built yet: refuse scenes that use them.
-    if let Some(m) = desc.media.first() {
-        p.errors.push(Diagnostic::error(
-            m.base.loc.clone(),
-            "participating media are not supported yet",
-        ));
-    }
+    // Participating media, by name.
+    let (media, medium_ids) = create_media(desc, p);
+    let medium_of = |name: &str| medium_ids.get(name).copied();
 
     // Filter, film, camera, sampler.
     let filter = p.take(reader(&desc.filter)).and_then(|r| {
@@ -174,7 +245,7 @@ pub fn create_scene(
         &camera_reader,
         camera_transform,
         &geometry,
-        None,
+        medium_of(&camera_entity.medium),
     );
     let Some(camera) = p.finish(camera_reader, camera) else {
         return Err(problems.errors);
@@ -209,14 +280,6 @@ pub fn create_scene(
     else {
         return Err(problems.errors);
     };
-    if let Some((_, loc)) = materials.first_subsurface() {
-        let loc = loc.cloned().unwrap_or_else(|| desc.integrator.loc.clone());
-        p.errors.push(Diagnostic::error(
-            loc,
-            "subsurface scattering is not supported yet: no rpbrt integrator renders BSSRDFs",
-        ));
-    }
-
     // Lights.
     let mut lights: Vec<Light> = Vec::new();
     for l in &desc.lights {
@@ -227,7 +290,7 @@ pub fn create_scene(
             &l.base.name,
             &r,
             &l.render_from_object,
-            None,
+            medium_of(&l.medium),
             camera_transform,
         );
         if let Some(light) = p.finish(r, light) {
@@ -240,6 +303,8 @@ pub fn create_scene(
         desc,
         textures: &textures,
         named_material_ids: &named_material_ids,
+        materials: &materials,
+        medium_ids: &medium_ids,
     };
     let default_accel = AccelParams::default();
     let mut prims: Vec<Primitive> = Vec::new();
@@ -323,9 +388,12 @@ pub fn create_scene(
         })
         .unwrap_or_default();
     let integrator = p.take(reader(&desc.integrator)).and_then(|r| {
-        let i = create_integrator(&desc.integrator.name, &r, !desc.media.is_empty());
+        let i = create_integrator(&desc.integrator.name, &r);
         p.finish(r, i)
     });
+    if let Some(i) = &integrator {
+        check_integrator_support(desc, i, &media, &materials, &lights, p);
+    }
     if !problems.errors.is_empty() {
         return Err(problems.errors);
     }
@@ -360,6 +428,8 @@ pub fn create_scene(
         lights,
         infinite_lights,
         light_sampler,
+        has_volumes: !media.is_empty() || materials.any_interface(),
+        media,
         materials,
         camera_differentials,
         samples_per_pixel: spp,

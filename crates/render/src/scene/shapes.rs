@@ -14,7 +14,8 @@ use super::entities::{
 };
 use crate::light::{create_area_light, Light};
 use crate::params::ParamReader;
-use crate::primitive::{Alpha, GeometricPrimitive, Primitive};
+use crate::material::MaterialSet;
+use crate::primitive::{Alpha, GeometricPrimitive, MediumInterface, Primitive};
 use crate::shape::create::create_shapes;
 use crate::shape::Shape;
 use crate::texture::{FloatTexture, NamedTextures, TextureParams};
@@ -28,6 +29,10 @@ pub(super) struct ShapeContext<'a> {
     pub textures: &'a NamedTextures,
     /// Named materials' indices.
     pub named_material_ids: &'a HashMap<String, u32>,
+    /// The materials (to recognise interfaces).
+    pub materials: &'a MaterialSet,
+    /// Named media's indices.
+    pub medium_ids: &'a HashMap<String, u32>,
 }
 
 /// A shape entity's reader (shapes have no colours of their own).
@@ -95,6 +100,17 @@ pub(super) fn create_primitives(
             }
         },
     };
+    // An `interface` material, named or not, is no material: rays pass.
+    let material = material.filter(|&m| {
+        !cx.materials
+            .materials()
+            .get(m as usize)
+            .is_some_and(|m| m.is_interface())
+    });
+    let Some(media) = medium_interface(cx, s, problems) else {
+        problems.warnings.extend(tp.take_warnings());
+        return;
+    };
     let area_light = s.attributes.light_index.map(|li| &cx.desc.area_lights[li]);
     let area = match (area_light, material) {
         (Some(al), Some(_)) => match ParamReader::new(&al.params, &al.loc, &al.color_space) {
@@ -126,8 +142,8 @@ pub(super) fn create_primitives(
                 &s.render_from_object,
                 &shape,
                 alpha_tex.clone(),
-                None,
-                None,
+                media.inside,
+                media.outside,
             );
             match light {
                 Ok(light) => {
@@ -144,7 +160,9 @@ pub(super) fn create_primitives(
             shape,
             material,
             area_light,
-            medium_interface: None,
+            // Kept only where it changes the medium (pbrt-v4
+            // `SetIntersectionProperties`): elsewhere rays keep theirs.
+            medium_interface: media.is_transition().then_some(media),
             alpha: alpha.clone(),
         }));
     }
@@ -154,6 +172,30 @@ pub(super) fn create_primitives(
         problems.warnings.extend(r.finish());
     }
     problems.warnings.extend(tp.finish());
+}
+
+/// The media inside and outside a shape entity, by their names (an
+/// error for a name no `MakeNamedMedium` defined).
+fn medium_interface(
+    cx: &ShapeContext,
+    s: &ShapeSceneEntity,
+    problems: &mut Problems,
+) -> Option<MediumInterface> {
+    let find = |name: &str| -> Result<Option<u32>, Diagnostic> {
+        if name.is_empty() {
+            return Ok(None);
+        }
+        cx.medium_ids.get(name).copied().map(Some).ok_or_else(|| {
+            Diagnostic::error(s.base.loc.clone(), format!("\"{name}\": medium not defined"))
+        })
+    };
+    match (find(&s.attributes.inside_medium), find(&s.attributes.outside_medium)) {
+        (Ok(inside), Ok(outside)) => Some(MediumInterface { inside, outside }),
+        (Err(e), _) | (_, Err(e)) => {
+            problems.errors.push(e);
+            None
+        }
+    }
 }
 
 /// Every shape of a scene, in directive order (instance definitions last),
