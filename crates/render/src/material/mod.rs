@@ -318,11 +318,11 @@ impl MaterialSet {
 
     /// The location of the first material whose surfaces scatter light
     /// (anything but `interface` and a constant black `diffuse`), for
-    /// integrators that handle media alone; `Some(None)` when it has no
-    /// recorded location.
-    pub fn first_scattering(&self) -> Option<Option<&FileLoc>> {
+    /// integrators that handle media alone, among those `used` accepts;
+    /// `Some(None)` when it has no recorded location.
+    pub fn first_scattering(&self, used: impl Fn(u32) -> bool) -> Option<Option<&FileLoc>> {
         use crate::texture::SpectrumTexture;
-        let i = self.materials.iter().position(|m| match m {
+        let i = self.materials.iter().enumerate().position(|(i, m)| used(i as u32) && match m {
             Material::Interface => false,
             Material::Diffuse(d) => !matches!(&*d.reflectance,
                 SpectrumTexture::Constant(s) if s.max_value() == 0.0),

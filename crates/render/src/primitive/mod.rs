@@ -170,6 +170,20 @@ pub enum Primitive {
 }
 
 impl Primitive {
+    /// Calls `f` with the material of every shape under this primitive
+    /// (instances included; once per use).
+    pub fn for_each_material(&self, f: &mut impl FnMut(u32)) {
+        match self {
+            Primitive::Geometric(p) => {
+                if let Some(m) = p.material {
+                    f(m)
+                }
+            }
+            Primitive::Transformed(p) => p.primitive.prims.iter().for_each(|q| q.for_each_material(f)),
+            Primitive::Animated(p) => p.primitive.prims.iter().for_each(|q| q.for_each_material(f)),
+        }
+    }
+
     /// Bounds in rendering space (over the whole shutter for animated ones).
     pub fn bounds(&self) -> Bounds3f {
         match self {

@@ -151,6 +151,15 @@ fn create_media(desc: &SceneDescription, p: &mut Problems) -> (Vec<Medium>, Hash
     (media, ids)
 }
 
+/// What [`check_integrator_support`] looks at.
+struct Support<'a> {
+    media: &'a [Medium],
+    materials: &'a MaterialSet,
+    /// Per material, whether some shape uses it.
+    used: &'a [bool],
+    lights: &'a [Light],
+}
+
 /// What pbrt-v4 says when an integrator cannot render part of a scene:
 /// warnings for media and subsurface scattering that the integrator
 /// ignores, and errors for what `simplevolpath` refuses (delta lights,
@@ -158,11 +167,10 @@ fn create_media(desc: &SceneDescription, p: &mut Problems) -> (Vec<Medium>, Hash
 fn check_integrator_support(
     desc: &SceneDescription,
     integrator: &Integrator,
-    media: &[Medium],
-    materials: &MaterialSet,
-    lights: &[Light],
+    support: &Support,
     p: &mut Problems,
 ) {
+    let Support { media, materials, used, lights } = *support;
     let name = desc.integrator.name.as_str();
     let loc = &desc.integrator.loc;
     let volumetric = matches!(integrator, Integrator::VolPath(_) | Integrator::SimpleVolPath(_));
@@ -187,7 +195,7 @@ fn check_integrator_support(
                 ));
             }
         }
-        if let Some(loc) = materials.first_scattering() {
+        if let Some(loc) = materials.first_scattering(|m| used.get(m as usize) == Some(&true)) {
             p.errors.push(Diagnostic::error(
                 loc.cloned().unwrap_or_else(|| loc_of(desc)),
                 "the \"simplevolpath\" integrator doesn't support surface scattering (only \"interface\" and black \"diffuse\" emitter surfaces)",
@@ -392,7 +400,16 @@ pub fn create_scene(
         p.finish(r, i)
     });
     if let Some(i) = &integrator {
-        check_integrator_support(desc, i, &media, &materials, &lights, p);
+        let mut used = vec![false; materials.materials().len()];
+        for prim in &prims {
+            prim.for_each_material(&mut |m| {
+                if let Some(u) = used.get_mut(m as usize) {
+                    *u = true;
+                }
+            });
+        }
+        let support = Support { media: &media, materials: &materials, used: &used, lights: &lights };
+        check_integrator_support(desc, i, &support, p);
     }
     if !problems.errors.is_empty() {
         return Err(problems.errors);
