@@ -5,6 +5,7 @@
 //! The builder only checks that a name is one of these; whether the renderer
 //! implements each is checked when the entity is turned into a render object.
 
+use crate::medium::MEDIUM_NAMES;
 use crate::params::unknown_type;
 use rpbrt_parser::{Diagnostic, FileLoc};
 
@@ -90,11 +91,6 @@ impl EntityKind {
         Err(unknown_type(self.describe(), name, self.known_names(), loc))
     }
 }
-
-/// The medium types `MakeNamedMedium` accepts (pbrt-v4 `Medium::Create`).
-/// rpbrt does not render participating media yet: the scene refuses them
-/// when it is created.
-pub const MEDIUM_NAMES: &[&str] = &["cloud", "homogeneous", "nanovdb", "rgbgrid", "uniformgrid"];
 
 /// The type of an `Option` setting's value.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
