@@ -175,11 +175,30 @@ fn renders_png_and_reports_mse_against_a_reference() {
 }
 
 #[test]
+fn integrators_that_ignore_media_or_subsurface_warn_at_the_directive() {
+    let cases = [
+        ("ss.pbrt", "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nIntegrator \"path\"\nWorldBegin\nLightSource \"point\" \"rgb I\" [1 1 1]\nMaterial \"subsurface\"\nShape \"sphere\"\n", "ss.pbrt:2:1", "subsurface"),
+        ("medium.pbrt", "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nIntegrator \"path\"\nWorldBegin\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nShape \"sphere\"\n", "medium.pbrt:2:1", "media"),
+    ];
+    for (name, text, loc, what) in cases {
+        let p = temp_scene(name, text);
+        let out = rpbrt()
+            .args(["--spp", "1", "--outfile"])
+            .arg(p.with_extension("exr"))
+            .arg(&p)
+            .output()
+            .unwrap();
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(0), "{name}: {e}");
+        assert!(e.contains(loc) && e.contains(what) && e.contains("volpath"), "{name}: {e}");
+    }
+}
+
+#[test]
 fn unsupported_features_are_located_errors_not_wrong_images() {
     let cases = [
-        ("ss.pbrt", "WorldBegin\nLightSource \"point\" \"rgb I\" [1 1 1]\nMaterial \"subsurface\"\nShape \"sphere\"\n", "ss.pbrt:3:1"),
         ("bdpt.pbrt", "Integrator \"bdpt\"\nWorldBegin\nShape \"sphere\"\n", "bdpt.pbrt:1:1"),
-        ("medium.pbrt", "WorldBegin\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nShape \"sphere\"\n", "medium.pbrt:2:"),
+        ("sppm.pbrt", "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nIntegrator \"sppm\"\nWorldBegin\nShape \"sphere\"\n", "sppm.pbrt:2:1"),
     ];
     for (name, text, loc) in cases {
         let p = temp_scene(name, text);
