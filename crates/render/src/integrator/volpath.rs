@@ -91,15 +91,18 @@ impl VolPathIntegrator {
         r_p: SampledSpectrum,
     ) -> SampledSpectrum {
         let zero = SampledSpectrum::new(0.0);
-        let ctx = match &vertex {
+        let mut vertex = vertex;
+        let ctx = match &mut vertex {
             LdVertex::Surface { origins, bsdf, .. } => {
+                // Nudged to the side the light can be on, with the
+                // vertex's cached offset origins.
                 let si = origins.si;
                 let mut ctx = LightSampleContext::from_si(si);
                 let flags = bsdf.flags();
                 if flags.is_reflective() && !flags.is_transmissive() {
-                    ctx.pi = Point3fi::from(si.offset_ray_origin(si.wo));
+                    ctx.pi = Point3fi::from(origins.toward(si.wo));
                 } else if flags.is_transmissive() && !flags.is_reflective() {
-                    ctx.pi = Point3fi::from(si.offset_ray_origin(-si.wo));
+                    ctx.pi = Point3fi::from(origins.toward(-si.wo));
                 }
                 ctx
             }

@@ -2,7 +2,8 @@
 //! `media.cpp`): a `MakeNamedMedium` directive's type and parameters turned
 //! into a [`Medium`], with located errors for values no medium can have.
 
-use super::{HomogeneousMedium, Medium};
+use super::nanovdb::{read_float_grid, require_float_grid, FloatGrid, GridClass, NanoVdbError};
+use super::{HomogeneousMedium, Medium, NanoVdbMedium, NanoVdbTemperature};
 use crate::material::data::get_medium_scattering_properties;
 use crate::params::{unknown_type, ParamReader};
 use crate::spectrum::{spectrum_to_photometric, DenselySampledSpectrum, Spectrum, SpectrumType};
@@ -20,10 +21,10 @@ pub fn create_medium(
     mp: &ParamReader,
     render_from_medium: &Transform,
 ) -> Result<Medium, Diagnostic> {
-    let _ = render_from_medium;
     match name {
         "homogeneous" => create_homogeneous(mp).map(Medium::Homogeneous),
-        "uniformgrid" | "rgbgrid" | "cloud" | "nanovdb" => Err(Diagnostic::error(
+        "nanovdb" => create_nanovdb(mp, render_from_medium).map(|m| Medium::NanoVdb(Box::new(m))),
+        "uniformgrid" | "rgbgrid" | "cloud" => Err(Diagnostic::error(
             mp.loc().clone(),
             format!("the \"{name}\" medium is not supported yet"),
         )),
@@ -121,4 +122,62 @@ pub(super) fn phase_asymmetry(mp: &ParamReader) -> Result<Float, Diagnostic> {
         mp.warn_at("g", format!("\"g\" = {g} is outside [-1, 1]; using {}", g.clamp(-0.99, 0.99)));
     }
     Ok(g)
+}
+
+/// pbrt-v4 `NanoVDBMedium::Create`: the density grid (`"gridname"`,
+/// default "density") and optional temperature grid (`"temperaturename"`)
+/// of a `.nvdb` file, with their emission and scattering parameters.
+fn create_nanovdb(
+    mp: &ParamReader,
+    render_from_medium: &Transform,
+) -> Result<NanoVdbMedium, Diagnostic> {
+    let Some(path) = mp.path("filename")? else {
+        return Err(mp.error("must supply \"filename\" to the \"nanovdb\" medium"));
+    };
+    let file_error = |e: NanoVdbError| mp.error_at("filename", format!("{}: {e}", path.display()));
+    let grid_name = mp.string("gridname", "density")?;
+    let density = require_float_grid(&path, &grid_name).map_err(file_error)?;
+    check_vdb_grid(mp, &path, &density)?;
+    let temperature_name = mp.string("temperaturename", "temperature")?;
+    let temperature_grid = read_float_grid(&path, &temperature_name).map_err(file_error)?;
+    let le_scale = mp.float("Lescale", 1.0)?;
+    let cutoff = mp.float("temperaturecutoff", 0.0)?;
+    let offset = mp.float("temperatureoffset", cutoff)?;
+    let scale_t = mp.float("temperaturescale", 1.0)?;
+    for (name, v) in [("Lescale", le_scale), ("temperatureoffset", offset), ("temperaturescale", scale_t)] {
+        if !v.is_finite() {
+            return Err(mp.error_at(name, format!("\"{name}\" must be finite")));
+        }
+    }
+    let temperature = match temperature_grid {
+        Some(grid) => {
+            check_vdb_grid(mp, &path, &grid)?;
+            Some(NanoVdbTemperature { grid, offset, scale: scale_t, le_scale })
+        }
+        None => None,
+    };
+    let g = phase_asymmetry(mp)?;
+    let sigma_a = coefficient(mp, "sigma_a")?;
+    let sigma_s = coefficient(mp, "sigma_s")?;
+    let scale = non_negative(mp, "scale", 1.0)?;
+    Ok(NanoVdbMedium::new(*render_from_medium, &sigma_a, &sigma_s, scale, g, density, temperature))
+}
+
+/// Refuses grids a medium cannot use: level sets and other non-fog
+/// classes (as pbrt-v4), negative or non-finite values, empty bounds.
+fn check_vdb_grid(mp: &ParamReader, path: &std::path::Path, grid: &FloatGrid) -> Result<(), Diagnostic> {
+    let err = |m: String| Err(mp.error_at("filename", format!("{}: grid \"{}\" {m}", path.display(), grid.name())));
+    match grid.grid_class() {
+        GridClass::FogVolume | GridClass::Unknown => {}
+        c => return err(format!("isn't a FogVolume grid (its class is {c:?})")),
+    }
+    let (lo, hi) = grid.min_max();
+    if !(lo.is_finite() && hi.is_finite()) || lo < 0.0 {
+        return err(format!("has values in [{lo}, {hi}]; a medium needs finite, non-negative ones"));
+    }
+    let (wlo, whi) = grid.world_bbox();
+    if (0..3).any(|a| !(whi[a] > wlo[a]) || !wlo[a].is_finite() || !whi[a].is_finite()) {
+        return err(format!("has zero-size bounds ({wlo:?} to {whi:?})"));
+    }
+    Ok(())
 }

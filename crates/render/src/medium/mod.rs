@@ -11,12 +11,15 @@
 mod create;
 mod homogeneous;
 mod majorant;
+pub mod nanovdb;
+mod nanovdb_medium;
 mod phase;
 #[cfg(test)]
 mod tests;
 
 pub use create::{create_medium, MEDIUM_NAMES};
 pub use homogeneous::HomogeneousMedium;
+pub use nanovdb_medium::{NanoVdbMedium, NanoVdbTemperature};
 pub use majorant::{DdaMajorantIterator, HomogeneousMajorantIterator, MajorantGrid, RayMajorantSegment};
 pub use phase::{henyey_greenstein, sample_henyey_greenstein, HGPhaseFunction, PhaseFunctionSample};
 
@@ -60,6 +63,8 @@ pub(crate) trait ConcreteMedium {
 pub enum Medium {
     /// `homogeneous`.
     Homogeneous(HomogeneousMedium),
+    /// `nanovdb` (boxed: its grids and majorants make it large).
+    NanoVdb(Box<NanoVdbMedium>),
 }
 
 impl Medium {
@@ -68,6 +73,7 @@ impl Medium {
     pub fn is_emissive(&self) -> bool {
         match self {
             Medium::Homogeneous(m) => m.is_emissive(),
+            Medium::NanoVdb(m) => m.is_emissive(),
         }
     }
 
@@ -76,6 +82,7 @@ impl Medium {
     pub fn sample_point(&self, p: Point3f, lambda: &SampledWavelengths) -> MediumProperties {
         match self {
             Medium::Homogeneous(m) => m.sample_point(p, lambda),
+            Medium::NanoVdb(m) => m.sample_point(p, lambda),
         }
     }
 
@@ -90,6 +97,7 @@ impl Medium {
         let (ray, t_max) = normalized(ray, t_max);
         match self {
             Medium::Homogeneous(m) => m.sample_ray(&ray, t_max, lambda).collect(),
+            Medium::NanoVdb(m) => m.sample_ray(&ray, t_max, lambda).collect(),
         }
     }
 }
@@ -129,6 +137,7 @@ pub fn sample_t_maj(
 ) -> SampledSpectrum {
     match medium {
         Medium::Homogeneous(m) => sample_t_maj_in(m, ray, t_max, u, rng, lambda, callback),
+        Medium::NanoVdb(m) => sample_t_maj_in(&**m, ray, t_max, u, rng, lambda, callback),
     }
 }
 

@@ -7,7 +7,7 @@ use super::majorant::{DdaMajorantIterator, MajorantGrid};
 use super::nanovdb::FloatGrid;
 use super::{ConcreteMedium, HGPhaseFunction, MediumProperties};
 use crate::spectrum::{
-    BlackbodySpectrum, DenselySampledSpectrum, SampledSpectrum, SampledWavelengths, Spectrum,
+    DenselySampledSpectrum, SampledSpectrum, SampledWavelengths, Spectrum,
 };
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::ray::Ray;
@@ -137,7 +137,7 @@ impl NanoVdbMedium {
         if temp <= 100.0 {
             return SampledSpectrum::new(0.0);
         }
-        BlackbodySpectrum::new(temp).sample(lambda) * t.le_scale
+        Spectrum::blackbody(temp).sample(lambda) * t.le_scale
     }
 }
 
