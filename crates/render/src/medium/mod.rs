@@ -159,7 +159,7 @@ fn sample_t_maj_in<M: ConcreteMedium>(
             // Nothing to collide with: the majorant transmittance of the
             // whole segment (unbounded segments kept finite).
             let dt = finite(seg.t_max - seg.t_min);
-            t_maj *= (-dt * seg.sigma_maj).exp();
+            t_maj *= fast_exp_spectrum(-dt * seg.sigma_maj);
             continue;
         }
         let mut t_min = seg.t_min;
@@ -167,7 +167,7 @@ fn sample_t_maj_in<M: ConcreteMedium>(
             let t = t_min + sample_exponential(u, seg.sigma_maj[0]);
             u = rng.uniform_float();
             if t < seg.t_max {
-                t_maj *= (-(t - t_min) * seg.sigma_maj).exp();
+                t_maj *= fast_exp_spectrum(-(t - t_min) * seg.sigma_maj);
                 let p = ray.at(t);
                 let mp = medium.sample_point(p, lambda);
                 if !callback(p, &mp, seg.sigma_maj, t_maj, rng) {
@@ -177,12 +177,53 @@ fn sample_t_maj_in<M: ConcreteMedium>(
                 t_min = t;
             } else {
                 let dt = finite(seg.t_max - t_min);
-                t_maj *= (-dt * seg.sigma_maj).exp();
+                t_maj *= fast_exp_spectrum(-dt * seg.sigma_maj);
                 break;
             }
         }
     }
     t_maj
+}
+
+/// pbrt-v4's `FastExp`: eˣ as 2^(x·log₂e), with 2^f on [0, 1) from a
+/// cubic polynomial (relative error below 2·10⁻⁴) and the integer part put
+/// in the exponent bits; 0 below the normal range, +∞ above it. Majorant
+/// transmittances need no more accuracy, and this keeps them off `libm`.
+#[inline(always)]
+pub fn fast_exp(x: Float) -> Float {
+    let xp = x * std::f32::consts::LOG2_E;
+    // ⌊xp⌋ by truncation (saturating for huge values and NaN, which the
+    // range checks below turn into 0, ∞ or NaN): `floor` is a libm call
+    // on baseline x86-64.
+    let mut i = xp as i32;
+    if (i as Float) > xp {
+        i = i.saturating_sub(1);
+    }
+    let f = xp - i as Float;
+    let two_to_f = 1.0 + f * (0.695_556_86 + f * (0.226_173_57 + f * 0.078_145_574));
+    if x.is_nan() {
+        return x;
+    }
+    let exponent = ((two_to_f.to_bits() >> 23) & 0xff) as i32 - 127 + i.clamp(-1000, 1000);
+    if exponent < -126 || !(f < 2.0) {
+        // Below the normal range (or a saturated cast of −∞).
+        return if xp > 0.0 { Float::INFINITY } else { 0.0 };
+    }
+    if exponent > 127 {
+        return Float::INFINITY;
+    }
+    let bits = (two_to_f.to_bits() & 0x807f_ffff) | (((exponent + 127) as u32) << 23);
+    Float::from_bits(bits)
+}
+
+/// [`fast_exp`] of every wavelength's value.
+#[inline(always)]
+pub fn fast_exp_spectrum(s: SampledSpectrum) -> SampledSpectrum {
+    let mut out = s;
+    for i in 0..crate::spectrum::N_SPECTRUM_SAMPLES {
+        out[i] = fast_exp(s[i]);
+    }
+    out
 }
 
 /// `x`, with +∞ replaced by the largest float (so that `0 × x` stays 0).

@@ -110,3 +110,18 @@ fn dda_visits_voxels_in_order_and_covers_the_ray() {
         }
     }
 }
+
+#[test]
+fn fast_exp_is_close_to_exp() {
+    let mut x = -87.0f32;
+    while x < 80.0 {
+        let (a, b) = (fast_exp(x), x.exp());
+        assert!((a - b).abs() <= 3e-4 * b, "{x}: {a} vs {b}");
+        x += 0.0137;
+    }
+    assert_eq!(fast_exp(-200.0), 0.0);
+    assert_eq!(fast_exp(-Float::MAX), 0.0);
+    assert_eq!(fast_exp(200.0), Float::INFINITY);
+    assert_eq!(fast_exp(0.0), 1.0);
+    assert!(fast_exp(Float::NAN).is_nan());
+}
