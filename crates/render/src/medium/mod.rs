@@ -5,18 +5,31 @@
 //! builds on.
 //!
 //! The files: `phase`, the phase function; `majorant`, majorant segments,
-//! the majorant grid and its DDA walk; one file per medium type; `create`,
-//! creation from `MakeNamedMedium`.
+//! the majorant grid and its DDA walk; `sampled_grid`, trilinearly
+//! interpolated sample grids; one file per medium type (`homogeneous`,
+//! `grid`, `rgbgrid`, `cloud`), each with its creation; `create`,
+//! creation from `MakeNamedMedium` and the parameter checks the media
+//! share.
 
+mod cloud;
 mod create;
+mod grid;
 mod homogeneous;
 mod majorant;
 mod phase;
+mod rgbgrid;
+mod sampled_grid;
+#[cfg(test)]
+mod grid_tests;
 #[cfg(test)]
 mod tests;
 
-pub use create::{create_medium, MEDIUM_NAMES};
+pub use cloud::{CloudMedium, CloudMediumParts};
+pub use create::{create_medium, MAX_GRID_SAMPLES, MEDIUM_NAMES};
+pub use grid::{GridMedium, GridMediumParts, GRID_MAJORANT_RES};
 pub use homogeneous::HomogeneousMedium;
+pub use rgbgrid::{RgbEmissionGrid, RgbGridMedium, RgbGridMediumParts, RGB_GRID_MAJORANT_RES};
+pub use sampled_grid::{GridValue, Interpolant, SampledGrid};
 pub use majorant::{DdaMajorantIterator, HomogeneousMajorantIterator, MajorantGrid, RayMajorantSegment};
 pub use phase::{henyey_greenstein, sample_henyey_greenstein, HGPhaseFunction, PhaseFunctionSample};
 
@@ -55,11 +68,18 @@ pub(crate) trait ConcreteMedium {
         -> Self::Majorants<'a>;
 }
 
-/// The closed set of participating media (pbrt-v4 `Medium`).
+/// The closed set of participating media (pbrt-v4 `Medium`). The grid
+/// media are boxed to keep the enum small.
 #[derive(Clone, Debug)]
 pub enum Medium {
     /// `homogeneous`.
     Homogeneous(HomogeneousMedium),
+    /// `uniformgrid` (and pbrt-v3's `heterogeneous`).
+    UniformGrid(Box<GridMedium>),
+    /// `rgbgrid`.
+    RgbGrid(Box<RgbGridMedium>),
+    /// `cloud`.
+    Cloud(Box<CloudMedium>),
 }
 
 impl Medium {
@@ -68,6 +88,9 @@ impl Medium {
     pub fn is_emissive(&self) -> bool {
         match self {
             Medium::Homogeneous(m) => m.is_emissive(),
+            Medium::UniformGrid(m) => m.is_emissive(),
+            Medium::RgbGrid(m) => m.is_emissive(),
+            Medium::Cloud(_) => false,
         }
     }
 
@@ -76,6 +99,9 @@ impl Medium {
     pub fn sample_point(&self, p: Point3f, lambda: &SampledWavelengths) -> MediumProperties {
         match self {
             Medium::Homogeneous(m) => m.sample_point(p, lambda),
+            Medium::UniformGrid(m) => m.sample_point(p, lambda),
+            Medium::RgbGrid(m) => m.sample_point(p, lambda),
+            Medium::Cloud(m) => m.sample_point(p, lambda),
         }
     }
 
@@ -90,6 +116,9 @@ impl Medium {
         let (ray, t_max) = normalized(ray, t_max);
         match self {
             Medium::Homogeneous(m) => m.sample_ray(&ray, t_max, lambda).collect(),
+            Medium::UniformGrid(m) => m.sample_ray(&ray, t_max, lambda).collect(),
+            Medium::RgbGrid(m) => m.sample_ray(&ray, t_max, lambda).collect(),
+            Medium::Cloud(m) => m.sample_ray(&ray, t_max, lambda).collect(),
         }
     }
 }
@@ -129,6 +158,9 @@ pub fn sample_t_maj(
 ) -> SampledSpectrum {
     match medium {
         Medium::Homogeneous(m) => sample_t_maj_in(m, ray, t_max, u, rng, lambda, callback),
+        Medium::UniformGrid(m) => sample_t_maj_in(&**m, ray, t_max, u, rng, lambda, callback),
+        Medium::RgbGrid(m) => sample_t_maj_in(&**m, ray, t_max, u, rng, lambda, callback),
+        Medium::Cloud(m) => sample_t_maj_in(&**m, ray, t_max, u, rng, lambda, callback),
     }
 }
 

@@ -3,6 +3,7 @@
 use super::*;
 use crate::spectrum::Spectrum;
 use rpbrt_geometry::float::PI;
+use rpbrt_geometry::Bounds3f;
 
 fn lambda() -> SampledWavelengths {
     SampledWavelengths::sample_visible(0.37)
