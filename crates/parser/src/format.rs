@@ -381,19 +381,28 @@ impl ParserTarget for FormattingTarget {
         loc: FileLoc,
     ) -> DirectiveResult {
         // The medium's kind is its "string type" parameter.
-        if self.upgrade {
-            let mut params = params;
-            upgrade::upgrade_param_types(&mut params);
-            for p in &mut params {
-                if p.name == "type" && p.strings == ["heterogeneous"] {
-                    p.strings = vec!["uniformgrid".into()];
-                }
-            }
+        if !self.upgrade {
             self.named("MakeNamedMedium", name, &params);
             return Ok(());
         }
-        self.named("MakeNamedMedium", name, &params);
-        let _ = loc;
+        let mut params = params;
+        let at = params
+            .iter()
+            .rposition(|p| p.name == "type" && p.ty == "string" && p.strings.len() == 1);
+        let Some(at) = at else {
+            // No usable type: only the parameter types are upgraded.
+            upgrade::upgrade_param_types(&mut params);
+            self.named("MakeNamedMedium", name, &params);
+            return Ok(());
+        };
+        let ty = params.remove(at);
+        let u = upgrade::upgrade_medium(&ty.strings[0], params, &loc);
+        let (new, mut p) = self.take(u);
+        p.insert(
+            0,
+            ParsedParameter::with_strings("string", "type", ty.loc, vec![new]),
+        );
+        self.named("MakeNamedMedium", name, &p);
         Ok(())
     }
     fn medium_interface(&mut self, inside: &str, outside: &str, _loc: FileLoc) -> DirectiveResult {

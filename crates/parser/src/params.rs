@@ -529,6 +529,17 @@ impl ParameterDictionary {
             .collect())
     }
 
+    /// All triples of the `rgb` (or v3 `color`) named `name`, in order
+    /// (empty if absent). A count that is not a multiple of three, or a
+    /// negative component, is an error.
+    pub fn get_rgb_array(&self, name: &str) -> Result<Vec<[f32; 3]>, ParamError> {
+        let rgbs = self.float_tuples::<3>(name, "rgb")?;
+        for c in &rgbs {
+            check_rgb(self, name, *c)?;
+        }
+        Ok(rgbs)
+    }
+
     /// All values of the `integer` named `name` (empty if absent).
     pub fn get_int_array(&self, name: &str) -> Result<Vec<i32>, ParamError> {
         let Some(p) = self.find(name, &["integer"], "\"integer\"")? else {
@@ -803,6 +814,26 @@ mod tests {
         let d = ParameterDictionary::new(vec![fl("float", "r", 2, &[1., 2.])]);
         assert!(d.get_one_float("r", 0.).is_err());
         assert_eq!(d.get_float_array("r"), Ok(vec![1., 2.]));
+    }
+
+    #[test]
+    fn rgb_arrays() {
+        let d = ParameterDictionary::new(vec![
+            fl("rgb", "sigma_a", 3, &[0.1, 0.2, 0.3, 1., 2., 3.]),
+            fl("color", "Le", 4, &[1., 1.]),
+            fl("rgb", "bad", 5, &[1., -2., 3.]),
+        ]);
+        assert_eq!(
+            d.get_rgb_array("sigma_a"),
+            Ok(vec![[0.1, 0.2, 0.3], [1., 2., 3.]])
+        );
+        assert_eq!(d.get_rgb_array("missing"), Ok(vec![]));
+        let e = d.get_rgb_array("Le").unwrap_err();
+        assert_eq!(e.loc().line, 4);
+        assert!(e.to_string().contains("multiple of 3"), "{e}");
+        let e = d.get_rgb_array("bad").unwrap_err();
+        assert_eq!(e.loc().line, 5);
+        assert!(e.to_string().contains("negative"), "{e}");
     }
 
     #[test]

@@ -537,10 +537,38 @@ pub fn upgrade_pixel_filter(name: &str, params: Vec<ParsedParameter>, loc: &File
 }
 
 /// Upgrades a `MakeNamedMedium` (`heterogeneous` → `uniformgrid`).
+///
+/// pbrt-v3's grid medium takes the same `density`, `nx`/`ny`/`nz`,
+/// `p0`/`p1`, `sigma_a`, `sigma_s`, `scale` and `g` as pbrt-v4's
+/// `uniformgrid` (and samples the grid the same way), but its default
+/// coefficients were those of whole milk, (.0011, .0024, .014) and
+/// (2.55, 3.21, 3.77), where pbrt-v4's are 1: an absent `sigma_a` or
+/// `sigma_s` is written out with the pbrt-v3 value so that the medium
+/// looks as it did. pbrt-v4's `uniformgrid` has no `"preset"`, so a preset
+/// is dropped with a warning. (pbrt-v4's own `--upgrade` compares the
+/// medium's name instead of its type with `"heterogeneous"`, so it never
+/// converts one.)
 pub fn upgrade_medium(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
     let mut e = Edit::new(name, params, loc);
     if name == "heterogeneous" {
         e.name = "uniformgrid".into();
+        if let Some(p) = e.remove("preset", &["string"]) {
+            e.warn(
+                Some(&p.loc),
+                "pbrt-v4's \"uniformgrid\" medium has no \"preset\"; give \"sigma_a\" and \"sigma_s\" instead (using pbrt-v3's defaults where absent)".into(),
+            );
+            e.remove_all("preset", &["string"]);
+        }
+        const V3_DEFAULTS: [(&str, [f32; 3]); 2] = [
+            ("sigma_a", [0.0011, 0.0024, 0.014]),
+            ("sigma_s", [2.55, 3.21, 3.77]),
+        ];
+        for (param, rgb) in V3_DEFAULTS {
+            if e.get(param, &SPECTRUM_TYPES).is_none() {
+                let p = ParsedParameter::with_floats("rgb", param, e.loc.clone(), rgb.to_vec());
+                e.add_front(p);
+            }
+        }
     }
     e.finish()
 }

@@ -229,6 +229,12 @@ impl<'a> ParamReader<'a> {
         Ok(self.dict.get_float_array(name)?)
     }
 
+    /// Every triple of `"rgb name"` (empty when absent; negative
+    /// components are an error).
+    pub fn rgbs(&self, name: &str) -> Result<Vec<[f32; 3]>, Diagnostic> {
+        Ok(self.dict.get_rgb_array(name)?)
+    }
+
     /// Every value of `"integer name"` (empty when absent).
     pub fn ints(&self, name: &str) -> Result<Vec<i32>, Diagnostic> {
         Ok(self.dict.get_int_array(name)?)

@@ -125,6 +125,7 @@ Sampler "lowdiscrepancy" "integer pixelsamples" 8
 Integrator "directlighting"
 PixelFilter "gaussian" "float xwidth" 2 "float alpha" 2
 Camera "environment"
+MakeNamedMedium "smoke" "string type" "heterogeneous" "integer nx" 2 "float density" [0.5 1] "color sigma_s" [1 1 1]
 WorldBegin
 LightSource "infinite" "string mapname" "sky.exr" "color L" [2 2 2] "color scale" [0.5 0.5 0.5]
 TransformBegin
@@ -155,6 +156,7 @@ fn upgrades_a_small_v3_scene() {
         "Integrator \"path\"\n    \"integer maxdepth\" [ 1 ]\n",
         "PixelFilter \"gaussian\"\n    \"float xradius\" [ 2 ]\n    \"float sigma\" [ 0.5 ]\n",
         "Camera \"spherical\"\n    \"string mapping\" [ \"equirectangular\" ]\n",
+        "MakeNamedMedium \"smoke\"\n    \"string type\" [ \"uniformgrid\" ]\n    \"rgb sigma_a\" [ 0.0011 0.0024 0.014 ]\n    \"integer nx\" [ 2 ]\n",
         "LightSource \"infinite\"\n    \"string filename\" [ \"sky.exr\" ]\n",
         "AttributeBegin\n    Translate 0 1 0\n    LightSource \"point\"\n        \"float scale\" [ 10 ]\n        \"blackbody I\" [ 5500 ]\nAttributeEnd\n",
         "Texture \"grid\" \"spectrum\" \"imagemap\"\n    \"string filter\" [ \"trilinear\" ]\n    \"string encoding\" [ \"gamma 2.2\" ]\n",

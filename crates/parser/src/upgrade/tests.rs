@@ -198,6 +198,52 @@ fn cameras_films_samplers_integrators_filters() {
 }
 
 #[test]
+fn heterogeneous_medium_becomes_uniformgrid_with_v3_defaults() {
+    let mut nx = ParsedParameter::new("integer", "nx", loc(4));
+    nx.ints = vec![2];
+    let u = upgrade_medium(
+        "heterogeneous",
+        vec![
+            f("float", "density", &[0.5, 1.0]),
+            nx,
+            f("point", "p1", &[2., 1., 1.]),
+            f("color", "sigma_s", &[1., 2., 3.]),
+        ],
+        &loc(1),
+    );
+    assert_eq!(u.name, "uniformgrid");
+    assert!(u.diagnostics.is_empty(), "{:?}", u.diagnostics);
+    // Only the absent coefficient gets pbrt-v3's default; v3 types are renamed.
+    assert_eq!(
+        names(&u),
+        ["rgb sigma_a", "float density", "integer nx", "point3 p1", "rgb sigma_s"]
+    );
+    assert_eq!(u.params[0].floats, [0.0011, 0.0024, 0.014]);
+    assert_eq!(u.params[0].loc.line, 1);
+    assert_eq!(u.params[4].floats, [1., 2., 3.]);
+
+    let u = upgrade_medium(
+        "heterogeneous",
+        vec![
+            f("float", "density", &[1.0]),
+            s("string", "preset", &["Wholemilk"]),
+        ],
+        &loc(1),
+    );
+    assert_eq!(names(&u), ["rgb sigma_a", "rgb sigma_s", "float density"]);
+    assert_eq!(u.params[1].floats, [2.55, 3.21, 3.77]);
+    assert_eq!(u.diagnostics.len(), 1);
+    assert!(!u.diagnostics[0].is_error());
+    assert_eq!(u.diagnostics[0].loc.as_ref().map(|l| l.line), Some(3));
+    assert!(u.diagnostics[0].message.contains("preset"));
+
+    // pbrt-v4 media are left alone.
+    let u = upgrade_medium("homogeneous", vec![f("float", "scale", &[2.])], &loc(1));
+    assert_eq!(u.name, "homogeneous");
+    assert_eq!(names(&u), ["float scale"]);
+}
+
+#[test]
 fn textures() {
     let (ty, u) = upgrade_texture(
         "float",

@@ -1,18 +1,25 @@
 //! Medium creation (pbrt-v4 `Medium::Create` and each medium's `Create` in
 //! `media.cpp`): a `MakeNamedMedium` directive's type and parameters turned
 //! into a [`Medium`], with located errors for values no medium can have.
+//! The grid media's own creation lives with them; the parameter checks
+//! they share are here.
 
 use super::nanovdb::{read_float_grid, require_float_grid, FloatGrid, GridClass, NanoVdbError};
-use super::{HomogeneousMedium, Medium, NanoVdbMedium, NanoVdbTemperature};
+use super::{CloudMedium, GridMedium, HomogeneousMedium, Medium, NanoVdbMedium, NanoVdbTemperature, RgbGridMedium};
 use crate::material::data::get_medium_scattering_properties;
 use crate::params::{unknown_type, ParamReader};
 use crate::spectrum::{spectrum_to_photometric, DenselySampledSpectrum, Spectrum, SpectrumType};
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::transform::Transform;
+use rpbrt_geometry::tuple::Point3f;
+use rpbrt_geometry::Bounds3f;
 use rpbrt_parser::Diagnostic;
 
 /// The medium types `MakeNamedMedium` accepts, sorted.
 pub const MEDIUM_NAMES: &[&str] = &["cloud", "homogeneous", "nanovdb", "rgbgrid", "uniformgrid"];
+
+/// The most samples a grid may have (so that indices stay in `i32`).
+pub const MAX_GRID_SAMPLES: u64 = i32::MAX as u64;
 
 /// Creates the medium of a `MakeNamedMedium` directive of type `name`;
 /// `render_from_medium` is the transformation in effect there.
@@ -24,10 +31,13 @@ pub fn create_medium(
     match name {
         "homogeneous" => create_homogeneous(mp).map(Medium::Homogeneous),
         "nanovdb" => create_nanovdb(mp, render_from_medium).map(|m| Medium::NanoVdb(Box::new(m))),
-        "uniformgrid" | "rgbgrid" | "cloud" => Err(Diagnostic::error(
-            mp.loc().clone(),
-            format!("the \"{name}\" medium is not supported yet"),
-        )),
+        "uniformgrid" => {
+            GridMedium::create(mp, render_from_medium).map(|m| Medium::UniformGrid(Box::new(m)))
+        }
+        "rgbgrid" => {
+            RgbGridMedium::create(mp, render_from_medium).map(|m| Medium::RgbGrid(Box::new(m)))
+        }
+        "cloud" => CloudMedium::create(mp, render_from_medium).map(|m| Medium::Cloud(Box::new(m))),
         _ => Err(unknown_type("medium", name, MEDIUM_NAMES, mp.loc())),
     }
 }
@@ -81,22 +91,111 @@ pub(super) fn coefficient(mp: &ParamReader, name: &str) -> Result<Spectrum, Diag
 /// black) and its scale, divided by the spectrum's photometric value as
 /// pbrt-v4 does for media.
 pub(super) fn emission(mp: &ParamReader) -> Result<(Spectrum, Float), Diagnostic> {
-    let le = mp.spectrum("Le", SpectrumType::Illuminant)?;
-    let mut scale = mp.float("Lescale", 1.0)?;
+    let le = le_spectrum(mp)?;
+    let scale = mp.float("Lescale", 1.0)?;
     if !scale.is_finite() {
         return Err(mp.error_at("Lescale", "\"Lescale\" must be finite"));
     }
-    match le {
-        Some(le) if le.max_value() != 0.0 => {
-            let dense = DenselySampledSpectrum::new(&le);
-            if dense.values().iter().any(|v| !v.is_finite()) {
-                return Err(mp.error_at("Le", "\"Le\" must be finite"));
-            }
-            scale /= spectrum_to_photometric(&le);
-            Ok((le, scale))
-        }
-        _ => Ok((Spectrum::constant(0.0), scale)),
+    Ok(match le {
+        Some((le, norm)) => (le, scale * norm),
+        None => (Spectrum::constant(0.0), scale),
+    })
+}
+
+/// `"Le"` when given: the spectrum (zero when black) and the factor that
+/// normalises it, one over its photometric value (one for black).
+pub(super) fn le_spectrum(mp: &ParamReader) -> Result<Option<(Spectrum, Float)>, Diagnostic> {
+    let Some(le) = mp.spectrum("Le", SpectrumType::Illuminant)? else {
+        return Ok(None);
+    };
+    let dense = DenselySampledSpectrum::new(&le);
+    if dense.values().iter().any(|v| !v.is_finite()) {
+        return Err(mp.error_at("Le", "\"Le\" must be finite"));
     }
+    if le.max_value() == 0.0 {
+        return Ok(Some((Spectrum::constant(0.0), 1.0)));
+    }
+    let norm = 1.0 / spectrum_to_photometric(&le);
+    if !norm.is_finite() {
+        return Err(mp.error_at("Le", "\"Le\" has no visible emission to normalise it by"));
+    }
+    Ok(Some((le, norm)))
+}
+
+/// `"nx"`, `"ny"`, `"nz"` (default 1 each) and their product, checked to
+/// be positive and at most [`MAX_GRID_SAMPLES`] before anything is
+/// allocated for the grid.
+pub(super) fn grid_resolution(mp: &ParamReader) -> Result<(i32, i32, i32, u64), Diagnostic> {
+    let mut n = [0i32; 3];
+    for (i, name) in ["nx", "ny", "nz"].into_iter().enumerate() {
+        let v = mp.int(name, 1)?;
+        if v <= 0 {
+            return Err(mp.error_at(name, format!("\"{name}\" must be positive, got {v}")));
+        }
+        n[i] = v;
+    }
+    let total = n.iter().fold(1u64, |acc, &v| acc.saturating_mul(v as u64));
+    if total > MAX_GRID_SAMPLES {
+        let at = if mp.has("nz") { "nz" } else if mp.has("ny") { "ny" } else { "nx" };
+        return Err(mp.error_at(
+            at,
+            format!(
+                "grid resolution {} x {} x {} is too large (more than {MAX_GRID_SAMPLES} samples)",
+                n[0], n[1], n[2]
+            ),
+        ));
+    }
+    Ok((n[0], n[1], n[2], total))
+}
+
+/// Checks that every value of float array `name` is finite and
+/// non-negative.
+pub(super) fn check_values(mp: &ParamReader, name: &str, values: &[Float]) -> Result<(), Diagnostic> {
+    if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !(v.is_finite() && **v >= 0.0)) {
+        return Err(mp.error_at(
+            name,
+            format!("\"{name}\" values must be finite and non-negative; value {i} is {v}"),
+        ));
+    }
+    Ok(())
+}
+
+/// `"p0"` and `"p1"` (default the unit cube): the medium's box, checked to
+/// be finite, with `p0` below `p1` on every axis.
+pub(super) fn grid_bounds(mp: &ParamReader) -> Result<Bounds3f, Diagnostic> {
+    let p0 = mp.point3("p0", [0.0; 3])?;
+    let p1 = mp.point3("p1", [1.0; 3])?;
+    for (name, p) in [("p0", p0), ("p1", p1)] {
+        if p.iter().any(|v| !v.is_finite()) {
+            return Err(mp.error_at(
+                name,
+                format!("\"{name}\" must be finite, got ({}, {}, {})", p[0], p[1], p[2]),
+            ));
+        }
+    }
+    let at = if mp.has("p1") { "p1" } else { "p0" };
+    if (0..3).any(|i| p0[i] == p1[i]) {
+        return Err(mp.error_at(
+            at,
+            format!(
+                "grid with zero-size bounds: p0 = ({}, {}, {}), p1 = ({}, {}, {})",
+                p0[0], p0[1], p0[2], p1[0], p1[1], p1[2]
+            ),
+        ));
+    }
+    if (0..3).any(|i| p0[i] > p1[i]) {
+        return Err(mp.error_at(
+            at,
+            format!(
+                "grid with inverted bounds: p0 = ({}, {}, {}) must be below p1 = ({}, {}, {}) on every axis",
+                p0[0], p0[1], p0[2], p1[0], p1[1], p1[2]
+            ),
+        ));
+    }
+    Ok(Bounds3f::new(
+        Point3f::new(p0[0], p0[1], p0[2]),
+        Point3f::new(p1[0], p1[1], p1[2]),
+    ))
 }
 
 /// A float parameter that must be finite and non-negative.

@@ -100,6 +100,12 @@ pub struct HomogeneousMajorantIterator {
 }
 
 impl HomogeneousMajorantIterator {
+    /// An iterator with no segment (a ray that misses the medium).
+    #[inline]
+    pub fn empty() -> Self {
+        HomogeneousMajorantIterator { seg: None }
+    }
+
     /// The segment `[t_min, t_max]` with majorant `sigma_maj`.
     #[inline]
     pub fn new(t_min: Float, t_max: Float, sigma_maj: SampledSpectrum) -> Self {

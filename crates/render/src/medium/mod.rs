@@ -5,21 +5,34 @@
 //! builds on.
 //!
 //! The files: `phase`, the phase function; `majorant`, majorant segments,
-//! the majorant grid and its DDA walk; one file per medium type; `create`,
-//! creation from `MakeNamedMedium`.
+//! the majorant grid and its DDA walk; `sampled_grid`, trilinearly
+//! interpolated sample grids; one file per medium type (`homogeneous`,
+//! `grid`, `rgbgrid`, `cloud`), each with its creation; `create`,
+//! creation from `MakeNamedMedium` and the parameter checks the media
+//! share.
 
+mod cloud;
 mod create;
+mod grid;
 mod homogeneous;
 mod majorant;
 pub mod nanovdb;
 mod nanovdb_medium;
 mod phase;
+mod rgbgrid;
+mod sampled_grid;
+#[cfg(test)]
+mod grid_tests;
 #[cfg(test)]
 mod tests;
 
-pub use create::{create_medium, MEDIUM_NAMES};
+pub use cloud::{CloudMedium, CloudMediumParts};
+pub use create::{create_medium, MAX_GRID_SAMPLES, MEDIUM_NAMES};
+pub use grid::{GridMedium, GridMediumParts, GRID_MAJORANT_RES};
 pub use homogeneous::HomogeneousMedium;
 pub use nanovdb_medium::{NanoVdbMedium, NanoVdbTemperature};
+pub use rgbgrid::{RgbEmissionGrid, RgbGridMedium, RgbGridMediumParts, RGB_GRID_MAJORANT_RES};
+pub use sampled_grid::{GridValue, Interpolant, SampledGrid};
 pub use majorant::{DdaMajorantIterator, HomogeneousMajorantIterator, MajorantGrid, RayMajorantSegment};
 pub use phase::{henyey_greenstein, sample_henyey_greenstein, HGPhaseFunction, PhaseFunctionSample};
 
@@ -58,13 +71,20 @@ pub(crate) trait ConcreteMedium {
         -> Self::Majorants<'a>;
 }
 
-/// The closed set of participating media (pbrt-v4 `Medium`).
+/// The closed set of participating media (pbrt-v4 `Medium`). The grid
+/// media are boxed to keep the enum small.
 #[derive(Clone, Debug)]
 pub enum Medium {
     /// `homogeneous`.
     Homogeneous(HomogeneousMedium),
     /// `nanovdb` (boxed: its grids and majorants make it large).
     NanoVdb(Box<NanoVdbMedium>),
+    /// `uniformgrid` (and pbrt-v3's `heterogeneous`).
+    UniformGrid(Box<GridMedium>),
+    /// `rgbgrid`.
+    RgbGrid(Box<RgbGridMedium>),
+    /// `cloud`.
+    Cloud(Box<CloudMedium>),
 }
 
 impl Medium {
@@ -74,6 +94,9 @@ impl Medium {
         match self {
             Medium::Homogeneous(m) => m.is_emissive(),
             Medium::NanoVdb(m) => m.is_emissive(),
+            Medium::UniformGrid(m) => m.is_emissive(),
+            Medium::RgbGrid(m) => m.is_emissive(),
+            Medium::Cloud(_) => false,
         }
     }
 
@@ -83,6 +106,9 @@ impl Medium {
         match self {
             Medium::Homogeneous(m) => m.sample_point(p, lambda),
             Medium::NanoVdb(m) => m.sample_point(p, lambda),
+            Medium::UniformGrid(m) => m.sample_point(p, lambda),
+            Medium::RgbGrid(m) => m.sample_point(p, lambda),
+            Medium::Cloud(m) => m.sample_point(p, lambda),
         }
     }
 
@@ -98,6 +124,9 @@ impl Medium {
         match self {
             Medium::Homogeneous(m) => m.sample_ray(&ray, t_max, lambda).collect(),
             Medium::NanoVdb(m) => m.sample_ray(&ray, t_max, lambda).collect(),
+            Medium::UniformGrid(m) => m.sample_ray(&ray, t_max, lambda).collect(),
+            Medium::RgbGrid(m) => m.sample_ray(&ray, t_max, lambda).collect(),
+            Medium::Cloud(m) => m.sample_ray(&ray, t_max, lambda).collect(),
         }
     }
 }
@@ -138,6 +167,9 @@ pub fn sample_t_maj(
     match medium {
         Medium::Homogeneous(m) => sample_t_maj_in(m, ray, t_max, u, rng, lambda, callback),
         Medium::NanoVdb(m) => sample_t_maj_in(&**m, ray, t_max, u, rng, lambda, callback),
+        Medium::UniformGrid(m) => sample_t_maj_in(&**m, ray, t_max, u, rng, lambda, callback),
+        Medium::RgbGrid(m) => sample_t_maj_in(&**m, ray, t_max, u, rng, lambda, callback),
+        Medium::Cloud(m) => sample_t_maj_in(&**m, ray, t_max, u, rng, lambda, callback),
     }
 }
 
