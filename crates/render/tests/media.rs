@@ -80,6 +80,14 @@ fn emitter_through_an_absorbing_slab() {
         let im = render_scene(&slab_scene(&tag, i, medium), 0);
         check(&tag, &im, (-0.5f64).exp(), 0.01);
     }
+    // The same slab as a constant `uniformgrid`: a grid's density falls off
+    // within half a cell of its bounds, so they reach past the slab.
+    let grid = "MakeNamedMedium \"slab\" \"string type\" \"uniformgrid\" \"rgb sigma_a\" [ 0.5 0.5 0.5 ] \"rgb sigma_s\" [ 0 0 0 ] \"integer nx\" 2 \"integer ny\" 2 \"integer nz\" 4 \"float density\" [ 1 1 1 1 1 1 1 1 1 1 1 1 1 1 1 1 ] \"point3 p0\" [ -20 -20 0 ] \"point3 p1\" [ 20 20 3 ]\n";
+    for i in ["volpath", "simplevolpath"] {
+        let tag = format!("slab-grid-{i}");
+        let im = render_scene(&slab_scene(&tag, i, grid), 0);
+        check(&tag, &im, (-0.5f64).exp(), 0.01);
+    }
     // Without the medium the interfaces are invisible.
     let im = render_scene(&slab_scene("slab-none", "volpath", "MakeNamedMedium \"slab\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [ 0 0 0 ] \"rgb sigma_s\" [ 0 0 0 ]\n"), 0);
     check("slab-none", &im, 1.0, 0.005);

@@ -365,7 +365,7 @@ fn create_subsurface(
     let constant = |s: Spectrum| -> SpectrumTextureRef { Arc::new(SpectrumTexture::Constant(s)) };
     let coefficients = if !name.is_empty() {
         let Some((sa, ss)) = get_medium_scattering_properties(&name) else {
-            let known: Vec<&str> = data::measured_medium_names().collect();
+            let known: Vec<&str> = crate::medium::measured::measured_medium_names().collect();
             return Err(Diagnostic::error(
                 tp.param_loc("name"),
                 format!(

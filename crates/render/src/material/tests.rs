@@ -345,7 +345,7 @@ fn subsurface_has_dielectric_boundary_and_bssrdf_flag() {
 
 #[test]
 fn measured_media_table_lookups() {
-    assert_eq!(data::MEASURED_MEDIA.len(), 47);
+    assert_eq!(crate::medium::measured::MEASURED_MEDIA.len(), 47);
     assert!(get_medium_scattering_properties("Ketchup").is_some());
     assert!(get_medium_scattering_properties("Pacific Ocean Surface Water").is_some());
     assert!(get_medium_scattering_properties("ketchup").is_none());

@@ -6,7 +6,7 @@
 
 use super::nanovdb::{read_float_grid, require_float_grid, FloatGrid, GridClass, NanoVdbError};
 use super::{CloudMedium, GridMedium, HomogeneousMedium, Medium, NanoVdbMedium, NanoVdbTemperature, RgbGridMedium};
-use crate::material::data::get_medium_scattering_properties;
+use super::measured::get_medium_scattering_properties;
 use crate::params::{unknown_type, ParamReader};
 use crate::spectrum::{spectrum_to_photometric, DenselySampledSpectrum, Spectrum, SpectrumType};
 use rpbrt_geometry::float::Float;

@@ -79,16 +79,28 @@ impl MajorantGrid {
         )
     }
 
-    /// Fills every voxel with `f(voxel bounds in [0, 1]³)`.
-    pub fn fill(&mut self, mut f: impl FnMut(&Bounds3f) -> Float) {
-        for z in 0..self.res[2] {
-            for y in 0..self.res[1] {
-                for x in 0..self.res[0] {
-                    let b = self.voxel_bounds(x, y, z);
-                    self.set(x, y, z, f(&b));
+    /// Fills every voxel with `f(voxel bounds in [0, 1]³)`, slices of
+    /// constant z in parallel (each voxel's value depends on it alone).
+    pub fn fill(&mut self, f: impl Fn(&Bounds3f) -> Float + Sync) {
+        use rayon::prelude::*;
+        let [rx, ry, _] = self.res;
+        let slice = (rx * ry) as usize;
+        let this = MajorantGrid {
+            bounds: self.bounds,
+            voxels: Vec::new(),
+            res: self.res,
+        };
+        self.voxels
+            .par_chunks_mut(slice)
+            .enumerate()
+            .for_each(|(z, out)| {
+                for y in 0..ry {
+                    for x in 0..rx {
+                        let b = this.voxel_bounds(x, y, z as i32);
+                        out[(x + rx * y) as usize] = f(&b);
+                    }
                 }
-            }
-        }
+            });
     }
 }
 

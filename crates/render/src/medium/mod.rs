@@ -16,6 +16,7 @@ mod create;
 mod grid;
 mod homogeneous;
 mod majorant;
+pub mod measured;
 pub mod nanovdb;
 mod nanovdb_medium;
 mod phase;
@@ -173,48 +174,70 @@ pub fn sample_t_maj(
     }
 }
 
+/// The most tentative collisions one [`sample_t_maj`] walk takes. Real
+/// media stop far earlier (a real collision ends the walk of a path, and
+/// Russian roulette that of a shadow ray); only majorants many orders of
+/// magnitude above the density they bound get here.
+pub const MAX_COLLISIONS: u32 = 1 << 22;
+
 /// [`sample_t_maj`] for one medium type.
 #[inline(always)]
 fn sample_t_maj_in<M: ConcreteMedium>(
     medium: &M,
     ray: &Ray,
     t_max: Float,
-    mut u: Float,
+    u: Float,
     rng: &mut Rng,
     lambda: &SampledWavelengths,
     mut callback: impl FnMut(Point3f, &MediumProperties, SampledSpectrum, SampledSpectrum, &mut Rng) -> bool,
 ) -> SampledSpectrum {
     let (ray, t_max) = normalized(ray, t_max);
-    let mut t_maj = SampledSpectrum::new(1.0);
+    // The collision distance is sampled as an optical depth in the hero
+    // wavelength's majorant and spent segment by segment: the same
+    // exponential distribution as pbrt-v4's fresh sample per segment (the
+    // process is memoryless), without a logarithm, an exponential and a
+    // random number for every majorant-grid voxel the ray crosses. The
+    // majorant optical depth of every wavelength since the last collision
+    // is summed and exponentiated once per collision.
+    let mut tau = sample_exponential(u, 1.0);
+    let mut depth = SampledSpectrum::new(0.0);
+    let mut collisions = 0u32;
     for seg in medium.sample_ray(&ray, t_max, lambda) {
-        if seg.sigma_maj[0] == 0.0 {
-            // Nothing to collide with: the majorant transmittance of the
-            // whole segment (unbounded segments kept finite).
-            let dt = finite(seg.t_max - seg.t_min);
-            t_maj *= fast_exp_spectrum(-dt * seg.sigma_maj);
-            continue;
-        }
+        let sigma = seg.sigma_maj[0];
         let mut t_min = seg.t_min;
         loop {
-            let t = t_min + sample_exponential(u, seg.sigma_maj[0]);
-            u = rng.uniform_float();
-            if t < seg.t_max {
-                t_maj *= fast_exp_spectrum(-(t - t_min) * seg.sigma_maj);
-                let p = ray.at(t);
-                let mp = medium.sample_point(p, lambda);
-                if !callback(p, &mp, seg.sigma_maj, t_maj, rng) {
-                    return SampledSpectrum::new(1.0);
+            if sigma > 0.0 {
+                let t = t_min + (tau / sigma).max(0.0);
+                if t < seg.t_max {
+                    collisions += 1;
+                    if collisions > MAX_COLLISIONS {
+                        // A guard against majorants absurdly above the
+                        // density (a file's claims): the walk ends as if
+                        // the ray were absorbed, rather than hanging.
+                        return SampledSpectrum::new(0.0);
+                    }
+                    depth += (t - t_min) * seg.sigma_maj;
+                    let t_maj = fast_exp_spectrum(-depth);
+                    let p = ray.at(t);
+                    let mp = medium.sample_point(p, lambda);
+                    if !callback(p, &mp, seg.sigma_maj, t_maj, rng) {
+                        return SampledSpectrum::new(1.0);
+                    }
+                    depth = SampledSpectrum::new(0.0);
+                    tau = sample_exponential(rng.uniform_float(), 1.0);
+                    t_min = t;
+                    continue;
                 }
-                t_maj = SampledSpectrum::new(1.0);
-                t_min = t;
-            } else {
-                let dt = finite(seg.t_max - t_min);
-                t_maj *= fast_exp_spectrum(-dt * seg.sigma_maj);
-                break;
             }
+            // No collision in the rest of the segment (unbounded segments
+            // kept finite so that a zero majorant gives zero depth).
+            let dt = finite(seg.t_max - t_min);
+            tau -= sigma * dt;
+            depth += dt * seg.sigma_maj;
+            break;
         }
     }
-    t_maj
+    fast_exp_spectrum(-depth)
 }
 
 /// pbrt-v4's `FastExp`: eˣ as 2^(x·log₂e), with 2^f on [0, 1) from a

@@ -4,6 +4,7 @@
 
 mod camera;
 mod materials;
+mod media;
 mod textures;
 
 use std::collections::HashMap;

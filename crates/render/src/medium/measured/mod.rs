@@ -1,5 +1,6 @@
-//! Measured data for materials: scattering properties of named media
-//! (pbrt-v4 `GetMediumScatteringProperties` in `media.cpp`).
+//! Measured scattering properties of named media (pbrt-v4
+//! `GetMediumScatteringProperties` in `media.cpp`), for homogeneous media's
+//! `preset` and the `subsurface` material's `name`.
 
 use crate::spectrum::{RgbColorSpace, RgbUnboundedSpectrum, Spectrum, RGB};
 
