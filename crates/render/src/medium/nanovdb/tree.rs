@@ -320,9 +320,25 @@ impl FloatGrid {
     /// (interpolated along z, then y, then x, as NanoVDB does).
     #[inline]
     pub fn sample_trilinear(&self, p_index: [f32; 3]) -> f32 {
-        let f = [p_index[0].floor(), p_index[1].floor(), p_index[2].floor()];
-        let w = [p_index[0] - f[0], p_index[1] - f[1], p_index[2] - f[2]];
-        let v = self.stencil([f[0] as i32, f[1] as i32, f[2] as i32]);
+        // ⌊x⌋ by truncation and a correction (`floor` is a libm call on
+        // baseline x86-64); coordinates are first kept where i32 and f32
+        // agree, far outside any grid (NaN stays NaN in the weights).
+        let floor = |x: f32| {
+            let x = x.clamp(-1e9, 1e9);
+            let i = x as i32;
+            if (i as f32) > x {
+                i - 1
+            } else {
+                i
+            }
+        };
+        let i = [floor(p_index[0]), floor(p_index[1]), floor(p_index[2])];
+        let w = [
+            p_index[0].clamp(-1e9, 1e9) - i[0] as f32,
+            p_index[1].clamp(-1e9, 1e9) - i[1] as f32,
+            p_index[2].clamp(-1e9, 1e9) - i[2] as f32,
+        ];
+        let v = self.stencil(i);
         let x0 = lerp(lerp(v[0], v[1], w[2]), lerp(v[2], v[3], w[2]), w[1]);
         let x1 = lerp(lerp(v[4], v[5], w[2]), lerp(v[6], v[7], w[2]), w[1]);
         lerp(x0, x1, w[0])
