@@ -61,7 +61,7 @@ fn sample_event(sigma_a: Float, sigma_s: Float, sigma_maj: Float, u: Float) -> u
     let p_scatter = sigma_s / sigma_maj;
     let p_null = (1.0 - p_absorb - p_scatter).max(0.0);
     let sum = p_absorb + p_scatter + p_null;
-    if !(sum > 0.0) {
+    if sum.is_nan() || sum <= 0.0 {
         return 2;
     }
     let up = u * sum;

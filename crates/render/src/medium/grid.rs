@@ -290,11 +290,7 @@ impl ConcreteMedium for GridMedium {
         t_max: Float,
         lambda: &SampledWavelengths,
     ) -> DdaMajorantIterator<'a> {
-        let (ray, t_max) = self.medium_from_render.apply_ray(ray, t_max);
-        let Some((t0, t1)) = self.bounds.intersect_p(ray.o, ray.d, t_max) else {
-            return DdaMajorantIterator::empty();
-        };
         let sigma_t = self.sigma_a.sample(lambda) + self.sigma_s.sample(lambda);
-        DdaMajorantIterator::new(&ray, t0, t1, &self.majorant, sigma_t)
+        DdaMajorantIterator::through_grid(ray, t_max, &self.medium_from_render, &self.majorant, sigma_t)
     }
 }

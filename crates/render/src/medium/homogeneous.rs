@@ -3,7 +3,7 @@
 //! majorant segment per ray.
 
 use super::majorant::HomogeneousMajorantIterator;
-use super::{ConcreteMedium, HGPhaseFunction, MediumProperties};
+use super::{scaled_spectrum, ConcreteMedium, HGPhaseFunction, MediumProperties};
 use crate::spectrum::{DenselySampledSpectrum, SampledSpectrum, SampledWavelengths, Spectrum};
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::ray::Ray;
@@ -31,15 +31,10 @@ impl HomogeneousMedium {
         le_scale: Float,
         g: Float,
     ) -> Self {
-        let scaled = |s: &Spectrum, k: Float| {
-            let d = DenselySampledSpectrum::new(s);
-            let values = d.values().iter().map(|v| v * k).collect();
-            DenselySampledSpectrum::from_values(d.lambda_min(), values)
-        };
-        let le = scaled(le, le_scale);
+        let le = scaled_spectrum(le, le_scale);
         HomogeneousMedium {
-            sigma_a: scaled(sigma_a, sigma_scale),
-            sigma_s: scaled(sigma_s, sigma_scale),
+            sigma_a: scaled_spectrum(sigma_a, sigma_scale),
+            sigma_s: scaled_spectrum(sigma_s, sigma_scale),
             emissive: le.max_value() > 0.0,
             le,
             phase: HGPhaseFunction::new(g),

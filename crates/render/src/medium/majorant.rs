@@ -8,6 +8,7 @@
 use crate::spectrum::SampledSpectrum;
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::ray::Ray;
+use rpbrt_geometry::transform::Transform;
 use rpbrt_geometry::tuple::*;
 use rpbrt_geometry::Bounds3f;
 
@@ -217,6 +218,27 @@ impl<'a> DdaMajorantIterator<'a> {
             }
         }
         it
+    }
+}
+
+impl<'a> DdaMajorantIterator<'a> {
+    /// The walk of a rendering-space `ray` over `[0, t_max]` through
+    /// `grid`, whose bounds are in the medium space `medium_from_render`
+    /// maps to (empty when the ray misses them): what every grid medium's
+    /// `SampleRay` does in pbrt-v4.
+    #[inline]
+    pub fn through_grid(
+        ray: &Ray,
+        t_max: Float,
+        medium_from_render: &Transform,
+        grid: &'a MajorantGrid,
+        sigma_t: SampledSpectrum,
+    ) -> Self {
+        let (ray, t_max) = medium_from_render.apply_ray(ray, t_max);
+        match grid.bounds.intersect_p(ray.o, ray.d, t_max) {
+            Some((t0, t1)) => DdaMajorantIterator::new(&ray, t0, t1, grid, sigma_t),
+            None => DdaMajorantIterator::empty(),
+        }
     }
 }
 

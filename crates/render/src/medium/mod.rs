@@ -141,6 +141,14 @@ fn normalized(ray: &Ray, t_max: Float) -> (Ray, Float) {
     (r, t_max * len)
 }
 
+/// `s` tabulated at every nanometre and multiplied by `k` (pbrt-v4's
+/// `DenselySampledSpectrum` followed by `Scale`).
+pub(crate) fn scaled_spectrum(s: &crate::spectrum::Spectrum, k: Float) -> crate::spectrum::DenselySampledSpectrum {
+    let mut d = crate::spectrum::DenselySampledSpectrum::new(s);
+    d.scale(k);
+    d
+}
+
 /// `−ln(1 − u) / a`: a sample of the exponential distribution with rate `a`.
 #[inline]
 pub fn sample_exponential(u: Float, a: Float) -> Float {

@@ -5,7 +5,7 @@
 
 use super::majorant::{DdaMajorantIterator, MajorantGrid};
 use super::nanovdb::FloatGrid;
-use super::{ConcreteMedium, HGPhaseFunction, MediumProperties};
+use super::{scaled_spectrum, ConcreteMedium, HGPhaseFunction, MediumProperties};
 use crate::spectrum::{
     DenselySampledSpectrum, SampledSpectrum, SampledWavelengths, Spectrum,
 };
@@ -34,20 +34,13 @@ pub struct NanoVdbTemperature {
 /// pbrt-v4's `nanovdb` medium.
 #[derive(Clone, Debug)]
 pub struct NanoVdbMedium {
-    bounds: Bounds3f,
-    render_from_medium: Transform,
+    medium_from_render: Transform,
     sigma_a: DenselySampledSpectrum,
     sigma_s: DenselySampledSpectrum,
     phase: HGPhaseFunction,
     majorants: MajorantGrid,
     density: FloatGrid,
     temperature: Option<NanoVdbTemperature>,
-}
-
-fn scaled(s: &Spectrum, k: Float) -> DenselySampledSpectrum {
-    let d = DenselySampledSpectrum::new(s);
-    let values = d.values().iter().map(|v| v * k).collect();
-    DenselySampledSpectrum::from_values(d.lambda_min(), values)
 }
 
 fn bbox_of(g: &FloatGrid) -> Bounds3f {
@@ -111,10 +104,9 @@ impl NanoVdbMedium {
             m
         });
         NanoVdbMedium {
-            bounds,
-            render_from_medium,
-            sigma_a: scaled(sigma_a, sigma_scale),
-            sigma_s: scaled(sigma_s, sigma_scale),
+            medium_from_render: render_from_medium.inverse(),
+            sigma_a: scaled_spectrum(sigma_a, sigma_scale),
+            sigma_s: scaled_spectrum(sigma_s, sigma_scale),
             phase: HGPhaseFunction::new(g),
             majorants,
             density,
@@ -146,7 +138,7 @@ impl ConcreteMedium for NanoVdbMedium {
 
     #[inline]
     fn sample_point(&self, p: Point3f, lambda: &SampledWavelengths) -> MediumProperties {
-        let p = self.render_from_medium.apply_inverse_point(p);
+        let p = self.medium_from_render.apply_point(p);
         let p = [p.x, p.y, p.z];
         let d = self.density.sample_trilinear(self.density.world_to_index(p));
         MediumProperties {
@@ -164,11 +156,7 @@ impl ConcreteMedium for NanoVdbMedium {
         t_max: Float,
         lambda: &SampledWavelengths,
     ) -> DdaMajorantIterator<'a> {
-        let (ray, t_max) = self.render_from_medium.apply_inverse_ray(ray, t_max);
-        let Some((t0, t1)) = self.bounds.intersect_p(ray.o, ray.d, t_max) else {
-            return DdaMajorantIterator::empty();
-        };
         let sigma_t = self.sigma_a.sample(lambda) + self.sigma_s.sample(lambda);
-        DdaMajorantIterator::new(&ray, t0, t1, &self.majorants, sigma_t)
+        DdaMajorantIterator::through_grid(ray, t_max, &self.medium_from_render, &self.majorants, sigma_t)
     }
 }

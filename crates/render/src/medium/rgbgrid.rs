@@ -265,11 +265,8 @@ impl ConcreteMedium for RgbGridMedium {
         t_max: Float,
         _lambda: &SampledWavelengths,
     ) -> DdaMajorantIterator<'a> {
-        let (ray, t_max) = self.medium_from_render.apply_ray(ray, t_max);
-        let Some((t0, t1)) = self.bounds.intersect_p(ray.o, ray.d, t_max) else {
-            return DdaMajorantIterator::empty();
-        };
         // The majorant grid holds extinctions already.
-        DdaMajorantIterator::new(&ray, t0, t1, &self.majorant, SampledSpectrum::new(1.0))
+        let one = SampledSpectrum::new(1.0);
+        DdaMajorantIterator::through_grid(ray, t_max, &self.medium_from_render, &self.majorant, one)
     }
 }
