@@ -76,13 +76,7 @@ pub(crate) fn sample_ld(
     u_light: Point2f,
 ) -> SampledSpectrum {
     let si = origins.si;
-    let mut ctx = LightSampleContext::from_si(si);
-    let flags = bsdf.flags();
-    if flags.is_reflective() && !flags.is_transmissive() {
-        ctx.pi = Point3fi::from(origins.toward(si.wo));
-    } else if flags.is_transmissive() && !flags.is_reflective() {
-        ctx.pi = Point3fi::from(origins.toward(-si.wo));
-    }
+    let ctx = surface_light_context(origins, bsdf);
     let sampled = light_sampler.sample(&ctx, u);
     let Some(sampled) = sampled else {
         return SampledSpectrum::new(0.0);
@@ -115,6 +109,22 @@ pub(crate) fn sample_ld(
     );
     let w_l = crate::sampling::power_heuristic(1.0, p_l, 1.0, p_b);
     ls.l * f * (w_l / p_l)
+}
+
+/// The light-sampling context of a surface vertex, its point nudged off
+/// the surface to the side the BSDF can receive light from (pbrt-v4
+/// `SampleLd`'s start), with the vertex's cached offset origins.
+#[inline]
+pub(crate) fn surface_light_context(origins: &mut VertexOrigins, bsdf: &BSDF) -> LightSampleContext {
+    let si = origins.si;
+    let mut ctx = LightSampleContext::from_si(si);
+    let flags = bsdf.flags();
+    if flags.is_reflective() && !flags.is_transmissive() {
+        ctx.pi = Point3fi::from(origins.toward(si.wo));
+    } else if flags.is_transmissive() && !flags.is_reflective() {
+        ctx.pi = Point3fi::from(origins.toward(-si.wo));
+    }
+    ctx
 }
 
 /// True when a sample of light `light` cannot contribute at the surface

@@ -4,7 +4,7 @@
 //! light sampling through media and interfaces by ratio tracking, medium
 //! emission, and subsurface scattering through the materials' BSSRDFs.
 
-use super::direct::light_sample_culled;
+use super::direct::{light_sample_culled, surface_light_context};
 use super::volume::{
     hit_medium_toward, medium_toward, segment_rng, shadow_transmittance, ShadowTransmittance,
 };
@@ -93,19 +93,7 @@ impl VolPathIntegrator {
         let zero = SampledSpectrum::new(0.0);
         let mut vertex = vertex;
         let ctx = match &mut vertex {
-            LdVertex::Surface { origins, bsdf, .. } => {
-                // Nudged to the side the light can be on, with the
-                // vertex's cached offset origins.
-                let si = origins.si;
-                let mut ctx = LightSampleContext::from_si(si);
-                let flags = bsdf.flags();
-                if flags.is_reflective() && !flags.is_transmissive() {
-                    ctx.pi = Point3fi::from(origins.toward(si.wo));
-                } else if flags.is_transmissive() && !flags.is_reflective() {
-                    ctx.pi = Point3fi::from(origins.toward(-si.wo));
-                }
-                ctx
-            }
+            LdVertex::Surface { origins, bsdf, .. } => surface_light_context(origins, bsdf),
             LdVertex::Medium { p, .. } => LightSampleContext::from_point(*p),
         };
         let Some(sampled) = scene.light_sampler.sample(&ctx, u) else {
