@@ -145,6 +145,34 @@ impl Mul for Interval {
     type Output = Interval;
     #[inline]
     fn mul(self, o: Interval) -> Interval {
+        // When the signs of both intervals are known, the extreme products
+        // are known too: the same bounds as the minimum and maximum of all
+        // four (rounding is monotonic), for two products instead of eight.
+        let (a, b) = (self, o);
+        if a.low >= 0.0 {
+            if b.low >= 0.0 {
+                return Interval::bounds(a.low, b.low, a.high, b.high);
+            }
+            if b.high <= 0.0 {
+                return Interval::bounds(a.high, b.low, a.low, b.high);
+            }
+            return Interval::bounds(a.high, b.low, a.high, b.high);
+        }
+        if a.high <= 0.0 {
+            if b.low >= 0.0 {
+                return Interval::bounds(a.low, b.high, a.high, b.low);
+            }
+            if b.high <= 0.0 {
+                return Interval::bounds(a.high, b.high, a.low, b.low);
+            }
+            return Interval::bounds(a.low, b.high, a.low, b.low);
+        }
+        if b.low >= 0.0 {
+            return Interval::bounds(a.low, b.high, a.high, b.high);
+        }
+        if b.high <= 0.0 {
+            return Interval::bounds(a.high, b.low, a.low, b.low);
+        }
         let lp = [
             mul_round_down(self.low, o.low),
             mul_round_down(self.high, o.low),
@@ -164,6 +192,26 @@ impl Mul for Interval {
     }
 }
 
+impl Interval {
+    /// `[a·b rounded down, c·d rounded up]`.
+    #[inline(always)]
+    fn bounds(a: Float, b: Float, c: Float, d: Float) -> Interval {
+        Interval {
+            low: mul_round_down(a, b),
+            high: mul_round_up(c, d),
+        }
+    }
+
+    /// `[a/b rounded down, c/d rounded up]`.
+    #[inline(always)]
+    fn quotient_bounds(a: Float, b: Float, c: Float, d: Float) -> Interval {
+        Interval {
+            low: div_round_down(a, b),
+            high: div_round_up(c, d),
+        }
+    }
+}
+
 impl Div for Interval {
     type Output = Interval;
     #[inline]
@@ -174,6 +222,27 @@ impl Div for Interval {
                 low: Float::NEG_INFINITY,
                 high: Float::INFINITY,
             };
+        }
+        // A divisor of known sign (it excludes zero) and a dividend of
+        // known sign or straddling zero: the extreme quotients are known.
+        let a = self;
+        if o.low > 0.0 {
+            if a.low >= 0.0 {
+                return Interval::quotient_bounds(a.low, o.high, a.high, o.low);
+            }
+            if a.high <= 0.0 {
+                return Interval::quotient_bounds(a.low, o.low, a.high, o.high);
+            }
+            return Interval::quotient_bounds(a.low, o.low, a.high, o.low);
+        }
+        if o.high < 0.0 {
+            if a.low >= 0.0 {
+                return Interval::quotient_bounds(a.high, o.high, a.low, o.low);
+            }
+            if a.high <= 0.0 {
+                return Interval::quotient_bounds(a.high, o.low, a.low, o.high);
+            }
+            return Interval::quotient_bounds(a.high, o.high, a.low, o.high);
         }
         let lq = [
             div_round_down(self.low, o.low),
@@ -258,6 +327,50 @@ impl Mul<Interval> for Float {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The bounds of all four rounded products or quotients: what the
+    /// sign-case shortcuts of `mul` and `div` must reproduce bit for bit.
+    fn all_four(a: Interval, b: Interval, down: fn(Float, Float) -> Float, up: fn(Float, Float) -> Float) -> Interval {
+        let pairs = [(a.low, b.low), (a.high, b.low), (a.low, b.high), (a.high, b.high)];
+        Interval {
+            low: pairs.iter().map(|&(x, y)| down(x, y)).fold(Float::INFINITY, Float::min),
+            high: pairs.iter().map(|&(x, y)| up(x, y)).fold(Float::NEG_INFINITY, Float::max),
+        }
+    }
+
+    #[test]
+    fn sign_case_products_and_quotients_equal_all_four() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let specials = [0.0, -0.0, 1.0, -1.0, 1e-30, -1e-30, 3.5e20, -3.5e20, 0.1, -7.25];
+        let mut value = || -> Float {
+            let r = next();
+            if r % 4 == 0 {
+                specials[(r >> 8) as usize % specials.len()]
+            } else {
+                let m = ((r >> 8) % 2_000_000) as Float / 1000.0 - 1000.0;
+                m * [1.0, 1e-6, 1e6][(r >> 40) as usize % 3]
+            }
+        };
+        for _ in 0..200_000 {
+            let (x0, x1, y0, y1) = (value(), value(), value(), value());
+            let a = Interval { low: x0.min(x1), high: x0.max(x1) };
+            let b = Interval { low: y0.min(y1), high: y0.max(y1) };
+            let p = a * b;
+            let q = all_four(a, b, mul_round_down, mul_round_up);
+            assert_eq!((p.low.to_bits(), p.high.to_bits()), (q.low.to_bits(), q.high.to_bits()), "{a:?} * {b:?}");
+            if !b.contains(0.0) {
+                let p = a / b;
+                let q = all_four(a, b, div_round_down, div_round_up);
+                assert_eq!((p.low.to_bits(), p.high.to_bits()), (q.low.to_bits(), q.high.to_bits()), "{a:?} / {b:?}");
+            }
+        }
+    }
 
     /// A simple deterministic generator for the tests.
     fn rng(seed: &mut u64) -> f64 {
