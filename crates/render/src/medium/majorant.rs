@@ -154,6 +154,10 @@ pub struct DdaMajorantIterator<'a> {
     step: [i32; 3],
     voxel_limit: [i32; 3],
     voxel: [i32; 3],
+    /// The current voxel's index into the grid's values, and what a step
+    /// along each axis adds to it.
+    index: i32,
+    index_step: [i32; 3],
 }
 
 impl<'a> DdaMajorantIterator<'a> {
@@ -169,6 +173,8 @@ impl<'a> DdaMajorantIterator<'a> {
             step: [0; 3],
             voxel_limit: [0; 3],
             voxel: [0; 3],
+            index: 0,
+            index_step: [0; 3],
         }
     }
 
@@ -194,6 +200,8 @@ impl<'a> DdaMajorantIterator<'a> {
             step: [0; 3],
             voxel_limit: [0; 3],
             voxel: [0; 3],
+            index: 0,
+            index_step: [0; 3],
         };
         for axis in 0..3 {
             let res = grid.res[axis];
@@ -217,6 +225,9 @@ impl<'a> DdaMajorantIterator<'a> {
                 it.voxel_limit[axis] = -1;
             }
         }
+        let strides = [1, grid.res[0], grid.res[0] * grid.res[1]];
+        it.index = it.voxel[0] + strides[1] * it.voxel[1] + strides[2] * it.voxel[2];
+        it.index_step = [0, 1, 2].map(|a| it.step[a] * strides[a]);
         it
     }
 }
@@ -260,7 +271,7 @@ impl Iterator for DdaMajorantIterator<'_> {
         const CMP_TO_AXIS: [usize; 8] = [2, 1, 2, 1, 2, 2, 0, 0];
         let axis = CMP_TO_AXIS[bits];
         let t_exit = self.t_max.min(c[axis]);
-        let density = grid.lookup(self.voxel[0], self.voxel[1], self.voxel[2]);
+        let density = grid.voxels.get(self.index as usize).copied().unwrap_or(0.0);
         let seg = RayMajorantSegment {
             t_min: self.t_min,
             t_max: t_exit,
@@ -271,6 +282,7 @@ impl Iterator for DdaMajorantIterator<'_> {
             self.t_min = self.t_max;
         }
         self.voxel[axis] += self.step[axis];
+        self.index += self.index_step[axis];
         if self.voxel[axis] == self.voxel_limit[axis] {
             self.t_min = self.t_max;
         }
