@@ -13,7 +13,7 @@ use crate::light::{Light, LightCull};
 use crate::lightsampler::LightSampler;
 use crate::material::MaterialSet;
 use crate::medium::Medium;
-use crate::primitive::{PrimitiveAggregate, PrimitiveIntersection};
+use crate::primitive::{HitRecord, PrimitiveAggregate, PrimitiveIntersection};
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::Float;
@@ -114,6 +114,18 @@ impl Scene {
             c.set((closest + 1, shadow));
         });
         self.aggregate.intersect(ray, t_max)
+    }
+
+    /// The closest hit along `ray` in (0, t_max) without its interaction
+    /// (build it with `aggregate.interaction` when needed: bit for bit the
+    /// one [`Scene::intersect`] gives).
+    #[inline]
+    pub fn intersect_record(&self, ray: &Ray, t_max: Float) -> Option<HitRecord> {
+        LOCAL_RAY_COUNTS.with(|c| {
+            let (closest, shadow) = c.get();
+            c.set((closest + 1, shadow));
+        });
+        self.aggregate.intersect_record(ray, t_max)
     }
 
     /// Whether anything blocks `ray` in (0, t_max).

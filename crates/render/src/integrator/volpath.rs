@@ -204,13 +204,16 @@ impl RayIntegrator for VolPathIntegrator {
         let mut eta_scale: Float = 1.0;
         let mut prev_ctx = LightSampleContext::default();
         loop {
-            let mut closest = scene.intersect(&ray.ray, Float::INFINITY);
+            let mut closest;
             if let Some(m) = ray.ray.medium {
-                // Delta tracking through the medium up to the surface.
+                // Delta tracking through the medium up to the surface: only
+                // the surface's distance is needed unless the ray gets
+                // there, so its interaction is built afterwards.
+                let record = scene.intersect_record(&ray.ray, Float::INFINITY);
                 let medium = &scene.media[m as usize];
                 let mut scattered = false;
                 let mut terminated = false;
-                let t_max = closest.as_ref().map_or(Float::INFINITY, |h| h.t_hit);
+                let t_max = record.as_ref().map_or(Float::INFINITY, |h| h.t_hit);
                 let mut rng = segment_rng(sampler);
                 let u = sampler.get_1d();
                 let r = ray.ray;
@@ -290,6 +293,9 @@ impl RayIntegrator for VolPathIntegrator {
                 beta *= t_maj / t_maj[0];
                 r_u *= t_maj / t_maj[0];
                 r_l *= t_maj / t_maj[0];
+                closest = record.and_then(|h| scene.aggregate.interaction(&r, &h));
+            } else {
+                closest = scene.intersect(&ray.ray, Float::INFINITY);
             }
 
             let Some(hit) = closest.as_mut() else {
