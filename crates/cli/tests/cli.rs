@@ -190,7 +190,10 @@ fn integrators_that_ignore_media_or_subsurface_warn_at_the_directive() {
             .unwrap();
         let e = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(0), "{name}: {e}");
-        assert!(e.contains(loc) && e.contains(what) && e.contains("volpath"), "{name}: {e}");
+        assert!(
+            e.contains(loc) && e.contains(what) && e.contains("volpath"),
+            "{name}: {e}"
+        );
     }
 }
 

@@ -330,11 +330,27 @@ mod tests {
 
     /// The bounds of all four rounded products or quotients: what the
     /// sign-case shortcuts of `mul` and `div` must reproduce bit for bit.
-    fn all_four(a: Interval, b: Interval, down: fn(Float, Float) -> Float, up: fn(Float, Float) -> Float) -> Interval {
-        let pairs = [(a.low, b.low), (a.high, b.low), (a.low, b.high), (a.high, b.high)];
+    fn all_four(
+        a: Interval,
+        b: Interval,
+        down: fn(Float, Float) -> Float,
+        up: fn(Float, Float) -> Float,
+    ) -> Interval {
+        let pairs = [
+            (a.low, b.low),
+            (a.high, b.low),
+            (a.low, b.high),
+            (a.high, b.high),
+        ];
         Interval {
-            low: pairs.iter().map(|&(x, y)| down(x, y)).fold(Float::INFINITY, Float::min),
-            high: pairs.iter().map(|&(x, y)| up(x, y)).fold(Float::NEG_INFINITY, Float::max),
+            low: pairs
+                .iter()
+                .map(|&(x, y)| down(x, y))
+                .fold(Float::INFINITY, Float::min),
+            high: pairs
+                .iter()
+                .map(|&(x, y)| up(x, y))
+                .fold(Float::NEG_INFINITY, Float::max),
         }
     }
 
@@ -347,7 +363,9 @@ mod tests {
             state ^= state << 17;
             state
         };
-        let specials = [0.0, -0.0, 1.0, -1.0, 1e-30, -1e-30, 3.5e20, -3.5e20, 0.1, -7.25];
+        let specials = [
+            0.0, -0.0, 1.0, -1.0, 1e-30, -1e-30, 3.5e20, -3.5e20, 0.1, -7.25,
+        ];
         let mut value = || -> Float {
             let r = next();
             if r % 4 == 0 {
@@ -359,15 +377,29 @@ mod tests {
         };
         for _ in 0..200_000 {
             let (x0, x1, y0, y1) = (value(), value(), value(), value());
-            let a = Interval { low: x0.min(x1), high: x0.max(x1) };
-            let b = Interval { low: y0.min(y1), high: y0.max(y1) };
+            let a = Interval {
+                low: x0.min(x1),
+                high: x0.max(x1),
+            };
+            let b = Interval {
+                low: y0.min(y1),
+                high: y0.max(y1),
+            };
             let p = a * b;
             let q = all_four(a, b, mul_round_down, mul_round_up);
-            assert_eq!((p.low.to_bits(), p.high.to_bits()), (q.low.to_bits(), q.high.to_bits()), "{a:?} * {b:?}");
+            assert_eq!(
+                (p.low.to_bits(), p.high.to_bits()),
+                (q.low.to_bits(), q.high.to_bits()),
+                "{a:?} * {b:?}"
+            );
             if !b.contains(0.0) {
                 let p = a / b;
                 let q = all_four(a, b, div_round_down, div_round_up);
-                assert_eq!((p.low.to_bits(), p.high.to_bits()), (q.low.to_bits(), q.high.to_bits()), "{a:?} / {b:?}");
+                assert_eq!(
+                    (p.low.to_bits(), p.high.to_bits()),
+                    (q.low.to_bits(), q.high.to_bits()),
+                    "{a:?} / {b:?}"
+                );
             }
         }
     }

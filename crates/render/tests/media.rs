@@ -20,14 +20,25 @@ fn render_scene(text: &str, threads: usize) -> Image {
         .unwrap_or_else(|d| panic!("{}", d.render()));
     let created = match create_scene(&desc, &CreateOptions::default()) {
         Ok(c) => c,
-        Err(e) => panic!("{:?}", e.iter().map(|d| d.message.clone()).collect::<Vec<_>>()),
+        Err(e) => panic!(
+            "{:?}",
+            e.iter().map(|d| d.message.clone()).collect::<Vec<_>>()
+        ),
     };
     let mut scene = created.scene;
-    let opts = RenderOptions { nthreads: threads, ..Default::default() };
+    let opts = RenderOptions {
+        nthreads: threads,
+        ..Default::default()
+    };
     let mut md = ImageMetadata::default();
-    created.integrator.render(&mut scene, &opts, &mut md, &|_| {}).unwrap();
+    created
+        .integrator
+        .render(&mut scene, &opts, &mut md, &|_| {})
+        .unwrap();
     let path = scene.film.filename().to_string();
-    Image::read(std::path::Path::new(&path), None).unwrap().image
+    Image::read(std::path::Path::new(&path), None)
+        .unwrap()
+        .image
 }
 
 fn mean_rgb(im: &Image) -> f64 {
@@ -104,7 +115,14 @@ fn camera_inside_an_absorbing_medium() {
 
 /// A unit sphere around the camera, its inside filled with `medium`
 /// ("fog"), with walls of the given reflectance emitting `le`.
-fn filled_sphere(tag: &str, integrator: &str, spp: i32, medium: &str, reflectance: f64, le: f64) -> String {
+fn filled_sphere(
+    tag: &str,
+    integrator: &str,
+    spp: i32,
+    medium: &str,
+    reflectance: f64,
+    le: f64,
+) -> String {
     header(tag, integrator, spp, false, "fog")
         + "WorldBegin\n"
         + medium
@@ -118,10 +136,16 @@ fn scattering_medium_in_a_furnace_keeps_radiance_one() {
     let medium = "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [ 0 0 0 ] \"rgb sigma_s\" [ 1.5 1.5 1.5 ] \"float g\" 0.4\n";
     // Walls of albedo 0.5 emitting 0.5: L = 1 without the medium, and a
     // conservative medium keeps the uniform radiance.
-    let im = render_scene(&filled_sphere("furnace-volpath", "volpath", 64, medium, 0.5, 0.5), 0);
+    let im = render_scene(
+        &filled_sphere("furnace-volpath", "volpath", 64, medium, 0.5, 0.5),
+        0,
+    );
     check("furnace-volpath", &im, 1.0, 0.03);
     // simplevolpath takes black walls emitting 1.
-    let im = render_scene(&filled_sphere("furnace-simple", "simplevolpath", 64, medium, 0.0, 1.0), 0);
+    let im = render_scene(
+        &filled_sphere("furnace-simple", "simplevolpath", 64, medium, 0.0, 1.0),
+        0,
+    );
     check("furnace-simple", &im, 1.0, 0.03);
 }
 
@@ -145,10 +169,19 @@ fn chromatic_scattering_medium_converges_like_simplevolpath() {
     // furnace of black walls emitting 1, with some absorption: volpath and
     // the hero-wavelength reference agree.
     let medium = "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [ 0.05 0.3 0.6 ] \"rgb sigma_s\" [ 2 0.8 0.2 ] \"float g\" -0.3\n";
-    let a = mean_rgb(&render_scene(&filled_sphere("chroma-volpath", "volpath", 128, medium, 0.0, 1.0), 0));
-    let b = mean_rgb(&render_scene(&filled_sphere("chroma-simple", "simplevolpath", 512, medium, 0.0, 1.0), 0));
+    let a = mean_rgb(&render_scene(
+        &filled_sphere("chroma-volpath", "volpath", 128, medium, 0.0, 1.0),
+        0,
+    ));
+    let b = mean_rgb(&render_scene(
+        &filled_sphere("chroma-simple", "simplevolpath", 512, medium, 0.0, 1.0),
+        0,
+    ));
     assert!((a - b).abs() < 0.03 * b, "volpath {a} vs simplevolpath {b}");
-    assert!(a < 0.95 && a > 0.3, "absorption must darken the furnace: {a}");
+    assert!(
+        a < 0.95 && a > 0.3,
+        "absorption must darken the furnace: {a}"
+    );
 }
 
 #[test]
@@ -163,29 +196,57 @@ fn media_render_identically_on_one_and_two_threads() {
 fn creation_errors(text: &str) -> Vec<String> {
     let (desc, _) = match build_scene_from_str(text, &BuildOptions::default()) {
         Ok(d) => d,
-        Err(d) => return d.iter().map(|d| format!("{}: {}", d.loc.as_ref().map_or(0, |l| l.line), d.message)).collect(),
+        Err(d) => {
+            return d
+                .iter()
+                .map(|d| format!("{}: {}", d.loc.as_ref().map_or(0, |l| l.line), d.message))
+                .collect()
+        }
     };
     match create_scene(&desc, &CreateOptions::default()) {
         Ok(_) => Vec::new(),
-        Err(e) => e.iter().map(|d| format!("{}: {}", d.loc.as_ref().map_or(0, |l| l.line), d.message)).collect(),
+        Err(e) => e
+            .iter()
+            .map(|d| format!("{}: {}", d.loc.as_ref().map_or(0, |l| l.line), d.message))
+            .collect(),
     }
 }
 
 #[test]
 fn bad_media_are_located_errors() {
-    let base = "Film \"rgb\" \"string filename\" \"/dev/null.exr\"\nIntegrator \"volpath\"\nWorldBegin\n";
+    let base =
+        "Film \"rgb\" \"string filename\" \"/dev/null.exr\"\nIntegrator \"volpath\"\nWorldBegin\n";
     let cases = [
-        ("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [ -1 0 0 ]\n", "sigma_a"),
-        ("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float scale\" -2\n", "scale"),
-        ("MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float g\" nan\n", ""),
+        (
+            "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [ -1 0 0 ]\n",
+            "sigma_a",
+        ),
+        (
+            "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float scale\" -2\n",
+            "scale",
+        ),
+        (
+            "MakeNamedMedium \"m\" \"string type\" \"homogeneous\" \"float g\" nan\n",
+            "",
+        ),
         ("MakeNamedMedium \"m\" \"string type\" \"smoke\"\n", "smoke"),
-        ("MediumInterface \"nothere\" \"\"\nShape \"sphere\"\n", "nothere"),
+        (
+            "MediumInterface \"nothere\" \"\"\nShape \"sphere\"\n",
+            "nothere",
+        ),
     ];
     for (text, needle) in cases {
         let errs = creation_errors(&format!("{base}{text}"));
         assert!(!errs.is_empty(), "no error for {text:?}");
-        assert!(errs.iter().any(|e| e.starts_with("4: ") || e.starts_with("5: ")), "{errs:?}");
-        assert!(errs.iter().any(|e| e.contains(needle)), "{errs:?} lacks {needle:?}");
+        assert!(
+            errs.iter()
+                .any(|e| e.starts_with("4: ") || e.starts_with("5: ")),
+            "{errs:?}"
+        );
+        assert!(
+            errs.iter().any(|e| e.contains(needle)),
+            "{errs:?} lacks {needle:?}"
+        );
     }
 }
 
@@ -193,7 +254,14 @@ fn bad_media_are_located_errors() {
 fn simplevolpath_refuses_delta_lights_and_scattering_surfaces() {
     let base = "Film \"rgb\" \"string filename\" \"/dev/null.exr\"\nIntegrator \"simplevolpath\"\nWorldBegin\n";
     let errs = creation_errors(&format!("{base}LightSource \"point\"\n"));
-    assert!(errs.iter().any(|e| e.starts_with("4: ") && e.contains("area and infinite")), "{errs:?}");
+    assert!(
+        errs.iter()
+            .any(|e| e.starts_with("4: ") && e.contains("area and infinite")),
+        "{errs:?}"
+    );
     let errs = creation_errors(&format!("{base}Material \"conductor\"\nShape \"sphere\"\n"));
-    assert!(errs.iter().any(|e| e.contains("surface scattering")), "{errs:?}");
+    assert!(
+        errs.iter().any(|e| e.contains("surface scattering")),
+        "{errs:?}"
+    );
 }

@@ -216,7 +216,13 @@ fn heterogeneous_medium_becomes_uniformgrid_with_v3_defaults() {
     // Only the absent coefficient gets pbrt-v3's default; v3 types are renamed.
     assert_eq!(
         names(&u),
-        ["rgb sigma_a", "float density", "integer nx", "point3 p1", "rgb sigma_s"]
+        [
+            "rgb sigma_a",
+            "float density",
+            "integer nx",
+            "point3 p1",
+            "rgb sigma_s"
+        ]
     );
     assert_eq!(u.params[0].floats, [0.0011, 0.0024, 0.014]);
     assert_eq!(u.params[0].loc.line, 1);

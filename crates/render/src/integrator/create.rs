@@ -26,10 +26,7 @@ pub const INTEGRATOR_NAMES: &[&str] = &[
 
 /// Creates the integrator of an `Integrator` directive. The light sampler
 /// it needs is created by the caller (it needs the lights).
-pub fn create_integrator(
-    name: &str,
-    ip: &ParamReader,
-) -> Result<Integrator, Diagnostic> {
+pub fn create_integrator(name: &str, ip: &ParamReader) -> Result<Integrator, Diagnostic> {
     let loc = ip.loc();
     let max_depth = ip.int("maxdepth", 5)?;
     if max_depth < 0 {

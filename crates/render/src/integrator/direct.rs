@@ -115,7 +115,10 @@ pub(crate) fn sample_ld(
 /// the surface to the side the BSDF can receive light from (pbrt-v4
 /// `SampleLd`'s start), with the vertex's cached offset origins.
 #[inline]
-pub(crate) fn surface_light_context(origins: &mut VertexOrigins, bsdf: &BSDF) -> LightSampleContext {
+pub(crate) fn surface_light_context(
+    origins: &mut VertexOrigins,
+    bsdf: &BSDF,
+) -> LightSampleContext {
     let si = origins.si;
     let mut ctx = LightSampleContext::from_si(si);
     let flags = bsdf.flags();

@@ -28,17 +28,17 @@ pub mod render;
 pub mod scene;
 mod simple;
 mod simplevolpath;
+pub mod tile;
 mod volpath;
 mod volume;
-pub mod tile;
 
 pub use create::{create_integrator, INTEGRATOR_NAMES};
 pub use path::PathIntegrator;
 pub use render::{Progress, ProgressFn, RenderError, RenderOptions, RenderStats};
 pub use scene::{RayCounters, Scene};
 pub use simple::{AmbientOcclusionIntegrator, RandomWalkIntegrator, SimplePathIntegrator};
-pub use tile::RayIntegrator;
 pub use simplevolpath::SimpleVolPathIntegrator;
+pub use tile::RayIntegrator;
 pub use volpath::VolPathIntegrator;
 
 pub(crate) use direct::{sample_ld, VertexOrigins};

@@ -50,34 +50,47 @@ impl RayIntegrator for SimpleVolPathIntegrator {
                 let mut u_mode = sampler.get_1d();
                 let r = ray.ray;
                 let wo = -r.d.normalize();
-                sample_t_maj(&scene.media[m as usize], &r, t_max, u, &mut rng, lambda, |p, mp, sigma_maj, _, rng| {
-                    let p_absorb = mp.sigma_a[0] / sigma_maj[0];
-                    let p_scatter = mp.sigma_s[0] / sigma_maj[0];
-                    if u_mode < p_absorb {
-                        l += beta * mp.le;
-                        terminated = true;
-                        false
-                    } else if u_mode < p_absorb + p_scatter {
-                        if depth >= self.max_depth {
+                sample_t_maj(
+                    &scene.media[m as usize],
+                    &r,
+                    t_max,
+                    u,
+                    &mut rng,
+                    lambda,
+                    |p, mp, sigma_maj, _, rng| {
+                        let p_absorb = mp.sigma_a[0] / sigma_maj[0];
+                        let p_scatter = mp.sigma_s[0] / sigma_maj[0];
+                        if u_mode < p_absorb {
+                            l += beta * mp.le;
                             terminated = true;
-                            return false;
-                        }
-                        depth += 1;
-                        let u = Point2f::new(rng.uniform_float(), rng.uniform_float());
-                        match mp.phase.sample_p(wo, u) {
-                            Some(ps) if ps.pdf > 0.0 => {
-                                beta *= ps.p / ps.pdf;
-                                ray = RayDifferential::new(Ray::with_time(p, ps.wi, r.time, Some(m)));
-                                scattered = true;
+                            false
+                        } else if u_mode < p_absorb + p_scatter {
+                            if depth >= self.max_depth {
+                                terminated = true;
+                                return false;
                             }
-                            _ => terminated = true,
+                            depth += 1;
+                            let u = Point2f::new(rng.uniform_float(), rng.uniform_float());
+                            match mp.phase.sample_p(wo, u) {
+                                Some(ps) if ps.pdf > 0.0 => {
+                                    beta *= ps.p / ps.pdf;
+                                    ray = RayDifferential::new(Ray::with_time(
+                                        p,
+                                        ps.wi,
+                                        r.time,
+                                        Some(m),
+                                    ));
+                                    scattered = true;
+                                }
+                                _ => terminated = true,
+                            }
+                            false
+                        } else {
+                            u_mode = rng.uniform_float();
+                            true
                         }
-                        false
-                    } else {
-                        u_mode = rng.uniform_float();
-                        true
-                    }
-                });
+                    },
+                );
             }
             if terminated {
                 return l;
@@ -93,7 +106,10 @@ impl RayIntegrator for SimpleVolPathIntegrator {
             };
             l += beta * scene.le(&hit, -ray.ray.d, lambda);
             let mut lambda_copy = *lambda;
-            if scene.get_bsdf(&mut hit, &ray, &mut lambda_copy, sampler).is_some() {
+            if scene
+                .get_bsdf(&mut hit, &ray, &mut lambda_copy, sampler)
+                .is_some()
+            {
                 // Surfaces that scatter are refused at creation; one that
                 // does not (a black diffuse emitter) ends the path.
                 return l;

@@ -149,13 +149,8 @@ impl VolPathIntegrator {
                 if v == 0.0 {
                     return zero;
                 }
-                let mut ray = spawn_ray_from_origin_to_surface(
-                    p,
-                    time,
-                    p_to,
-                    ls.p_light.error(),
-                    ls.n_light,
-                );
+                let mut ray =
+                    spawn_ray_from_origin_to_surface(p, time, p_to, ls.p_light.error(), ls.n_light);
                 ray.medium = medium;
                 (SampledSpectrum::new(v), phase.pdf(wo, wi), ray)
             }
@@ -219,68 +214,88 @@ impl RayIntegrator for VolPathIntegrator {
                 let r = ray.ray;
                 let wo = -r.d.normalize();
                 let lambda_ref: &SampledWavelengths = lambda;
-                let t_maj = sample_t_maj(medium, &r, t_max, u, &mut rng, lambda_ref, |p, mp, sigma_maj, t_maj, rng| {
-                    if beta.is_black() {
-                        terminated = true;
-                        return false;
-                    }
-                    // Emission at the collision, as if it were an absorption.
-                    if depth < max_depth && !mp.le.is_black() {
-                        let pdf = sigma_maj[0] * t_maj[0];
-                        let betap = beta * t_maj / pdf;
-                        let r_e = r_u * sigma_maj * t_maj / pdf;
-                        if !r_e.is_black() {
-                            l += betap * mp.sigma_a * mp.le / r_e.average();
-                        }
-                    }
-                    let um = rng.uniform_float();
-                    match sample_event(mp.sigma_a[0], mp.sigma_s[0], sigma_maj[0], um) {
-                        0 => {
+                let t_maj = sample_t_maj(
+                    medium,
+                    &r,
+                    t_max,
+                    u,
+                    &mut rng,
+                    lambda_ref,
+                    |p, mp, sigma_maj, t_maj, rng| {
+                        if beta.is_black() {
                             terminated = true;
-                            false
+                            return false;
                         }
-                        1 => {
-                            if depth >= max_depth {
+                        // Emission at the collision, as if it were an absorption.
+                        if depth < max_depth && !mp.le.is_black() {
+                            let pdf = sigma_maj[0] * t_maj[0];
+                            let betap = beta * t_maj / pdf;
+                            let r_e = r_u * sigma_maj * t_maj / pdf;
+                            if !r_e.is_black() {
+                                l += betap * mp.sigma_a * mp.le / r_e.average();
+                            }
+                        }
+                        let um = rng.uniform_float();
+                        match sample_event(mp.sigma_a[0], mp.sigma_s[0], sigma_maj[0], um) {
+                            0 => {
                                 terminated = true;
-                                return false;
+                                false
                             }
-                            depth += 1;
-                            let pdf = t_maj[0] * mp.sigma_s[0];
-                            beta *= t_maj * mp.sigma_s / pdf;
-                            r_u *= t_maj * mp.sigma_s / pdf;
-                            if !beta.is_black() && !r_u.is_black() {
-                                let (u_l, u_l2) = (sampler.get_1d(), sampler.get_2d());
-                                let vertex = LdVertex::Medium { p, wo, time: r.time, phase: mp.phase, medium: Some(m) };
-                                l += self.sample_ld(scene, vertex, lambda_ref, u_l, u_l2, beta, r_u);
-                                let u = sampler.get_2d();
-                                match mp.phase.sample_p(wo, u) {
-                                    Some(ps) if ps.pdf > 0.0 => {
-                                        beta *= ps.p / ps.pdf;
-                                        r_l = r_u / ps.pdf;
-                                        prev_ctx = LightSampleContext::from_point(p);
-                                        scattered = true;
-                                        ray = RayDifferential::new(Ray::with_time(p, ps.wi, r.time, Some(m)));
-                                        specular_bounce = false;
-                                        any_non_specular = true;
-                                    }
-                                    _ => terminated = true,
+                            1 => {
+                                if depth >= max_depth {
+                                    terminated = true;
+                                    return false;
                                 }
+                                depth += 1;
+                                let pdf = t_maj[0] * mp.sigma_s[0];
+                                beta *= t_maj * mp.sigma_s / pdf;
+                                r_u *= t_maj * mp.sigma_s / pdf;
+                                if !beta.is_black() && !r_u.is_black() {
+                                    let (u_l, u_l2) = (sampler.get_1d(), sampler.get_2d());
+                                    let vertex = LdVertex::Medium {
+                                        p,
+                                        wo,
+                                        time: r.time,
+                                        phase: mp.phase,
+                                        medium: Some(m),
+                                    };
+                                    l += self
+                                        .sample_ld(scene, vertex, lambda_ref, u_l, u_l2, beta, r_u);
+                                    let u = sampler.get_2d();
+                                    match mp.phase.sample_p(wo, u) {
+                                        Some(ps) if ps.pdf > 0.0 => {
+                                            beta *= ps.p / ps.pdf;
+                                            r_l = r_u / ps.pdf;
+                                            prev_ctx = LightSampleContext::from_point(p);
+                                            scattered = true;
+                                            ray = RayDifferential::new(Ray::with_time(
+                                                p,
+                                                ps.wi,
+                                                r.time,
+                                                Some(m),
+                                            ));
+                                            specular_bounce = false;
+                                            any_non_specular = true;
+                                        }
+                                        _ => terminated = true,
+                                    }
+                                }
+                                false
                             }
-                            false
-                        }
-                        _ => {
-                            let sigma_n = (sigma_maj - mp.sigma_a - mp.sigma_s).clamp_zero();
-                            let pdf = t_maj[0] * sigma_n[0];
-                            beta *= t_maj * sigma_n / pdf;
-                            if pdf == 0.0 {
-                                beta = SampledSpectrum::new(0.0);
+                            _ => {
+                                let sigma_n = (sigma_maj - mp.sigma_a - mp.sigma_s).clamp_zero();
+                                let pdf = t_maj[0] * sigma_n[0];
+                                beta *= t_maj * sigma_n / pdf;
+                                if pdf == 0.0 {
+                                    beta = SampledSpectrum::new(0.0);
+                                }
+                                r_u *= t_maj * sigma_n / pdf;
+                                r_l *= t_maj * sigma_maj / pdf;
+                                !beta.is_black() && !r_u.is_black()
                             }
-                            r_u *= t_maj * sigma_n / pdf;
-                            r_l *= t_maj * sigma_maj / pdf;
-                            !beta.is_black() && !r_u.is_black()
                         }
-                    }
-                });
+                    },
+                );
                 if terminated || beta.is_black() || r_u.is_black() || r_u.has_nan() {
                     return l;
                 }
@@ -324,8 +339,8 @@ impl RayIntegrator for VolPathIntegrator {
                     l += beta * le / r_u.average();
                 } else if let Some(al) = hit.area_light {
                     let light = &scene.lights[al as usize];
-                    let p_l = light_sampler.pmf(&prev_ctx, al)
-                        * light.pdf_li(&prev_ctx, ray.ray.d, true);
+                    let p_l =
+                        light_sampler.pmf(&prev_ctx, al) * light.pdf_li(&prev_ctx, ray.ray.d, true);
                     r_l *= p_l;
                     l += beta * le / (r_u + r_l).average();
                 }
@@ -392,7 +407,19 @@ impl RayIntegrator for VolPathIntegrator {
                     .material
                     .and_then(|m| scene.materials.get_bssrdf(m, &hit.si, lambda))
                 {
-                    match self.subsurface(scene, &bssrdf, hit.material, ray.ray.time, lambda, sampler, &mut beta, &mut r_u, &mut r_l, &mut l, &mut prev_ctx) {
+                    match self.subsurface(
+                        scene,
+                        &bssrdf,
+                        hit.material,
+                        ray.ray.time,
+                        lambda,
+                        sampler,
+                        &mut beta,
+                        &mut r_u,
+                        &mut r_l,
+                        &mut l,
+                        &mut prev_ctx,
+                    ) {
                         Some((next_ray, specular)) => {
                             ray = next_ray;
                             specular_bounce = specular;
@@ -497,9 +524,18 @@ impl VolPathIntegrator {
             ray_medium: None,
         };
         *l += self.sample_ld(scene, vertex, lambda, u_light, u_light_2d, *beta, *r_u);
-        let bs = sw.sample_f(pi.wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL)?;
+        let bs = sw.sample_f(
+            pi.wo,
+            u,
+            u2,
+            TransportMode::Radiance,
+            BxDFReflTransFlags::ALL,
+        )?;
         *beta *= bs.f * (abs_dot(bs.wi, pi.shading.n) / bs.pdf);
         *r_l = *r_u / bs.pdf;
-        Some((RayDifferential::new(origins.spawn_ray(bs.wi)), bs.is_specular()))
+        Some((
+            RayDifferential::new(origins.spawn_ray(bs.wi)),
+            bs.is_specular(),
+        ))
     }
 }

@@ -36,11 +36,11 @@ mod subsurface;
 #[cfg(test)]
 mod tests;
 
+pub use crate::medium::measured::get_medium_scattering_properties;
 pub use bump::{bump_map, normal_map, read_normal_map};
 pub use coated::{CoatedConductorMaterial, CoatedDiffuseMaterial};
 pub use conductor::{ConductorMaterial, ConductorSpectra};
 pub use create::{create_material, NormalMapCache, MATERIAL_NAMES};
-pub use crate::medium::measured::get_medium_scattering_properties;
 pub use dielectric::{DielectricMaterial, ThinDielectricMaterial};
 pub use diffuse::{DiffuseMaterial, DiffuseTransmissionMaterial};
 pub use hair::{HairAbsorption, HairMaterial};
@@ -321,11 +321,14 @@ impl MaterialSet {
     /// `Some(None)` when it has no recorded location.
     pub fn first_scattering(&self, used: impl Fn(u32) -> bool) -> Option<Option<&FileLoc>> {
         use crate::texture::SpectrumTexture;
-        let i = self.materials.iter().enumerate().position(|(i, m)| used(i as u32) && match m {
-            Material::Interface => false,
-            Material::Diffuse(d) => !matches!(&*d.reflectance,
+        let i = self.materials.iter().enumerate().position(|(i, m)| {
+            used(i as u32)
+                && match m {
+                    Material::Interface => false,
+                    Material::Diffuse(d) => !matches!(&*d.reflectance,
                 SpectrumTexture::Constant(s) if s.max_value() == 0.0),
-            _ => true,
+                    _ => true,
+                }
         })?;
         Some(self.loc(i as u32))
     }

@@ -4,9 +4,12 @@
 //! The grid media's own creation lives with them; the parameter checks
 //! they share are here.
 
-use super::nanovdb::{read_float_grid, require_float_grid, FloatGrid, GridClass, NanoVdbError};
-use super::{CloudMedium, GridMedium, HomogeneousMedium, Medium, NanoVdbMedium, NanoVdbTemperature, RgbGridMedium};
 use super::measured::get_medium_scattering_properties;
+use super::nanovdb::{read_float_grid, require_float_grid, FloatGrid, GridClass, NanoVdbError};
+use super::{
+    CloudMedium, GridMedium, HomogeneousMedium, Medium, NanoVdbMedium, NanoVdbTemperature,
+    RgbGridMedium,
+};
 use crate::params::{unknown_type, ParamReader};
 use crate::spectrum::{spectrum_to_photometric, DenselySampledSpectrum, Spectrum, SpectrumType};
 use rpbrt_geometry::float::Float;
@@ -68,7 +71,9 @@ fn create_homogeneous(mp: &ParamReader) -> Result<HomogeneousMedium, Diagnostic>
     let (le, le_scale) = emission(mp)?;
     let scale = non_negative(mp, "scale", 1.0)?;
     let g = phase_asymmetry(mp)?;
-    Ok(HomogeneousMedium::new(&sig_a, &sig_s, scale, &le, le_scale, g))
+    Ok(HomogeneousMedium::new(
+        &sig_a, &sig_s, scale, &le, le_scale, g,
+    ))
 }
 
 /// An absorption or scattering spectrum (default 1), checked to be finite
@@ -78,7 +83,11 @@ pub(super) fn coefficient(mp: &ParamReader, name: &str) -> Result<Spectrum, Diag
         return Ok(Spectrum::constant(1.0));
     };
     let dense = DenselySampledSpectrum::new(&s);
-    if let Some(v) = dense.values().iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+    if let Some(v) = dense
+        .values()
+        .iter()
+        .find(|v| !(v.is_finite() && **v >= 0.0))
+    {
         return Err(mp.error_at(
             name,
             format!("\"{name}\" must be finite and non-negative, got a value of {v}"),
@@ -136,7 +145,13 @@ pub(super) fn grid_resolution(mp: &ParamReader) -> Result<(i32, i32, i32, u64), 
     }
     let total = n.iter().fold(1u64, |acc, &v| acc.saturating_mul(v as u64));
     if total > MAX_GRID_SAMPLES {
-        let at = if mp.has("nz") { "nz" } else if mp.has("ny") { "ny" } else { "nx" };
+        let at = if mp.has("nz") {
+            "nz"
+        } else if mp.has("ny") {
+            "ny"
+        } else {
+            "nx"
+        };
         return Err(mp.error_at(
             at,
             format!(
@@ -150,8 +165,16 @@ pub(super) fn grid_resolution(mp: &ParamReader) -> Result<(i32, i32, i32, u64), 
 
 /// Checks that every value of float array `name` is finite and
 /// non-negative.
-pub(super) fn check_values(mp: &ParamReader, name: &str, values: &[Float]) -> Result<(), Diagnostic> {
-    if let Some((i, v)) = values.iter().enumerate().find(|(_, v)| !(v.is_finite() && **v >= 0.0)) {
+pub(super) fn check_values(
+    mp: &ParamReader,
+    name: &str,
+    values: &[Float],
+) -> Result<(), Diagnostic> {
+    if let Some((i, v)) = values
+        .iter()
+        .enumerate()
+        .find(|(_, v)| !(v.is_finite() && **v >= 0.0))
+    {
         return Err(mp.error_at(
             name,
             format!("\"{name}\" values must be finite and non-negative; value {i} is {v}"),
@@ -169,7 +192,10 @@ pub(super) fn grid_bounds(mp: &ParamReader) -> Result<Bounds3f, Diagnostic> {
         if p.iter().any(|v| !v.is_finite()) {
             return Err(mp.error_at(
                 name,
-                format!("\"{name}\" must be finite, got ({}, {}, {})", p[0], p[1], p[2]),
+                format!(
+                    "\"{name}\" must be finite, got ({}, {}, {})",
+                    p[0], p[1], p[2]
+                ),
             ));
         }
     }
@@ -199,7 +225,11 @@ pub(super) fn grid_bounds(mp: &ParamReader) -> Result<Bounds3f, Diagnostic> {
 }
 
 /// A float parameter that must be finite and non-negative.
-pub(super) fn non_negative(mp: &ParamReader, name: &str, default: Float) -> Result<Float, Diagnostic> {
+pub(super) fn non_negative(
+    mp: &ParamReader,
+    name: &str,
+    default: Float,
+) -> Result<Float, Diagnostic> {
     let v = mp.float(name, default)?;
     if !(v.is_finite() && v >= 0.0) {
         return Err(mp.error_at(
@@ -218,7 +248,13 @@ pub(super) fn phase_asymmetry(mp: &ParamReader) -> Result<Float, Diagnostic> {
         return Err(mp.error_at("g", "\"g\" must be finite"));
     }
     if !(-1.0..=1.0).contains(&g) {
-        mp.warn_at("g", format!("\"g\" = {g} is outside [-1, 1]; using {}", g.clamp(-0.99, 0.99)));
+        mp.warn_at(
+            "g",
+            format!(
+                "\"g\" = {g} is outside [-1, 1]; using {}",
+                g.clamp(-0.99, 0.99)
+            ),
+        );
     }
     Ok(g)
 }
@@ -243,7 +279,11 @@ fn create_nanovdb(
     let cutoff = mp.float("temperaturecutoff", 0.0)?;
     let offset = mp.float("temperatureoffset", cutoff)?;
     let scale_t = mp.float("temperaturescale", 1.0)?;
-    for (name, v) in [("Lescale", le_scale), ("temperatureoffset", offset), ("temperaturescale", scale_t)] {
+    for (name, v) in [
+        ("Lescale", le_scale),
+        ("temperatureoffset", offset),
+        ("temperaturescale", scale_t),
+    ] {
         if !v.is_finite() {
             return Err(mp.error_at(name, format!("\"{name}\" must be finite")));
         }
@@ -251,7 +291,12 @@ fn create_nanovdb(
     let temperature = match temperature_grid {
         Some(grid) => {
             check_vdb_grid(mp, &path, &grid)?;
-            Some(NanoVdbTemperature { grid, offset, scale: scale_t, le_scale })
+            Some(NanoVdbTemperature {
+                grid,
+                offset,
+                scale: scale_t,
+                le_scale,
+            })
         }
         None => None,
     };
@@ -259,20 +304,39 @@ fn create_nanovdb(
     let sigma_a = coefficient(mp, "sigma_a")?;
     let sigma_s = coefficient(mp, "sigma_s")?;
     let scale = non_negative(mp, "scale", 1.0)?;
-    Ok(NanoVdbMedium::new(*render_from_medium, &sigma_a, &sigma_s, scale, g, density, temperature))
+    Ok(NanoVdbMedium::new(
+        *render_from_medium,
+        &sigma_a,
+        &sigma_s,
+        scale,
+        g,
+        density,
+        temperature,
+    ))
 }
 
 /// Refuses grids a medium cannot use: level sets and other non-fog
 /// classes (as pbrt-v4), negative or non-finite values, empty bounds.
-fn check_vdb_grid(mp: &ParamReader, path: &std::path::Path, grid: &FloatGrid) -> Result<(), Diagnostic> {
-    let err = |m: String| Err(mp.error_at("filename", format!("{}: grid \"{}\" {m}", path.display(), grid.name())));
+fn check_vdb_grid(
+    mp: &ParamReader,
+    path: &std::path::Path,
+    grid: &FloatGrid,
+) -> Result<(), Diagnostic> {
+    let err = |m: String| {
+        Err(mp.error_at(
+            "filename",
+            format!("{}: grid \"{}\" {m}", path.display(), grid.name()),
+        ))
+    };
     match grid.grid_class() {
         GridClass::FogVolume | GridClass::Unknown => {}
         c => return err(format!("isn't a FogVolume grid (its class is {c:?})")),
     }
     let (lo, hi) = grid.min_max();
     if !(lo.is_finite() && hi.is_finite()) || lo < 0.0 {
-        return err(format!("has values in [{lo}, {hi}]; a medium needs finite, non-negative ones"));
+        return err(format!(
+            "has values in [{lo}, {hi}]; a medium needs finite, non-negative ones"
+        ));
     }
     let (wlo, whi) = grid.world_bbox();
     if (0..3).any(|a| !(whi[a] > wlo[a]) || !wlo[a].is_finite() || !whi[a].is_finite()) {

@@ -291,6 +291,12 @@ impl ConcreteMedium for GridMedium {
         lambda: &SampledWavelengths,
     ) -> DdaMajorantIterator<'a> {
         let sigma_t = self.sigma_a.sample(lambda) + self.sigma_s.sample(lambda);
-        DdaMajorantIterator::through_grid(ray, t_max, &self.medium_from_render, &self.majorant, sigma_t)
+        DdaMajorantIterator::through_grid(
+            ray,
+            t_max,
+            &self.medium_from_render,
+            &self.majorant,
+            sigma_t,
+        )
     }
 }

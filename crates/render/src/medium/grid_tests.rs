@@ -740,10 +740,18 @@ fn a_majorant_far_above_the_density_cannot_make_tracking_hang() {
     let ray = Ray::new(Point3f::new(6.4, 0.5, -1.0), Vector3f::new(0.0, 0.0, 1.0));
     let mut rng = Rng::new(1, 0);
     let mut nulls = 0u64;
-    let t = sample_t_maj(&m, &ray, 3.0, 0.5, &mut rng, &lambda(0.3), |_, _, _, _, _| {
-        nulls += 1;
-        true
-    });
+    let t = sample_t_maj(
+        &m,
+        &ray,
+        3.0,
+        0.5,
+        &mut rng,
+        &lambda(0.3),
+        |_, _, _, _, _| {
+            nulls += 1;
+            true
+        },
+    );
     assert!(nulls <= MAX_COLLISIONS as u64, "{nulls}");
     assert!(t.is_black(), "the walk ends as an absorption: {t:?}");
 }

@@ -14,6 +14,8 @@
 mod cloud;
 mod create;
 mod grid;
+#[cfg(test)]
+mod grid_tests;
 mod homogeneous;
 mod majorant;
 pub mod measured;
@@ -23,19 +25,21 @@ mod phase;
 mod rgbgrid;
 mod sampled_grid;
 #[cfg(test)]
-mod grid_tests;
-#[cfg(test)]
 mod tests;
 
 pub use cloud::{CloudMedium, CloudMediumParts};
 pub use create::{create_medium, MAX_GRID_SAMPLES, MEDIUM_NAMES};
 pub use grid::{GridMedium, GridMediumParts, GRID_MAJORANT_RES};
 pub use homogeneous::HomogeneousMedium;
+pub use majorant::{
+    DdaMajorantIterator, HomogeneousMajorantIterator, MajorantGrid, RayMajorantSegment,
+};
 pub use nanovdb_medium::{NanoVdbMedium, NanoVdbTemperature};
+pub use phase::{
+    henyey_greenstein, sample_henyey_greenstein, HGPhaseFunction, PhaseFunctionSample,
+};
 pub use rgbgrid::{RgbEmissionGrid, RgbGridMedium, RgbGridMediumParts, RGB_GRID_MAJORANT_RES};
 pub use sampled_grid::{GridValue, Interpolant, SampledGrid};
-pub use majorant::{DdaMajorantIterator, HomogeneousMajorantIterator, MajorantGrid, RayMajorantSegment};
-pub use phase::{henyey_greenstein, sample_henyey_greenstein, HGPhaseFunction, PhaseFunctionSample};
 
 use crate::rng::Rng;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -68,8 +72,12 @@ pub(crate) trait ConcreteMedium {
     fn sample_point(&self, p: Point3f, lambda: &SampledWavelengths) -> MediumProperties;
     /// The majorant segments along `ray` (rendering space, unit direction)
     /// over `[0, t_max]`.
-    fn sample_ray<'a>(&'a self, ray: &Ray, t_max: Float, lambda: &SampledWavelengths)
-        -> Self::Majorants<'a>;
+    fn sample_ray<'a>(
+        &'a self,
+        ray: &Ray,
+        t_max: Float,
+        lambda: &SampledWavelengths,
+    ) -> Self::Majorants<'a>;
 }
 
 /// The closed set of participating media (pbrt-v4 `Medium`). The grid
@@ -143,7 +151,10 @@ fn normalized(ray: &Ray, t_max: Float) -> (Ray, Float) {
 
 /// `s` tabulated at every nanometre and multiplied by `k` (pbrt-v4's
 /// `DenselySampledSpectrum` followed by `Scale`).
-pub(crate) fn scaled_spectrum(s: &crate::spectrum::Spectrum, k: Float) -> crate::spectrum::DenselySampledSpectrum {
+pub(crate) fn scaled_spectrum(
+    s: &crate::spectrum::Spectrum,
+    k: Float,
+) -> crate::spectrum::DenselySampledSpectrum {
     let mut d = crate::spectrum::DenselySampledSpectrum::new(s);
     d.scale(k);
     d
@@ -197,7 +208,13 @@ fn sample_t_maj_in<M: ConcreteMedium>(
     u: Float,
     rng: &mut Rng,
     lambda: &SampledWavelengths,
-    mut callback: impl FnMut(Point3f, &MediumProperties, SampledSpectrum, SampledSpectrum, &mut Rng) -> bool,
+    mut callback: impl FnMut(
+        Point3f,
+        &MediumProperties,
+        SampledSpectrum,
+        SampledSpectrum,
+        &mut Rng,
+    ) -> bool,
 ) -> SampledSpectrum {
     let (ray, t_max) = normalized(ray, t_max);
     // The collision distance is sampled as an optical depth in the hero

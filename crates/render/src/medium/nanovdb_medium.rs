@@ -6,9 +6,7 @@
 use super::majorant::{DdaMajorantIterator, MajorantGrid};
 use super::nanovdb::FloatGrid;
 use super::{scaled_spectrum, ConcreteMedium, HGPhaseFunction, MediumProperties};
-use crate::spectrum::{
-    DenselySampledSpectrum, SampledSpectrum, SampledWavelengths, Spectrum,
-};
+use crate::spectrum::{DenselySampledSpectrum, SampledSpectrum, SampledWavelengths, Spectrum};
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::ray::Ray;
 use rpbrt_geometry::transform::Transform;
@@ -140,7 +138,9 @@ impl ConcreteMedium for NanoVdbMedium {
     fn sample_point(&self, p: Point3f, lambda: &SampledWavelengths) -> MediumProperties {
         let p = self.medium_from_render.apply_point(p);
         let p = [p.x, p.y, p.z];
-        let d = self.density.sample_trilinear(self.density.world_to_index(p));
+        let d = self
+            .density
+            .sample_trilinear(self.density.world_to_index(p));
         MediumProperties {
             sigma_a: self.sigma_a.sample(lambda) * d,
             sigma_s: self.sigma_s.sample(lambda) * d,
@@ -157,6 +157,12 @@ impl ConcreteMedium for NanoVdbMedium {
         lambda: &SampledWavelengths,
     ) -> DdaMajorantIterator<'a> {
         let sigma_t = self.sigma_a.sample(lambda) + self.sigma_s.sample(lambda);
-        DdaMajorantIterator::through_grid(ray, t_max, &self.medium_from_render, &self.majorants, sigma_t)
+        DdaMajorantIterator::through_grid(
+            ray,
+            t_max,
+            &self.medium_from_render,
+            &self.majorants,
+            sigma_t,
+        )
     }
 }

@@ -19,7 +19,10 @@ fn hg_is_normalised_and_sampling_matches_its_pdf() {
         let mut integral = 0.0f64;
         for i in 0..n {
             for j in 0..n {
-                let u = Point2f::new((i as Float + 0.5) / n as Float, (j as Float + 0.5) / n as Float);
+                let u = Point2f::new(
+                    (i as Float + 0.5) / n as Float,
+                    (j as Float + 0.5) / n as Float,
+                );
                 let w = crate::sampling::sample_uniform_sphere(u);
                 integral += phase.p(wo, w) as f64 * 4.0 * PI as f64;
             }
@@ -36,12 +39,19 @@ fn hg_is_normalised_and_sampling_matches_its_pdf() {
             let s = phase.sample_p(wo, u).unwrap();
             assert!((s.wi.length() - 1.0).abs() < 1e-3);
             let p = phase.p(wo, s.wi);
-            assert!((s.pdf - p).abs() <= 1e-3 * p.max(1.0), "g={g}: pdf {} vs p {p}", s.pdf);
+            assert!(
+                (s.pdf - p).abs() <= 1e-3 * p.max(1.0),
+                "g={g}: pdf {} vs p {p}",
+                s.pdf
+            );
             assert_eq!(s.p, s.pdf);
             mean_cos += dot(wo, s.wi) as f64;
         }
         mean_cos /= m as f64;
-        assert!((mean_cos + g as f64).abs() < 0.02, "g={g}: mean cos {mean_cos}");
+        assert!(
+            (mean_cos + g as f64).abs() < 0.02,
+            "g={g}: mean cos {mean_cos}"
+        );
     }
 }
 
@@ -52,7 +62,14 @@ fn homogeneous_transmittance_estimators_are_unbiased() {
     // estimates exp(−σt d).
     let sa = Spectrum::constant(0.3);
     let ss = Spectrum::constant(0.9);
-    let m = Medium::Homogeneous(HomogeneousMedium::new(&sa, &ss, 1.0, &Spectrum::constant(0.0), 1.0, 0.0));
+    let m = Medium::Homogeneous(HomogeneousMedium::new(
+        &sa,
+        &ss,
+        1.0,
+        &Spectrum::constant(0.0),
+        1.0,
+        0.0,
+    ));
     let lambda = lambda();
     let ray = Ray::new(Point3f::new(0.0, 0.0, 0.0), Vector3f::new(0.0, 0.0, 2.0));
     // t_max 1 along a direction of length 2: a distance of 2.
@@ -73,7 +90,10 @@ fn homogeneous_transmittance_estimators_are_unbiased() {
         }
     }
     let frac = escaped as f64 / n as f64;
-    assert!((frac - expected).abs() < 0.01, "escaped {frac}, expected {expected}");
+    assert!(
+        (frac - expected).abs() < 0.01,
+        "escaped {frac}, expected {expected}"
+    );
     let segs = m.majorant_segments(&ray, 1.0, &lambda);
     assert_eq!(segs.len(), 1);
     assert!((segs[0].t_max - 2.0).abs() < 1e-6);
@@ -87,14 +107,27 @@ fn dda_visits_voxels_in_order_and_covers_the_ray() {
     grid.fill(|b| b.p_min.x + 2.0 * b.p_min.y + 4.0 * b.p_min.z);
     let mut rng = Rng::new(11, 0);
     for _ in 0..500 {
-        let o = Point3f::new(rng.uniform_float() * 4.0 - 2.0, rng.uniform_float() * 4.0 - 2.0, rng.uniform_float() * 4.0 - 2.0);
-        let d = crate::sampling::sample_uniform_sphere(Point2f::new(rng.uniform_float(), rng.uniform_float()));
+        let o = Point3f::new(
+            rng.uniform_float() * 4.0 - 2.0,
+            rng.uniform_float() * 4.0 - 2.0,
+            rng.uniform_float() * 4.0 - 2.0,
+        );
+        let d = crate::sampling::sample_uniform_sphere(Point2f::new(
+            rng.uniform_float(),
+            rng.uniform_float(),
+        ));
         let ray = Ray::new(o, d);
-        let Some((t0, t1)) = bounds.intersect_p(o, d, 10.0) else { continue };
-        let segs: Vec<_> = DdaMajorantIterator::new(&ray, t0, t1, &grid, SampledSpectrum::new(1.0)).collect();
+        let Some((t0, t1)) = bounds.intersect_p(o, d, 10.0) else {
+            continue;
+        };
+        let segs: Vec<_> =
+            DdaMajorantIterator::new(&ray, t0, t1, &grid, SampledSpectrum::new(1.0)).collect();
         assert!(!segs.is_empty());
         assert!((segs[0].t_min - t0).abs() < 1e-5);
-        assert!((segs.last().unwrap().t_max - t1).abs() < 1e-4, "{segs:?} t1={t1}");
+        assert!(
+            (segs.last().unwrap().t_max - t1).abs() < 1e-4,
+            "{segs:?} t1={t1}"
+        );
         for w in segs.windows(2) {
             assert_eq!(w[0].t_max, w[1].t_min);
         }

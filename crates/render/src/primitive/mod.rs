@@ -179,8 +179,16 @@ impl Primitive {
                     f(m)
                 }
             }
-            Primitive::Transformed(p) => p.primitive.prims.iter().for_each(|q| q.for_each_material(f)),
-            Primitive::Animated(p) => p.primitive.prims.iter().for_each(|q| q.for_each_material(f)),
+            Primitive::Transformed(p) => p
+                .primitive
+                .prims
+                .iter()
+                .for_each(|q| q.for_each_material(f)),
+            Primitive::Animated(p) => p
+                .primitive
+                .prims
+                .iter()
+                .for_each(|q| q.for_each_material(f)),
         }
     }
 

@@ -20,9 +20,9 @@ use crate::filter::create_filter;
 use crate::image::MIPMapCache;
 use crate::integrator::{create_integrator, Integrator, RayCounters, Scene};
 use crate::light::{create_light, Light, LightCull, LightType};
+use crate::lightsampler::create_light_sampler;
 use crate::material::MaterialSet;
 use crate::medium::{create_medium, Medium};
-use crate::lightsampler::create_light_sampler;
 use crate::params::{unknown_type, ParamReader};
 use crate::primitive::{AnimatedPrimitive, Primitive, PrimitiveAggregate, TransformedPrimitive};
 use crate::sampler::create_sampler;
@@ -170,10 +170,18 @@ fn check_integrator_support(
     support: &Support,
     p: &mut Problems,
 ) {
-    let Support { media, materials, used, lights } = *support;
+    let Support {
+        media,
+        materials,
+        used,
+        lights,
+    } = *support;
     let name = desc.integrator.name.as_str();
     let loc = &desc.integrator.loc;
-    let volumetric = matches!(integrator, Integrator::VolPath(_) | Integrator::SimpleVolPath(_));
+    let volumetric = matches!(
+        integrator,
+        Integrator::VolPath(_) | Integrator::SimpleVolPath(_)
+    );
     if !media.is_empty() && !volumetric {
         p.warnings.push(Diagnostic::warning(
             loc.clone(),
@@ -408,7 +416,12 @@ pub fn create_scene(
                 }
             });
         }
-        let support = Support { media: &media, materials: &materials, used: &used, lights: &lights };
+        let support = Support {
+            media: &media,
+            materials: &materials,
+            used: &used,
+            lights: &lights,
+        };
         check_integrator_support(desc, i, &support, p);
     }
     if !problems.errors.is_empty() {

@@ -13,8 +13,8 @@ use super::entities::{
     AnimatedShapeSceneEntity, MaterialRef, SceneDescription, SceneEntity, ShapeSceneEntity,
 };
 use crate::light::{create_area_light, Light};
-use crate::params::ParamReader;
 use crate::material::MaterialSet;
+use crate::params::ParamReader;
 use crate::primitive::{Alpha, GeometricPrimitive, MediumInterface, Primitive};
 use crate::shape::create::create_shapes;
 use crate::shape::Shape;
@@ -186,10 +186,16 @@ fn medium_interface(
             return Ok(None);
         }
         cx.medium_ids.get(name).copied().map(Some).ok_or_else(|| {
-            Diagnostic::error(s.base.loc.clone(), format!("\"{name}\": medium not defined"))
+            Diagnostic::error(
+                s.base.loc.clone(),
+                format!("\"{name}\": medium not defined"),
+            )
         })
     };
-    match (find(&s.attributes.inside_medium), find(&s.attributes.outside_medium)) {
+    match (
+        find(&s.attributes.inside_medium),
+        find(&s.attributes.outside_medium),
+    ) {
         (Ok(inside), Ok(outside)) => Some(MediumInterface { inside, outside }),
         (Err(e), _) | (_, Err(e)) => {
             problems.errors.push(e);

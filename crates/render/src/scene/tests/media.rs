@@ -149,4 +149,3 @@ fn bad_grid_media_are_located_errors() {
         assert!(e.message.contains(message), "{text}: {}", e.message);
     }
 }
-
