@@ -7,14 +7,18 @@
 //! `f64` additions in sample order within a tile, so when every pixel
 //! belongs to exactly one tile the image does not depend on the thread
 //! count or on the merge order. Splats ([`Film::add_splat`], for
-//! light-tracing integrators) use atomic `f64` additions from any thread
-//! and are not bit-deterministic across thread counts.
+//! light-tracing integrators) are atomic `f64` additions; integrators
+//! record them per unit of work in a [`SplatBuffer`] and apply the
+//! buffers in a fixed order through [`OrderedSplats`], so that they too
+//! do not depend on the thread count.
 
 use std::sync::Arc;
 
 use rpbrt_geometry::{
     Bounds2f, Bounds2i, Float, Normal3f, Point2f, Point2i, Point3f, Vector2f, Vector3f,
 };
+
+pub use splat::{OrderedSplats, SplatBuffer};
 
 use crate::camera::FilmGeometry;
 use crate::filter::Filter;
@@ -25,6 +29,7 @@ mod create;
 mod data;
 mod pixels;
 mod sensor;
+mod splat;
 #[cfg(test)]
 mod tests;
 

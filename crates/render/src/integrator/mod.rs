@@ -38,7 +38,7 @@ pub use render::{Progress, ProgressFn, RenderError, RenderOptions, RenderStats};
 pub use scene::{RayCounters, Scene};
 pub use simple::{AmbientOcclusionIntegrator, RandomWalkIntegrator, SimplePathIntegrator};
 pub use simplevolpath::SimpleVolPathIntegrator;
-pub use tile::RayIntegrator;
+pub use tile::{RayIntegrator, TileIntegrator};
 pub use volpath::VolPathIntegrator;
 
 pub(crate) use direct::{sample_ld, VertexOrigins};
@@ -78,14 +78,24 @@ impl Integrator {
         // One match per render: each arm runs a loop built for its
         // integrator (no dispatch per ray).
         match self {
-            Integrator::Path(i) => tile::render_tiles(i, scene, opts, metadata, progress),
-            Integrator::SimplePath(i) => tile::render_tiles(i, scene, opts, metadata, progress),
-            Integrator::AmbientOcclusion(i) => {
-                tile::render_tiles(i, scene, opts, metadata, progress)
+            Integrator::Path(i) => {
+                tile::render_tiles(&tile::RayTiles(i), scene, opts, metadata, progress)
             }
-            Integrator::RandomWalk(i) => tile::render_tiles(i, scene, opts, metadata, progress),
-            Integrator::VolPath(i) => tile::render_tiles(i, scene, opts, metadata, progress),
-            Integrator::SimpleVolPath(i) => tile::render_tiles(i, scene, opts, metadata, progress),
+            Integrator::SimplePath(i) => {
+                tile::render_tiles(&tile::RayTiles(i), scene, opts, metadata, progress)
+            }
+            Integrator::AmbientOcclusion(i) => {
+                tile::render_tiles(&tile::RayTiles(i), scene, opts, metadata, progress)
+            }
+            Integrator::RandomWalk(i) => {
+                tile::render_tiles(&tile::RayTiles(i), scene, opts, metadata, progress)
+            }
+            Integrator::VolPath(i) => {
+                tile::render_tiles(&tile::RayTiles(i), scene, opts, metadata, progress)
+            }
+            Integrator::SimpleVolPath(i) => {
+                tile::render_tiles(&tile::RayTiles(i), scene, opts, metadata, progress)
+            }
         }
     }
 

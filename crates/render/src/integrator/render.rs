@@ -150,12 +150,14 @@ pub(crate) fn with_progress<R>(
     result
 }
 
-/// Writes the film's image to its file (pbrt-v4 `Film::WriteImage`).
+/// Writes the film's image to its file, splats weighted by `splat_scale`
+/// (pbrt-v4 `Film::WriteImage`).
 pub(crate) fn write_film(
     film: &crate::film::Film,
     metadata: &crate::image::ImageMetadata,
+    splat_scale: rpbrt_geometry::float::Float,
 ) -> Result<(), RenderError> {
-    film.write_image(metadata, 1.0)
+    film.write_image(metadata, splat_scale)
         .map_err(|source| RenderError::WriteImage {
             path: film.filename().to_string(),
             source,

@@ -5,24 +5,24 @@
 //! for, otherwise one sample per pixel and then the rest. Ctrl-C is checked
 //! at every pixel; progress is counted per tile.
 //!
-//! The loop is generic over the [`RayIntegrator`]: each integrator gets its
-//! own copy, with its radiance estimate called directly per sample.
+//! The loop is generic over the [`TileIntegrator`]: each integrator gets
+//! its own copy, with its per-sample work called directly.
 
 use super::render::{
     with_progress, write_film, ProgressFn, RenderError, RenderOptions, RenderStats,
 };
 use super::Scene;
 use crate::camera::CameraSample;
-use crate::film::{FilmTile, VisibleSurface};
+use crate::film::{FilmTile, OrderedSplats, SplatBuffer, VisibleSurface};
 use crate::image::ImageMetadata;
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use rayon::prelude::*;
 use rpbrt_geometry::bounds::Bounds2i;
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::ray::RayDifferential;
 use rpbrt_geometry::tuple::*;
-use std::sync::atomic::Ordering;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
 use std::time::Instant;
 
 /// An integrator that estimates the radiance along one camera ray at a
@@ -65,71 +65,154 @@ fn tiles(bounds: Bounds2i) -> Vec<Bounds2i> {
     out
 }
 
-/// One camera sample through one pixel (pbrt-v4 `EvaluatePixelSample`).
-fn evaluate_pixel_sample<I: RayIntegrator>(
-    scene: &Scene,
-    integrator: &I,
-    opts: &RenderOptions,
-    p_pixel: Point2i,
-    sampler: &mut Sampler,
-    tile: &mut FilmTile,
-    differentials: bool,
-) {
-    let (mut lu, u_pixel, time, p_lens) = sampler.get_camera_samples();
-    if opts.disable_wavelength_jitter {
-        lu = 0.5;
+/// An integrator driven by the tile loop, one pixel sample at a time
+/// (pbrt-v4 `ImageTileIntegrator::EvaluatePixelSample`). Per-ray
+/// integrators get this through [`RayTiles`]; integrators that splat
+/// (light tracing, bdpt) implement it themselves and record their splats
+/// in the tile's [`SplatBuffer`], which the loop applies to the film in
+/// tile order.
+pub trait TileIntegrator: Sync {
+    /// Takes sample `sampler` (already started for this pixel and sample
+    /// index) of pixel `p_pixel`: adds to `tile` and/or records splats.
+    /// `differentials`: whether camera rays need their differentials.
+    #[allow(clippy::too_many_arguments)]
+    fn evaluate_pixel_sample(
+        &self,
+        scene: &Scene,
+        opts: &RenderOptions,
+        p_pixel: Point2i,
+        sampler: &mut Sampler,
+        tile: &mut FilmTile,
+        splats: &mut SplatBuffer,
+        differentials: bool,
+    );
+}
+
+/// A [`RayIntegrator`] as a [`TileIntegrator`].
+pub(crate) struct RayTiles<'a, I>(pub &'a I);
+
+impl<I: RayIntegrator> TileIntegrator for RayTiles<'_, I> {
+    #[inline]
+    fn evaluate_pixel_sample(
+        &self,
+        scene: &Scene,
+        opts: &RenderOptions,
+        p_pixel: Point2i,
+        sampler: &mut Sampler,
+        tile: &mut FilmTile,
+        _splats: &mut SplatBuffer,
+        differentials: bool,
+    ) {
+        let cs = CameraRaySample::take(scene, opts, p_pixel, sampler, differentials);
+        cs.finish(scene, tile, |ray, lambda, visible| {
+            self.0.li(scene, ray, lambda, sampler, visible)
+        });
     }
-    let mut lambda = scene.film.sample_wavelengths(lu);
-    let mut fs = scene.filter.sample(u_pixel);
-    if opts.disable_pixel_jitter {
-        fs.p = Point2f::new(0.0, 0.0);
-        fs.weight = 1.0;
-    }
-    let cs = CameraSample {
-        p_film: Point2f::new(
-            p_pixel.x as Float + fs.p.x + 0.5,
-            p_pixel.y as Float + fs.p.y + 0.5,
-        ),
-        p_lens,
-        time,
-        filter_weight: fs.weight,
-    };
-    let mut l = SampledSpectrum::new(0.0);
-    // Only G-buffer films record the first visible surface.
-    let mut visible: Option<VisibleSurface> = if scene.film.uses_visible_surface() {
-        Some(VisibleSurface::default())
-    } else {
-        None
-    };
-    let camera_ray = if differentials {
-        scene.camera.generate_ray_differential(&cs).map(|mut cr| {
-            if !opts.disable_pixel_jitter {
-                let scale = (1.0 / (sampler.samples_per_pixel() as Float).sqrt()).max(0.125);
-                cr.ray.scale_differentials(scale);
-            }
-            (cr.ray, cr.weight)
-        })
-    } else {
-        // Nothing reads them: the same main ray without its offset rays.
-        scene
-            .camera
-            .generate_ray(&cs)
-            .map(|cr| (RayDifferential::new(cr.ray), cr.weight))
-    };
-    if let Some((ray, weight)) = camera_ray {
-        l = integrator.li(scene, ray, &mut lambda, sampler, visible.as_mut()) * weight;
-        if l.has_nan() || !l.y(&lambda).is_finite() {
-            // pbrt-v4 drops such samples (and logs them).
-            l = SampledSpectrum::new(0.0);
+}
+
+/// One camera sample through one pixel: its wavelengths, film position
+/// and camera ray (pbrt-v4 `RayIntegrator::EvaluatePixelSample`'s first
+/// half).
+pub(crate) struct CameraRaySample {
+    /// The pixel.
+    pub p_pixel: Point2i,
+    /// The sampled wavelengths.
+    pub lambda: SampledWavelengths,
+    /// The film position, time, lens sample and filter weight.
+    pub cs: CameraSample,
+    /// The camera ray and its weight (`None` when the camera makes none).
+    pub ray: Option<(RayDifferential, Float)>,
+}
+
+impl CameraRaySample {
+    /// Draws the camera sample's dimensions from `sampler` in pbrt-v4's
+    /// order and generates the ray.
+    #[inline]
+    pub(crate) fn take(
+        scene: &Scene,
+        opts: &RenderOptions,
+        p_pixel: Point2i,
+        sampler: &mut Sampler,
+        differentials: bool,
+    ) -> Self {
+        let (mut lu, u_pixel, time, p_lens) = sampler.get_camera_samples();
+        if opts.disable_wavelength_jitter {
+            lu = 0.5;
+        }
+        let lambda = scene.film.sample_wavelengths(lu);
+        let mut fs = scene.filter.sample(u_pixel);
+        if opts.disable_pixel_jitter {
+            fs.p = Point2f::new(0.0, 0.0);
+            fs.weight = 1.0;
+        }
+        let cs = CameraSample {
+            p_film: Point2f::new(
+                p_pixel.x as Float + fs.p.x + 0.5,
+                p_pixel.y as Float + fs.p.y + 0.5,
+            ),
+            p_lens,
+            time,
+            filter_weight: fs.weight,
+        };
+        let ray = if differentials {
+            scene.camera.generate_ray_differential(&cs).map(|mut cr| {
+                if !opts.disable_pixel_jitter {
+                    let scale = (1.0 / (sampler.samples_per_pixel() as Float).sqrt()).max(0.125);
+                    cr.ray.scale_differentials(scale);
+                }
+                (cr.ray, cr.weight)
+            })
+        } else {
+            // Nothing reads them: the same main ray without its offset rays.
+            scene
+                .camera
+                .generate_ray(&cs)
+                .map(|cr| (RayDifferential::new(cr.ray), cr.weight))
+        };
+        CameraRaySample {
+            p_pixel,
+            lambda,
+            cs,
+            ray,
         }
     }
-    tile.add_sample(
-        p_pixel,
-        l,
-        &lambda,
-        visible.as_ref().filter(|v| v.set),
-        cs.filter_weight,
-    );
+
+    /// Estimates the radiance along the ray with `li` and adds it to the
+    /// tile (zero when there is no ray; NaN and infinite estimates are
+    /// dropped, as pbrt-v4 does).
+    #[inline]
+    pub(crate) fn finish(
+        mut self,
+        scene: &Scene,
+        tile: &mut FilmTile,
+        li: impl FnOnce(
+            RayDifferential,
+            &mut SampledWavelengths,
+            Option<&mut VisibleSurface>,
+        ) -> SampledSpectrum,
+    ) {
+        let mut l = SampledSpectrum::new(0.0);
+        // Only G-buffer films record the first visible surface.
+        let mut visible: Option<VisibleSurface> = if scene.film.uses_visible_surface() {
+            Some(VisibleSurface::default())
+        } else {
+            None
+        };
+        if let Some((ray, weight)) = self.ray {
+            l = li(ray, &mut self.lambda, visible.as_mut()) * weight;
+            if l.has_nan() || !l.y(&self.lambda).is_finite() {
+                // pbrt-v4 drops such samples (and logs them).
+                l = SampledSpectrum::new(0.0);
+            }
+        }
+        tile.add_sample(
+            self.p_pixel,
+            l,
+            &self.lambda,
+            visible.as_ref().filter(|v| v.set),
+            self.cs.filter_weight,
+        );
+    }
 }
 
 /// The samples of the wave after `[start, end)`: pbrt-v4's schedule,
@@ -150,7 +233,11 @@ fn next_wave(end: i32, wave_size: i32, spp: i32, progressive: bool) -> (i32, i32
 /// Renders `scene` with `integrator` tile by tile, writing the film's image
 /// (and partial images when asked). `metadata` is completed with timing and
 /// sample counts; `progress` hears of the camera samples taken.
-pub(crate) fn render_tiles<I: RayIntegrator>(
+///
+/// Worker threads take tiles in index order from a shared counter; each
+/// tile's splats are applied in tile order ([`OrderedSplats`]), so few wait
+/// and the image does not depend on the thread count.
+pub(crate) fn render_tiles<I: TileIntegrator>(
     integrator: &I,
     scene: &mut Scene,
     opts: &RenderOptions,
@@ -181,49 +268,61 @@ pub(crate) fn render_tiles<I: RayIntegrator>(
     // finish (the progress reporter reads it while a wave runs).
     let done = with_progress(total, start, progress, |samples_done| {
         while wave_start < spp {
-            let results: Vec<FilmTile> = {
+            let next_tile = AtomicUsize::new(0);
+            let finished: Mutex<Vec<(usize, FilmTile)>> = Mutex::new(Vec::new());
+            let splats = OrderedSplats::new();
+            {
                 let scene_ref: &Scene = scene;
-                pool.install(|| {
-                    tile_list
-                        .par_iter()
-                        .map(|&b| {
-                            let mut tile = scene_ref.film.make_tile(b);
-                            let mut sampler = scene_ref.sampler.clone();
-                            super::RayCounters::reset_local();
-                            let mut camera_rays = 0u64;
-                            for p in b.iter() {
-                                // Checked per pixel: a wave can be the
-                                // whole render.
-                                if opts.interrupted() {
-                                    break;
-                                }
-                                for s in wave_start..wave_end {
-                                    sampler.start_pixel_sample(p, s, 0);
-                                    evaluate_pixel_sample(
-                                        scene_ref,
-                                        integrator,
-                                        opts,
-                                        p,
-                                        &mut sampler,
-                                        &mut tile,
-                                        differentials,
-                                    );
-                                }
-                                camera_rays += (wave_end - wave_start) as u64;
+                let work = || {
+                    let mut sampler = scene_ref.sampler.clone();
+                    loop {
+                        let index = next_tile.fetch_add(1, Ordering::Relaxed);
+                        let Some(&b) = tile_list.get(index) else {
+                            break;
+                        };
+                        let mut tile = scene_ref.film.make_tile(b);
+                        let mut tile_splats = SplatBuffer::new();
+                        super::RayCounters::reset_local();
+                        let mut camera_rays = 0u64;
+                        for p in b.iter() {
+                            // Checked per pixel: a wave can be the whole
+                            // render.
+                            if opts.interrupted() {
+                                break;
                             }
-                            scene_ref.counters.flush_local();
-                            scene_ref
-                                .counters
-                                .camera_rays
-                                .fetch_add(camera_rays, Ordering::Relaxed);
-                            samples_done.fetch_add(camera_rays, Ordering::Relaxed);
-                            tile
-                        })
-                        .collect()
-                })
-            };
-            for t in results {
-                scene.film.merge_tile(&t);
+                            for s in wave_start..wave_end {
+                                sampler.start_pixel_sample(p, s, 0);
+                                integrator.evaluate_pixel_sample(
+                                    scene_ref,
+                                    opts,
+                                    p,
+                                    &mut sampler,
+                                    &mut tile,
+                                    &mut tile_splats,
+                                    differentials,
+                                );
+                            }
+                            camera_rays += (wave_end - wave_start) as u64;
+                        }
+                        scene_ref.counters.flush_local();
+                        scene_ref
+                            .counters
+                            .camera_rays
+                            .fetch_add(camera_rays, Ordering::Relaxed);
+                        samples_done.fetch_add(camera_rays, Ordering::Relaxed);
+                        splats.submit(&scene_ref.film, index, tile_splats);
+                        finished
+                            .lock()
+                            .unwrap_or_else(|e| e.into_inner())
+                            .push((index, tile));
+                    }
+                };
+                pool.broadcast(|_| work());
+            }
+            let mut results = finished.into_inner().unwrap_or_else(|e| e.into_inner());
+            results.sort_unstable_by_key(|(i, _)| *i);
+            for (_, t) in &results {
+                scene.film.merge_tile(t);
             }
             if opts.interrupted() {
                 interrupted = true;
@@ -233,7 +332,7 @@ pub(crate) fn render_tiles<I: RayIntegrator>(
             (wave_end, next_wave_size) = next_wave(wave_end, next_wave_size, spp, progressive);
             if let Some(reference) = &opts.mse_reference {
                 let mut md = ImageMetadata::default();
-                let image = scene.film.get_image(&mut md, 1.0);
+                let image = scene.film.get_image(&mut md, splat_scale(wave_start));
                 let d = crate::image::ops::diff(&image, reference)
                     .map_err(RenderError::MseReference)?;
                 mse_per_wave.push((wave_start, d.mse));
@@ -241,7 +340,7 @@ pub(crate) fn render_tiles<I: RayIntegrator>(
             if opts.write_partial_images && wave_start < spp {
                 metadata.render_time_seconds = Some(start.elapsed().as_secs_f32());
                 metadata.samples_per_pixel = Some(wave_start);
-                write_film(&scene.film, metadata)?;
+                write_film(&scene.film, metadata, splat_scale(wave_start))?;
             }
         }
         Ok(samples_done.load(Ordering::Relaxed))
@@ -253,13 +352,21 @@ pub(crate) fn render_tiles<I: RayIntegrator>(
     if let Some(&(_, mse)) = mse_per_wave.last() {
         metadata.mse = Some(mse as f32);
     }
-    write_film(&scene.film, metadata)?;
+    // An interrupted wave's splats are partial: the scale of the completed
+    // waves keeps them at most slightly bright, as pbrt-v4's.
+    write_film(&scene.film, metadata, splat_scale(wave_start))?;
     Ok(RenderStats {
         render_time,
         samples: done,
         interrupted,
         mse_per_wave,
     })
+}
+
+/// The weight of splats after `spp` samples per pixel (pbrt-v4 writes
+/// `1 / waveStart`).
+fn splat_scale(spp: i32) -> Float {
+    1.0 / spp.max(1) as Float
 }
 
 #[cfg(test)]
