@@ -2,7 +2,7 @@
 //! convert). The numbers come from `rpbrt_render::image::ops`; this module
 //! only parses arguments and prints.
 
-use rpbrt_render::image::ops::{diff, info};
+use rpbrt_render::image::ops::{diff, info, worst_block, BLOCK_SIZE};
 use rpbrt_render::image::{Image, ImageMetadata};
 use std::path::Path;
 use std::process::ExitCode;
@@ -106,6 +106,12 @@ fn cmd_diff(args: &[String]) -> Result<(), String> {
             f64::NAN
         }
     );
+    if let Some(w) = worst_block(&a, &b, BLOCK_SIZE).map_err(|e| e.to_string())? {
+        println!(
+            "worst {BLOCK_SIZE}x{BLOCK_SIZE} block: z {:.2} (mean ratio {:.4}, block at {}, {})",
+            w.z, w.ratio, w.at.x, w.at.y
+        );
+    }
     println!("max |difference|: {:.6e}", s.max_abs_diff);
     println!("differing pixels: {}", s.differing_pixels);
     println!("non-finite terms: {}", s.non_finite);

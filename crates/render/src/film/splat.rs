@@ -18,6 +18,9 @@ use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 /// One recorded splat: `Film::add_splat`'s arguments.
 #[derive(Clone, Copy, Debug)]
 struct Splat {
+    /// Which film: 0 the render's, k ≥ 1 the k-th extra film (bdpt's
+    /// strategy images).
+    film: u32,
     p: Point2f,
     l: SampledSpectrum,
     lambda: SampledWavelengths,
@@ -38,7 +41,21 @@ impl SplatBuffer {
     /// Records a splat of radiance `l` at continuous raster position `p`.
     #[inline]
     pub fn add(&mut self, p: Point2f, l: SampledSpectrum, lambda: &SampledWavelengths) {
+        self.add_to(0, p, l, lambda);
+    }
+
+    /// Records a splat for film `film` (0: the render's film; k ≥ 1: the
+    /// k-th extra film of the render loop).
+    #[inline]
+    pub fn add_to(
+        &mut self,
+        film: usize,
+        p: Point2f,
+        l: SampledSpectrum,
+        lambda: &SampledWavelengths,
+    ) {
         self.splats.push(Splat {
+            film: film as u32,
             p,
             l,
             lambda: *lambda,
@@ -50,15 +67,23 @@ impl SplatBuffer {
         self.splats.len()
     }
 
+    /// Forgets the splats, keeping the memory.
+    pub fn clear(&mut self) {
+        self.splats.clear();
+    }
+
     /// True when nothing was recorded.
     pub fn is_empty(&self) -> bool {
         self.splats.is_empty()
     }
 
-    /// Adds the splats to `film` in the order they were recorded.
-    pub fn apply(&self, film: &Film) {
+    /// Adds the splats to their films (`films[k]` for film index k) in
+    /// the order they were recorded.
+    pub fn apply(&self, films: &[&Film]) {
         for s in &self.splats {
-            film.add_splat(s.p, s.l, &s.lambda);
+            if let Some(f) = films.get(s.film as usize) {
+                f.add_splat(s.p, s.l, &s.lambda);
+            }
         }
     }
 }
@@ -72,7 +97,13 @@ struct Pending {
     waiting: BTreeMap<usize, SplatBuffer>,
     /// A thread is applying buffers (outside the lock).
     applying: bool,
+    /// Applied buffers, emptied, for [`OrderedSplats::buffer`] to hand
+    /// out again (their memory stays allocated).
+    free: Vec<SplatBuffer>,
 }
+
+/// Emptied buffers kept for reuse.
+const FREE_BUFFERS: usize = 64;
 
 /// Applies numbered [`SplatBuffer`]s to a film in index order (0, 1, 2, …)
 /// as they are submitted from any thread. A buffer submitted early waits
@@ -91,8 +122,18 @@ impl OrderedSplats {
         OrderedSplats::default()
     }
 
+    /// An empty buffer, reusing the memory of one already applied.
+    pub fn buffer(&self) -> SplatBuffer {
+        self.pending
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .free
+            .pop()
+            .unwrap_or_default()
+    }
+
     /// Submits buffer `index`; applies what has become applicable.
-    pub fn submit(&self, film: &Film, index: usize, buffer: SplatBuffer) {
+    pub fn submit(&self, films: &[&Film], index: usize, buffer: SplatBuffer) {
         let lock = || self.pending.lock().unwrap_or_else(|e| e.into_inner());
         let mut p = lock();
         p.waiting.insert(index, buffer);
@@ -108,9 +149,14 @@ impl OrderedSplats {
                 return;
             };
             drop(p);
-            buf.apply(film);
+            let mut buf = buf;
+            buf.apply(films);
+            buf.clear();
             p = lock();
             p.next += 1;
+            if p.free.len() < FREE_BUFFERS {
+                p.free.push(buf);
+            }
         }
     }
 

@@ -177,6 +177,102 @@ pub fn diff(a: &Image, b: &Image) -> Result<DiffStats, ImageError> {
     })
 }
 
+/// The side of the pixel blocks [`worst_block`] compares.
+pub const BLOCK_SIZE: i32 = 16;
+
+/// How one block of an image differs from the same block of a reference.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BlockDifference {
+    /// The block's first pixel.
+    pub at: Point2i,
+    /// The block's mean over the reference's.
+    pub ratio: f64,
+    /// The mean difference in units of its standard error (the spread of
+    /// the sub-blocks' differences over the square root of their count):
+    /// beyond 4 or so, the block differs by more than noise.
+    pub z: f64,
+}
+
+/// The block of `a` that differs most from the same block of the
+/// reference `b`, measured against the noise within it: blocks of
+/// `size`×`size` pixels (partial ones at the edges), differences averaged
+/// over channels (non-finite ones left out) and over each of the block's
+/// 4×4 sub-blocks. A difference image
+/// with structure (a missing caustic, a shifted highlight) shows here as a
+/// large |z| even when the overall means agree. `None` for an empty image.
+pub fn worst_block(a: &Image, b: &Image, size: i32) -> Result<Option<BlockDifference>, ImageError> {
+    let (names, va, vb) = paired(a, b)?;
+    let nc = names.len().max(1);
+    let res = a.resolution();
+    let size = size.max(1);
+    let mut worst: Option<BlockDifference> = None;
+    let mut by = 0;
+    while by < res.y {
+        let mut bx = 0;
+        while bx < res.x {
+            // The differences are taken over 4×4 sub-blocks, whose means
+            // are nearly independent even when a reconstruction filter
+            // spreads each sample over neighbouring pixels.
+            let (mut sa, mut sb) = (0.0f64, 0.0f64);
+            let (mut sd, mut sd2, mut n) = (0.0f64, 0.0f64, 0usize);
+            let sub = (size / 4).max(1);
+            let (ey, ex) = ((by + size).min(res.y), (bx + size).min(res.x));
+            let mut sy = by;
+            while sy < ey {
+                let mut sx = bx;
+                while sx < ex {
+                    let (mut ta, mut tb, mut m) = (0.0f64, 0.0f64, 0usize);
+                    for y in sy..(sy + sub).min(ey) {
+                        for x in sx..(sx + sub).min(ex) {
+                            let i = (y as usize * res.x as usize + x as usize) * nc;
+                            let (pa, pb) = (&va[i..i + nc], &vb[i..i + nc]);
+                            if pa.iter().chain(pb).all(|v| v.is_finite()) {
+                                ta += pa.iter().map(|&v| v as f64).sum::<f64>() / nc as f64;
+                                tb += pb.iter().map(|&v| v as f64).sum::<f64>() / nc as f64;
+                                m += 1;
+                            }
+                        }
+                    }
+                    if m > 0 {
+                        sa += ta;
+                        sb += tb;
+                        let d = (ta - tb) / m as f64;
+                        sd += d;
+                        sd2 += d * d;
+                        n += 1;
+                    }
+                    sx += sub;
+                }
+                sy += sub;
+            }
+            if n > 1 {
+                let nf = n as f64;
+                let mean = sd / nf;
+                let var = ((sd2 - sd * sd / nf) / (nf - 1.0)).max(0.0);
+                let se = (var / nf).sqrt();
+                let z = if se > 0.0 {
+                    mean / se
+                } else if mean == 0.0 {
+                    0.0
+                } else {
+                    f64::INFINITY
+                };
+                let ratio = if sb > 0.0 { sa / sb } else { f64::NAN };
+                if worst.is_none_or(|w| z.abs() > w.z.abs()) {
+                    worst = Some(BlockDifference {
+                        at: Point2i::new(bx, by),
+                        ratio,
+                        z,
+                    });
+                }
+            }
+            bx += size;
+        }
+        by += size;
+    }
+    Ok(worst)
+}
+
 /// Statistics of one channel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ChannelStats {

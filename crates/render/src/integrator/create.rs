@@ -3,8 +3,9 @@
 //! turned into an [`Integrator`].
 
 use super::{
-    AmbientOcclusionIntegrator, Integrator, PathIntegrator, RandomWalkIntegrator,
-    SimplePathIntegrator, SimpleVolPathIntegrator, VolPathIntegrator,
+    AmbientOcclusionIntegrator, BdptIntegrator, Integrator, LightPathIntegrator, MltIntegrator,
+    PathIntegrator, RandomWalkIntegrator, SimplePathIntegrator, SimpleVolPathIntegrator,
+    VolPathIntegrator,
 };
 use crate::params::{unknown_type, ParamReader};
 use rpbrt_geometry::float::Float;
@@ -24,9 +25,22 @@ pub const INTEGRATOR_NAMES: &[&str] = &[
     "volpath",
 ];
 
+/// The command line's say in integrator creation.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct IntegratorOptions {
+    /// `--spp`: MLT's mutations per pixel, as in pbrt-v4.
+    pub spp: Option<i32>,
+    /// `--seed`.
+    pub seed: Option<i32>,
+}
+
 /// Creates the integrator of an `Integrator` directive. The light sampler
 /// it needs is created by the caller (it needs the lights).
-pub fn create_integrator(name: &str, ip: &ParamReader) -> Result<Integrator, Diagnostic> {
+pub fn create_integrator(
+    name: &str,
+    ip: &ParamReader,
+    opts: &IntegratorOptions,
+) -> Result<Integrator, Diagnostic> {
     let loc = ip.loc();
     let max_depth = ip.int("maxdepth", 5)?;
     if max_depth < 0 {
@@ -60,7 +74,70 @@ pub fn create_integrator(name: &str, ip: &ParamReader) -> Result<Integrator, Dia
             Ok(Integrator::AmbientOcclusion(AmbientOcclusionIntegrator { cos_sample: ip.bool("cossample", true)?, max_distance }))
         }
         "randomwalk" => Ok(Integrator::RandomWalk(RandomWalkIntegrator { max_depth })),
-        "bdpt" | "lightpath" | "mlt" | "sppm" => Err(Diagnostic::error(
+        "bdpt" => {
+            let visualize_strategies = ip.bool("visualizestrategies", false)?;
+            let visualize_weights = ip.bool("visualizeweights", false)?;
+            let mut max_depth = max_depth;
+            if (visualize_strategies || visualize_weights) && max_depth > 5 {
+                ip.warn_at(
+                    "maxdepth",
+                    "visualizestrategies/visualizeweights was enabled, limiting maxdepth to 5",
+                );
+                max_depth = 5;
+            }
+            Ok(Integrator::Bdpt(BdptIntegrator {
+                max_depth,
+                regularize: ip.bool("regularize", false)?,
+                visualize_strategies,
+                visualize_weights,
+            }))
+        }
+        "lightpath" => Ok(Integrator::LightPath(LightPathIntegrator { max_depth })),
+        "mlt" => {
+            let bootstrap_samples = ip.int("bootstrapsamples", 100_000)?;
+            if bootstrap_samples <= 0 {
+                return Err(ip.error_at(
+                    "bootstrapsamples",
+                    format!("\"bootstrapsamples\" must be positive, got {bootstrap_samples}"),
+                ));
+            }
+            let chains = ip.int("chains", 1000)?;
+            if chains <= 0 {
+                return Err(ip.error_at("chains", format!("\"chains\" must be positive, got {chains}")));
+            }
+            let mut mutations_per_pixel = ip.int("mutationsperpixel", 100)?;
+            if mutations_per_pixel <= 0 {
+                return Err(ip.error_at(
+                    "mutationsperpixel",
+                    format!("\"mutationsperpixel\" must be positive, got {mutations_per_pixel}"),
+                ));
+            }
+            if let Some(spp) = opts.spp {
+                mutations_per_pixel = spp;
+            }
+            let large_step_probability = ip.float("largestepprobability", 0.3)?;
+            if !(0.0..=1.0).contains(&large_step_probability) {
+                return Err(ip.error_at(
+                    "largestepprobability",
+                    format!("\"largestepprobability\" must be in [0, 1], got {large_step_probability}"),
+                ));
+            }
+            let sigma = ip.float("sigma", 0.01)?;
+            if !(sigma > 0.0 && sigma.is_finite()) {
+                return Err(ip.error_at("sigma", format!("\"sigma\" must be positive, got {sigma}")));
+            }
+            Ok(Integrator::Mlt(MltIntegrator {
+                max_depth,
+                bootstrap_samples,
+                chains,
+                mutations_per_pixel,
+                large_step_probability,
+                sigma,
+                regularize: ip.bool("regularize", false)?,
+                seed: opts.seed.unwrap_or(0) as u64,
+            }))
+        }
+        "sppm" => Err(Diagnostic::error(
             loc.clone(),
             format!("the \"{name}\" integrator is not supported yet; rpbrt renders with \"path\", \"volpath\", \"simplevolpath\", \"simplepath\", \"ambientocclusion\" and \"randomwalk\""),
         )),

@@ -21,8 +21,11 @@
 //! `simple`, the integrators; `volume`, what the volumetric ones share;
 //! `volpath` and `simplevolpath`, pbrt-v4's volumetric path tracers.
 
+pub(crate) mod bdpt;
 mod create;
 mod direct;
+mod lightpath;
+mod mlt;
 mod path;
 pub mod render;
 pub mod scene;
@@ -32,7 +35,10 @@ pub mod tile;
 mod volpath;
 mod volume;
 
-pub use create::{create_integrator, INTEGRATOR_NAMES};
+pub use bdpt::BdptIntegrator;
+pub use create::{create_integrator, IntegratorOptions, INTEGRATOR_NAMES};
+pub use lightpath::LightPathIntegrator;
+pub use mlt::MltIntegrator;
 pub use path::PathIntegrator;
 pub use render::{Progress, ProgressFn, RenderError, RenderOptions, RenderStats};
 pub use scene::{RayCounters, Scene};
@@ -60,6 +66,12 @@ pub enum Integrator {
     VolPath(VolPathIntegrator),
     /// `simplevolpath`.
     SimpleVolPath(SimpleVolPathIntegrator),
+    /// `bdpt`.
+    Bdpt(BdptIntegrator),
+    /// `lightpath`.
+    LightPath(LightPathIntegrator),
+    /// `mlt`.
+    Mlt(MltIntegrator),
 }
 
 impl Integrator {
@@ -96,7 +108,19 @@ impl Integrator {
             Integrator::SimpleVolPath(i) => {
                 tile::render_tiles(&tile::RayTiles(i), scene, opts, metadata, progress)
             }
+            Integrator::Bdpt(i) => bdpt::render(i, scene, opts, metadata, progress),
+            Integrator::LightPath(i) => tile::render_tiles(i, scene, opts, metadata, progress),
+            Integrator::Mlt(i) => mlt::render(i, scene, opts, metadata, progress),
         }
+    }
+
+    /// True for integrators that connect paths to the camera's lens (they
+    /// need [`crate::camera::Camera::we`] and its kin).
+    pub fn needs_camera_importance(&self) -> bool {
+        matches!(
+            self,
+            Integrator::Bdpt(_) | Integrator::LightPath(_) | Integrator::Mlt(_)
+        )
     }
 
     /// The light sampler, if the integrator samples lights.
@@ -104,6 +128,8 @@ impl Integrator {
         match self {
             Integrator::Path(i) => Some(&i.light_sampler_name),
             Integrator::VolPath(i) => Some(&i.light_sampler_name),
+            // pbrt-v4's bidirectional integrators choose lights by power.
+            Integrator::Bdpt(_) | Integrator::LightPath(_) | Integrator::Mlt(_) => Some("power"),
             _ => None,
         }
     }

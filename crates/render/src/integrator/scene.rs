@@ -14,7 +14,7 @@ use crate::lightsampler::LightSampler;
 use crate::material::MaterialSet;
 use crate::medium::Medium;
 use crate::primitive::{HitRecord, PrimitiveAggregate, PrimitiveIntersection};
-use crate::sampler::Sampler;
+use crate::sampler::{SampleSource, Sampler};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::interaction::{CameraDifferentials, SurfaceInteraction};
@@ -187,12 +187,12 @@ impl Scene {
     /// pbrt-v4's `SurfaceInteraction::GetBSDF`: computes the screen-space
     /// differentials (when the material can use them), then asks the material for its BSDF (`None` for
     /// interfaces between media, which the ray passes through).
-    pub fn get_bsdf(
+    pub fn get_bsdf<S: SampleSource>(
         &self,
         hit: &mut PrimitiveIntersection,
         ray: &RayDifferential,
         lambda: &mut SampledWavelengths,
-        sampler: &mut Sampler,
+        sampler: &mut S,
     ) -> Option<BSDF> {
         let material = hit.material?;
         // The differentials only feed texture filtering and bump mapping;

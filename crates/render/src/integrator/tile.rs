@@ -86,6 +86,12 @@ pub trait TileIntegrator: Sync {
         splats: &mut SplatBuffer,
         differentials: bool,
     );
+
+    /// Films besides the render's that splats may go to (film index k ≥ 1
+    /// of [`SplatBuffer::add_to`] is `extra_films()[k - 1]`).
+    fn extra_films(&self) -> &[crate::film::Film] {
+        &[]
+    }
 }
 
 /// A [`RayIntegrator`] as a [`TileIntegrator`].
@@ -273,6 +279,9 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
             let splats = OrderedSplats::new();
             {
                 let scene_ref: &Scene = scene;
+                let mut targets = vec![&scene_ref.film];
+                targets.extend(integrator.extra_films());
+                let targets = &targets;
                 let work = || {
                     let mut sampler = scene_ref.sampler.clone();
                     loop {
@@ -281,7 +290,7 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
                             break;
                         };
                         let mut tile = scene_ref.film.make_tile(b);
-                        let mut tile_splats = SplatBuffer::new();
+                        let mut tile_splats = splats.buffer();
                         super::RayCounters::reset_local();
                         let mut camera_rays = 0u64;
                         for p in b.iter() {
@@ -310,7 +319,7 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
                             .camera_rays
                             .fetch_add(camera_rays, Ordering::Relaxed);
                         samples_done.fetch_add(camera_rays, Ordering::Relaxed);
-                        splats.submit(&scene_ref.film, index, tile_splats);
+                        splats.submit(targets, index, tile_splats);
                         finished
                             .lock()
                             .unwrap_or_else(|e| e.into_inner())

@@ -56,7 +56,7 @@ enum LdVertex<'v, 'a> {
 /// at a tentative collision, with `u` choosing one (pbrt-v4
 /// `SampleDiscrete({pAbsorb, pScatter, pNull}, u)`).
 #[inline]
-fn sample_event(sigma_a: Float, sigma_s: Float, sigma_maj: Float, u: Float) -> u8 {
+pub(crate) fn sample_event(sigma_a: Float, sigma_s: Float, sigma_maj: Float, u: Float) -> u8 {
     let p_absorb = sigma_a / sigma_maj;
     let p_scatter = sigma_s / sigma_maj;
     let p_null = (1.0 - p_absorb - p_scatter).max(0.0);

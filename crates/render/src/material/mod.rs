@@ -21,7 +21,7 @@ use rpbrt_parser::FileLoc;
 use crate::bxdf::{BxDF, DiffuseBxDF, TrowbridgeReitzDistribution, BSDF};
 use crate::image::Image;
 use crate::spectrum::{SampledWavelengths, Spectrum};
-use crate::texture::{FloatTextureRef, TextureEvalContext};
+use crate::texture::{FloatTextureRef, SpectrumTextureRef, TextureEvalContext};
 
 mod bump;
 mod coated;
@@ -392,16 +392,44 @@ impl MaterialSet {
     /// constant textures alone answer false (the rest conservatively
     /// true), so skipping the differentials for them cannot change a BSDF.
     pub fn needs_differentials(&self, material: u32) -> bool {
-        use crate::texture::SpectrumTexture;
-        match self.materials.get(material as usize) {
-            Some(Material::Diffuse(m)) => {
-                !matches!(*m.reflectance, SpectrumTexture::Constant(_))
-                    || m.perturbation.displacement.is_some()
-                    || m.perturbation.normal_map.is_some()
+        use crate::texture::{FloatTexture, SpectrumTexture};
+        let fc = |t: &FloatTextureRef| matches!(**t, FloatTexture::Constant(_));
+        let sc = |t: &SpectrumTextureRef| matches!(**t, SpectrumTexture::Constant(_));
+        let rough = |r: &Roughness| fc(&r.u) && fc(&r.v);
+        let layer = |l: &coated::LayerSettings| fc(&l.thickness) && sc(&l.albedo) && fc(&l.g);
+        let conductor = |c: &conductor::ConductorSpectra| match c {
+            conductor::ConductorSpectra::EtaK { eta, k } => sc(eta) && sc(k),
+            conductor::ConductorSpectra::Reflectance(r) => sc(r),
+        };
+        // Materials whose textures are all constants and that perturb no
+        // normals read no differentials: their BSDFs are the same without.
+        let constant = match self.materials.get(material as usize) {
+            Some(Material::Diffuse(m)) => sc(&m.reflectance) && !m.perturbation.is_some(),
+            Some(Material::DiffuseTransmission(m)) => {
+                sc(&m.reflectance) && sc(&m.transmittance) && !m.perturbation.is_some()
             }
-            Some(Material::Interface) => false,
-            _ => true,
-        }
+            Some(Material::Conductor(m)) => {
+                conductor(&m.spectra) && rough(&m.roughness) && !m.perturbation.is_some()
+            }
+            Some(Material::Dielectric(m)) => rough(&m.roughness) && !m.perturbation.is_some(),
+            Some(Material::ThinDielectric(m)) => !m.perturbation.is_some(),
+            Some(Material::CoatedDiffuse(m)) => {
+                sc(&m.reflectance)
+                    && rough(&m.roughness)
+                    && layer(&m.layer)
+                    && !m.perturbation.is_some()
+            }
+            Some(Material::CoatedConductor(m)) => {
+                rough(&m.interface_roughness)
+                    && conductor(&m.conductor)
+                    && rough(&m.conductor_roughness)
+                    && layer(&m.layer)
+                    && !m.perturbation.is_some()
+            }
+            Some(Material::Interface) => true,
+            _ => false,
+        };
+        !constant
     }
 
     /// True when some material of the set may read hits' screen-space

@@ -29,6 +29,28 @@ pub use pmj02bn::Pmj02bnSampler;
 pub use sobol::{PaddedSobolSampler, SobolSampler, ZSobolSampler};
 pub use stratified::StratifiedSampler;
 
+/// Where sample values come from, for code that runs under both the
+/// pixel samplers ([`Sampler`]) and MLT's primary-sample-space sampler
+/// (pbrt-v4 puts `MLTSampler` in its `Sampler` union; here the path code
+/// that MLT shares is generic over this trait instead).
+pub trait SampleSource {
+    /// The next sample dimension, in [0,1).
+    fn get_1d(&mut self) -> Float;
+    /// The next two sample dimensions, in [0,1)².
+    fn get_2d(&mut self) -> Point2f;
+}
+
+impl SampleSource for Sampler {
+    #[inline]
+    fn get_1d(&mut self) -> Float {
+        Sampler::get_1d(self)
+    }
+    #[inline]
+    fn get_2d(&mut self) -> Point2f {
+        Sampler::get_2d(self)
+    }
+}
+
 /// A sampler: a closed set of variants with one-line delegation (the
 /// Rust form of pbrt-v4's tagged `Sampler`).
 #[derive(Clone, Debug)]

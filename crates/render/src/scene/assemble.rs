@@ -18,7 +18,7 @@ use crate::camera::create_camera;
 use crate::film::{create_film, FilmOverrides};
 use crate::filter::create_filter;
 use crate::image::MIPMapCache;
-use crate::integrator::{create_integrator, Integrator, RayCounters, Scene};
+use crate::integrator::{create_integrator, Integrator, IntegratorOptions, RayCounters, Scene};
 use crate::light::{create_light, Light, LightCull, LightType};
 use crate::lightsampler::create_light_sampler;
 use crate::material::MaterialSet;
@@ -178,9 +178,13 @@ fn check_integrator_support(
     } = *support;
     let name = desc.integrator.name.as_str();
     let loc = &desc.integrator.loc;
+    // pbrt-v4's list: the integrators that trace through media.
     let volumetric = matches!(
         integrator,
-        Integrator::VolPath(_) | Integrator::SimpleVolPath(_)
+        Integrator::VolPath(_)
+            | Integrator::SimpleVolPath(_)
+            | Integrator::Bdpt(_)
+            | Integrator::Mlt(_)
     );
     if !media.is_empty() && !volumetric {
         p.warnings.push(Diagnostic::warning(
@@ -404,7 +408,11 @@ pub fn create_scene(
         })
         .unwrap_or_default();
     let integrator = p.take(reader(&desc.integrator)).and_then(|r| {
-        let i = create_integrator(&desc.integrator.name, &r);
+        let iopts = IntegratorOptions {
+            spp: opts.spp,
+            seed: opts.seed,
+        };
+        let i = create_integrator(&desc.integrator.name, &r, &iopts);
         p.finish(r, i)
     });
     if let Some(i) = &integrator {
@@ -423,6 +431,17 @@ pub fn create_scene(
             lights: &lights,
         };
         check_integrator_support(desc, i, &support, p);
+        // Light tracing connects to the camera through its importance,
+        // which only the perspective camera has (pbrt-v4's error).
+        if i.needs_camera_importance() && !camera.supports_importance() {
+            p.errors.push(Diagnostic::error(
+                desc.integrator.loc.clone(),
+                format!(
+                    "Only the \"perspective\" camera is currently supported with the \"{}\" integrator.",
+                    desc.integrator.name
+                ),
+            ));
+        }
     }
     if !problems.errors.is_empty() {
         return Err(problems.errors);
