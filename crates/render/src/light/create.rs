@@ -154,7 +154,7 @@ pub fn create_light(
             let i = spectrum_param(lp, "I")?.unwrap_or_else(|| cs.illuminant_spectrum());
             let mut scale = normalize_scale(scale_param(lp)?, &i, "\"I\"", loc)?;
             let coneangle = lp.float("coneangle", 30.0)?;
-            let conedelta = lp.float("conedelta", 5.0)?;
+            let conedelta = lp.float("conedeltaangle", 5.0)?;
             let from = point3(lp, "from", [0.0; 3])?;
             let to = point3(lp, "to", [0.0, 0.0, 1.0])?;
             let dir = (to - from).try_normalize().ok_or_else(|| {

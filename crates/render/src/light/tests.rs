@@ -182,7 +182,7 @@ fn spot_light_power_falloff_and_integral() {
         vec![
             floats("power", &[50.0]),
             floats("coneangle", &[40.0]),
-            floats("conedelta", &[10.0]),
+            floats("conedeltaangle", &[10.0]),
             floats("from", &[0.0, 0.0, 0.0]),
             floats("to", &[1.0, 0.0, 0.0]),
         ],

@@ -178,7 +178,7 @@ fn spot_light_le_follows_the_falloff() {
             "spot",
             vec![
                 floats("coneangle", &[cone]),
-                floats("conedelta", &[delta]),
+                floats("conedeltaangle", &[delta]),
                 floats("from", &[0.5, 0.0, 1.0]),
                 floats("to", &[1.5, 1.0, 1.0]),
             ],
