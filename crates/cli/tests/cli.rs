@@ -200,7 +200,6 @@ fn integrators_that_ignore_media_or_subsurface_warn_at_the_directive() {
 #[test]
 fn unsupported_features_are_located_errors_not_wrong_images() {
     let cases = [
-        ("bdpt.pbrt", "Integrator \"bdpt\"\nWorldBegin\nShape \"sphere\"\n", "bdpt.pbrt:1:1"),
         ("sppm.pbrt", "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nIntegrator \"sppm\"\nWorldBegin\nShape \"sphere\"\n", "sppm.pbrt:2:1"),
     ];
     for (name, text, loc) in cases {
@@ -213,4 +212,62 @@ fn unsupported_features_are_located_errors_not_wrong_images() {
             "{name}: {e}"
         );
     }
+}
+
+#[test]
+fn bidirectional_integrators_need_the_perspective_camera() {
+    for integrator in ["bdpt", "lightpath", "mlt"] {
+        let name = format!("{integrator}-ortho.pbrt");
+        let text = format!(
+            "Camera \"orthographic\"\nIntegrator \"{integrator}\"\nWorldBegin\nShape \"sphere\"\n"
+        );
+        let p = temp_scene(&name, &text);
+        let out = rpbrt().arg("--quiet").arg(&p).output().unwrap();
+        assert_eq!(out.status.code(), Some(1), "{name}");
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            e.contains(&format!("{name}:2:1")) && e.contains("Only the \"perspective\" camera"),
+            "{name}: {e}"
+        );
+    }
+}
+
+/// bdpt's `visualizestrategies` writes one image per (s, t) strategy into
+/// the working directory, named as pbrt-v4 names them.
+#[test]
+fn bdpt_writes_its_strategy_images() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-cli-strategies-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" 45\nSampler \"independent\" \"integer pixelsamples\" 4\nFilm \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8 \"string filename\" \"main.exr\"\nIntegrator \"bdpt\" \"integer maxdepth\" 2 \"bool visualizestrategies\" true\nWorldBegin\nAttributeBegin\nReverseOrientation\nMaterial \"diffuse\" \"rgb reflectance\" [ 0.5 0.5 0.5 ]\nAreaLightSource \"diffuse\" \"rgb L\" [ 0.5 0.5 0.5 ]\nShape \"sphere\" \"float radius\" 1\nAttributeEnd\n";
+    std::fs::write(dir.join("s.pbrt"), text).unwrap();
+    let out = rpbrt()
+        .current_dir(&dir)
+        .args(["--quiet", "s.pbrt"])
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // Depth 0: (0,2); depth 1: (0,3), (1,2), (2,1); depth 2: s from 0 to 3.
+    for name in [
+        "bdpt_d00_s00_t02.exr",
+        "bdpt_d01_s00_t03.exr",
+        "bdpt_d01_s01_t02.exr",
+        "bdpt_d01_s02_t01.exr",
+        "bdpt_d02_s03_t01.exr",
+    ] {
+        assert!(dir.join(name).exists(), "{name} missing");
+    }
+    assert!(!dir.join("bdpt_d00_s01_t01.exr").exists());
+    // The direct view of the emitter (0,2) carries its radiance 0.5.
+    let info = rpbrt()
+        .args(["imgtool", "info"])
+        .arg(dir.join("bdpt_d00_s00_t02.exr"))
+        .output()
+        .unwrap();
+    let info = String::from_utf8_lossy(&info.stdout);
+    assert!(info.contains("0.5"), "{info}");
 }
