@@ -262,12 +262,21 @@ fn bdpt_writes_its_strategy_images() {
         assert!(dir.join(name).exists(), "{name} missing");
     }
     assert!(!dir.join("bdpt_d00_s01_t01.exr").exists());
-    // The direct view of the emitter (0,2) carries its radiance 0.5.
+    // The direct view of the emitter (0,2) carries its radiance 0.5 (a
+    // little less on average: samples near the border land outside).
     let info = rpbrt()
         .args(["imgtool", "info"])
         .arg(dir.join("bdpt_d00_s00_t02.exr"))
         .output()
         .unwrap();
     let info = String::from_utf8_lossy(&info.stdout);
-    assert!(info.contains("0.5"), "{info}");
+    let avgs: Vec<f64> = info
+        .split("avg ")
+        .skip(1)
+        .filter_map(|t| t.split_whitespace().next()?.parse().ok())
+        .collect();
+    assert!(
+        avgs.len() == 3 && avgs.iter().all(|a| (0.4..0.52).contains(a)),
+        "{info}"
+    );
 }
