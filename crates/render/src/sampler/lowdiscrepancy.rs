@@ -463,6 +463,22 @@ pub fn sobol_sample(a: u64, dimension: usize, scrambler: BinaryScrambler) -> Flo
     (v as Float * f32::from_bits(0x2f80_0000)).min(ONE_MINUS_EPSILON)
 }
 
+/// [`sobol_sample`] of an index given by the positions of its set bits
+/// (ascending), for dimensions ≥ 2: the same value, with one XOR per set
+/// bit instead of a step per bit up to the highest. Samplers that draw
+/// many dimensions of one index list its bits once.
+#[inline]
+pub fn sobol_sample_at_bits(bits: &[u8], dimension: usize, scrambler: BinaryScrambler) -> Float {
+    debug_assert!((2..N_SOBOL_DIMENSIONS).contains(&dimension));
+    let m = &sobol_matrices()[dimension * SOBOL_MATRIX_SIZE..(dimension + 1) * SOBOL_MATRIX_SIZE];
+    let mut v = 0u32;
+    for &b in bits {
+        v ^= m.get(b as usize).copied().unwrap_or(0);
+    }
+    let v = scrambler.apply(v);
+    (v as Float * f32::from_bits(0x2f80_0000)).min(ONE_MINUS_EPSILON)
+}
+
 /// [`sobol_byte_tables`] with every entry bit-reversed.
 fn sobol_reversed_byte_tables() -> &'static [[[u32; 256]; 7]; 2] {
     static T: OnceLock<Box<[[[u32; 256]; 7]; 2]>> = OnceLock::new();
