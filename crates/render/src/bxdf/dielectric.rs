@@ -151,14 +151,20 @@ impl BxDFMethods for DielectricBxDF {
         if pr == 0.0 && pt == 0.0 {
             return None;
         }
+        // D(ωm) and Λ(ωo) once for the density and the value (the same
+        // operations as `d.pdf` and `d.d`·`d.g`).
+        let dm = d.d(wm);
+        let lambda_o = d.lambda(wo);
+        let d_visible = (1.0 / (1.0 + lambda_o)) / abs_cos_theta(wo) * dm * abs_dot(wo, wm);
         if uc < pr / (pr + pt) {
             let wi = reflect(wo, wm);
             if !same_hemisphere(wo, wi) {
                 return None;
             }
-            let pdf = d.pdf(wo, wm) / (4.0 * abs_dot(wo, wm)) * pr / (pr + pt);
+            let pdf = d_visible / (4.0 * abs_dot(wo, wm)) * pr / (pr + pt);
             let f = SampledSpectrum::new(
-                d.d(wm) * d.g(wo, wi) * r / (4.0 * cos_theta(wi) * cos_theta(wo)),
+                dm * (1.0 / (1.0 + lambda_o + d.lambda(wi))) * r
+                    / (4.0 * cos_theta(wi) * cos_theta(wo)),
             );
             Some(BSDFSample::new(f, wi, pdf, BxDFFlags::GLOSSY_REFLECTION))
         } else {
@@ -168,10 +174,10 @@ impl BxDFMethods for DielectricBxDF {
             }
             let denom = sqr(dot(wi, wm) + dot(wo, wm) / etap);
             let dwm_dwi = abs_dot(wi, wm) / denom;
-            let pdf = d.pdf(wo, wm) * dwm_dwi * pt / (pr + pt);
+            let pdf = d_visible * dwm_dwi * pt / (pr + pt);
             let mut ft = (1.0 - r)
-                * d.d(wm)
-                * d.g(wo, wi)
+                * dm
+                * (1.0 / (1.0 + lambda_o + d.lambda(wi)))
                 * (dot(wi, wm) * dot(wo, wm) / (cos_theta(wi) * cos_theta(wo) * denom)).abs();
             if mode == TransportMode::Radiance {
                 ft /= sqr(etap);
