@@ -176,10 +176,13 @@ pub(crate) fn connect_bdpt<S: SampleSource>(
         let qs = &light[s - 1];
         let pt = &camera[t - 1];
         if qs.is_connectible(scene) && pt.is_connectible(scene) {
-            l = qs.beta
-                * qs.f(pt, TransportMode::Importance)
-                * pt.f(qs, TransportMode::Radiance)
-                * pt.beta;
+            // The second BSDF only when the first passes light (layered
+            // BSDFs are costly; each is seeded by its own directions, so
+            // skipping one changes nothing else).
+            let fq = qs.beta * qs.f(pt, TransportMode::Importance);
+            if !fq.is_black() {
+                l = fq * pt.f(qs, TransportMode::Radiance) * pt.beta;
+            }
             if !l.is_black() {
                 l *= g(scene, qs, pt, lambda);
             }
