@@ -105,6 +105,15 @@ impl std::error::Error for RenderError {
     }
 }
 
+/// The worker pool a render runs on (`opts.nthreads` threads; 0: all
+/// cores).
+pub(crate) fn thread_pool(opts: &RenderOptions) -> Result<rayon::ThreadPool, RenderError> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(opts.nthreads)
+        .build()
+        .map_err(RenderError::ThreadPool)
+}
+
 /// The progress callback's type: called from a reporting thread, so `Sync`.
 pub type ProgressFn<'a> = &'a (dyn Fn(Progress) + Sync);
 

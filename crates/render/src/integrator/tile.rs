@@ -9,7 +9,7 @@
 //! its own copy, with its per-sample work called directly.
 
 use super::render::{
-    with_progress, write_film, ProgressFn, RenderError, RenderOptions, RenderStats,
+    thread_pool, with_progress, write_film, ProgressFn, RenderError, RenderOptions, RenderStats,
 };
 use super::Scene;
 use crate::camera::CameraSample;
@@ -251,10 +251,7 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
     progress: ProgressFn,
 ) -> Result<RenderStats, RenderError> {
     let start = Instant::now();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.nthreads)
-        .build()
-        .map_err(RenderError::ThreadPool)?;
+    let pool = thread_pool(opts)?;
     let spp = scene.sampler.samples_per_pixel().max(1);
     let pixel_bounds = scene.film.pixel_bounds();
     let tile_list = tiles(pixel_bounds);

@@ -16,7 +16,7 @@ use super::bdpt::{
     connect_bdpt, generate_camera_subpath, generate_light_subpath, Vertex, WalkOptions,
 };
 use super::render::{
-    with_progress, write_film, ProgressFn, RenderError, RenderOptions, RenderStats,
+    thread_pool, with_progress, write_film, ProgressFn, RenderError, RenderOptions, RenderStats,
 };
 use super::Scene;
 use crate::camera::CameraSample;
@@ -145,10 +145,7 @@ pub(crate) fn render(
     progress: ProgressFn,
 ) -> Result<RenderStats, RenderError> {
     let start = Instant::now();
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(opts.nthreads)
-        .build()
-        .map_err(RenderError::ThreadPool)?;
+    let pool = thread_pool(opts)?;
     let it = integrator;
     let max_depth = it.max_depth.max(0) as usize;
     let n_bootstrap = it.bootstrap_samples.max(1) as usize;
