@@ -106,6 +106,16 @@ fn cmd_diff(args: &[String]) -> Result<(), String> {
             f64::NAN
         }
     );
+    println!(
+        "median pixel brightness: {:.6} (reference {:.6}, ratio {:.4})",
+        s.median_a,
+        s.median_b,
+        if s.median_b != 0.0 {
+            s.median_a / s.median_b
+        } else {
+            f64::NAN
+        }
+    );
     println!("max |difference|: {:.6e}", s.max_abs_diff);
     println!("differing pixels: {}", s.differing_pixels);
     println!("non-finite terms: {}", s.non_finite);

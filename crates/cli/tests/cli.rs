@@ -201,7 +201,7 @@ fn integrators_that_ignore_media_or_subsurface_warn_at_the_directive() {
 fn unsupported_features_are_located_errors_not_wrong_images() {
     let cases = [
         ("bdpt.pbrt", "Integrator \"bdpt\"\nWorldBegin\nShape \"sphere\"\n", "bdpt.pbrt:1:1"),
-        ("sppm.pbrt", "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nIntegrator \"sppm\"\nWorldBegin\nShape \"sphere\"\n", "sppm.pbrt:2:1"),
+        ("mlt.pbrt", "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nIntegrator \"mlt\"\nWorldBegin\nShape \"sphere\"\n", "mlt.pbrt:2:1"),
     ];
     for (name, text, loc) in cases {
         let p = temp_scene(name, text);

@@ -4,7 +4,7 @@
 
 use super::{
     AmbientOcclusionIntegrator, Integrator, PathIntegrator, RandomWalkIntegrator,
-    SimplePathIntegrator, SimpleVolPathIntegrator, VolPathIntegrator,
+    SimplePathIntegrator, SimpleVolPathIntegrator, SppmIntegrator, VolPathIntegrator,
 };
 use crate::params::{unknown_type, ParamReader};
 use rpbrt_geometry::float::Float;
@@ -25,8 +25,14 @@ pub const INTEGRATOR_NAMES: &[&str] = &[
 ];
 
 /// Creates the integrator of an `Integrator` directive. The light sampler
-/// it needs is created by the caller (it needs the lights).
-pub fn create_integrator(name: &str, ip: &ParamReader) -> Result<Integrator, Diagnostic> {
+/// it needs is created by the caller (it needs the lights). `options_seed`
+/// is the command line's `--seed` (0 without it), the default of `sppm`'s
+/// `seed` as pbrt-v4's `Options->seed`.
+pub fn create_integrator(
+    name: &str,
+    ip: &ParamReader,
+    options_seed: i32,
+) -> Result<Integrator, Diagnostic> {
     let loc = ip.loc();
     let max_depth = ip.int("maxdepth", 5)?;
     if max_depth < 0 {
@@ -60,9 +66,32 @@ pub fn create_integrator(name: &str, ip: &ParamReader) -> Result<Integrator, Dia
             Ok(Integrator::AmbientOcclusion(AmbientOcclusionIntegrator { cos_sample: ip.bool("cossample", true)?, max_distance }))
         }
         "randomwalk" => Ok(Integrator::RandomWalk(RandomWalkIntegrator { max_depth })),
-        "bdpt" | "lightpath" | "mlt" | "sppm" => Err(Diagnostic::error(
+        "sppm" => {
+            let photons_per_iteration = ip.int("photonsperiteration", -1)?;
+            if photons_per_iteration == 0 || photons_per_iteration < -1 {
+                return Err(ip.error_at(
+                    "photonsperiteration",
+                    format!("\"photonsperiteration\" must be positive (or -1 for one photon per pixel), got {photons_per_iteration}"),
+                ));
+            }
+            let radius = ip.float("radius", 1.0)?;
+            if !(radius > 0.0) || !radius.is_finite() {
+                return Err(ip.error_at(
+                    "radius",
+                    format!("\"radius\" must be positive, got {radius}"),
+                ));
+            }
+            Ok(Integrator::Sppm(SppmIntegrator {
+                max_depth,
+                photons_per_iteration,
+                initial_radius: radius,
+                seed: ip.int("seed", options_seed)?,
+                color_space: ip.color_space().name.clone(),
+            }))
+        }
+        "bdpt" | "lightpath" | "mlt" => Err(Diagnostic::error(
             loc.clone(),
-            format!("the \"{name}\" integrator is not supported yet; rpbrt renders with \"path\", \"volpath\", \"simplevolpath\", \"simplepath\", \"ambientocclusion\" and \"randomwalk\""),
+            format!("the \"{name}\" integrator is not supported yet; rpbrt renders with \"path\", \"volpath\", \"simplevolpath\", \"simplepath\", \"ambientocclusion\", \"randomwalk\" and \"sppm\""),
         )),
         _ => Err(unknown_type("integrator", name, INTEGRATOR_NAMES, loc)),
     }

@@ -404,7 +404,7 @@ pub fn create_scene(
         })
         .unwrap_or_default();
     let integrator = p.take(reader(&desc.integrator)).and_then(|r| {
-        let i = create_integrator(&desc.integrator.name, &r);
+        let i = create_integrator(&desc.integrator.name, &r, opts.seed.unwrap_or(0));
         p.finish(r, i)
     });
     if let Some(i) = &integrator {
