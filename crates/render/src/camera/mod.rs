@@ -25,9 +25,11 @@ mod tests;
 
 use rpbrt_geometry::interaction::CameraDifferentials;
 use rpbrt_geometry::{
-    lerp, Bounds2i, Float, Frame, MediumId, Point2f, Point2i, Ray, RayDifferential, Transform,
-    Vector3f,
+    lerp, Bounds2f, Bounds2i, Float, Frame, MediumId, Normal3f, Point2f, Point2i, Point3f, Ray,
+    RayDifferential, Transform, Vector2f, Vector3f,
 };
+
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 pub use create::{create_camera, read_lens_file, CAMERA_NAMES};
 pub use projective::{OrthographicCamera, PerspectiveCamera, ProjectiveTransforms};
@@ -79,6 +81,25 @@ pub struct CameraRayDifferential {
     pub weight: Float,
 }
 
+/// Importance arriving at a reference point from a point sampled on the
+/// camera's lens (pbrt-v4 `CameraWiSample`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraWiSample {
+    /// The importance `We` of the ray from the lens point toward the
+    /// reference point (pbrt-v4 `Wi`).
+    pub wi_importance: SampledSpectrum,
+    /// Unit direction from the reference point toward the lens point.
+    pub wi: Vector3f,
+    /// Density of `wi` per unit solid angle at the reference point.
+    pub pdf: Float,
+    /// Where on the film (raster coordinates) the reference point lands.
+    pub p_raster: Point2f,
+    /// The lens point, in render space.
+    pub p_lens: Point3f,
+    /// The lens's normal: the camera's viewing direction in render space.
+    pub n_lens: Normal3f,
+}
+
 /// What a camera needs to know about the film.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FilmGeometry {
@@ -125,6 +146,11 @@ pub struct CameraBase {
     pub min_dir_differential_x: Vector3f,
     /// Smallest change of ray direction per pixel in y.
     pub min_dir_differential_y: Vector3f,
+    /// The radius of the film's reconstruction filter (pbrt-v4 asks the
+    /// film for it): it decides the film's sample bounds and how far off
+    /// axis the perspective camera's importance reaches. (0.5, 0.5), a box
+    /// filter's, until [`Camera::set_filter_radius`] sets it.
+    pub filter_radius: Vector2f,
 }
 
 impl CameraBase {
@@ -153,7 +179,25 @@ impl CameraBase {
             min_pos_differential_y: Vector3f::default(),
             min_dir_differential_x: Vector3f::default(),
             min_dir_differential_y: Vector3f::default(),
+            filter_radius: Vector2f::new(0.5, 0.5),
         }
+    }
+
+    /// The film area that receives samples: the pixel bounds grown by the
+    /// filter radius less half a pixel (pbrt-v4 `Film::SampleBounds`).
+    pub fn film_sample_bounds(&self) -> Bounds2f {
+        let b = self.film.pixel_bounds;
+        let r = self.filter_radius;
+        Bounds2f::new(
+            Point2f::new(
+                b.p_min.x as Float - r.x + 0.5,
+                b.p_min.y as Float - r.y + 0.5,
+            ),
+            Point2f::new(
+                b.p_max.x as Float + r.x - 0.5,
+                b.p_max.y as Float + r.y - 0.5,
+            ),
+        )
     }
 
     /// The time for the sample value `u` in [0,1): a lerp across the shutter
@@ -359,5 +403,63 @@ impl Camera {
     /// The minimum differentials for approximate texture footprints.
     pub fn camera_differentials(&self) -> CameraDifferentials {
         self.base().camera_differentials()
+    }
+
+    /// Records the radius of the film's reconstruction filter, which
+    /// [`we`](Self::we) and [`pdf_we`](Self::pdf_we) need (pbrt-v4 reads
+    /// it from the film); the scene sets it when it creates the camera.
+    pub fn set_filter_radius(&mut self, radius: Vector2f) {
+        match self {
+            Camera::Perspective(c) => c.set_filter_radius(radius),
+            Camera::Orthographic(c) => c.base.filter_radius = radius,
+            Camera::Spherical(c) => c.base.filter_radius = radius,
+            Camera::Realistic(c) => c.base.filter_radius = radius,
+        }
+    }
+
+    /// True for cameras with importance functions, which light-tracing
+    /// methods can connect to (pbrt-v4: the perspective camera only).
+    #[inline]
+    pub fn supports_importance(&self) -> bool {
+        matches!(self, Camera::Perspective(_))
+    }
+
+    /// The importance of `ray` leaving the lens and the raster position
+    /// it reaches (pbrt-v4 `We`): zero outside the film's sample bounds,
+    /// behind the camera, and for cameras without importance.
+    #[inline]
+    pub fn we(&self, ray: &Ray, lambda: &SampledWavelengths) -> (SampledSpectrum, Point2f) {
+        match self {
+            Camera::Perspective(c) => c.we(ray, lambda),
+            _ => (SampledSpectrum::new(0.0), Point2f::new(0.0, 0.0)),
+        }
+    }
+
+    /// The densities `(pdf_pos, pdf_dir)` of `ray` leaving the camera
+    /// (pbrt-v4 `PDF_We`): per unit lens area and per unit solid angle;
+    /// zero where [`we`](Self::we) is.
+    #[inline]
+    pub fn pdf_we(&self, ray: &Ray) -> (Float, Float) {
+        match self {
+            Camera::Perspective(c) => c.pdf_we(ray),
+            _ => (0.0, 0.0),
+        }
+    }
+
+    /// Samples a point on the lens (`u`) as seen from `p_ref` at `time`
+    /// (pbrt-v4 `SampleWi`); `None` when the camera does not see `p_ref`
+    /// or has no importance function.
+    #[inline]
+    pub fn sample_wi(
+        &self,
+        p_ref: Point3f,
+        time: Float,
+        u: Point2f,
+        lambda: &SampledWavelengths,
+    ) -> Option<CameraWiSample> {
+        match self {
+            Camera::Perspective(c) => c.sample_wi(p_ref, time, u, lambda),
+            _ => None,
+        }
     }
 }

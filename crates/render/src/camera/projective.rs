@@ -4,11 +4,13 @@
 //! raster, and an optional thin lens.
 
 use rpbrt_geometry::{
-    Bounds2f, Float, Point2f, Point3f, Ray, RayDifferential, Transform, TransformError, Vector3f,
+    abs_dot, dot, Bounds2f, Float, Normal3f, Point2f, Point3f, Ray, RayDifferential, Transform,
+    TransformError, Vector2f, Vector3f, PI,
 };
 
-use super::{CameraBase, CameraRay, CameraRayDifferential, CameraSample};
+use super::{CameraBase, CameraRay, CameraRayDifferential, CameraSample, CameraWiSample};
 use crate::sampling::sample_uniform_disk_concentric;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 /// The transformations between camera, screen and raster space.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -193,6 +195,10 @@ pub struct PerspectiveCamera {
     pub focal_distance: Float,
     /// Area of the image rectangle on the plane z = 1 (for importance).
     pub image_plane_area: Float,
+    /// Cosine of the angle between the viewing direction and the film's
+    /// corner grown by the filter radius: directions further off axis
+    /// carry no importance (pbrt-v4 `cosTotalWidth`).
+    pub cos_total_width: Float,
     dx_camera: Vector3f,
     dy_camera: Vector3f,
 }
@@ -227,12 +233,144 @@ impl PerspectiveCamera {
             lens_radius,
             focal_distance,
             image_plane_area,
+            cos_total_width: 0.0,
             dx_camera,
             dy_camera,
         };
         base.find_minimum_differentials(|b, s| cam.differential_with_base(b, s));
         cam.base = base;
+        cam.set_filter_radius(cam.base.filter_radius);
         Ok(cam)
+    }
+
+    /// Records the film filter's radius and the importance cone it
+    /// implies: the direction through raster (−r.x, −r.y), one corner of
+    /// the film grown by the radius, as pbrt-v4 computes it.
+    pub fn set_filter_radius(&mut self, radius: Vector2f) {
+        self.base.filter_radius = radius;
+        let corner = self
+            .xf
+            .camera_from_raster
+            .apply_point(Point3f::new(-radius.x, -radius.y, 0.0));
+        self.cos_total_width = Vector3f::from(corner).try_normalize().map_or(1.0, |w| w.z);
+    }
+
+    /// The lens area, 1 for a pinhole (as pbrt-v4, so that importance and
+    /// densities keep their units).
+    #[inline]
+    fn lens_area(&self) -> Float {
+        if self.lens_radius != 0.0 {
+            PI * self.lens_radius * self.lens_radius
+        } else {
+            1.0
+        }
+    }
+
+    /// For a ray leaving the lens: the cosine of its angle to the viewing
+    /// direction and the raster point it comes from (through the plane of
+    /// focus); `None` when outside the importance cone.
+    fn raster_of(&self, ray: &Ray) -> Option<(Float, Point2f)> {
+        let render_from_camera = self
+            .base
+            .camera_transform
+            .render_from_camera
+            .interpolate(ray.time);
+        let view = render_from_camera
+            .apply_vector(Vector3f::new(0.0, 0.0, 1.0))
+            .try_normalize()?;
+        let d = ray.d.try_normalize()?;
+        let cos_theta = dot(d, view);
+        if cos_theta <= self.cos_total_width {
+            return None;
+        }
+        let dist = if self.lens_radius > 0.0 {
+            self.focal_distance
+        } else {
+            1.0
+        };
+        let p_focus = ray.o + d * (dist / cos_theta);
+        let p_camera = render_from_camera.apply_inverse_point(p_focus);
+        let p_raster = self.xf.camera_from_raster.apply_inverse_point(p_camera);
+        Some((cos_theta, Point2f::new(p_raster.x, p_raster.y)))
+    }
+
+    /// pbrt-v4 `We`: 1/(A · lens area · cos⁴θ) for rays that land inside
+    /// the film's sample bounds, with the raster point they land on.
+    pub fn we(&self, ray: &Ray, _lambda: &SampledWavelengths) -> (SampledSpectrum, Point2f) {
+        let Some((cos_theta, p_raster)) = self.raster_of(ray) else {
+            return (SampledSpectrum::new(0.0), Point2f::new(0.0, 0.0));
+        };
+        if !self.base.film_sample_bounds().inside(p_raster) {
+            return (SampledSpectrum::new(0.0), p_raster);
+        }
+        let cos2 = cos_theta * cos_theta;
+        let we = 1.0 / (self.image_plane_area * self.lens_area() * cos2 * cos2);
+        (SampledSpectrum::new(we), p_raster)
+    }
+
+    /// pbrt-v4 `PDF_We`: (1/lens area, 1/(A cos³θ)) for rays that land
+    /// inside the film's sample bounds, zeros otherwise.
+    pub fn pdf_we(&self, ray: &Ray) -> (Float, Float) {
+        let Some((cos_theta, p_raster)) = self.raster_of(ray) else {
+            return (0.0, 0.0);
+        };
+        if !self.base.film_sample_bounds().inside(p_raster) {
+            return (0.0, 0.0);
+        }
+        (
+            1.0 / self.lens_area(),
+            1.0 / (self.image_plane_area * cos_theta * cos_theta * cos_theta),
+        )
+    }
+
+    /// pbrt-v4 `SampleWi`: a point sampled uniformly on the lens (the
+    /// pinhole itself without one), the direction to it from `p_ref`, its
+    /// solid-angle density there and the importance of the ray from the
+    /// lens point back to `p_ref`.
+    pub fn sample_wi(
+        &self,
+        p_ref: Point3f,
+        time: Float,
+        u: Point2f,
+        lambda: &SampledWavelengths,
+    ) -> Option<CameraWiSample> {
+        let render_from_camera = self
+            .base
+            .camera_transform
+            .render_from_camera
+            .interpolate(time);
+        let pl = sample_uniform_disk_concentric(u);
+        let p_lens = render_from_camera.apply_point(Point3f::new(
+            self.lens_radius * pl.x,
+            self.lens_radius * pl.y,
+            0.0,
+        ));
+        let n_lens = Normal3f::from(
+            render_from_camera
+                .apply_vector(Vector3f::new(0.0, 0.0, 1.0))
+                .try_normalize()?,
+        );
+        let to_lens = p_lens - p_ref;
+        let dist = to_lens.length();
+        if dist == 0.0 || !dist.is_finite() {
+            return None;
+        }
+        let wi = to_lens / dist;
+        let pdf = dist * dist / (abs_dot(n_lens, wi) * self.lens_area());
+        // The lens point has no rounding error: the ray leaves it exactly.
+        let ray = Ray::with_time(p_lens, -wi, time, self.base.medium);
+        let (wi_importance, p_raster) = self.we(&ray, lambda);
+        if wi_importance.is_black() || !pdf.is_finite() {
+            return None;
+        }
+        Some(CameraWiSample {
+            wi_importance,
+            wi,
+            pdf,
+            p_raster,
+            p_lens,
+            n_lens,
+        })
     }
 
     #[inline]

@@ -8,6 +8,8 @@ use crate::params::ParamReader;
 use crate::rng::Rng;
 use rpbrt_geometry::MediumId;
 
+mod importance;
+
 fn loc(line: u32) -> FileLoc {
     FileLoc::new(Arc::from("cams.pbrt"), line, 5)
 }

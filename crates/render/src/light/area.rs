@@ -1,10 +1,17 @@
 //! Diffuse area lights (book section 12.3; pbrt-v4 `DiffuseAreaLight`).
 
-use rpbrt_geometry::{dot, Float, MediumId, Normal3f, Point2f, Point2i, Point3f, Vector3f, PI};
+use rpbrt_geometry::{
+    dot, offset_ray_origin, Float, Frame, MediumId, Normal3f, Point2f, Point2i, Point3f, Ray,
+    Vector3f, ONE_MINUS_EPSILON, PI,
+};
 
-use super::{rgb_illuminant, LightBounds, LightLiSample, LightSampleContext};
+use super::{
+    rgb_illuminant, LightBounds, LightLeSample, LightLiSample, LightSampleContext,
+    LightSurfacePoint,
+};
 use crate::image::{Image, WrapMode, WrapMode2D};
 use crate::rng::mix_bits;
+use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::shape::{SampledTriangle, Shape, ShapeMethods, ShapeSampleContext};
 use crate::spectrum::{RgbColorSpace, SampledSpectrum, SampledWavelengths, Spectrum};
 use crate::texture::{FloatTextureRef, TextureEvalContext};
@@ -155,6 +162,82 @@ impl DiffuseAreaLight {
     /// The shape's solid-angle density for `wi` from `ctx`.
     pub fn pdf_li(&self, ctx: &LightSampleContext, wi: Vector3f, _a: bool) -> Float {
         self.shape.pdf(&Self::shape_ctx(ctx), wi)
+    }
+
+    /// A ray leaving a point sampled uniformly by area on the shape (`u1`)
+    /// in a cosine-distributed direction (`u2`) about the surface normal;
+    /// a two-sided light first picks the side with `u2[0]` (then reused,
+    /// stretched, for the direction) and halves the density, as pbrt-v4.
+    /// `None` where the alpha texture masks the point out.
+    pub fn sample_le(
+        &self,
+        u1: Point2f,
+        u2: Point2f,
+        lambda: &SampledWavelengths,
+        time: Float,
+    ) -> Option<LightLeSample> {
+        let ss = self.shape.sample_area(u1)?;
+        if self.alpha_masked(ss.p(), ss.uv) {
+            return None;
+        }
+        let (w_local, pdf_dir) = if self.two_sided {
+            let (u, flip) = if u2.x < 0.5 {
+                ((u2.x * 2.0).min(ONE_MINUS_EPSILON), false)
+            } else {
+                (((u2.x - 0.5) * 2.0).min(ONE_MINUS_EPSILON), true)
+            };
+            let mut w = sample_cosine_hemisphere(Point2f::new(u, u2.y));
+            if flip {
+                w.z = -w.z;
+            }
+            (w, cosine_hemisphere_pdf(w.z.abs()) / 2.0)
+        } else {
+            let w = sample_cosine_hemisphere(u2);
+            (w, cosine_hemisphere_pdf(w.z))
+        };
+        if pdf_dir == 0.0 {
+            return None;
+        }
+        let w = Frame::from_normal(ss.n).from_local(w_local);
+        let l = self.l(ss.p(), ss.n, ss.uv, w, lambda);
+        // pbrt-v4's `Interaction::SpawnRay`: offset off the surface, in the
+        // medium on the side the ray leaves by.
+        let medium = if dot(w, ss.n) > 0.0 {
+            self.medium_outside
+        } else {
+            self.medium_inside
+        };
+        let o = offset_ray_origin(ss.p(), ss.pi.error(), ss.n, w);
+        Some(LightLeSample {
+            l,
+            ray: Ray::with_time(o, w, time, medium),
+            surface: Some(LightSurfacePoint {
+                pi: ss.pi,
+                n: ss.n,
+                uv: ss.uv,
+            }),
+            pdf_pos: ss.pdf,
+            pdf_dir,
+        })
+    }
+
+    /// The densities with which [`sample_le`](Self::sample_le) leaves
+    /// surface point `p` (normal `n`) toward `w`: the shape's area density
+    /// at `p` and the cosine density (halved when two-sided). pbrt-v4's
+    /// one-sided density goes negative behind the surface; it is zero
+    /// here.
+    pub fn pdf_le_surface(&self, p: Point3f, n: Normal3f, w: Vector3f) -> (Float, Float) {
+        let Some(w) = w.try_normalize() else {
+            return (0.0, 0.0);
+        };
+        let pdf_pos = self.shape.pdf_area_at_point(p);
+        let cos = dot(n, w);
+        let pdf_dir = if self.two_sided {
+            cosine_hemisphere_pdf(cos.abs()) / 2.0
+        } else {
+            cosine_hemisphere_pdf(cos.max(0.0))
+        };
+        (pdf_pos, pdf_dir)
     }
 
     /// Mean emission · scale · area · π, doubled when two-sided.

@@ -218,13 +218,13 @@ pub fn create_light(
                 Vector3f::new(0.0, 0.0, 1.0),
                 Vector3f::new(0.0, 1.0, 0.0),
             );
-            Light::Goniometric(Box::new(GoniometricLight {
-                render_from_light: render_from_light * swap_yz,
-                i: dense(&i),
+            Light::Goniometric(Box::new(GoniometricLight::new(
+                render_from_light * swap_yz,
+                dense(&i),
                 scale,
                 image,
                 medium,
-            }))
+            )))
         }
         "projection" => {
             let scale = scale_param(lp)?;

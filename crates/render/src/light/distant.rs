@@ -2,10 +2,10 @@
 //! `DistantLight`).
 
 use rpbrt_geometry::{
-    Bounds3f, Float, MediumId, Normal3f, Point2f, Point3fi, Transform, Vector3f, PI,
+    Bounds3f, Float, MediumId, Normal3f, Point2f, Point3fi, Ray, Transform, Vector3f, PI,
 };
 
-use super::{LightBounds, LightLiSample, LightSampleContext, SceneSphere};
+use super::{LightBounds, LightLeSample, LightLiSample, LightSampleContext, SceneSphere};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths, Spectrum};
 
 /// Radiance `scale · L` arriving along light-space +z (pbrt-v4
@@ -50,6 +50,32 @@ impl DistantLight {
     /// Always zero: a delta distribution.
     pub fn pdf_li(&self, _ctx: &LightSampleContext, _wi: Vector3f, _a: bool) -> Float {
         0.0
+    }
+    /// A ray along the light's direction through a point sampled by `u1`
+    /// on the scene's bounding disk facing the light, starting outside
+    /// the scene (`u2` unused). The ray is in no medium, as pbrt-v4's.
+    pub fn sample_le(
+        &self,
+        u1: Point2f,
+        _u2: Point2f,
+        lambda: &SampledWavelengths,
+        time: Float,
+    ) -> Option<LightLeSample> {
+        let (ray, pdf_pos) = self
+            .scene
+            .sample_ray_through_disk(-self.direction(), u1, time);
+        Some(LightLeSample {
+            l: self.l_emit.sample(lambda) * self.scale,
+            ray,
+            surface: None,
+            pdf_pos,
+            pdf_dir: 1.0,
+        })
+    }
+    /// `(1/(π r²), 0)`: pbrt-v4 reports no directional density for a
+    /// delta.
+    pub fn pdf_le(&self, _ray: &Ray) -> (Float, Float) {
+        (self.scene.disk_pdf(), 0.0)
     }
     /// Power through the scene's disk: scale · L · π r².
     pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {

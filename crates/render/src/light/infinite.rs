@@ -6,7 +6,9 @@ use rpbrt_geometry::{
     Point2f, Point2i, Point3fi, Ray, Transform, Vector3f, PI,
 };
 
-use super::{rgb_illuminant, LightBounds, LightLiSample, LightSampleContext, SceneSphere};
+use super::{
+    rgb_illuminant, LightBounds, LightLeSample, LightLiSample, LightSampleContext, SceneSphere,
+};
 use crate::image::{Image, WrapMode, WrapMode2D};
 use crate::sampling::sample_uniform_sphere;
 use crate::sampling::tabulated::PiecewiseConstant2D;
@@ -80,6 +82,29 @@ impl UniformInfiniteLight {
     /// Radiance along any escaping ray.
     pub fn le(&self, _ray: &Ray, lambda: &SampledWavelengths) -> SampledSpectrum {
         self.l_emit.sample(lambda) * self.scale
+    }
+    /// A ray from a uniformly sampled direction (`u1`) through a point on
+    /// the scene's bounding disk (`u2`), starting outside the scene.
+    pub fn sample_le(
+        &self,
+        u1: Point2f,
+        u2: Point2f,
+        lambda: &SampledWavelengths,
+        time: Float,
+    ) -> Option<LightLeSample> {
+        let w = sample_uniform_sphere(u1);
+        let (ray, pdf_pos) = self.scene.sample_ray_through_disk(w, u2, time);
+        Some(LightLeSample {
+            l: self.l_emit.sample(lambda) * self.scale,
+            ray,
+            surface: None,
+            pdf_pos,
+            pdf_dir: INV_4PI,
+        })
+    }
+    /// `(1/(π r²), 1/4π)` for every ray.
+    pub fn pdf_le(&self, _ray: &Ray) -> (Float, Float) {
+        (self.scene.disk_pdf(), INV_4PI)
     }
     /// 4π · π r² · scale · L.
     pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
@@ -232,6 +257,48 @@ impl ImageInfiniteLight {
             return SampledSpectrum::new(0.0);
         };
         self.image_le(equal_area_sphere_to_square(wl), lambda)
+    }
+
+    /// A ray whose direction is sampled by the image's brightness (`u1`;
+    /// the ray travels away from the sampled direction of arrival) through
+    /// a point on the scene's bounding disk (`u2`).
+    pub fn sample_le(
+        &self,
+        u1: Point2f,
+        u2: Point2f,
+        lambda: &SampledWavelengths,
+        time: Float,
+    ) -> Option<LightLeSample> {
+        let (uv, map_pdf, _) = self.distribution.sample(u1);
+        if map_pdf == 0.0 {
+            return None;
+        }
+        let w_light = equal_area_square_to_sphere(uv);
+        let w = -self
+            .render_from_light
+            .apply_vector(w_light)
+            .try_normalize()?;
+        let (ray, pdf_pos) = self.scene.sample_ray_through_disk(w, u2, time);
+        Some(LightLeSample {
+            l: self.image_le(uv, lambda),
+            ray,
+            surface: None,
+            pdf_pos,
+            pdf_dir: map_pdf * INV_4PI,
+        })
+    }
+    /// The densities of [`sample_le`](Self::sample_le) for `ray` (by the
+    /// full, not the compensated, distribution).
+    pub fn pdf_le(&self, ray: &Ray) -> (Float, Float) {
+        let Some(wl) = self
+            .render_from_light
+            .apply_inverse_vector(-ray.d)
+            .try_normalize()
+        else {
+            return (0.0, 0.0);
+        };
+        let map_pdf = self.distribution.pdf(equal_area_sphere_to_square(wl));
+        (self.scene.disk_pdf(), map_pdf * INV_4PI)
     }
 
     /// 4π · π r² · scale · mean pixel radiance.

@@ -120,6 +120,41 @@ pub struct LightLiSample {
     pub n_light: Normal3f,
 }
 
+/// A point on an area light's surface (the `Interaction` of pbrt-v4's
+/// `LightLeSample`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightSurfacePoint {
+    /// The point with its rounding-error intervals.
+    pub pi: Point3fi,
+    /// The surface normal there (oriented as the shape's intersections).
+    pub n: Normal3f,
+    /// Surface (u, v) of the point.
+    pub uv: Point2f,
+}
+
+/// A ray of emitted light sampled from a light (pbrt-v4 `LightLeSample`),
+/// for methods that trace paths from the lights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightLeSample {
+    /// Emitted radiance along the ray (area and infinite lights) or, for
+    /// delta lights, the intensity (point-like) or radiance (distant)
+    /// whose delta distribution the ray samples, as pbrt-v4.
+    pub l: SampledSpectrum,
+    /// The ray: unit direction, its time, and the medium it starts in
+    /// (for area lights the one on the side of the surface it leaves by;
+    /// the origin is offset off the surface).
+    pub ray: Ray,
+    /// The point on the surface for area lights; `None` for other lights.
+    pub surface: Option<LightSurfacePoint>,
+    /// Density of the ray's origin: per unit area on the light's surface
+    /// (area lights) or on the disk the ray is sampled through (distant
+    /// and infinite lights); 1 for the delta position of point-like lights.
+    pub pdf_pos: Float,
+    /// Density of the ray's direction per unit solid angle (1 for the
+    /// delta direction of distant lights).
+    pub pdf_dir: Float,
+}
+
 /// A bound on a light's position, emitted power and emission directions,
 /// used by the BVH light sampler (pbrt-v4 `LightBounds`, book section
 /// 12.6.3).
@@ -542,6 +577,54 @@ impl Light {
         }
     }
 
+    /// Samples a ray leaving the light (pbrt-v4 `SampleLe`): `u1` and
+    /// `u2` choose the origin and direction (which one does what depends
+    /// on the light, as in pbrt-v4), `time` is the ray's time. `None` when
+    /// no ray could be sampled (zero density, a masked-out point).
+    #[inline]
+    pub fn sample_le(
+        &self,
+        u1: Point2f,
+        u2: Point2f,
+        lambda: &SampledWavelengths,
+        time: Float,
+    ) -> Option<LightLeSample> {
+        dispatch!(self, l => l.sample_le(u1, u2, lambda, time))
+    }
+
+    /// The densities `(pdf_pos, pdf_dir)` with which
+    /// [`sample_le`](Self::sample_le) would produce `ray` (pbrt-v4
+    /// `PDF_Le(ray)`); `(0, 0)` for area lights, which need
+    /// [`pdf_le_surface`](Self::pdf_le_surface). As in pbrt-v4, point-like
+    /// lights report `pdf_pos = 0` (their position is a delta) and distant
+    /// lights `pdf_dir = 0` (their direction is).
+    #[inline]
+    pub fn pdf_le(&self, ray: &Ray) -> (Float, Float) {
+        match self {
+            Light::Point(l) => l.pdf_le(ray),
+            Light::Spot(l) => l.pdf_le(ray),
+            Light::Goniometric(l) => l.pdf_le(ray),
+            Light::Projection(l) => l.pdf_le(ray),
+            Light::Distant(l) => l.pdf_le(ray),
+            Light::DiffuseArea(_) => (0.0, 0.0),
+            Light::UniformInfinite(l) => l.pdf_le(ray),
+            Light::ImageInfinite(l) => l.pdf_le(ray),
+            Light::PortalImageInfinite(l) => l.pdf_le(ray),
+        }
+    }
+
+    /// The densities `(pdf_pos, pdf_dir)` with which an area light's
+    /// [`sample_le`](Self::sample_le) would leave point `p` (normal `n`)
+    /// toward `w` (pbrt-v4 `PDF_Le(Interaction, w)`); `(0, 0)` for other
+    /// lights.
+    #[inline]
+    pub fn pdf_le_surface(&self, p: Point3f, n: Normal3f, w: Vector3f) -> (Float, Float) {
+        match self {
+            Light::DiffuseArea(l) => l.pdf_le_surface(p, n, w),
+            _ => (0.0, 0.0),
+        }
+    }
+
     /// Bounds for the BVH light sampler; `None` for lights at infinity.
     #[inline]
     pub fn bounds(&self) -> Option<LightBounds> {
@@ -578,6 +661,28 @@ impl SceneSphere {
     pub fn from_bounds(b: &Bounds3f) -> Self {
         let (center, radius) = b.bounding_sphere();
         SceneSphere { center, radius }
+    }
+}
+
+impl SceneSphere {
+    /// A ray of direction `w` (unit) through a point sampled uniformly by
+    /// `u` on the disk of the scene's bounding sphere perpendicular to
+    /// `w`, starting a radius before the disk (outside the sphere), and
+    /// the density of that point per unit disk area (pbrt-v4's infinite
+    /// and distant lights' `SampleLe`).
+    pub fn sample_ray_through_disk(&self, w: Vector3f, u: Point2f, time: Float) -> (Ray, Float) {
+        let frame = rpbrt_geometry::Frame::from_z(-w);
+        let cd = crate::sampling::sample_uniform_disk_concentric(u);
+        let p_disk = self.center + frame.from_local(Vector3f::new(cd.x, cd.y, 0.0)) * self.radius;
+        let ray = Ray::with_time(p_disk - w * self.radius, w, time, None);
+        (ray, self.disk_pdf())
+    }
+
+    /// The density per unit area of a point on the disk of the scene's
+    /// bounding sphere: 1/(π r²).
+    #[inline]
+    pub fn disk_pdf(&self) -> Float {
+        1.0 / (rpbrt_geometry::PI * self.radius * self.radius)
     }
 }
 

@@ -2,12 +2,21 @@
 //! `SpotLight`, `GoniometricLight`, `ProjectionLight`).
 
 use rpbrt_geometry::{
-    distance_squared, equal_area_sphere_to_square, Bounds2f, Float, MediumId, Normal3f, Point2f,
-    Point2i, Point3f, Point3fi, Transform, Vector3f, PI,
+    distance_squared, equal_area_sphere_to_square, equal_area_square_to_sphere, safe_sqrt,
+    spherical_direction, Bounds2f, Float, MediumId, Normal3f, Point2f, Point2i, Point3f, Point3fi,
+    Ray, Transform, Vector3f, PI,
 };
 
-use super::{acos_c, rgb_illuminant, smooth_step, LightBounds, LightLiSample, LightSampleContext};
+use super::{
+    acos_c, rgb_illuminant, smooth_step, LightBounds, LightLeSample, LightLiSample,
+    LightSampleContext,
+};
+use crate::bssrdf::spline::newton_bisection;
 use crate::image::{Image, WrapMode, WrapMode2D};
+use crate::sampling::tabulated::PiecewiseConstant2D;
+use crate::sampling::{
+    sample_uniform_cone, sample_uniform_sphere, uniform_cone_pdf, UNIFORM_SPHERE_PDF,
+};
 use crate::spectrum::{RgbColorSpace, SampledSpectrum, SampledWavelengths, Spectrum};
 
 /// The sample every point-like light returns: direction and distance
@@ -30,6 +39,55 @@ fn delta_sample(
         p_light: Point3fi::from(p),
         n_light: Normal3f::default(),
     })
+}
+
+/// The ray leaving a point-like light at light-space origin along
+/// light-space direction `w_light`, in render space with a unit direction
+/// (pbrt-v4 transforms the light-space ray by `renderFromLight`).
+fn delta_position_le(
+    render_from_light: &Transform,
+    w_light: Vector3f,
+    l: SampledSpectrum,
+    pdf_dir: Float,
+    time: Float,
+    medium: Option<MediumId>,
+) -> Option<LightLeSample> {
+    let o = render_from_light.apply_point(Point3f::new(0.0, 0.0, 0.0));
+    let d = render_from_light.apply_vector(w_light).try_normalize()?;
+    Some(LightLeSample {
+        l,
+        ray: Ray::with_time(o, d, time, medium),
+        surface: None,
+        pdf_pos: 1.0,
+        pdf_dir,
+    })
+}
+
+/// A render-space direction taken to light space, unit length.
+fn light_dir(render_from_light: &Transform, w: Vector3f) -> Option<Vector3f> {
+    render_from_light.apply_inverse_vector(w).try_normalize()
+}
+
+/// pbrt-v4's `SmoothStepPDF`: the density ∝ smoothstep on [a, b].
+#[inline]
+fn smooth_step_pdf(x: Float, a: Float, b: Float) -> Float {
+    if x < a || x > b {
+        return 0.0;
+    }
+    (2.0 / (b - a)) * smooth_step(x, a, b)
+}
+
+/// pbrt-v4's `SampleSmoothStep`: inverts the CDF 2t³ − t⁴ by Newton
+/// steps safeguarded with bisection.
+fn sample_smooth_step(u: Float, a: Float, b: Float) -> Float {
+    let cdf_minus_u = |x: Float| {
+        let t = (x - a) / (b - a);
+        (
+            2.0 * t * t * t - t * t * t * t - u,
+            smooth_step_pdf(x, a, b),
+        )
+    };
+    newton_bisection(a, b, cdf_minus_u, 1e-6, 1e-6)
 }
 
 /// An isotropic point light (pbrt-v4 `PointLight`).
@@ -63,6 +121,31 @@ impl PointLight {
     /// Always zero: a delta distribution.
     pub fn pdf_li(&self, _ctx: &LightSampleContext, _wi: Vector3f, _a: bool) -> Float {
         0.0
+    }
+    /// A ray in a uniformly sampled direction (`u1`; `u2` unused).
+    pub fn sample_le(
+        &self,
+        u1: Point2f,
+        _u2: Point2f,
+        lambda: &SampledWavelengths,
+        time: Float,
+    ) -> Option<LightLeSample> {
+        Some(LightLeSample {
+            l: self.i.sample(lambda) * self.scale,
+            ray: Ray::with_time(
+                self.position(),
+                sample_uniform_sphere(u1),
+                time,
+                self.medium,
+            ),
+            surface: None,
+            pdf_pos: 1.0,
+            pdf_dir: UNIFORM_SPHERE_PDF,
+        })
+    }
+    /// `(0, 1/4π)`: pbrt-v4 reports no positional density for a delta.
+    pub fn pdf_le(&self, _ray: &Ray) -> (Float, Float) {
+        (0.0, UNIFORM_SPHERE_PDF)
     }
     /// 4π · scale · I.
     pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
@@ -134,6 +217,77 @@ impl SpotLight {
     pub fn pdf_li(&self, _ctx: &LightSampleContext, _wi: Vector3f, _a: bool) -> Float {
         0.0
     }
+    /// The weights of the full-intensity cone and the falloff band in
+    /// pbrt-v4's choice between them: their integrals over cos θ.
+    fn section_weights(&self) -> [Float; 2] {
+        [
+            1.0 - self.cos_falloff_start,
+            (self.cos_falloff_start - self.cos_falloff_end) / 2.0,
+        ]
+    }
+    /// A ray sampled as pbrt-v4 does: `u2[0]` chooses the full-intensity
+    /// cone or the falloff band by their power, `u1` the direction in it
+    /// (uniform in the cone; cos θ ∝ smoothstep in the band).
+    pub fn sample_le(
+        &self,
+        u1: Point2f,
+        u2: Point2f,
+        lambda: &SampledWavelengths,
+        time: Float,
+    ) -> Option<LightLeSample> {
+        let p = self.section_weights();
+        let sum = p[0] + p[1];
+        if sum <= 0.0 {
+            return None;
+        }
+        // pbrt-v4's `SampleDiscrete` over the two weights.
+        let mut up = u2.x * sum;
+        if up == sum {
+            up = rpbrt_geometry::next_float_down(up);
+        }
+        let section = if p[0] > up { 0 } else { 1 };
+        let section_pdf = p[section] / sum;
+        let (w_light, pdf_dir) = if section == 0 {
+            let w = sample_uniform_cone(u1, self.cos_falloff_start);
+            (w, uniform_cone_pdf(self.cos_falloff_start) * section_pdf)
+        } else {
+            let cos_theta = sample_smooth_step(u1.x, self.cos_falloff_end, self.cos_falloff_start);
+            let sin_theta = safe_sqrt(1.0 - cos_theta * cos_theta);
+            let phi = u1.y * 2.0 * PI;
+            let w = spherical_direction(sin_theta, cos_theta, phi);
+            let pdf = smooth_step_pdf(cos_theta, self.cos_falloff_end, self.cos_falloff_start)
+                * section_pdf
+                / (2.0 * PI);
+            (w, pdf)
+        };
+        delta_position_le(
+            &self.render_from_light,
+            w_light,
+            self.intensity(w_light, lambda),
+            pdf_dir,
+            time,
+            self.medium,
+        )
+    }
+    /// `(0, pdf_dir)` of [`sample_le`](Self::sample_le) for the ray's
+    /// direction.
+    pub fn pdf_le(&self, ray: &Ray) -> (Float, Float) {
+        let p = self.section_weights();
+        let Some(w) = light_dir(&self.render_from_light, ray.d) else {
+            return (0.0, 0.0);
+        };
+        if p[0] + p[1] <= 0.0 {
+            return (0.0, 0.0);
+        }
+        let cos_theta = w.z;
+        let pdf_dir = if cos_theta >= self.cos_falloff_start {
+            uniform_cone_pdf(self.cos_falloff_start) * p[0] / (p[0] + p[1])
+        } else {
+            smooth_step_pdf(cos_theta, self.cos_falloff_end, self.cos_falloff_start) * p[1]
+                / ((p[0] + p[1]) * (2.0 * PI))
+        };
+        (0.0, pdf_dir)
+    }
     /// The integral of the falloff over the sphere times scale · I:
     /// 2π((1 − cos start) + (cos start − cos end)/2).
     pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
@@ -183,6 +337,8 @@ pub struct GoniometricLight {
     pub image: Image,
     /// The medium around the light.
     pub medium: Option<MediumId>,
+    /// Directions are sampled by image value over the equal-area square.
+    distribution: PiecewiseConstant2D,
 }
 
 const OCTA_WRAP: WrapMode2D = WrapMode2D {
@@ -201,7 +357,57 @@ fn channel_sum(image: &Image, c: usize) -> Float {
     sum as Float
 }
 
+/// pbrt-v4's `Image::GetSamplingDistribution`: the average of the
+/// channels of each pixel times `dxda` at the pixel's centre mapped into
+/// `domain`, row by row.
+fn sampling_distribution(
+    image: &Image,
+    domain: Bounds2f,
+    dxda: impl Fn(Point2f) -> Float,
+) -> PiecewiseConstant2D {
+    let res = image.resolution();
+    let (nx, ny) = (res.x.max(1) as usize, res.y.max(1) as usize);
+    let nc = image.n_channels().max(1);
+    let clamp = WrapMode2D::new(WrapMode::Clamp, WrapMode::Clamp);
+    let mut d = Vec::with_capacity(nx * ny);
+    for y in 0..res.y {
+        for x in 0..res.x {
+            let avg = (0..nc)
+                .map(|c| image.get_channel(Point2i::new(x, y), c, clamp))
+                .sum::<Float>()
+                / nc as Float;
+            let p = domain.lerp(Point2f::new(
+                (x as Float + 0.5) / res.x as Float,
+                (y as Float + 0.5) / res.y as Float,
+            ));
+            d.push(avg * dxda(p));
+        }
+    }
+    PiecewiseConstant2D::new(&d, nx, ny, domain)
+}
+
 impl GoniometricLight {
+    /// The light with its direction-sampling distribution (the image's
+    /// values over the equal-area square).
+    pub fn new(
+        render_from_light: Transform,
+        i: Spectrum,
+        scale: Float,
+        image: Image,
+        medium: Option<MediumId>,
+    ) -> Self {
+        let unit = Bounds2f::new(Point2f::new(0.0, 0.0), Point2f::new(1.0, 1.0));
+        let distribution = sampling_distribution(&image, unit, |_| 1.0);
+        GoniometricLight {
+            render_from_light,
+            i,
+            scale,
+            image,
+            medium,
+            distribution,
+        }
+    }
+
     fn position(&self) -> Point3f {
         self.render_from_light
             .apply_point(Point3f::new(0.0, 0.0, 0.0))
@@ -231,6 +437,38 @@ impl GoniometricLight {
     /// Always zero: a delta distribution.
     pub fn pdf_li(&self, _ctx: &LightSampleContext, _wi: Vector3f, _a: bool) -> Float {
         0.0
+    }
+    /// A ray in a direction sampled by the image's values (`u1`; `u2`
+    /// unused).
+    pub fn sample_le(
+        &self,
+        u1: Point2f,
+        _u2: Point2f,
+        lambda: &SampledWavelengths,
+        time: Float,
+    ) -> Option<LightLeSample> {
+        let (uv, pdf, _) = self.distribution.sample(u1);
+        if pdf == 0.0 {
+            return None;
+        }
+        let w_light = equal_area_square_to_sphere(uv);
+        delta_position_le(
+            &self.render_from_light,
+            w_light,
+            self.intensity(w_light, lambda),
+            pdf / (4.0 * PI),
+            time,
+            self.medium,
+        )
+    }
+    /// `(0, pdf_dir)` of [`sample_le`](Self::sample_le) for the ray's
+    /// direction.
+    pub fn pdf_le(&self, ray: &Ray) -> (Float, Float) {
+        let Some(w) = light_dir(&self.render_from_light, ray.d) else {
+            return (0.0, 0.0);
+        };
+        let uv = equal_area_sphere_to_square(w);
+        (0.0, self.distribution.pdf(uv) / (4.0 * PI))
     }
     /// Mean image value times 4π · scale · I (each equal-area pixel
     /// subtends the same solid angle).
@@ -281,6 +519,9 @@ pub struct ProjectionLight {
     pub cos_total_width: Float,
     /// The medium around the light.
     pub medium: Option<MediumId>,
+    /// Screen points are sampled by pixel value times cos³θ over the
+    /// screen bounds.
+    distribution: PiecewiseConstant2D,
 }
 
 /// pbrt-v4's near plane for projection lights: directions closer to the
@@ -321,8 +562,10 @@ impl ProjectionLight {
             a,
             cos_total_width: 0.0,
             medium,
+            distribution: PiecewiseConstant2D::unit(&[1.0], 1, 1),
         };
         l.cos_total_width = l.dir_from_screen(screen_bounds.p_max).z;
+        l.distribution = sampling_distribution(&l.image, screen_bounds, |p| l.dwda(p));
         l
     }
 
@@ -387,6 +630,53 @@ impl ProjectionLight {
     /// Always zero: a delta distribution.
     pub fn pdf_li(&self, _ctx: &LightSampleContext, _wi: Vector3f, _a: bool) -> Float {
         0.0
+    }
+    /// A ray through a screen point sampled by pixel value times cos³θ
+    /// (`u1`; `u2` unused), as pbrt-v4.
+    pub fn sample_le(
+        &self,
+        u1: Point2f,
+        _u2: Point2f,
+        lambda: &SampledWavelengths,
+        time: Float,
+    ) -> Option<LightLeSample> {
+        let (ps, pdf, _) = self.distribution.sample(u1);
+        if pdf == 0.0 {
+            return None;
+        }
+        let w = self.dir_from_screen(ps);
+        let cos_theta = w.z;
+        let pdf_dir =
+            pdf * self.screen_bounds.area() / (self.a * cos_theta * cos_theta * cos_theta);
+        // pbrt-v4 looks the image up at the sampled screen point directly
+        // (no near-plane or bounds test: the point is inside by
+        // construction).
+        let st = self.screen_bounds.offset(ps);
+        let st = Point2f::new(st.x, st.y);
+        let clamp = WrapMode2D::new(WrapMode::Clamp, WrapMode::Clamp);
+        let rgb = [0, 1, 2].map(|c| self.image.lookup_nearest_channel(st, c, clamp));
+        let l = rgb_illuminant(self.color_space, rgb, lambda) * self.scale;
+        delta_position_le(&self.render_from_light, w, l, pdf_dir, time, self.medium)
+    }
+    /// `(0, pdf_dir)` of [`sample_le`](Self::sample_le) for the ray's
+    /// direction: zero outside the frustum.
+    pub fn pdf_le(&self, ray: &Ray) -> (Float, Float) {
+        let Some(w) = light_dir(&self.render_from_light, ray.d) else {
+            return (0.0, 0.0);
+        };
+        if w.z < HITHER {
+            return (0.0, 0.0);
+        }
+        let ps = Point2f::new(
+            w.x / (w.z * self.tan_half_fov),
+            w.y / (w.z * self.tan_half_fov),
+        );
+        if !self.screen_bounds.inside(ps) {
+            return (0.0, 0.0);
+        }
+        let pdf_dir =
+            self.distribution.pdf(ps) * self.screen_bounds.area() / (self.a * w.z * w.z * w.z);
+        (0.0, pdf_dir)
     }
     /// Sum over pixels of their emission times their solid angle.
     pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {

@@ -12,6 +12,8 @@ use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary, ParsedParameter};
 
 use super::*;
 use crate::camera::CameraTransform;
+
+mod le;
 use crate::image::Image;
 use crate::params::ParamReader;
 use crate::rng::Rng;
@@ -530,13 +532,13 @@ fn goniometric_and_projection_power_integrals() {
     }
     let image = Image::from_f32(data, Point2i::new(res, res), &["Y"]).unwrap();
     let cs = RgbColorSpace::srgb();
-    let g = Light::Goniometric(Box::new(GoniometricLight {
-        render_from_light: Transform::translate(Vector3f::new(1.0, 0.0, 0.0)),
-        i: dense(&cs.illuminant_spectrum()),
-        scale: 0.01,
+    let g = Light::Goniometric(Box::new(GoniometricLight::new(
+        Transform::translate(Vector3f::new(1.0, 0.0, 0.0)),
+        dense(&cs.illuminant_spectrum()),
+        0.01,
         image,
-        medium: None,
-    }));
+        None,
+    )));
     check_phi_against_integral(&g, Point3f::new(1.0, 0.0, 0.0), 1e-2);
 
     let mut data = Vec::new();

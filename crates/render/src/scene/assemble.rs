@@ -263,9 +263,11 @@ pub fn create_scene(
         &geometry,
         medium_of(&camera_entity.medium),
     );
-    let Some(camera) = p.finish(camera_reader, camera) else {
+    let Some(mut camera) = p.finish(camera_reader, camera) else {
         return Err(problems.errors);
     };
+    // Importance (pbrt-v4 `We`) depends on the film's filter.
+    camera.set_filter_radius(filter.radius());
     let sampler = p.take(reader(&desc.sampler)).and_then(|r| {
         let s = create_sampler(
             &desc.sampler.name,

@@ -425,6 +425,34 @@ impl BilinearPatch {
         pdf / cross(dpdu, dpdv).length()
     }
 
+    /// The patch parameters (u, v) of a point `q` on the patch: the
+    /// least-squares solution of bilerp(u, v) = q by Gauss–Newton steps
+    /// from the centre, kept in [0, 1]² (pbrt-v4 inverts the texture
+    /// coordinates of the interaction instead; rpbrt is given the point).
+    pub fn invert_point(&self, q: Point3f) -> Point2f {
+        let p = self.vertices();
+        let (mut u, mut v) = (0.5, 0.5);
+        for _ in 0..24 {
+            let r = bilerp(&p, u, v) - q;
+            let (dpdu, dpdv) = partials(&p, u, v);
+            let (a, b, c) = (dot(dpdu, dpdu), dot(dpdu, dpdv), dot(dpdv, dpdv));
+            let det = a * c - b * b;
+            if !(det.abs() > 0.0) {
+                break;
+            }
+            let (ru, rv) = (dot(dpdu, r), dot(dpdv, r));
+            let du = (c * ru - b * rv) / det;
+            let dv = (a * rv - b * ru) / det;
+            let (nu, nv) = (clamp(u - du, 0.0, 1.0), clamp(v - dv, 0.0, 1.0));
+            let step = (nu - u).abs() + (nv - v).abs();
+            (u, v) = (nu, nv);
+            if !(step > 1e-7) {
+                break;
+            }
+        }
+        Point2f::new(u, v)
+    }
+
     /// The texture coordinates at patch parameters (u, v).
     fn st(&self, u: Float, v: Float) -> Point2f {
         match &self.mesh.uv {
@@ -696,6 +724,15 @@ impl ShapeMethods for BilinearPatch {
             time: 0.0,
             pdf,
         })
+    }
+
+    /// The density of [`ShapeMethods::sample_area`] at `p`: uniform
+    /// (1/area) on rectangles, the warped density elsewhere.
+    fn pdf_area_at_point(&self, p: Point3f) -> Float {
+        if self.rectangle {
+            return 1.0 / self.area;
+        }
+        self.pdf_area_at(self.invert_point(p))
     }
 
     fn sample(&self, ctx: &ShapeSampleContext, u: Point2f) -> Option<ShapeSample> {

@@ -143,6 +143,12 @@ pub trait ShapeMethods {
     fn pdf_area(&self) -> Float {
         1.0 / self.area()
     }
+    /// Density per unit area with which [`ShapeMethods::sample_area`]
+    /// produces the surface point `p` (pbrt-v4 `Shape::PDF(Interaction)`):
+    /// [`ShapeMethods::pdf_area`] for shapes sampled uniformly by area.
+    fn pdf_area_at_point(&self, _p: Point3f) -> Float {
+        self.pdf_area()
+    }
     /// A point sampled as seen from `ctx`, density per unit solid angle.
     fn sample(&self, ctx: &ShapeSampleContext, u: Point2f) -> Option<ShapeSample>;
     /// Density per unit solid angle of sampling direction `wi` from `ctx`.
@@ -260,6 +266,10 @@ impl ShapeMethods for Shape {
     #[inline]
     fn pdf_area(&self) -> Float {
         delegate!(self, s => s.pdf_area())
+    }
+    #[inline]
+    fn pdf_area_at_point(&self, p: Point3f) -> Float {
+        delegate!(self, s => s.pdf_area_at_point(p))
     }
     #[inline]
     fn sample(&self, ctx: &ShapeSampleContext, u: Point2f) -> Option<ShapeSample> {

@@ -18,7 +18,9 @@ use rpbrt_geometry::{
     Point2f, Point2i, Point3f, Point3fi, Ray, Transform, Vector3f, PI,
 };
 
-use super::{rgb_illuminant, LightBounds, LightLiSample, LightSampleContext, SceneSphere};
+use super::{
+    rgb_illuminant, LightBounds, LightLeSample, LightLiSample, LightSampleContext, SceneSphere,
+};
 use crate::image::{Image, WrapMode, WrapMode2D};
 use crate::spectrum::{RgbColorSpace, SampledSpectrum, SampledWavelengths};
 
@@ -60,6 +62,15 @@ pub struct PortalImageInfiniteLight {
     /// The scene's bounding sphere, set by `preprocess`.
     pub scene: SceneSphere,
     distribution: WindowedPiecewiseConstant2D,
+}
+
+/// dω/d(u,v) for the unit portal-frame direction `w`: pbrt-v4's
+/// π² (1 − x²)(1 − y²) / z, with 1 − x² written as y² + z² and 1 − y² as
+/// x² + z² (equal for a unit vector) so that grazing directions, where
+/// x or y is nearly ±1, do not lose their digits to cancellation.
+#[inline]
+fn dw_duv(w: Vector3f) -> Float {
+    PI * PI * (w.y * w.y + w.z * w.z) * (w.x * w.x + w.z * w.z) / w.z
 }
 
 /// Checks that `portal` is a rectangle as pbrt-v4 does (opposite edges
@@ -157,7 +168,7 @@ impl PortalImageInfiniteLight {
         if w.z <= 0.0 {
             return None;
         }
-        let dw_duv = PI * PI * (1.0 - w.x * w.x) * (1.0 - w.y * w.y) / w.z;
+        let dw_duv = dw_duv(w);
         let alpha = w.x.atan2(w.z);
         let beta = w.y.atan2(w.z);
         let uv = Point2f::new(
@@ -173,7 +184,7 @@ impl PortalImageInfiniteLight {
         let alpha = -PI / 2.0 + uv.x * PI;
         let beta = -PI / 2.0 + uv.y * PI;
         let w = Vector3f::new(alpha.tan(), beta.tan(), 1.0).normalize();
-        let dw_duv = PI * PI * (1.0 - w.x * w.x) * (1.0 - w.y * w.y) / w.z;
+        let dw_duv = dw_duv(w);
         (self.portal_frame.from_local(w), dw_duv)
     }
 
@@ -255,6 +266,53 @@ impl PortalImageInfiniteLight {
             (Some((uv, _)), Some(b)) if b.inside(uv) => self.image_lookup(uv, lambda),
             _ => SampledSpectrum::new(0.0),
         }
+    }
+
+    /// A ray whose direction is sampled over the whole rectified image
+    /// (every direction arriving through the portal's plane, not only
+    /// through the portal) by `u1`, through a point on the scene's
+    /// bounding disk chosen by `u2`, as pbrt-v4 does (its variant that
+    /// samples points on the portal itself is disabled there, as it does
+    /// not work with BDPT).
+    pub fn sample_le(
+        &self,
+        u1: Point2f,
+        u2: Point2f,
+        lambda: &SampledWavelengths,
+        time: Float,
+    ) -> Option<LightLeSample> {
+        let unit = Bounds2f::new(Point2f::new(0.0, 0.0), Point2f::new(1.0, 1.0));
+        let (uv, map_pdf) = self.distribution.sample(u1, &unit)?;
+        let (w, dw_duv) = self.render_from_image(uv);
+        if dw_duv == 0.0 || map_pdf == 0.0 {
+            return None;
+        }
+        let (ray, pdf_pos) = self.scene.sample_ray_through_disk(-w, u2, time);
+        Some(LightLeSample {
+            l: self.image_lookup(uv, lambda),
+            ray,
+            surface: None,
+            pdf_pos,
+            pdf_dir: map_pdf / dw_duv,
+        })
+    }
+
+    /// The densities of [`sample_le`](Self::sample_le) for `ray`: zero for
+    /// rays that do not travel away from the environment's side of the
+    /// portal's plane.
+    pub fn pdf_le(&self, ray: &Ray) -> (Float, Float) {
+        let Some((uv, dw_duv)) = (-ray.d)
+            .try_normalize()
+            .and_then(|w| self.image_from_render(w))
+        else {
+            return (0.0, 0.0);
+        };
+        if dw_duv == 0.0 {
+            return (0.0, 0.0);
+        }
+        let unit = Bounds2f::new(Point2f::new(0.0, 0.0), Point2f::new(1.0, 1.0));
+        let pdf = self.distribution.pdf(uv, &unit);
+        (self.scene.disk_pdf(), pdf / dw_duv)
     }
 
     /// pbrt-v4's power estimate, kept as it is: scale · portal area · the

@@ -55,3 +55,22 @@ fn ray(c: &Camera, x: Float, y: Float) -> Ray {
 fn closep(a: Point3f, b: Point3f, eps: Float) -> bool {
     (a - b).length() <= eps
 }
+
+#[test]
+fn the_scene_gives_the_camera_its_filter_radius() {
+    use crate::scene::assemble::{create_scene, CreateOptions};
+    use rpbrt_geometry::Vector2f;
+    let text = "Camera \"perspective\"\nFilm \"rgb\" \"integer xresolution\" 20 \
+                \"integer yresolution\" 10\nPixelFilter \"gaussian\" \"float xradius\" 2 \
+                \"float yradius\" 1\nWorldBegin\n";
+    let (desc, _) = build_scene_from_str(text, &BuildOptions::default()).expect("scene");
+    let Ok(created) = create_scene(&desc, &CreateOptions::default()) else {
+        panic!("scene creation failed")
+    };
+    let camera = &created.scene.camera;
+    assert_eq!(camera.base().filter_radius, Vector2f::new(2.0, 1.0));
+    assert_eq!(
+        camera.base().film_sample_bounds(),
+        created.scene.film.sample_bounds()
+    );
+}

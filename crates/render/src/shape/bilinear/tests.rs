@@ -494,3 +494,20 @@ fn orientation_shading_and_texture_coordinates() {
         si.dpdv
     );
 }
+
+#[test]
+fn area_density_at_a_point_matches_area_sampling() {
+    let mut r = Rng::with_sequence(31);
+    for bp in [twisted(), rectangle()] {
+        let p = bp.vertices();
+        for _ in 0..500 {
+            let ss = bp.sample_area(ru(&mut r)).expect("sample");
+            let pdf = bp.pdf_area_at_point(ss.p());
+            assert!((pdf - ss.pdf).abs() <= 1e-3 * ss.pdf, "{pdf} vs {}", ss.pdf);
+            // The patch parameters of a point come back from the point.
+            let uv = ru(&mut r);
+            let back = bp.invert_point(bilerp(&p, uv.x, uv.y));
+            assert!((back - uv).length() < 1e-4, "{uv:?} -> {back:?}");
+        }
+    }
+}
