@@ -179,6 +179,7 @@ fn integrators_that_ignore_media_or_subsurface_warn_at_the_directive() {
     let cases = [
         ("ss.pbrt", "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nIntegrator \"path\"\nWorldBegin\nLightSource \"point\" \"rgb I\" [1 1 1]\nMaterial \"subsurface\"\nShape \"sphere\"\n", "ss.pbrt:2:1", "subsurface"),
         ("medium.pbrt", "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nIntegrator \"path\"\nWorldBegin\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nShape \"sphere\"\n", "medium.pbrt:2:1", "media"),
+        ("sppm-medium.pbrt", "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nIntegrator \"sppm\"\nWorldBegin\nLightSource \"point\" \"rgb I\" [1 1 1]\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nShape \"sphere\"\n", "sppm-medium.pbrt:2:1", "media"),
     ];
     for (name, text, loc, what) in cases {
         let p = temp_scene(name, text);

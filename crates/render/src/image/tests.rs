@@ -787,7 +787,12 @@ fn diff_stats_on_known_images() {
     let bgr = rgb.select_channels(&rgb.get_channel_desc(&["B", "G", "R"]).unwrap());
     assert_eq!(diff(&rgb, &bgr).unwrap().mse, 0.0);
     // A pixel's brightness is the mean of its channels.
-    let two = Image::from_f32(vec![0.0, 3.0, 6.0, 1.0, 1.0, 1.0], p(2, 1), &["R", "G", "B"]).unwrap();
+    let two = Image::from_f32(
+        vec![0.0, 3.0, 6.0, 1.0, 1.0, 1.0],
+        p(2, 1),
+        &["R", "G", "B"],
+    )
+    .unwrap();
     assert_eq!(diff(&two, &two).unwrap().median_a, 1.0);
     assert!(diff(&rgb, &a).is_err());
     let y = Image::from_f32(vec![0.0; 9], p(3, 3), &["Y"]).unwrap();

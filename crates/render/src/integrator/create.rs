@@ -75,7 +75,7 @@ pub fn create_integrator(
                 ));
             }
             let radius = ip.float("radius", 1.0)?;
-            if !(radius > 0.0) || !radius.is_finite() {
+            if radius.is_nan() || radius <= 0.0 || radius.is_infinite() {
                 return Err(ip.error_at(
                     "radius",
                     format!("\"radius\" must be positive, got {radius}"),

@@ -196,8 +196,8 @@ impl SppmIntegrator {
                     l += beta * le;
                 } else if let Some(al) = hit.area_light {
                     let light = &scene.lights[al as usize];
-                    let light_pdf = light_sampler.pmf(&prev_ctx, al)
-                        * light.pdf_li(&prev_ctx, ray.ray.d, true);
+                    let light_pdf =
+                        light_sampler.pmf(&prev_ctx, al) * light.pdf_li(&prev_ctx, ray.ray.d, true);
                     let w_l = power_heuristic(1.0, bsdf_pdf, 1.0, light_pdf);
                     l += beta * w_l * le;
                 }
@@ -397,7 +397,8 @@ pub(crate) fn render(
         md.full_resolution = Some(scene.film.full_resolution());
         md.color_space = Some(integrator.color_space.clone());
         if let Some(reference) = &opts.mse_reference {
-            let d = crate::image::ops::diff(&image, reference).map_err(RenderError::MseReference)?;
+            let d =
+                crate::image::ops::diff(&image, reference).map_err(RenderError::MseReference)?;
             mse_per_wave.push((iterations_done, d.mse));
             md.mse = Some(d.mse as f32);
         }
@@ -487,8 +488,10 @@ pub(crate) fn render(
                                 let begin = chunk * PHOTON_CHUNK;
                                 let end = (begin + PHOTON_CHUNK).min(photons_per_iteration);
                                 let mut out = Vec::new();
-                                let mut sampler =
-                                    Sampler::Independent(IndependentSampler::new(1, integrator.seed));
+                                let mut sampler = Sampler::Independent(IndependentSampler::new(
+                                    1,
+                                    integrator.seed,
+                                ));
                                 RayCounters::reset_local();
                                 for i in begin..end {
                                     pass.trace(i, &mut sampler, &mut out);

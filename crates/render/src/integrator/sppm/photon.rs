@@ -200,10 +200,7 @@ impl PhotonPass<'_> {
             }
             out.push(Deposit {
                 pixel: e.pixel,
-                phi: self
-                    .scene
-                    .film
-                    .to_output_rgb(vp.beta * phi, &photon_lambda),
+                phi: self.scene.film.to_output_rgb(vp.beta * phi, &photon_lambda),
             });
         }
     }
