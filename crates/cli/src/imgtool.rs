@@ -106,6 +106,16 @@ fn cmd_diff(args: &[String]) -> Result<(), String> {
             f64::NAN
         }
     );
+    println!(
+        "median pixel brightness: {:.6} (reference {:.6}, ratio {:.4})",
+        s.median_a,
+        s.median_b,
+        if s.median_b != 0.0 {
+            s.median_a / s.median_b
+        } else {
+            f64::NAN
+        }
+    );
     if let Some(w) = worst_block(&a, &b, BLOCK_SIZE).map_err(|e| e.to_string())? {
         println!(
             "worst {BLOCK_SIZE}x{BLOCK_SIZE} block: z {:.2} (mean ratio {:.4}, block at {}, {})",

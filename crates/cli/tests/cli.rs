@@ -179,6 +179,7 @@ fn integrators_that_ignore_media_or_subsurface_warn_at_the_directive() {
     let cases = [
         ("ss.pbrt", "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nIntegrator \"path\"\nWorldBegin\nLightSource \"point\" \"rgb I\" [1 1 1]\nMaterial \"subsurface\"\nShape \"sphere\"\n", "ss.pbrt:2:1", "subsurface"),
         ("medium.pbrt", "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nIntegrator \"path\"\nWorldBegin\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nShape \"sphere\"\n", "medium.pbrt:2:1", "media"),
+        ("sppm-medium.pbrt", "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nIntegrator \"sppm\"\nWorldBegin\nLightSource \"point\" \"rgb I\" [1 1 1]\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nShape \"sphere\"\n", "sppm-medium.pbrt:2:1", "media"),
     ];
     for (name, text, loc, what) in cases {
         let p = temp_scene(name, text);
@@ -199,9 +200,14 @@ fn integrators_that_ignore_media_or_subsurface_warn_at_the_directive() {
 
 #[test]
 fn unsupported_features_are_located_errors_not_wrong_images() {
-    let cases = [
-        ("sppm.pbrt", "Film \"rgb\" \"integer xresolution\" 8 \"integer yresolution\" 8\nIntegrator \"sppm\"\nWorldBegin\nShape \"sphere\"\n", "sppm.pbrt:2:1"),
-    ];
+    let cases = [(
+        "halton.pbrt",
+        "Sampler \"halton\" \"string randomization\" \"fastowen\"
+WorldBegin
+Shape \"sphere\"
+",
+        "halton.pbrt:1:",
+    )];
     for (name, text, loc) in cases {
         let p = temp_scene(name, text);
         let out = rpbrt().arg("--quiet").arg(&p).output().unwrap();

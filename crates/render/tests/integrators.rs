@@ -436,3 +436,105 @@ fn bidirectional_integrators_refuse_what_they_cannot_render() {
         );
     }
 }
+
+/// SPPM on pbrt-v4's two analytic spheres (area-lit and point-lit), with
+/// two samplers: the mean radiance is 1 within pbrt-v4's tolerance. The
+/// part of a unit sphere within distance r of one of its points has area
+/// exactly πr², but a visible point's BSDF turns away photons that arrive
+/// below its own tangent plane, which at the default radius (1) costs a
+/// few percent: hence a radius of 0.2.
+#[test]
+fn sppm_matches_the_analytic_spheres() {
+    type SceneFn = fn(&str, &str, &str, &str, i32) -> String;
+    let scenes: [(&str, SceneFn); 2] = [("emit", emitting_sphere), ("point", point_lit_sphere)];
+    for sampler in ["zsobol", "halton"] {
+        for (name, scene) in scenes {
+            let tag = format!("sppm-{name}-{sampler}");
+            let text = scene(&tag, "perspective", sampler, "sppm", 64).replace(
+                "Integrator \"sppm\"",
+                "Integrator \"sppm\" \"float radius\" 0.2",
+            );
+            let im = render_scene(&text, 0);
+            check(&tag, &im, 1.0, 0.025);
+        }
+    }
+}
+
+/// SPPM's pixels do not depend on the thread count, photon contributions
+/// included (several photon chunks, one of them partial).
+#[test]
+fn sppm_is_identical_on_one_and_three_threads() {
+    let text = |tag: &str| {
+        point_lit_sphere(tag, "perspective", "zsobol", "sppm", 4).replace(
+            "Integrator \"sppm\"",
+            "Integrator \"sppm\" \"integer photonsperiteration\" 2500 \"float radius\" 0.3",
+        )
+    };
+    let a = render_scene(&text("sppm-det-1"), 1);
+    let b = render_scene(&text("sppm-det-3"), 3);
+    assert_eq!(a.to_f32_vec(), b.to_f32_vec());
+    assert!(mean_rgb(&a) > 0.5);
+}
+
+/// SPPM reports its progress (camera paths and photons) up to its total,
+/// and counts one sample per pixel and iteration.
+#[test]
+fn sppm_reports_progress() {
+    let c = created(&emitting_sphere(
+        "sppm-progress",
+        "orthographic",
+        "independent",
+        "sppm",
+        4,
+    ));
+    let mut scene = c.scene;
+    let reports = std::sync::Mutex::new(Vec::new());
+    let mut md = ImageMetadata::default();
+    let stats = c
+        .integrator
+        .render(&mut scene, &RenderOptions::default(), &mut md, &|p| {
+            reports.lock().unwrap().push(p)
+        })
+        .unwrap();
+    let reports = reports.into_inner().unwrap();
+    let last = reports.last().expect("no progress reported");
+    // 4 iterations of 256 camera paths and 256 photons.
+    assert_eq!(last.total, 4 * (256 + 256));
+    assert_eq!(last.done, last.total);
+    assert_eq!(stats.samples, 16 * 16 * 4);
+    assert_eq!(md.samples_per_pixel, Some(4));
+}
+
+/// Bad SPPM parameters are errors located at the parameter.
+#[test]
+fn sppm_bad_parameters_are_located_errors() {
+    let cases = [
+        ("\"float radius\" 0", "radius"),
+        ("\"float radius\" -0.5", "radius"),
+        ("\"integer photonsperiteration\" 0", "photonsperiteration"),
+        ("\"integer photonsperiteration\" -2", "photonsperiteration"),
+    ];
+    for (param, needle) in cases {
+        let text = format!(
+            "Film \"rgb\" \"string filename\" \"/dev/null.exr\"\nIntegrator \"sppm\" {param}\nWorldBegin\nShape \"sphere\"\n"
+        );
+        let (desc, _) = build_scene_from_str(&text, &BuildOptions::default())
+            .unwrap_or_else(|d| panic!("{}", d.render()));
+        let errs = match create_scene(&desc, &CreateOptions::default()) {
+            Ok(_) => panic!("no error for {param}"),
+            Err(e) => e,
+        };
+        assert!(
+            errs.iter().any(|d| {
+                d.loc
+                    .as_ref()
+                    .is_some_and(|l| l.line == 2 && l.column == 19)
+                    && d.message.contains(needle)
+            }),
+            "{param}: {:?}",
+            errs.iter()
+                .map(|d| (d.loc.clone(), d.message.clone()))
+                .collect::<Vec<_>>()
+        );
+    }
+}

@@ -37,6 +37,12 @@ pub struct DiffStats {
     pub clamped_mean_a: f64,
     /// Mean of the reference clamped the same way.
     pub clamped_mean_b: f64,
+    /// The median over pixels of each pixel's brightness (the mean of its
+    /// compared channels): insensitive to fireflies and to a few dark
+    /// pixels alike.
+    pub median_a: f64,
+    /// The reference's median pixel brightness.
+    pub median_b: f64,
 }
 
 /// Fraction of pixels dropped by the trimmed relative MSE.
@@ -125,6 +131,16 @@ pub fn percentile(v: &[f32], p: f64) -> f64 {
     f[rank.clamp(1, f.len()) - 1] as f64
 }
 
+/// The median of the pixels' brightnesses, each the mean of the pixel's
+/// `nc` channel values.
+fn median_brightness(v: &[f32], nc: usize) -> f64 {
+    let brightness: Vec<f32> = v
+        .chunks_exact(nc)
+        .map(|px| (px.iter().map(|&x| x as f64).sum::<f64>() / nc as f64) as f32)
+        .collect();
+    percentile(&brightness, 50.0)
+}
+
 /// Compares `a` with the reference `b` over `a`'s channels.
 pub fn diff(a: &Image, b: &Image) -> Result<DiffStats, ImageError> {
     let (names, va, vb) = paired(a, b)?;
@@ -165,6 +181,8 @@ pub fn diff(a: &Image, b: &Image) -> Result<DiffStats, ImageError> {
         clamp_value: clamp,
         clamped_mean_a: clamped_mean(&va),
         clamped_mean_b: clamped_mean(&vb),
+        median_a: median_brightness(&va, nc),
+        median_b: median_brightness(&vb, nc),
         rel_mse_trimmed: trimmed_mean(per_pixel_rel(&va, &vb, nc), TRIM_FRACTION),
         channels: names,
         mse: se / n,

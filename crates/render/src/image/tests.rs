@@ -768,6 +768,9 @@ fn diff_stats_on_known_images() {
     assert_eq!(d.mean_b, 2.0);
     assert_eq!(d.max_abs_diff, 2.0);
     assert_eq!(d.differing_pixels, 1);
+    // Nearest-rank medians: the 2nd of 4 values.
+    assert_eq!(d.median_a, 2.0);
+    assert_eq!(d.median_b, 2.0);
     assert_eq!(diff(&a, &a).unwrap().mse, 0.0);
     // Dropping 0.1% of 1000 pixels removes exactly the one outlier.
     let n = 1000;
@@ -783,6 +786,14 @@ fn diff_stats_on_known_images() {
     let rgb = random_float_image(3, 3, &["R", "G", "B"], 1);
     let bgr = rgb.select_channels(&rgb.get_channel_desc(&["B", "G", "R"]).unwrap());
     assert_eq!(diff(&rgb, &bgr).unwrap().mse, 0.0);
+    // A pixel's brightness is the mean of its channels.
+    let two = Image::from_f32(
+        vec![0.0, 3.0, 6.0, 1.0, 1.0, 1.0],
+        p(2, 1),
+        &["R", "G", "B"],
+    )
+    .unwrap();
+    assert_eq!(diff(&two, &two).unwrap().median_a, 1.0);
     assert!(diff(&rgb, &a).is_err());
     let y = Image::from_f32(vec![0.0; 9], p(3, 3), &["Y"]).unwrap();
     assert!(diff(&y, &rgb).is_err());

@@ -5,7 +5,7 @@
 use super::{
     AmbientOcclusionIntegrator, BdptIntegrator, Integrator, LightPathIntegrator, MltIntegrator,
     PathIntegrator, RandomWalkIntegrator, SimplePathIntegrator, SimpleVolPathIntegrator,
-    VolPathIntegrator,
+    SppmIntegrator, VolPathIntegrator,
 };
 use crate::params::{unknown_type, ParamReader};
 use rpbrt_geometry::float::Float;
@@ -60,7 +60,9 @@ pub fn create_integrator(
             light_sampler_name: ip.string("lightsampler", "bvh")?,
             regularize: ip.bool("regularize", false)?,
         })),
-        "simplevolpath" => Ok(Integrator::SimpleVolPath(SimpleVolPathIntegrator { max_depth })),
+        "simplevolpath" => Ok(Integrator::SimpleVolPath(SimpleVolPathIntegrator {
+            max_depth,
+        })),
         "simplepath" => Ok(Integrator::SimplePath(SimplePathIntegrator {
             max_depth,
             sample_lights: ip.bool("samplelights", true)?,
@@ -71,7 +73,10 @@ pub fn create_integrator(
             if !(max_distance > 0.0) {
                 return Err(ip.error_at("maxdistance", "\"maxdistance\" must be positive"));
             }
-            Ok(Integrator::AmbientOcclusion(AmbientOcclusionIntegrator { cos_sample: ip.bool("cossample", true)?, max_distance }))
+            Ok(Integrator::AmbientOcclusion(AmbientOcclusionIntegrator {
+                cos_sample: ip.bool("cossample", true)?,
+                max_distance,
+            }))
         }
         "randomwalk" => Ok(Integrator::RandomWalk(RandomWalkIntegrator { max_depth })),
         "bdpt" => {
@@ -103,7 +108,10 @@ pub fn create_integrator(
             }
             let chains = ip.int("chains", 1000)?;
             if chains <= 0 {
-                return Err(ip.error_at("chains", format!("\"chains\" must be positive, got {chains}")));
+                return Err(ip.error_at(
+                    "chains",
+                    format!("\"chains\" must be positive, got {chains}"),
+                ));
             }
             let mut mutations_per_pixel = ip.int("mutationsperpixel", 100)?;
             if mutations_per_pixel <= 0 {
@@ -119,12 +127,16 @@ pub fn create_integrator(
             if !(0.0..=1.0).contains(&large_step_probability) {
                 return Err(ip.error_at(
                     "largestepprobability",
-                    format!("\"largestepprobability\" must be in [0, 1], got {large_step_probability}"),
+                    format!(
+                        "\"largestepprobability\" must be in [0, 1], got {large_step_probability}"
+                    ),
                 ));
             }
             let sigma = ip.float("sigma", 0.01)?;
             if !(sigma > 0.0 && sigma.is_finite()) {
-                return Err(ip.error_at("sigma", format!("\"sigma\" must be positive, got {sigma}")));
+                return Err(
+                    ip.error_at("sigma", format!("\"sigma\" must be positive, got {sigma}"))
+                );
             }
             Ok(Integrator::Mlt(MltIntegrator {
                 max_depth,
@@ -137,10 +149,29 @@ pub fn create_integrator(
                 seed: opts.seed.unwrap_or(0) as u64,
             }))
         }
-        "sppm" => Err(Diagnostic::error(
-            loc.clone(),
-            format!("the \"{name}\" integrator is not supported yet; rpbrt renders with \"path\", \"volpath\", \"simplevolpath\", \"simplepath\", \"ambientocclusion\" and \"randomwalk\""),
-        )),
+        "sppm" => {
+            let photons_per_iteration = ip.int("photonsperiteration", -1)?;
+            if photons_per_iteration == 0 || photons_per_iteration < -1 {
+                return Err(ip.error_at(
+                    "photonsperiteration",
+                    format!("\"photonsperiteration\" must be positive (or -1 for one photon per pixel), got {photons_per_iteration}"),
+                ));
+            }
+            let radius = ip.float("radius", 1.0)?;
+            if radius.is_nan() || radius <= 0.0 || radius.is_infinite() {
+                return Err(ip.error_at(
+                    "radius",
+                    format!("\"radius\" must be positive, got {radius}"),
+                ));
+            }
+            Ok(Integrator::Sppm(SppmIntegrator {
+                max_depth,
+                photons_per_iteration,
+                initial_radius: radius,
+                seed: ip.int("seed", opts.seed.unwrap_or(0))?,
+                color_space: ip.color_space().name.clone(),
+            }))
+        }
         _ => Err(unknown_type("integrator", name, INTEGRATOR_NAMES, loc)),
     }
 }

@@ -2,10 +2,10 @@
 //! the light-transport algorithms and how each renders a [`Scene`].
 //!
 //! [`Integrator::render`] is the one entry point: each integrator owns its
-//! render loop. Every integrator here is a pbrt-v4 `RayIntegrator`
-//! ([`RayIntegrator`]): it estimates the radiance along one camera ray, and
-//! the shared tile loop ([`tile`]) drives it over image tiles in parallel.
-//! An integrator that needs a loop of its own (MLT, SPPM) gets a match arm
+//! render loop. Most integrators here are pbrt-v4 `RayIntegrator`s
+//! ([`RayIntegrator`]): each estimates the radiance along one camera ray,
+//! and the shared tile loop ([`tile`]) drives it over image tiles in
+//! parallel. An integrator that needs a loop of its own (SPPM) gets a match arm
 //! in [`Integrator::render`] calling its own function, which reports
 //! progress through the same callback ([`Progress`]) and fails with the
 //! same [`RenderError`].
@@ -19,7 +19,8 @@
 //! lighting; [`render`], what render loops share (options, statistics,
 //! errors, progress); [`tile`], the per-ray tile loop; `path` and
 //! `simple`, the integrators; `volume`, what the volumetric ones share;
-//! `volpath` and `simplevolpath`, pbrt-v4's volumetric path tracers.
+//! `volpath` and `simplevolpath`, pbrt-v4's volumetric path tracers;
+//! `sppm`, stochastic progressive photon mapping, with its own loop.
 
 pub(crate) mod bdpt;
 mod create;
@@ -31,6 +32,7 @@ pub mod render;
 pub mod scene;
 mod simple;
 mod simplevolpath;
+mod sppm;
 pub mod tile;
 mod volpath;
 mod volume;
@@ -44,6 +46,7 @@ pub use render::{Progress, ProgressFn, RenderError, RenderOptions, RenderStats};
 pub use scene::{RayCounters, Scene};
 pub use simple::{AmbientOcclusionIntegrator, RandomWalkIntegrator, SimplePathIntegrator};
 pub use simplevolpath::SimpleVolPathIntegrator;
+pub use sppm::SppmIntegrator;
 pub use tile::{RayIntegrator, TileIntegrator};
 pub use volpath::VolPathIntegrator;
 
@@ -72,6 +75,8 @@ pub enum Integrator {
     LightPath(LightPathIntegrator),
     /// `mlt`.
     Mlt(MltIntegrator),
+    /// `sppm`.
+    Sppm(SppmIntegrator),
 }
 
 impl Integrator {
@@ -111,6 +116,7 @@ impl Integrator {
             Integrator::Bdpt(i) => bdpt::render(i, scene, opts, metadata, progress),
             Integrator::LightPath(i) => tile::render_tiles(i, scene, opts, metadata, progress),
             Integrator::Mlt(i) => mlt::render(i, scene, opts, metadata, progress),
+            Integrator::Sppm(i) => sppm::render(i, scene, opts, metadata, progress),
         }
     }
 

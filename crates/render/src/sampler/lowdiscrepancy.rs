@@ -447,34 +447,16 @@ pub fn sobol_sample(a: u64, dimension: usize, scrambler: BinaryScrambler) -> Flo
     } else {
         let m =
             &sobol_matrices()[dimension * SOBOL_MATRIX_SIZE..(dimension + 1) * SOBOL_MATRIX_SIZE];
+        // One XOR per set bit of the index, found with trailing-zero
+        // counts (no branch on each bit, whose values are random).
         let mut v = 0u32;
         let mut a = a;
-        let mut i = 0;
-        // Branch-free: the index bits are random, so a branch per bit
-        // mispredicts half the time.
         while a != 0 {
-            v ^= m[i] & 0u32.wrapping_sub((a & 1) as u32);
-            a >>= 1;
-            i += 1;
+            v ^= m.get(a.trailing_zeros() as usize).copied().unwrap_or(0);
+            a &= a - 1;
         }
         v
     };
-    let v = scrambler.apply(v);
-    (v as Float * f32::from_bits(0x2f80_0000)).min(ONE_MINUS_EPSILON)
-}
-
-/// [`sobol_sample`] of an index given by the positions of its set bits
-/// (ascending), for dimensions ≥ 2: the same value, with one XOR per set
-/// bit instead of a step per bit up to the highest. Samplers that draw
-/// many dimensions of one index list its bits once.
-#[inline]
-pub fn sobol_sample_at_bits(bits: &[u8], dimension: usize, scrambler: BinaryScrambler) -> Float {
-    debug_assert!((2..N_SOBOL_DIMENSIONS).contains(&dimension));
-    let m = &sobol_matrices()[dimension * SOBOL_MATRIX_SIZE..(dimension + 1) * SOBOL_MATRIX_SIZE];
-    let mut v = 0u32;
-    for &b in bits {
-        v ^= m.get(b as usize).copied().unwrap_or(0);
-    }
     let v = scrambler.apply(v);
     (v as Float * f32::from_bits(0x2f80_0000)).min(ONE_MINUS_EPSILON)
 }

@@ -15,8 +15,8 @@ use rpbrt_geometry::tuple::{Point2f, Point2i};
 
 use super::lowdiscrepancy::{
     encode_morton2, mix_bits, permutation_element, sobol_matrices, sobol_sample,
-    sobol_sample_at_bits, sobol_sample_fast_owen_01, BinaryScrambler, RandomizeStrategy,
-    N_SOBOL_DIMENSIONS, PERMUTATIONS_4, SOBOL_MATRIX_SIZE,
+    sobol_sample_fast_owen_01, BinaryScrambler, RandomizeStrategy, N_SOBOL_DIMENSIONS,
+    PERMUTATIONS_4, SOBOL_MATRIX_SIZE,
 };
 
 /// Largest supported log2 of the Sobol' sampler's pixel scale (so that
@@ -37,11 +37,6 @@ pub struct SobolSampler {
     pixel: Point2i,
     dimension: i32,
     sobol_index: u64,
-    /// The positions of `sobol_index`'s set bits (the first
-    /// `index_bit_count`): every dimension of the sample XORs the
-    /// generator-matrix columns at these positions.
-    index_bits: [u8; 64],
-    index_bit_count: u8,
 }
 
 impl SobolSampler {
@@ -67,8 +62,6 @@ impl SobolSampler {
             pixel: Point2i::new(0, 0),
             dimension: 0,
             sobol_index: 0,
-            index_bits: [0; 64],
-            index_bit_count: 0,
         }
     }
 
@@ -84,14 +77,6 @@ impl SobolSampler {
         self.pixel = p;
         self.dimension = dim.max(2);
         self.sobol_index = self.interval_to_index(sample_index as u64, p);
-        let mut a = self.sobol_index;
-        let mut n = 0;
-        while a != 0 {
-            self.index_bits[n] = a.trailing_zeros() as u8;
-            n += 1;
-            a &= a - 1;
-        }
-        self.index_bit_count = n as u8;
     }
 
     /// The index of the `frame`-th Sobol' point whose first two dimensions,
@@ -144,11 +129,7 @@ impl SobolSampler {
             let hash = mix_bits(((dimension as u64) << 32) ^ self.seed as i64 as u64) as u32;
             BinaryScrambler::new(self.randomize, hash)
         };
-        if dimension < 2 {
-            return sobol_sample(self.sobol_index, dimension, scrambler);
-        }
-        let bits = &self.index_bits[..self.index_bit_count as usize];
-        sobol_sample_at_bits(bits, dimension, scrambler)
+        sobol_sample(self.sobol_index, dimension, scrambler)
     }
 
     /// The next 1-D value (dimensions wrap to 2 after 1024).
