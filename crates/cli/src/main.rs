@@ -204,6 +204,11 @@ fn render_command(opts: &args::Options) -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
+    if !opts.quiet {
+        for w in &stats.warnings {
+            eprintln!("rpbrt: warning: {w}");
+        }
+    }
     if let Some(path) = &opts.mse_reference_out {
         let text: String = stats
             .mse_per_wave

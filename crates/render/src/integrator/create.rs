@@ -2,6 +2,7 @@
 //! `cpu/integrators.cpp`): an `Integrator` directive's name and parameters
 //! turned into an [`Integrator`].
 
+use super::function::{FunctionIntegrator, TestFunction};
 use super::{
     AmbientOcclusionIntegrator, BdptIntegrator, Integrator, LightPathIntegrator, MltIntegrator,
     PathIntegrator, RandomWalkIntegrator, SimplePathIntegrator, SimpleVolPathIntegrator,
@@ -15,6 +16,7 @@ use rpbrt_parser::Diagnostic;
 pub const INTEGRATOR_NAMES: &[&str] = &[
     "ambientocclusion",
     "bdpt",
+    "function",
     "lightpath",
     "mlt",
     "path",
@@ -26,12 +28,15 @@ pub const INTEGRATOR_NAMES: &[&str] = &[
 ];
 
 /// The command line's say in integrator creation.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct IntegratorOptions {
     /// `--spp`: MLT's mutations per pixel, as in pbrt-v4.
     pub spp: Option<i32>,
     /// `--seed`.
     pub seed: Option<i32>,
+    /// `--outfile`: the `function` integrator's default output file, as
+    /// pbrt-v4's `Options->imageFile`.
+    pub outfile: Option<String>,
 }
 
 /// Creates the integrator of an `Integrator` directive. The light sampler
@@ -149,6 +154,7 @@ pub fn create_integrator(
                 seed: opts.seed.unwrap_or(0) as u64,
             }))
         }
+        "function" => create_function(ip, opts),
         "sppm" => {
             let photons_per_iteration = ip.int("photonsperiteration", -1)?;
             if photons_per_iteration == 0 || photons_per_iteration < -1 {
@@ -174,4 +180,47 @@ pub fn create_integrator(
         }
         _ => Err(unknown_type("integrator", name, INTEGRATOR_NAMES, loc)),
     }
+}
+
+/// The `function` integrator (pbrt-v4 `FunctionIntegrator::Create`). The
+/// sampler check (no `"sobol"`) is made where the sampler is known.
+fn create_function(ip: &ParamReader, opts: &IntegratorOptions) -> Result<Integrator, Diagnostic> {
+    let name = ip.string("function", "step")?;
+    let Some(function) = TestFunction::from_name(&name) else {
+        let known = TestFunction::NAMES.map(|n| format!("\"{n}\"")).join(", ");
+        return Err(ip.error_at(
+            "function",
+            format!("\"{name}\": function for the \"function\" integrator unknown; expected one of {known}"),
+        ));
+    };
+    let default_filename = match &opts.outfile {
+        Some(f) => f.clone(),
+        None => format!("{name}-mse.txt"),
+    };
+    let filename = ip.string("filename", &default_filename)?;
+    let skip_bad = ip.bool("skipbad", true)?;
+    let image_filename = ip.string("imagefilename", "")?;
+    if !image_filename.is_empty() {
+        // Refused here rather than after the render has started.
+        let ext = std::path::Path::new(&image_filename)
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase())
+            .unwrap_or_default();
+        if !crate::film::IMAGE_EXTENSIONS.contains(&ext.as_str()) {
+            return Err(ip.error_at(
+                "imagefilename",
+                format!(
+                    "\"{image_filename}\": cannot write images with extension \"{ext}\" (supported: {})",
+                    crate::film::IMAGE_EXTENSIONS.join(", ")
+                ),
+            ));
+        }
+    }
+    Ok(Integrator::Function(FunctionIntegrator {
+        function,
+        filename,
+        skip_bad,
+        image_filename: (!image_filename.is_empty()).then_some(image_filename),
+    }))
 }

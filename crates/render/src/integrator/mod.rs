@@ -20,11 +20,13 @@
 //! errors, progress); [`tile`], the per-ray tile loop; `path` and
 //! `simple`, the integrators; `volume`, what the volumetric ones share;
 //! `volpath` and `simplevolpath`, pbrt-v4's volumetric path tracers;
-//! `sppm`, stochastic progressive photon mapping, with its own loop.
+//! `sppm`, stochastic progressive photon mapping, with its own loop;
+//! `function`, pbrt-v4's sampler bench, with its own loop too.
 
 pub(crate) mod bdpt;
 mod create;
 mod direct;
+mod function;
 mod lightpath;
 mod mlt;
 mod path;
@@ -39,6 +41,7 @@ mod volume;
 
 pub use bdpt::BdptIntegrator;
 pub use create::{create_integrator, IntegratorOptions, INTEGRATOR_NAMES};
+pub use function::{FunctionIntegrator, TestFunction};
 pub use lightpath::LightPathIntegrator;
 pub use mlt::MltIntegrator;
 pub use path::PathIntegrator;
@@ -77,6 +80,8 @@ pub enum Integrator {
     Mlt(MltIntegrator),
     /// `sppm`.
     Sppm(SppmIntegrator),
+    /// `function`: a sampler bench, no light transport.
+    Function(FunctionIntegrator),
 }
 
 impl Integrator {
@@ -117,6 +122,7 @@ impl Integrator {
             Integrator::LightPath(i) => tile::render_tiles(i, scene, opts, metadata, progress),
             Integrator::Mlt(i) => mlt::render(i, scene, opts, metadata, progress),
             Integrator::Sppm(i) => sppm::render(i, scene, opts, metadata, progress),
+            Integrator::Function(i) => function::render(i, scene, opts, progress),
         }
     }
 

@@ -48,8 +48,12 @@ pub struct RenderStats {
     /// True when the render was interrupted (Ctrl-C).
     pub interrupted: bool,
     /// (samples per pixel, MSE against the reference) after each wave, when
-    /// a reference image was given.
+    /// a reference image was given (the `function` integrator: against
+    /// the true integral, after each reported sample count).
     pub mse_per_wave: Vec<(i32, f64)>,
+    /// Warnings about the result, for the caller to show (the library
+    /// never prints).
+    pub warnings: Vec<String>,
 }
 
 /// How far a render has come, reported to the caller's progress callback.
@@ -79,6 +83,14 @@ pub enum RenderError {
         /// Why.
         source: ImageError,
     },
+    /// A text output file (the `function` integrator's errors) could not
+    /// be written.
+    WriteFile {
+        /// The file.
+        path: String,
+        /// Why.
+        source: std::io::Error,
+    },
 }
 
 impl std::fmt::Display for RenderError {
@@ -91,6 +103,7 @@ impl std::fmt::Display for RenderError {
                 ImageError::Io { .. } | ImageError::Format { .. } => write!(f, "{source}"),
                 ImageError::Invalid(m) => write!(f, "{path}: {m}"),
             },
+            RenderError::WriteFile { path, source } => write!(f, "{path}: {source}"),
         }
     }
 }
@@ -101,6 +114,7 @@ impl std::error::Error for RenderError {
             RenderError::ThreadPool(e) => Some(e),
             RenderError::MseReference(e) => Some(e),
             RenderError::WriteImage { source, .. } => Some(source),
+            RenderError::WriteFile { source, .. } => Some(source),
         }
     }
 }

@@ -366,6 +366,7 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
         samples: done,
         interrupted,
         mse_per_wave,
+        warnings: Vec::new(),
     })
 }
 

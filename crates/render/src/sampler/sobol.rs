@@ -252,6 +252,11 @@ impl PaddedSobolSampler {
         self.dimension = dimension;
     }
 
+    /// The randomisation in use.
+    pub fn randomize(&self) -> RandomizeStrategy {
+        self.randomize
+    }
+
     #[inline]
     fn hash_and_index(&self) -> (u64, u64) {
         let hash = mix_bits(

@@ -25,7 +25,7 @@ use crate::material::MaterialSet;
 use crate::medium::{create_medium, Medium};
 use crate::params::{unknown_type, ParamReader};
 use crate::primitive::{AnimatedPrimitive, Primitive, PrimitiveAggregate, TransformedPrimitive};
-use crate::sampler::create_sampler;
+use crate::sampler::{create_sampler, Sampler};
 use crate::texture::TextureOptions;
 
 /// Command-line settings that change how the scene is created.
@@ -244,6 +244,16 @@ pub fn create_scene(
     let exposure = camera_reader.float("shutterclose", 1.0).unwrap_or(1.0)
         - camera_reader.float("shutteropen", 0.0).unwrap_or(0.0);
     let camera_transform = &camera_entity.camera_transform;
+    // The `function` integrator takes `--outfile` for its text file and
+    // never writes the film (pbrt-v4's `Options->imageFile`).
+    let film_overrides = FilmOverrides {
+        outfile: opts
+            .film
+            .outfile
+            .clone()
+            .filter(|_| desc.integrator.name != "function"),
+        ..opts.film.clone()
+    };
     let film = filter.as_ref().and_then(|filter| {
         let r = p.take(reader(&desc.film))?;
         let f = create_film(
@@ -252,7 +262,7 @@ pub fn create_scene(
             filter,
             exposure,
             camera_transform,
-            &opts.film,
+            &film_overrides,
         );
         p.finish(r, f)
     });
@@ -413,6 +423,7 @@ pub fn create_scene(
         let iopts = IntegratorOptions {
             spp: opts.spp,
             seed: opts.seed,
+            outfile: opts.film.outfile.clone(),
         };
         let i = create_integrator(&desc.integrator.name, &r, &iopts);
         p.finish(r, i)
@@ -442,6 +453,14 @@ pub fn create_scene(
                     "Only the \"perspective\" camera is currently supported with the \"{}\" integrator.",
                     desc.integrator.name
                 ),
+            ));
+        }
+        // pbrt-v4's check: the global Sobol' sequence spreads a pixel's
+        // points over the image.
+        if matches!(i, Integrator::Function(_)) && matches!(sampler, Some(Sampler::Sobol(_))) {
+            p.errors.push(Diagnostic::error(
+                desc.integrator.loc.clone(),
+                "\"sobol\" sampler should be replaced with \"paddedsobol\" for the \"function\" integrator.",
             ));
         }
     }

@@ -282,5 +282,6 @@ pub(crate) fn render(
         samples: taken,
         interrupted,
         mse_per_wave: Vec::new(),
+        warnings: Vec::new(),
     })
 }

@@ -545,5 +545,6 @@ pub(crate) fn render(
         samples: iterations_done as u64 * n_pixels as u64,
         interrupted,
         mse_per_wave,
+        warnings: Vec::new(),
     })
 }
