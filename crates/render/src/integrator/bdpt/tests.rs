@@ -167,8 +167,8 @@ fn strategy_weights_of_a_path_sum_to_one() {
             } else {
                 None
             };
-            if c.iter().skip(1).any(|v| !(v.pdf_fwd > 0.0)) || l.iter().any(|v| !(v.pdf_fwd > 0.0))
-            {
+            let unsampleable = |v: &Vertex| v.pdf_fwd.is_nan() || v.pdf_fwd <= 0.0;
+            if c.iter().skip(1).any(unsampleable) || l.iter().any(unsampleable) {
                 ok = false;
                 break;
             }

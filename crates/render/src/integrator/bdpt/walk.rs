@@ -252,7 +252,7 @@ fn random_walk<S: SampleSource>(
             if scattered {
                 continue;
             }
-            if !(t_maj[0] > 0.0) {
+            if t_maj[0].is_nan() || t_maj[0] <= 0.0 {
                 return;
             }
             beta *= t_maj / t_maj[0];
