@@ -116,6 +116,53 @@ impl<I: RayIntegrator> TileIntegrator for RayTiles<'_, I> {
     }
 }
 
+/// The film position of a camera sample in pixel `p_pixel` (the filter
+/// sampled with `u_pixel`) and the camera ray through it, with
+/// differentials scaled by `diff_scale` when `differentials` asks for
+/// them (pbrt-v4 `GetCameraSample` and the ray generation that follows).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub(crate) fn camera_ray(
+    scene: &Scene,
+    opts: &RenderOptions,
+    p_pixel: Point2i,
+    u_pixel: Point2f,
+    time: Float,
+    p_lens: Point2f,
+    differentials: bool,
+    diff_scale: Float,
+) -> (CameraSample, Option<(RayDifferential, Float)>) {
+    let mut fs = scene.filter.sample(u_pixel);
+    if opts.disable_pixel_jitter {
+        fs.p = Point2f::new(0.0, 0.0);
+        fs.weight = 1.0;
+    }
+    let cs = CameraSample {
+        p_film: Point2f::new(
+            p_pixel.x as Float + fs.p.x + 0.5,
+            p_pixel.y as Float + fs.p.y + 0.5,
+        ),
+        p_lens,
+        time,
+        filter_weight: fs.weight,
+    };
+    let ray = if differentials {
+        scene.camera.generate_ray_differential(&cs).map(|mut cr| {
+            if !opts.disable_pixel_jitter {
+                cr.ray.scale_differentials(diff_scale);
+            }
+            (cr.ray, cr.weight)
+        })
+    } else {
+        // Nothing reads them: the same main ray without its offset rays.
+        scene
+            .camera
+            .generate_ray(&cs)
+            .map(|cr| (RayDifferential::new(cr.ray), cr.weight))
+    };
+    (cs, ray)
+}
+
 /// One camera sample through one pixel: its wavelengths, film position
 /// and camera ray (pbrt-v4 `RayIntegrator::EvaluatePixelSample`'s first
 /// half).
@@ -146,35 +193,17 @@ impl CameraRaySample {
             lu = 0.5;
         }
         let lambda = scene.film.sample_wavelengths(lu);
-        let mut fs = scene.filter.sample(u_pixel);
-        if opts.disable_pixel_jitter {
-            fs.p = Point2f::new(0.0, 0.0);
-            fs.weight = 1.0;
-        }
-        let cs = CameraSample {
-            p_film: Point2f::new(
-                p_pixel.x as Float + fs.p.x + 0.5,
-                p_pixel.y as Float + fs.p.y + 0.5,
-            ),
-            p_lens,
+        let scale = (1.0 / (sampler.samples_per_pixel() as Float).sqrt()).max(0.125);
+        let (cs, ray) = camera_ray(
+            scene,
+            opts,
+            p_pixel,
+            u_pixel,
             time,
-            filter_weight: fs.weight,
-        };
-        let ray = if differentials {
-            scene.camera.generate_ray_differential(&cs).map(|mut cr| {
-                if !opts.disable_pixel_jitter {
-                    let scale = (1.0 / (sampler.samples_per_pixel() as Float).sqrt()).max(0.125);
-                    cr.ray.scale_differentials(scale);
-                }
-                (cr.ray, cr.weight)
-            })
-        } else {
-            // Nothing reads them: the same main ray without its offset rays.
-            scene
-                .camera
-                .generate_ray(&cs)
-                .map(|cr| (RayDifferential::new(cr.ray), cr.weight))
-        };
+            p_lens,
+            differentials,
+            scale,
+        );
         CameraRaySample {
             p_pixel,
             lambda,

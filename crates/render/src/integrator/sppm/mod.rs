@@ -20,9 +20,9 @@ mod grid;
 mod photon;
 
 use super::render::{with_progress, ProgressFn, RenderError, RenderOptions, RenderStats};
+use super::tile::camera_ray;
 use super::{sample_ld, skip_intersection, RayCounters, Scene, VertexOrigins};
 use crate::bxdf::{BxDFReflTransFlags, TransportMode, BSDF};
-use crate::camera::CameraSample;
 use crate::image::{ColorEncoding, Image, ImageMetadata, PixelFormat};
 use crate::light::LightSampleContext;
 use crate::lightsampler::PowerLightSampler;
@@ -116,34 +116,16 @@ impl SppmIntegrator {
         let u_pixel = sampler.get_pixel_2d();
         let time = sampler.get_1d();
         let p_lens = sampler.get_2d();
-        let mut fs = scene.filter.sample(u_pixel);
-        if opts.disable_pixel_jitter {
-            fs.p = Point2f::new(0.0, 0.0);
-            fs.weight = 1.0;
-        }
-        let cs = CameraSample {
-            p_film: Point2f::new(
-                p_pixel.x as Float + fs.p.x + 0.5,
-                p_pixel.y as Float + fs.p.y + 0.5,
-            ),
-            p_lens,
+        let (_, camera_ray) = camera_ray(
+            scene,
+            opts,
+            p_pixel,
+            u_pixel,
             time,
-            filter_weight: fs.weight,
-        };
-        let camera_ray = if differentials {
-            scene.camera.generate_ray_differential(&cs).map(|mut cr| {
-                if !opts.disable_pixel_jitter {
-                    cr.ray.scale_differentials(inv_sqrt_spp);
-                }
-                (cr.ray, cr.weight)
-            })
-        } else {
-            // Nothing reads them: the same main ray without its offsets.
-            scene
-                .camera
-                .generate_ray(&cs)
-                .map(|cr| (RayDifferential::new(cr.ray), cr.weight))
-        };
+            p_lens,
+            differentials,
+            inv_sqrt_spp,
+        );
         let Some((mut ray, weight)) = camera_ray else {
             return;
         };
