@@ -124,20 +124,11 @@ impl TriangleMesh {
                 face_indices.len()
             ));
         }
-        if let Some(i) = n.iter().position(|v| !v.is_finite()) {
-            return err(format!("normal \"N\" {i} is not finite"));
-        }
-        if let Some(i) = s.iter().position(|v| !v.is_finite()) {
-            return err(format!("tangent \"S\" {i} is not finite"));
-        }
-        if let Some(i) = uv
-            .iter()
-            .position(|v| !(v.x.is_finite() && v.y.is_finite()))
-        {
-            return err(format!("texture coordinate \"uv\" {i} is not finite"));
-        }
-
         let mut warnings = Vec::new();
+        // Flawed per-vertex data renders with a warning, as pbrt-v4 renders
+        // such files: normals are recomputed, tangents and uvs dropped.
+        let (n, s, uv) = repair_vertex_data(&indices, &p, n, s, uv, &mut warnings);
+
         let bad_p = p.iter().filter(|q| !q.is_finite()).count();
         if bad_p > 0 {
             warnings.push(format!(
@@ -216,6 +207,122 @@ impl TriangleMesh {
         let a2 = c.length_squared();
         a2 > 0.0 && a2.is_finite()
     }
+}
+
+/// True for a vector that can serve as a direction: finite and not zero.
+fn usable_direction(x: Float, y: Float, z: Float) -> bool {
+    let l2 = x * x + y * y + z * z;
+    x.is_finite() && y.is_finite() && z.is_finite() && l2 > 0.0 && l2.is_finite()
+}
+
+/// Mends a mesh's per-vertex normals, tangents and uvs (object space, before
+/// they are transformed), warning once per kind with the count:
+/// - a non-finite or zero-length normal is replaced by the area-weighted
+///   average of the geometric normals of the triangles around its vertex,
+///   turned to the side the mesh's good normals there point to; when no
+///   normal is usable, the mesh renders with geometric normals;
+/// - a non-finite or zero-length tangent becomes zero (it then drops out
+///   of the interpolation; where all three are zero the shading frame
+///   falls back to ∂p/∂u, as without tangents);
+/// - a non-finite uv becomes (0, 0).
+fn repair_vertex_data(
+    indices: &[u32],
+    p: &[Point3f],
+    mut n: Vec<Normal3f>,
+    mut s: Vec<Vector3f>,
+    mut uv: Vec<Point2f>,
+    warnings: &mut Vec<String>,
+) -> (Vec<Normal3f>, Vec<Vector3f>, Vec<Point2f>) {
+    let bad_n: Vec<usize> = (0..n.len())
+        .filter(|&i| !usable_direction(n[i].x, n[i].y, n[i].z))
+        .collect();
+    if !bad_n.is_empty() {
+        if bad_n.len() == n.len() {
+            warnings.push(format!(
+                "trianglemesh: none of the {} normals \"N\" is usable (non-finite or zero length); rendering with geometric normals",
+                n.len()
+            ));
+            n.clear();
+        } else {
+            let mut bad = vec![false; n.len()];
+            for &i in &bad_n {
+                bad[i] = true;
+            }
+            // Per vertex: the summed (area-weighted) geometric normals of
+            // its triangles and the summed good normals around it.
+            let mut geo = vec![Vector3f::default(); n.len()];
+            let mut good = vec![Vector3f::default(); n.len()];
+            for t in indices.chunks_exact(3) {
+                let v = [t[0] as usize, t[1] as usize, t[2] as usize];
+                let c = cross(p[v[1]] - p[v[0]], p[v[2]] - p[v[0]]);
+                if !c.x.is_finite() || !c.y.is_finite() || !c.z.is_finite() {
+                    continue;
+                }
+                let good_here = v
+                    .iter()
+                    .filter(|&&k| !bad[k])
+                    .fold(Vector3f::default(), |acc, &k| acc + Vector3f::from(n[k]));
+                for &k in &v {
+                    if bad[k] {
+                        geo[k] = geo[k] + c;
+                        good[k] = good[k] + good_here;
+                    }
+                }
+            }
+            let mut unrepaired = 0;
+            for &i in &bad_n {
+                let g = geo[i];
+                if usable_direction(g.x, g.y, g.z) {
+                    let g = g.normalize();
+                    n[i] = Normal3f::from(if dot(g, good[i]) < 0.0 { -g } else { g });
+                } else {
+                    unrepaired += 1;
+                    n[i] = Normal3f::default();
+                }
+            }
+            warnings.push(format!(
+                "trianglemesh: {} of {} normals \"N\" are non-finite or zero length; recomputed from the surrounding triangles{}",
+                bad_n.len(),
+                n.len(),
+                if unrepaired > 0 {
+                    format!(" ({unrepaired} without a usable triangle left at zero)")
+                } else {
+                    String::new()
+                }
+            ));
+        }
+    }
+    let bad_s = s
+        .iter()
+        .filter(|v| !usable_direction(v.x, v.y, v.z))
+        .count();
+    if bad_s > 0 {
+        for v in s.iter_mut() {
+            if !usable_direction(v.x, v.y, v.z) {
+                *v = Vector3f::default();
+            }
+        }
+        warnings.push(format!(
+            "trianglemesh: {bad_s} of {} tangents \"S\" are non-finite or zero length; dropped at those vertices",
+            s.len()
+        ));
+    }
+    let bad_uv = uv
+        .iter()
+        .filter(|q| !(q.x.is_finite() && q.y.is_finite()))
+        .count();
+    if bad_uv > 0 {
+        for q in uv.iter_mut() {
+            if !(q.x.is_finite() && q.y.is_finite()) {
+                *q = Point2f::new(0.0, 0.0);
+            }
+        }
+        warnings.push(format!(
+            "trianglemesh: {bad_uv} of {} texture coordinates \"uv\" are not finite; set to (0, 0)",
+            uv.len()
+        ));
+    }
+    (n, s, uv)
 }
 
 /// The usable triangles of `mesh`: degenerate ones (zero area, non-finite

@@ -396,15 +396,19 @@ fn validation_errors() {
     assert!(
         msg(new(vec![], p3.clone(), vec![], vec![], vec![], vec![1, 2])).contains("face indices")
     );
-    assert!(msg(new(
+    // Flawed per-vertex data is mended with a warning, not refused.
+    let (m, w) = new(
         vec![],
         p3.clone(),
         vec![],
         vec![Normal3f::new(Float::NAN, 0.0, 1.0); 3],
         vec![],
-        vec![]
-    ))
-    .contains("not finite"));
+        vec![],
+    )
+    .expect("NaN normals render");
+    assert!(m.n.is_none(), "all-NaN normals fall back to geometric ones");
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(w[0].contains("geometric normals"), "{w:?}");
     let (m, w) = new(vec![], p3, vec![], vec![], vec![], vec![7]).expect("one triangle");
     assert!(w.is_empty());
     assert_eq!(m.indices, vec![0, 1, 2]);
@@ -729,4 +733,63 @@ fn sampled_triangle_matches_mesh_triangle() {
         }
     }
     assert!(compared > 5000 && none > 10, "{compared} {none}");
+}
+
+/// A quad of two triangles in the z = 0 plane with normals along −z (the
+/// side opposite the winding's): one normal non-finite and one zero are
+/// recomputed from the triangles around them, turned to −z like the good
+/// ones; a NaN tangent is dropped and a NaN uv set to (0, 0), each kind
+/// with one warning giving the count.
+#[test]
+fn flawed_vertex_data_is_mended_with_warnings() {
+    let id = Transform::identity();
+    let p = vec![
+        Point3f::new(0.0, 0.0, 0.0),
+        Point3f::new(1.0, 0.0, 0.0),
+        Point3f::new(1.0, 1.0, 0.0),
+        Point3f::new(0.0, 1.0, 0.0),
+    ];
+    let down = Normal3f::new(0.0, 0.0, -1.0);
+    let n = vec![
+        down,
+        Normal3f::new(Float::NAN, 0.0, 0.0),
+        Normal3f::new(0.0, 0.0, 0.0),
+        down,
+    ];
+    let s = vec![
+        Vector3f::new(1.0, 0.0, 0.0),
+        Vector3f::new(Float::INFINITY, 0.0, 0.0),
+        Vector3f::new(1.0, 0.0, 0.0),
+        Vector3f::new(1.0, 0.0, 0.0),
+    ];
+    let uv = vec![
+        Point2f::new(0.0, 0.0),
+        Point2f::new(1.0, 0.0),
+        Point2f::new(Float::NAN, 1.0),
+        Point2f::new(0.0, 1.0),
+    ];
+    let (m, w) = TriangleMesh::new(&id, false, vec![0, 1, 2, 0, 2, 3], p, s, n, uv, vec![])
+        .expect("flawed data renders");
+    let ns = m.n.as_ref().expect("normals kept");
+    for (i, v) in ns.iter().enumerate() {
+        assert!(
+            (v.z + 1.0).abs() < 1e-6 && v.x.abs() < 1e-6,
+            "normal {i}: {v:?}"
+        );
+    }
+    let ss = m.s.as_ref().expect("tangents kept");
+    assert_eq!(ss[1], Vector3f::default());
+    assert_eq!(ss[0], Vector3f::new(1.0, 0.0, 0.0));
+    let uvs = m.uv.as_ref().expect("uvs kept");
+    assert_eq!(uvs[2], Point2f::new(0.0, 0.0));
+    assert_eq!(w.len(), 3, "{w:?}");
+    assert!(w[0].contains("2 of 4 normals"), "{w:?}");
+    assert!(w[1].contains("1 of 4 tangents"), "{w:?}");
+    assert!(w[2].contains("1 of 4 texture coordinates"), "{w:?}");
+    // The mended mesh shades like the intact one.
+    let tri = Triangle::new(m.clone(), 1);
+    let ray = Ray::new(Point3f::new(0.6, 0.7, 1.0), Vector3f::new(0.0, 0.0, -1.0));
+    let hit = tri.intersect(&ray, Float::INFINITY).expect("hit");
+    let sn = hit.intr.shading.n;
+    assert!((sn.z + 1.0).abs() < 1e-5, "shading normal {sn:?}");
 }
