@@ -450,12 +450,14 @@ pub fn upgrade_film(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> 
 }
 
 /// Upgrades a `Sampler` (`lowdiscrepancy`/`02sequence` → `paddedsobol`,
-/// `maxmindist` → `pmj02bn`).
+/// `maxmindist` → `pmj02bn`, `random` → `independent`, as pbrt-v4's
+/// `--upgrade`).
 pub fn upgrade_sampler(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
     let mut e = Edit::new(name, params, loc);
     match name {
         "lowdiscrepancy" | "02sequence" => e.name = "paddedsobol".into(),
         "maxmindist" => e.name = "pmj02bn".into(),
+        "random" => e.name = "independent".into(),
         _ => {}
     }
     e.finish()

@@ -160,6 +160,10 @@ fn cameras_films_samplers_integrators_filters() {
         upgrade_sampler("maxmindist", vec![], &loc(1)).name,
         "pmj02bn"
     );
+    assert_eq!(
+        upgrade_sampler("random", vec![], &loc(1)).name,
+        "independent"
+    );
     assert_eq!(upgrade_sampler("halton", vec![], &loc(1)).name, "halton");
     let u = upgrade_film(
         "image",

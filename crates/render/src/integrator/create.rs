@@ -6,7 +6,7 @@ use super::function::{FunctionIntegrator, TestFunction};
 use super::{
     AmbientOcclusionIntegrator, BdptIntegrator, Integrator, LightPathIntegrator, MltIntegrator,
     PathIntegrator, RandomWalkIntegrator, SimplePathIntegrator, SimpleVolPathIntegrator,
-    SppmIntegrator, VolPathIntegrator,
+    SppmIntegrator, VolPathIntegrator, WhittedIntegrator,
 };
 use crate::params::{unknown_type, ParamReader};
 use rpbrt_geometry::float::Float;
@@ -25,6 +25,7 @@ pub const INTEGRATOR_NAMES: &[&str] = &[
     "simplevolpath",
     "sppm",
     "volpath",
+    "whitted",
 ];
 
 /// The command line's say in integrator creation.
@@ -178,6 +179,7 @@ pub fn create_integrator(
                 color_space: ip.color_space().name.clone(),
             }))
         }
+        "whitted" => Ok(Integrator::Whitted(WhittedIntegrator { max_depth })),
         _ => Err(unknown_type("integrator", name, INTEGRATOR_NAMES, loc)),
     }
 }

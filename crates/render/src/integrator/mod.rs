@@ -38,6 +38,7 @@ mod sppm;
 pub mod tile;
 mod volpath;
 mod volume;
+mod whitted;
 
 pub use bdpt::BdptIntegrator;
 pub use create::{create_integrator, IntegratorOptions, INTEGRATOR_NAMES};
@@ -52,6 +53,7 @@ pub use simplevolpath::SimpleVolPathIntegrator;
 pub use sppm::SppmIntegrator;
 pub use tile::{RayIntegrator, TileIntegrator};
 pub use volpath::VolPathIntegrator;
+pub use whitted::WhittedIntegrator;
 
 pub(crate) use direct::{sample_ld, VertexOrigins};
 pub(crate) use scene::skip_intersection;
@@ -80,6 +82,8 @@ pub enum Integrator {
     Mlt(MltIntegrator),
     /// `sppm`.
     Sppm(SppmIntegrator),
+    /// pbrt-v3's `whitted`.
+    Whitted(WhittedIntegrator),
     /// `function`: a sampler bench, no light transport.
     Function(FunctionIntegrator),
 }
@@ -122,6 +126,9 @@ impl Integrator {
             Integrator::LightPath(i) => tile::render_tiles(i, scene, opts, metadata, progress),
             Integrator::Mlt(i) => mlt::render(i, scene, opts, metadata, progress),
             Integrator::Sppm(i) => sppm::render(i, scene, opts, metadata, progress),
+            Integrator::Whitted(i) => {
+                tile::render_tiles(&tile::RayTiles(i), scene, opts, metadata, progress)
+            }
             Integrator::Function(i) => function::render(i, scene, opts, progress),
         }
     }
