@@ -5,23 +5,29 @@
 //! render loop. Most integrators here are pbrt-v4 `RayIntegrator`s
 //! ([`RayIntegrator`]): each estimates the radiance along one camera ray,
 //! and the shared tile loop ([`tile`]) drives it over image tiles in
-//! parallel. An integrator that needs a loop of its own (SPPM) gets a match arm
-//! in [`Integrator::render`] calling its own function, which reports
-//! progress through the same callback ([`Progress`]) and fails with the
-//! same [`RenderError`].
+//! parallel. Light tracers that splat onto the film (bdpt, lightpath) use
+//! the same loop through [`TileIntegrator`], one pixel sample at a time.
+//! An integrator that needs a loop of its own (MLT, SPPM, the function
+//! bench) gets a match arm in [`Integrator::render`] calling its own
+//! function, which reports progress through the same callback
+//! ([`Progress`]) and fails with the same [`RenderError`].
 //!
 //! Results never depend on the thread count: each pixel's samples come
-//! from a sampler seeded by the pixel and sample index, and each pixel
-//! belongs to exactly one tile.
+//! from a sampler seeded by the pixel and sample index, each pixel belongs
+//! to exactly one tile, and splats are applied in tile (or MLT chain)
+//! order ([`crate::film::OrderedSplats`]).
 //!
 //! The files: [`scene`], the render-ready scene and its ray queries;
 //! `create`, creation from the scene description; `direct`, direct
 //! lighting; [`render`], what render loops share (options, statistics,
-//! errors, progress); [`tile`], the per-ray tile loop; `path` and
-//! `simple`, the integrators; `volume`, what the volumetric ones share;
-//! `volpath` and `simplevolpath`, pbrt-v4's volumetric path tracers;
-//! `sppm`, stochastic progressive photon mapping, with its own loop;
-//! `function`, pbrt-v4's sampler bench, with its own loop too.
+//! errors, progress); [`tile`], the tile loop; `path` and `simple`, the
+//! integrators; `volume`, what the volumetric ones share; `volpath` and
+//! `simplevolpath`, pbrt-v4's volumetric path tracers; `bdpt`, the
+//! bidirectional path tracer and the vertices, random walks and
+//! connections that `mlt` (primary-sample-space Metropolis) and
+//! `lightpath` (the light tracer) share; `sppm`, stochastic progressive
+//! photon mapping; `function`, pbrt-v4's sampler bench; `whitted`,
+//! pbrt-v3's Whitted ray tracer.
 
 pub(crate) mod bdpt;
 mod create;
