@@ -286,3 +286,52 @@ fn bdpt_writes_its_strategy_images() {
         "{info}"
     );
 }
+
+/// `imgtool average` (pbrt-v4's): the images whose names start with a
+/// base, averaged; a missing base or --outfile and no match are errors.
+#[test]
+fn imgtool_average_matches_a_filename_base() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-cli-average-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // Two renders of a tiny scene at different seeds.
+    let scene = dir.join("s.pbrt");
+    std::fs::write(&scene, "Film \"rgb\" \"integer xresolution\" 4 \"integer yresolution\" 4\nWorldBegin\nLightSource \"point\" \"rgb I\" [1 1 1]\nShape \"sphere\"\n").unwrap();
+    for seed in ["1", "2"] {
+        let out = rpbrt()
+            .args(["--quiet", "--spp", "2", "--seed", seed, "--outfile"])
+            .arg(dir.join(format!("r-{seed}.exr")))
+            .arg(&scene)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0));
+    }
+    let avg = dir.join("avg.exr");
+    let out = rpbrt()
+        .args(["imgtool", "average", "--outfile"])
+        .arg(&avg)
+        .arg(dir.join("r-"))
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(avg.exists());
+    let out = rpbrt()
+        .args(["imgtool", "average", "--outfile"])
+        .arg(&avg)
+        .arg(dir.join("nothing-"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no matching filenames"));
+    let out = rpbrt()
+        .args(["imgtool", "average"])
+        .arg(dir.join("r-"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--outfile"));
+}

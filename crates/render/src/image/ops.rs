@@ -291,6 +291,54 @@ pub fn worst_block(a: &Image, b: &Image, size: i32) -> Result<Option<BlockDiffer
     Ok(worst)
 }
 
+/// The per-pixel average of `images` (pbrt-v4 `imgtool average`): all of
+/// the same resolution and channels (names and order) as the first;
+/// infinite values count as zero, as pbrt-v4 does, and a NaN is an error
+/// naming the image (by index) and pixel. Sums are taken in `f64` in the
+/// order given, so the result does not depend on anything else.
+pub fn average(images: &[Image]) -> Result<Image, ImageError> {
+    let Some(first) = images.first() else {
+        return Err(ImageError::Invalid("no images to average".into()));
+    };
+    let res = first.resolution();
+    let names = first.channel_names().to_vec();
+    let nc = names.len().max(1);
+    let mut sum = vec![0.0f64; first.to_f32_vec().len()];
+    let n = images.len() as f64;
+    for (k, im) in images.iter().enumerate() {
+        if im.resolution() != res {
+            return Err(ImageError::Invalid(format!(
+                "image {k}: resolution {}x{} differs from the first image's {}x{}",
+                im.resolution().x,
+                im.resolution().y,
+                res.x,
+                res.y
+            )));
+        }
+        if im.channel_names() != names.as_slice() {
+            return Err(ImageError::Invalid(format!(
+                "image {k}: channels {:?} differ from the first image's {:?}",
+                im.channel_names(),
+                names
+            )));
+        }
+        for (i, &v) in im.to_f32_vec().iter().enumerate() {
+            if v.is_nan() {
+                let px = i / nc;
+                return Err(ImageError::Invalid(format!(
+                    "image {k}: NaN at pixel ({}, {})",
+                    px as i32 % res.x.max(1),
+                    px as i32 / res.x.max(1)
+                )));
+            }
+            if v.is_finite() {
+                sum[i] += v as f64 / n;
+            }
+        }
+    }
+    Image::from_f32(sum.into_iter().map(|v| v as f32).collect(), res, &names)
+}
+
 /// Statistics of one channel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ChannelStats {

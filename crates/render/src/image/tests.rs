@@ -915,3 +915,31 @@ fn writes_replace_the_file_whole_and_leave_no_temporary_files() {
     assert_eq!(names, ["out.pfm", "sub.pfm"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn average_of_images_counts_infinities_as_zero_and_refuses_mismatches() {
+    use crate::image::ops::average;
+    let res = Point2i::new(2, 1);
+    let a = Image::from_f32(vec![1.0, 2.0, f32::INFINITY, 4.0], res, &["R", "G"]).unwrap();
+    let b = Image::from_f32(vec![3.0, 4.0, 1.0, 0.0], res, &["R", "G"]).unwrap();
+    let avg = average(&[a.clone(), b.clone()]).unwrap();
+    assert_eq!(avg.to_f32_vec(), vec![2.0, 3.0, 0.5, 2.0]);
+    assert_eq!(avg.channel_names(), ["R", "G"]);
+    let nan = Image::from_f32(vec![0.0, f32::NAN, 0.0, 0.0], res, &["R", "G"]).unwrap();
+    let e = average(&[a.clone(), nan]).unwrap_err().to_string();
+    assert!(
+        e.contains("image 1") && e.contains("NaN at pixel (0, 0)"),
+        "{e}"
+    );
+    let other = Image::from_f32(vec![0.0; 4], Point2i::new(1, 2), &["R", "G"]).unwrap();
+    assert!(average(&[a.clone(), other])
+        .unwrap_err()
+        .to_string()
+        .contains("resolution"));
+    let chans = Image::from_f32(vec![0.0; 4], res, &["R", "B"]).unwrap();
+    assert!(average(&[a, chans])
+        .unwrap_err()
+        .to_string()
+        .contains("channels"));
+    assert!(average(&[]).is_err());
+}
