@@ -21,6 +21,10 @@ pub struct Options {
     pub crop_window: Option<[f32; 4]>,
     /// `--pixelbounds x0 x1 y0 y1`.
     pub pixel_bounds: Option<[i32; 4]>,
+    /// `--tile K/N`: render tile K of N (0-based).
+    pub tile: Option<(u32, u32)>,
+    /// `--spp-range A..B`: render samples A..B-1 of every pixel.
+    pub spp_range: Option<(i32, i32)>,
     /// `--quick`: a fast, reduced-quality render.
     pub quick: bool,
     /// `--quiet`: no progress bar or statistics.
@@ -87,7 +91,12 @@ Rendering options:
   --render-coord-sys <name>    Rendering space: camera, cameraworld (default), world.
   --seed <n>                   Seed for the random number generators.
   --spp <n>                    Samples per pixel (overrides the Sampler).
+  --spp-range <a..b>           Render samples a..b-1 of every pixel, as a full render
+                               takes them; the EXR carries the sums that
+                               `imgtool merge` adds into the full render's image.
   --stats                      Print statistics after rendering.
+  --tile <k/n>                 Render tile k (0-based) of n tiles of the image;
+                               `imgtool assemble` joins them.
   --write-partial-images       Write the image periodically while rendering.
 
 Scene file tools:
@@ -98,7 +107,7 @@ Scene file tools:
   --help                       Print this help.
   --version                    Print the version.
 
-  rpbrt imgtool diff|info|convert ...   Image utilities (see: rpbrt imgtool help).
+  rpbrt imgtool <command> ...  Image utilities (see: rpbrt imgtool help).
 ";
 
 /// Lower-case and drop '-' and '_' so flag spellings compare equal.
@@ -218,6 +227,34 @@ pub fn parse_args(args: &[String]) -> Result<Options, ArgError> {
                     o.pixel_bounds = Some(b);
                 }
             }
+            "tile" => {
+                let v = value(&mut i)?;
+                let parsed = v.split_once('/').and_then(|(k, n)| {
+                    Some((k.trim().parse::<u32>().ok()?, n.trim().parse::<u32>().ok()?))
+                });
+                match parsed {
+                    Some((k, n)) if k < n => o.tile = Some((k, n)),
+                    _ => {
+                        return Err(ArgError(format!(
+                            "--tile \"{v}\": expected K/N with 0 <= K < N (e.g. 3/16)"
+                        )))
+                    }
+                }
+            }
+            "spprange" => {
+                let v = value(&mut i)?;
+                let parsed = v.split_once("..").and_then(|(a, b)| {
+                    Some((a.trim().parse::<i32>().ok()?, b.trim().parse::<i32>().ok()?))
+                });
+                match parsed {
+                    Some((a, b)) if 0 <= a && a < b => o.spp_range = Some((a, b)),
+                    _ => {
+                        return Err(ArgError(format!(
+                            "--spp-range \"{v}\": expected A..B with 0 <= A < B (samples A to B-1)"
+                        )))
+                    }
+                }
+            }
             "quick" => o.quick = true,
             "quiet" => o.quiet = true,
             "stats" => o.stats = true,
@@ -291,6 +328,8 @@ mod tests {
             Some([0, 16, 8, 24])
         );
         assert!(p(&["--cropwindow", "0,2,0,1"]).is_err());
+        assert_eq!(p(&["--tile", "3/16"]).unwrap().tile, Some((3, 16)));
+        assert_eq!(p(&["--spp-range=8..16"]).unwrap().spp_range, Some((8, 16)));
         assert!(p(&["--pixelbounds", "5,1,0,1"]).is_err());
     }
 
@@ -302,5 +341,11 @@ mod tests {
         assert!(p(&["--spp"]).is_err());
         assert!(p(&["--render-coord-sys", "object"]).is_err());
         assert!(p(&["--no-such-flag"]).is_err());
+        for bad in ["3", "4/4", "a/b", "-1/4", "2/0"] {
+            assert!(p(&["--tile", bad]).is_err(), "{bad}");
+        }
+        for bad in ["4", "4..4", "5..2", "-1..3", "a..b"] {
+            assert!(p(&["--spp-range", bad]).is_err(), "{bad}");
+        }
     }
 }

@@ -8,7 +8,7 @@ mod imgtool;
 use rpbrt_parser::{parse_files, FormattingTarget};
 use rpbrt_render::accel::Aggregate;
 use rpbrt_render::camera::RenderingCoordinateSystem;
-use rpbrt_render::film::FilmOverrides;
+use rpbrt_render::film::{FilmOverrides, SampleRange};
 use rpbrt_render::image::ImageMetadata;
 use rpbrt_render::integrator::{Progress, RenderOptions};
 use rpbrt_render::scene::assemble::{create_scene, CreateOptions};
@@ -129,6 +129,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
             crop_window: opts.crop_window,
             pixel_bounds: opts.pixel_bounds,
             quick: opts.quick,
+            tile: opts.tile,
         },
         disable_texture_filtering: opts.disable_texture_filtering
             || desc_flag(&desc, "disabletexturefiltering"),
@@ -150,6 +151,29 @@ fn render_command(opts: &args::Options) -> ExitCode {
     let mut scene = created.scene;
     let integrator = created.integrator;
     let t_create = t0.elapsed() - t_parse;
+    if let Some((start, end)) = opts.spp_range {
+        if !integrator.renders_pixel_samples() {
+            eprintln!(
+                "rpbrt: error: --spp-range: the \"{}\" integrator does not take samples pixel by pixel, so its samples cannot be split into ranges",
+                integrator.name()
+            );
+            return ExitCode::FAILURE;
+        }
+        if let Err(e) = (SampleRange { start, end }).check(scene.sampler.samples_per_pixel()) {
+            eprintln!("rpbrt: error: {e}");
+            return ExitCode::FAILURE;
+        }
+    }
+    if opts.tile.is_some() && !opts.quiet {
+        let name = integrator.name();
+        if matches!(name, "bdpt" | "lightpath" | "mlt" | "sppm") {
+            eprintln!(
+                "rpbrt: warning: --tile: the tiles of a \"{name}\" render do not join into its full image (light paths splat across tile edges{}){}",
+                if name == "sppm" { " and the photon count follows the pixel count" } else { "" },
+                if integrator.renders_pixel_samples() { "; split it with --spp-range instead" } else { "" }
+            );
+        }
+    }
 
     let interrupt = Arc::new(AtomicBool::new(false));
     // A second Ctrl-C ends the process at once; the first one stops the
@@ -182,6 +206,9 @@ fn render_command(opts: &args::Options) -> ExitCode {
             || desc_flag(&desc, "disablewavelengthjitter"),
         interrupt: Some(Arc::clone(&interrupt)),
         mse_reference,
+        sample_range: opts
+            .spp_range
+            .map(|(start, end)| SampleRange { start, end }),
     };
     let mut metadata = ImageMetadata::default();
     // The progress bar, redrawn in place on each report.

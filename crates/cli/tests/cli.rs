@@ -335,3 +335,169 @@ fn imgtool_average_matches_a_filename_base() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--outfile"));
 }
+
+/// A small lit scene for partial-render tests.
+const PARTIAL_SCENE: &str = r#"
+LookAt 0 1 -4  0 0.5 0  0 1 0
+Camera "perspective" "float fov" 45
+Film "rgb" "integer xresolution" 37 "integer yresolution" 23 "string filename" "full.exr"
+Sampler "zsobol" "integer pixelsamples" 8
+Integrator "INTEGRATOR" "integer maxdepth" 4
+WorldBegin
+LightSource "infinite" "rgb L" [0.2 0.3 0.4]
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [8 7 6]
+  Translate 0 2.5 0
+  Shape "sphere" "float radius" 0.4
+AttributeEnd
+Material "diffuse" "rgb reflectance" [0.6 0.5 0.4]
+Shape "sphere" "float radius" 0.7
+Shape "bilinearmesh" "point3 P" [-3 -0.7 -3  3 -0.7 -3  -3 -0.7 3  3 -0.7 3]
+"#;
+
+fn run_ok(cmd: &mut Command) -> String {
+    let out = cmd.output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert!(out.status.success(), "{cmd:?} failed: {err}");
+    err + &String::from_utf8_lossy(&out.stdout)
+}
+
+/// `imgtool diff`'s count of differing pixels.
+fn differing_pixels(a: &std::path::Path, b: &std::path::Path) -> String {
+    let s = run_ok(rpbrt().args(["imgtool", "diff"]).arg(a).arg(b));
+    s.lines()
+        .find_map(|l| l.strip_prefix("differing pixels: "))
+        .unwrap_or("?")
+        .to_string()
+}
+
+#[test]
+fn tiles_and_sample_ranges_join_into_the_full_render() {
+    for integrator in ["path", "bdpt"] {
+        let dir =
+            std::env::temp_dir().join(format!("rpbrt-partial-{integrator}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let scene = dir.join("scene.pbrt");
+        std::fs::write(&scene, PARTIAL_SCENE.replace("INTEGRATOR", integrator)).unwrap();
+        let full = dir.join("full.exr");
+        run_ok(
+            rpbrt()
+                .arg("--quiet")
+                .arg("--outfile")
+                .arg(&full)
+                .arg(&scene),
+        );
+
+        // Three sample ranges, given out of order, with two threads each.
+        let mut ranges = Vec::new();
+        for r in ["3..8", "0..1", "1..3"] {
+            let f = dir.join(format!("range-{r}.exr"));
+            run_ok(
+                rpbrt()
+                    .args(["--quiet", "--nthreads", "2", "--spp-range", r, "--outfile"])
+                    .arg(&f)
+                    .arg(&scene),
+            );
+            ranges.push(f);
+        }
+        let merged = dir.join("merged.exr");
+        run_ok(
+            rpbrt()
+                .args(["imgtool", "merge", "--outfile"])
+                .arg(&merged)
+                .args(&ranges),
+        );
+        assert_eq!(differing_pixels(&merged, &full), "0", "{integrator} ranges");
+
+        if integrator == "path" {
+            let mut tiles = Vec::new();
+            for k in 0..7 {
+                let f = dir.join(format!("tile-{k}.exr"));
+                run_ok(
+                    rpbrt()
+                        .args(["--quiet", "--tile", &format!("{k}/7"), "--outfile"])
+                        .arg(&f)
+                        .arg(&scene),
+                );
+                tiles.push(f);
+            }
+            let joined = dir.join("joined.exr");
+            run_ok(
+                rpbrt()
+                    .args(["imgtool", "assemble", "--outfile"])
+                    .arg(&joined)
+                    .args(&tiles),
+            );
+            assert_eq!(differing_pixels(&joined, &full), "0", "tiles");
+
+            // A missing tile, a doubled tile: clear errors.
+            let out = rpbrt()
+                .args(["imgtool", "assemble", "--outfile"])
+                .arg(dir.join("x.exr"))
+                .args(&tiles[1..])
+                .output()
+                .unwrap();
+            assert_eq!(out.status.code(), Some(1));
+            let e = String::from_utf8_lossy(&out.stderr);
+            assert!(
+                e.contains("uncovered") && e.contains("a tile is missing"),
+                "{e}"
+            );
+            let out = rpbrt()
+                .args(["imgtool", "assemble", "--outfile"])
+                .arg(dir.join("x.exr"))
+                .args(&tiles)
+                .arg(&tiles[2])
+                .output()
+                .unwrap();
+            assert_eq!(out.status.code(), Some(1));
+            assert!(String::from_utf8_lossy(&out.stderr).contains("overlap"));
+            // Overlapping sample ranges.
+            let out = rpbrt()
+                .args(["imgtool", "merge", "--outfile"])
+                .arg(dir.join("x.exr"))
+                .args([&ranges[0], &ranges[0]])
+                .output()
+                .unwrap();
+            assert_eq!(out.status.code(), Some(1));
+            assert!(String::from_utf8_lossy(&out.stderr).contains("overlap"));
+            // A range past the sampler's samples, a tile that does not exist.
+            let out = rpbrt()
+                .args(["--spp-range", "4..9"])
+                .arg(&scene)
+                .output()
+                .unwrap();
+            assert_eq!(out.status.code(), Some(1));
+            assert!(String::from_utf8_lossy(&out.stderr).contains("at most 8"));
+            let out = rpbrt()
+                .args(["--tile", "0/5000"])
+                .arg(&scene)
+                .output()
+                .unwrap();
+            assert_eq!(out.status.code(), Some(1));
+            assert!(String::from_utf8_lossy(&out.stderr).contains("cannot be split"));
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
+
+#[test]
+fn sample_ranges_are_refused_where_they_cannot_merge() {
+    let scene = temp_scene(
+        "sppm-range.pbrt",
+        &PARTIAL_SCENE
+            .replace("INTEGRATOR", "sppm")
+            .replace("\"integer maxdepth\" 4", "\"integer iterations\" 2"),
+    );
+    let out = rpbrt()
+        .args(["--spp-range", "0..1"])
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        e.contains("\"sppm\" integrator does not take samples pixel by pixel"),
+        "{e}"
+    );
+}

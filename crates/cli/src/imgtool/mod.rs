@@ -6,10 +6,12 @@ use rpbrt_render::image::Image;
 use std::path::Path;
 use std::process::ExitCode;
 
+mod assemble;
 mod average;
 mod convert;
 mod diff;
 mod info;
+mod merge;
 
 /// A command: its name, one-line summary, usage text and entry point.
 struct Command {
@@ -21,6 +23,12 @@ struct Command {
 
 /// Every command, in the order `help` lists them.
 const COMMANDS: &[Command] = &[
+    Command {
+        name: "assemble",
+        summary: "join tiles (crops) of an image into the whole",
+        usage: assemble::USAGE,
+        run: assemble::run,
+    },
     Command {
         name: "average",
         summary: "average images sharing a filename base",
@@ -44,6 +52,12 @@ const COMMANDS: &[Command] = &[
         summary: "print resolution, channels and statistics",
         usage: info::USAGE,
         run: info::run,
+    },
+    Command {
+        name: "merge",
+        summary: "join sample ranges (--spp-range) of the same pixels",
+        usage: merge::USAGE,
+        run: merge::run,
     },
 ];
 

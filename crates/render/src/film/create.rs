@@ -38,6 +38,9 @@ pub struct FilmOverrides {
     pub pixel_bounds: Option<[i32; 4]>,
     /// Quarter the resolution.
     pub quick: bool,
+    /// `--tile K/N`: render only tile K of N of the pixel bounds
+    /// ([`super::tile_bounds`]).
+    pub tile: Option<(u32, u32)>,
 }
 
 fn extension(name: &str) -> String {
@@ -238,6 +241,15 @@ pub fn create_film(
             }
             pixel_bounds = crop_to_pixel_bounds(full, c);
         }
+    }
+    if let Some((k, n)) = overrides.tile {
+        let area = pixel_bounds.area();
+        pixel_bounds = super::tile_bounds(pixel_bounds, k, n).ok_or_else(|| {
+            Diagnostic::error(
+                loc.clone(),
+                format!("--tile {k}/{n}: the film's {area} pixels cannot be split into {n} tiles of at least one pixel (need K < N <= pixels)"),
+            )
+        })?;
     }
     if pixel_bounds.is_empty() {
         return Err(Diagnostic::error(

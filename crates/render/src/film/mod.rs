@@ -18,15 +18,20 @@ use rpbrt_geometry::{
     Bounds2f, Bounds2i, Float, Normal3f, Point2f, Point2i, Point3f, Vector2f, Vector3f,
 };
 
+pub use partial::{
+    merge_sample_ranges, splat_scale, sum_channel_names, tile_bounds, PartialError, SampleRange,
+    SAMPLE_RANGE_KEY,
+};
 pub use splat::{OrderedSplats, SplatBuffer};
 
 use crate::camera::FilmGeometry;
 use crate::filter::Filter;
-use crate::image::{ColorEncoding, Image, ImageMetadata, PixelFormat};
+use crate::image::{Image, ImageMetadata};
 use crate::spectrum::{ColorMatrix, RgbColorSpace, SampledSpectrum, SampledWavelengths, RGB};
 
 mod create;
 mod data;
+mod partial;
 mod pixels;
 mod sensor;
 mod splat;
@@ -198,38 +203,22 @@ impl FilmCore {
             return RGB::new(0.0, 0.0, 0.0);
         }
         let i = self.pixels.index(p);
-        let px = self.pixels.rgb[i];
-        let mut v = [px[0], px[1], px[2]];
-        if px[3] != 0.0 {
-            v = v.map(|c| c / px[3]);
-        }
-        for (c, vc) in v.iter_mut().enumerate() {
-            *vc += splat_scale as f64 * self.splat_rgb.get(3 * i + c) / self.filter_integral as f64;
-        }
-        RGB::from_array(self.output_rgb_from_sensor_rgb.apply(v.map(|c| c as Float)))
-    }
-
-    fn new_image(&self, channels: &[String]) -> Image {
-        let format = if self.write_fp16 {
-            PixelFormat::Half
-        } else {
-            PixelFormat::Float
-        };
-        let d = self.pixel_bounds.diagonal();
-        Image::new(
-            format,
-            Point2i::new(d.x, d.y),
-            channels,
-            ColorEncoding::Linear,
+        partial::resolve_rgb(
+            self.pixels.rgb[i],
+            [0, 1, 2].map(|c| self.splat_rgb.get(3 * i + c)),
+            splat_scale,
+            self.filter_integral,
+            &self.output_rgb_from_sensor_rgb,
         )
     }
 
+    fn new_image(&self, channels: &[String]) -> Image {
+        let d = self.pixel_bounds.diagonal();
+        partial::output_image(self.write_fp16, Point2i::new(d.x, d.y), channels)
+    }
+
     fn clamp16(&self, v: Float) -> Float {
-        if self.write_fp16 && v > 65504.0 {
-            65504.0
-        } else {
-            v
-        }
+        partial::clamp16(self.write_fp16, v)
     }
 
     fn get_image(&self, metadata: &mut ImageMetadata, splat_scale: Float) -> Image {

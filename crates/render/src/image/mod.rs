@@ -5,6 +5,7 @@
 //! Reading and writing files lives in [`io`]; MIP-mapped filtering in [`mipmap`]; the
 //! comparisons and statistics behind `imgtool` in [`ops`].
 
+pub mod assemble;
 mod encoding;
 pub mod io;
 pub mod mipmap;

@@ -107,6 +107,12 @@ impl Integrator {
         metadata: &mut ImageMetadata,
         progress: ProgressFn,
     ) -> Result<RenderStats, RenderError> {
+        if opts.sample_range.is_some() && !self.renders_pixel_samples() {
+            return Err(RenderError::Partial(crate::film::PartialError(format!(
+                "--spp-range: the \"{}\" integrator does not take samples pixel by pixel, so its samples cannot be split into ranges",
+                self.name()
+            ))));
+        }
         // One match per render: each arm runs a loop built for its
         // integrator (no dispatch per ray).
         match self {
@@ -137,6 +143,35 @@ impl Integrator {
             }
             Integrator::Function(i) => function::render(i, scene, opts, progress),
         }
+    }
+
+    /// The integrator's name in scene files.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrator::Path(_) => "path",
+            Integrator::SimplePath(_) => "simplepath",
+            Integrator::AmbientOcclusion(_) => "ambientocclusion",
+            Integrator::RandomWalk(_) => "randomwalk",
+            Integrator::VolPath(_) => "volpath",
+            Integrator::SimpleVolPath(_) => "simplevolpath",
+            Integrator::Bdpt(_) => "bdpt",
+            Integrator::LightPath(_) => "lightpath",
+            Integrator::Mlt(_) => "mlt",
+            Integrator::Sppm(_) => "sppm",
+            Integrator::Whitted(_) => "whitted",
+            Integrator::Function(_) => "function",
+        }
+    }
+
+    /// True for integrators that take each pixel's samples by index, so
+    /// that tiles and sample ranges (`--spp-range`) of a render can be made
+    /// separately; mlt's chains, sppm's photon passes and the function
+    /// bench cannot.
+    pub fn renders_pixel_samples(&self) -> bool {
+        !matches!(
+            self,
+            Integrator::Mlt(_) | Integrator::Sppm(_) | Integrator::Function(_)
+        )
     }
 
     /// True for integrators that connect paths to the camera's lens (they

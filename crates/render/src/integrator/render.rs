@@ -26,6 +26,11 @@ pub struct RenderOptions {
     /// `--mse-reference-image`: after every wave of samples, the image's
     /// MSE against this reference is recorded.
     pub mse_reference: Option<crate::image::Image>,
+    /// `--spp-range`: render only these samples of every pixel (with the
+    /// sampler indices a full render uses) and write a partial image that
+    /// carries the film's sums ([`crate::film::merge_sample_ranges`]).
+    /// Integrators that do not render pixel samples refuse it.
+    pub sample_range: Option<crate::film::SampleRange>,
 }
 
 impl RenderOptions {
@@ -91,6 +96,8 @@ pub enum RenderError {
         /// Why.
         source: std::io::Error,
     },
+    /// A partial render (`--spp-range`) cannot be made as asked.
+    Partial(crate::film::PartialError),
 }
 
 impl std::fmt::Display for RenderError {
@@ -104,6 +111,7 @@ impl std::fmt::Display for RenderError {
                 ImageError::Invalid(m) => write!(f, "{path}: {m}"),
             },
             RenderError::WriteFile { path, source } => write!(f, "{path}: {source}"),
+            RenderError::Partial(e) => write!(f, "{e}"),
         }
     }
 }
@@ -115,6 +123,7 @@ impl std::error::Error for RenderError {
             RenderError::MseReference(e) => Some(e),
             RenderError::WriteImage { source, .. } => Some(source),
             RenderError::WriteFile { source, .. } => Some(source),
+            RenderError::Partial(e) => Some(e),
         }
     }
 }
@@ -175,6 +184,26 @@ pub(crate) fn with_progress<R>(
 
 /// Writes the film's image to its file, splats weighted by `splat_scale`
 /// (pbrt-v4 `Film::WriteImage`).
+/// Writes a sample-range partial image (its own RGB and the film's sums)
+/// to the film's file.
+pub(crate) fn write_partial(
+    film: &crate::film::Film,
+    metadata: &crate::image::ImageMetadata,
+    range: crate::film::SampleRange,
+    spp: i32,
+) -> Result<(), RenderError> {
+    let mut md = metadata.clone();
+    let image = film
+        .partial_image(&mut md, range, spp)
+        .map_err(RenderError::Partial)?;
+    image
+        .write(film.filename(), &md)
+        .map_err(|source| RenderError::WriteImage {
+            path: film.filename().to_string(),
+            source,
+        })
+}
+
 pub(crate) fn write_film(
     film: &crate::film::Film,
     metadata: &crate::image::ImageMetadata,

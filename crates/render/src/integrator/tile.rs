@@ -9,11 +9,14 @@
 //! its own copy, with its per-sample work called directly.
 
 use super::render::{
-    thread_pool, with_progress, write_film, ProgressFn, RenderError, RenderOptions, RenderStats,
+    thread_pool, with_progress, write_film, write_partial, ProgressFn, RenderError, RenderOptions,
+    RenderStats,
 };
 use super::Scene;
 use crate::camera::CameraSample;
-use crate::film::{FilmTile, OrderedSplats, SplatBuffer, VisibleSurface};
+use crate::film::{
+    splat_scale, FilmTile, OrderedSplats, PartialError, SplatBuffer, VisibleSurface,
+};
 use crate::image::ImageMetadata;
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -282,24 +285,33 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
     let start = Instant::now();
     let pool = thread_pool(opts)?;
     let spp = scene.sampler.samples_per_pixel().max(1);
+    // The samples of every pixel this render takes: all, or a range of
+    // them (`--spp-range`) with the same sampler indices.
+    let (first, last) = match opts.sample_range {
+        Some(r) => {
+            let r = r.check(spp).map_err(RenderError::Partial)?;
+            (r.start, r.end)
+        }
+        None => (0, spp),
+    };
     let pixel_bounds = scene.film.pixel_bounds();
     let tile_list = tiles(pixel_bounds);
     let pixels = pixel_bounds.area().max(0) as u64;
-    let total = pixels * spp as u64;
+    let total = pixels * (last - first) as u64;
     // Camera rays carry differentials only when something reads them:
     // texture filtering or bump mapping, or a G-buffer film's depth slopes.
     let differentials =
         scene.film.uses_visible_surface() || scene.materials.any_needs_differentials();
     let progressive = opts.write_partial_images || opts.mse_reference.is_some();
-    let mut wave_start = 0;
-    let mut wave_end = 1;
+    let mut wave_start = first;
+    let mut wave_end = first + 1;
     let mut next_wave_size = 1;
     let mut interrupted = false;
     let mut mse_per_wave = Vec::new();
     // `samples_done`: samples taken so far, counted by the tiles as they
     // finish (the progress reporter reads it while a wave runs).
     let done = with_progress(total, start, progress, |samples_done| {
-        while wave_start < spp {
+        while wave_start < last {
             let next_tile = AtomicUsize::new(0);
             let finished: Mutex<Vec<(usize, FilmTile)>> = Mutex::new(Vec::new());
             let splats = OrderedSplats::new();
@@ -364,18 +376,20 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
                 break;
             }
             wave_start = wave_end;
-            (wave_end, next_wave_size) = next_wave(wave_end, next_wave_size, spp, progressive);
+            (wave_end, next_wave_size) = next_wave(wave_end, next_wave_size, last, progressive);
             if let Some(reference) = &opts.mse_reference {
                 let mut md = ImageMetadata::default();
-                let image = scene.film.get_image(&mut md, splat_scale(wave_start));
+                let image = scene
+                    .film
+                    .get_image(&mut md, splat_scale(wave_start - first));
                 let d = crate::image::ops::diff(&image, reference)
                     .map_err(RenderError::MseReference)?;
                 mse_per_wave.push((wave_start, d.mse));
             }
-            if opts.write_partial_images && wave_start < spp {
+            if opts.write_partial_images && wave_start < last {
                 metadata.render_time_seconds = Some(start.elapsed().as_secs_f32());
-                metadata.samples_per_pixel = Some(wave_start);
-                write_film(&scene.film, metadata, splat_scale(wave_start))?;
+                metadata.samples_per_pixel = Some(wave_start - first);
+                write_film(&scene.film, metadata, splat_scale(wave_start - first))?;
             }
         }
         Ok(samples_done.load(Ordering::Relaxed))
@@ -383,13 +397,25 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
     let render_time = start.elapsed();
     metadata.render_time_seconds = Some(render_time.as_secs_f32());
     // Every pixel has at least the samples of the completed waves.
-    metadata.samples_per_pixel = Some(wave_start);
+    metadata.samples_per_pixel = Some(wave_start - first);
     if let Some(&(_, mse)) = mse_per_wave.last() {
         metadata.mse = Some(mse as f32);
     }
-    // An interrupted wave's splats are partial: the scale of the completed
-    // waves keeps them at most slightly bright, as pbrt-v4's.
-    write_film(&scene.film, metadata, splat_scale(wave_start))?;
+    if let Some(range) = opts.sample_range {
+        if interrupted {
+            // The interrupted wave's samples are in the sums: they would
+            // not merge exactly with any other range.
+            return Err(RenderError::Partial(PartialError(format!(
+                "interrupted: the partial image of samples {}..{} is incomplete and was not written",
+                range.start, range.end
+            ))));
+        }
+        write_partial(&scene.film, metadata, range, spp)?;
+    } else {
+        // An interrupted wave's splats are partial: the scale of the
+        // completed waves keeps them at most slightly bright, as pbrt-v4's.
+        write_film(&scene.film, metadata, splat_scale(wave_start - first))?;
+    }
     Ok(RenderStats {
         render_time,
         samples: done,
@@ -397,12 +423,6 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
         mse_per_wave,
         warnings: Vec::new(),
     })
-}
-
-/// The weight of splats after `spp` samples per pixel (pbrt-v4 writes
-/// `1 / waveStart`).
-fn splat_scale(spp: i32) -> Float {
-    1.0 / spp.max(1) as Float
 }
 
 #[cfg(test)]
