@@ -45,6 +45,9 @@ def parse_args(argv: Optional[List[str]] = None) -> argparse.Namespace:
     p.add_argument("--worker-rpbrt", help="the rpbrt binary on the workers (default: --rpbrt, else their PATH)")
     p.add_argument("--ship", choices=["auto", "always", "never"], default="auto",
                    help="send the scene's folder with the tasks (default auto: folders up to 256 MiB)")
+    p.add_argument("--no-reuse", action="store_true",
+                   help="one rpbrt run per part (default: each worker parses a scene once and "
+                        "renders all its parts of it in one rpbrt --serve-parts process)")
     p.add_argument("--retries", type=int, default=2, help="retries of a failed part (default 2)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -89,8 +92,10 @@ def main(argv: Optional[List[str]] = None) -> int:
         else:
             n = args.workers or os.cpu_count() or 1
             cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                   dashboard_address=None)
+                                   dashboard_address=":0")
             client = Client(cluster)
+        if not args.quiet and client.dashboard_link:
+            print(f"rpbrt-farm: Dask dashboard at {client.dashboard_link}", file=sys.stderr)
         try:
             worker_rpbrt = args.worker_rpbrt
             if worker_rpbrt is None and args.rpbrt:
@@ -98,7 +103,7 @@ def main(argv: Optional[List[str]] = None) -> int:
             written = render_frames(
                 client, args.scenes, parts, outfiles,
                 rpbrt=args.rpbrt, worker_rpbrt=worker_rpbrt, extra_args=extra,
-                ship=args.ship, retries=args.retries,
+                ship=args.ship, retries=args.retries, reuse=not args.no_reuse,
                 progress=None if args.quiet else sys.stderr,
             )
         finally:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import io
 import os
 import shutil
@@ -122,6 +123,7 @@ def render_frames(
     extra_args: Sequence[str] = (),
     ship: str = "auto",
     retries: int = 2,
+    reuse: bool = True,
     progress: Optional[TextIO] = sys.stderr,
     on_submitted: Optional[Callable[[List], None]] = None,
 ) -> List[str]:
@@ -133,7 +135,9 @@ def render_frames(
     ``--spp 64``). A part that fails is retried ``retries`` times on any
     worker (a worker that dies mid-part loses nothing: the scheduler
     reschedules it); a part that fails every try raises FarmError with
-    rpbrt's message. ``on_submitted`` hears the futures once submitted.
+    rpbrt's message. With ``reuse`` each worker parses a scene once and
+    renders all its parts of it in one ``rpbrt --serve-parts`` process.
+    ``on_submitted`` hears the futures once submitted.
     """
     if len(scenes) != len(outfiles):
         raise FarmError("one output file per scene is needed")
@@ -144,15 +148,19 @@ def render_frames(
         if not os.path.isfile(scene):
             raise FarmError(f"{scene}: no such scene file")
         archive = None
+        archive_id = None
         scene_ref = os.path.abspath(scene)
         if should_ship(scene, ship):
             folder = os.path.dirname(scene_ref)
+            packed = pack_folder(folder)
+            archive_id = hashlib.sha256(packed).hexdigest()
             # Sent once to every worker, not once per task.
-            archive = client.scatter(pack_folder(folder), broadcast=True)
+            archive = client.scatter(packed, broadcast=True)
             scene_ref = os.path.relpath(scene_ref, folder)
         for part in parts:
             label = f"{os.path.basename(scene)}: {part.label()}"
-            spec = TaskSpec(worker_rpbrt, scene_ref, [*extra_args, *part.rpbrt_args()], label)
+            spec = TaskSpec(worker_rpbrt, scene_ref, tuple(extra_args), tuple(part.rpbrt_args()),
+                            label, archive_id, reuse)
             fut = client.submit(
                 render_part,
                 spec,

@@ -45,7 +45,7 @@ def client():
     from distributed import Client, LocalCluster
 
     cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                           dashboard_address=None)
+                           dashboard_address=":0")
     c = Client(cluster)
     yield c
     c.close()
@@ -76,8 +76,8 @@ def test_plan_splits_exactly():
         plan_frame(0, None, None)
 
 
-@pytest.mark.parametrize("ship", ["always", "never"])
-def test_tiles_and_ranges_are_bit_identical(rpbrt, client, tmp_path, ship):
+@pytest.mark.parametrize("ship,reuse", [("always", True), ("never", True), ("always", False)])
+def test_tiles_and_ranges_are_bit_identical(rpbrt, client, tmp_path, ship, reuse):
     spp = 4
     full = str(tmp_path / "full.exr")
     single_render(rpbrt, full, spp)
@@ -85,7 +85,7 @@ def test_tiles_and_ranges_are_bit_identical(rpbrt, client, tmp_path, ship):
         out = str(tmp_path / f"farm-{parts[0].kind}.exr")
         render_frames(client, [SCENE], parts, [out], rpbrt=rpbrt, worker_rpbrt=rpbrt,
                       extra_args=["--spp", str(spp), "--nthreads", "1"], ship=ship,
-                      progress=None)
+                      reuse=reuse, progress=None)
         assert differing_pixels(rpbrt, out, full) == 0, parts[0].kind
 
 
@@ -120,13 +120,14 @@ def test_a_killed_worker_loses_nothing(rpbrt, client, tmp_path):
     assert differing_pixels(rpbrt, out, full) == 0
 
 
-def test_a_failing_part_fails_the_render_with_rpbrts_message(rpbrt, client, tmp_path):
+@pytest.mark.parametrize("reuse", [True, False])
+def test_a_failing_part_fails_the_render_with_rpbrts_message(rpbrt, client, tmp_path, reuse):
     bad = tmp_path / "bad.pbrt"
     bad.write_text('Film "rgb" "integer xresolution" 16 "integer yresolution" 16\n'
                    'WorldBegin\nShape "sphere" "float radius" "big"\n')
     with pytest.raises(FarmError) as e:
         render_frames(client, [str(bad)], plan_frame(2, None, None), [str(tmp_path / "x.exr")],
-                      rpbrt=rpbrt, worker_rpbrt=rpbrt, retries=1, progress=None)
+                      rpbrt=rpbrt, worker_rpbrt=rpbrt, retries=1, reuse=reuse, progress=None)
     msg = str(e.value)
     assert "bad.pbrt:3:" in msg and "failed 2 times" in msg, msg
 

@@ -25,6 +25,8 @@ pub struct Options {
     pub tile: Option<(u32, u32)>,
     /// `--spp-range A..B`: render samples A..B-1 of every pixel.
     pub spp_range: Option<(i32, i32)>,
+    /// `--serve-parts`: build the scene once, render parts asked on stdin.
+    pub serve_parts: bool,
     /// `--quick`: a fast, reduced-quality render.
     pub quick: bool,
     /// `--quiet`: no progress bar or statistics.
@@ -94,6 +96,9 @@ Rendering options:
   --spp-range <a..b>           Render samples a..b-1 of every pixel, as a full render
                                takes them; the EXR carries the sums that
                                `imgtool merge` adds into the full render's image.
+  --serve-parts                Build the scene once, then render the parts that stdin
+                               asks for ('--tile k/n --spp-range a..b --outfile f' a
+                               line), answering 'ok' or 'error: ...' on stdout.
   --stats                      Print statistics after rendering.
   --tile <k/n>                 Render tile k (0-based) of n tiles of the image;
                                `imgtool assemble` joins them.
@@ -255,6 +260,7 @@ pub fn parse_args(args: &[String]) -> Result<Options, ArgError> {
                     }
                 }
             }
+            "serveparts" => o.serve_parts = true,
             "quick" => o.quick = true,
             "quiet" => o.quiet = true,
             "stats" => o.stats = true,

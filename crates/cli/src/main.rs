@@ -4,6 +4,7 @@
 
 mod args;
 mod imgtool;
+mod serve;
 
 use rpbrt_parser::{parse_files, FormattingTarget};
 use rpbrt_render::accel::Aggregate;
@@ -210,6 +211,9 @@ fn render_command(opts: &args::Options) -> ExitCode {
             .spp_range
             .map(|(start, end)| SampleRange { start, end }),
     };
+    if opts.serve_parts {
+        return serve::run(&integrator, &mut scene, render_opts);
+    }
     let mut metadata = ImageMetadata::default();
     // The progress bar, redrawn in place on each report.
     let show_progress = !opts.quiet && std::io::stderr().is_terminal();

@@ -73,6 +73,9 @@ pub struct VisibleSurface {
 pub struct FilmCore {
     full_resolution: Point2i,
     pixel_bounds: Bounds2i,
+    /// The pixels a render takes and the image holds: `pixel_bounds`, or
+    /// part of it ([`Film::set_active_bounds`]).
+    active: Bounds2i,
     diagonal_m: Float,
     filename: String,
     filter: Filter,
@@ -120,6 +123,7 @@ impl FilmCore {
         FilmCore {
             full_resolution: p.full_resolution,
             pixel_bounds: p.pixel_bounds,
+            active: p.pixel_bounds,
             diagonal_m: p.diagonal_mm * 0.001,
             filename: p.filename,
             filter_integral: filter.integral(),
@@ -213,7 +217,7 @@ impl FilmCore {
     }
 
     fn new_image(&self, channels: &[String]) -> Image {
-        let d = self.pixel_bounds.diagonal();
+        let d = self.active.diagonal();
         partial::output_image(self.write_fp16, Point2i::new(d.x, d.y), channels)
     }
 
@@ -235,8 +239,8 @@ impl FilmCore {
             } => names.extend(spectral_channel_names(*lambda_min, *lambda_max, *n_buckets)),
         }
         let mut image = self.new_image(&names);
-        let pmin = self.pixel_bounds.p_min;
-        for p in self.pixel_bounds.iter() {
+        let pmin = self.active.p_min;
+        for p in self.active.iter() {
             let rgb = self.get_pixel_rgb(p, splat_scale);
             let off = Point2i::new(p.x - pmin.x, p.y - pmin.y);
             image.set_channels(
@@ -314,7 +318,7 @@ impl FilmCore {
                 }
             }
         }
-        metadata.pixel_bounds = Some(self.pixel_bounds);
+        metadata.pixel_bounds = Some(self.active);
         metadata.full_resolution = Some(self.full_resolution);
         metadata.color_space = Some(self.color_space.name.clone());
         if let KindConfig::Spectral { .. } = self.config.kind {
@@ -473,6 +477,35 @@ impl Film {
     #[inline]
     pub fn pixel_bounds(&self) -> Bounds2i {
         self.core().pixel_bounds
+    }
+    /// The pixels a render takes and the image holds: the pixel bounds,
+    /// unless [`Film::set_active_bounds`] chose part of them.
+    #[inline]
+    pub fn active_bounds(&self) -> Bounds2i {
+        self.core().active
+    }
+    /// Renders and writes only `bounds` (non-empty, inside the pixel
+    /// bounds) from now on: a tile of a film whose camera and splats still
+    /// see the whole pixel bounds. Returns false (changing nothing) for
+    /// bounds that do not fit.
+    pub fn set_active_bounds(&mut self, bounds: Bounds2i) -> bool {
+        let c = self.core_mut();
+        let fits = !bounds.is_empty() && bounds.intersect(&c.pixel_bounds) == bounds;
+        if fits {
+            c.active = bounds;
+        }
+        fits
+    }
+    /// Forgets every sample and splat, for another render of the same film.
+    pub fn reset(&mut self) {
+        let c = self.core_mut();
+        c.pixels = Pixels::new(c.pixel_bounds, &c.config.kind);
+        c.splat_rgb = pixels::AtomicF64s::new(c.splat_rgb.len());
+        c.splat_buckets = pixels::AtomicF64s::new(c.splat_buckets.len());
+    }
+    /// Writes to `name` from now on (format by extension).
+    pub fn set_filename(&mut self, name: String) {
+        self.core_mut().filename = name;
     }
     /// The full image resolution.
     #[inline]

@@ -220,12 +220,12 @@ impl FilmCore {
         }
         let mut names: Vec<String> = ["R", "G", "B"].iter().map(|s| s.to_string()).collect();
         names.extend(sum_channel_names());
-        let d = self.pixel_bounds.diagonal();
+        let d = self.active.diagonal();
         let mut image = output_image(false, Point2i::new(d.x, d.y), &names);
         let own_scale = splat_scale(range.end - range.start);
-        let pmin = self.pixel_bounds.p_min;
+        let pmin = self.active.p_min;
         let mut vals = Vec::with_capacity(names.len());
-        for p in self.pixel_bounds.iter() {
+        for p in self.active.iter() {
             let i = self.pixels.index(p);
             let sums = self.pixels.rgb[i];
             let splat = [0, 1, 2].map(|c| self.splat_rgb.get(3 * i + c));
@@ -243,7 +243,7 @@ impl FilmCore {
             }
             image.set_channels(Point2i::new(p.x - pmin.x, p.y - pmin.y), &vals);
         }
-        metadata.pixel_bounds = Some(self.pixel_bounds);
+        metadata.pixel_bounds = Some(self.active);
         metadata.full_resolution = Some(self.full_resolution);
         metadata.color_space = Some(self.color_space.name.clone());
         metadata.samples_per_pixel = Some(range.end - range.start);

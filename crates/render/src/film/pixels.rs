@@ -298,6 +298,11 @@ impl AtomicF64s {
     pub fn new(n: usize) -> Self {
         AtomicF64s((0..n).map(|_| AtomicU64::new(0f64.to_bits())).collect())
     }
+    /// The number of entries.
+    #[allow(clippy::len_without_is_empty)] // never asked of an empty film
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
     /// Adds `v` to entry `i`.
     pub fn add(&self, i: usize, v: f64) {
         let a = &self.0[i];

@@ -107,9 +107,11 @@ impl Integrator {
         metadata: &mut ImageMetadata,
         progress: ProgressFn,
     ) -> Result<RenderStats, RenderError> {
-        if opts.sample_range.is_some() && !self.renders_pixel_samples() {
+        let partial =
+            opts.sample_range.is_some() || scene.film.active_bounds() != scene.film.pixel_bounds();
+        if partial && !self.renders_pixel_samples() {
             return Err(RenderError::Partial(crate::film::PartialError(format!(
-                "--spp-range: the \"{}\" integrator does not take samples pixel by pixel, so its samples cannot be split into ranges",
+                "the \"{}\" integrator does not take samples pixel by pixel, so it cannot render sample ranges or parts of its film",
                 self.name()
             ))));
         }

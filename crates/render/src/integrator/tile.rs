@@ -294,7 +294,7 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
         }
         None => (0, spp),
     };
-    let pixel_bounds = scene.film.pixel_bounds();
+    let pixel_bounds = scene.film.active_bounds();
     let tile_list = tiles(pixel_bounds);
     let pixels = pixel_bounds.area().max(0) as u64;
     let total = pixels * (last - first) as u64;
