@@ -430,6 +430,33 @@ fn tiles_and_sample_ranges_join_into_the_full_render() {
             );
             assert_eq!(differing_pixels(&joined, &full), "0", "tiles");
 
+            // The same parts from one --serve-parts process.
+            use std::io::Write;
+            let mut server = rpbrt()
+                .args(["--quiet", "--serve-parts"])
+                .arg(&scene)
+                .stdin(std::process::Stdio::piped())
+                .stdout(std::process::Stdio::piped())
+                .spawn()
+                .unwrap();
+            let served_tile = dir.join("served tile.exr");
+            let served_range = dir.join("served-range.exr");
+            let mut stdin = server.stdin.take().unwrap();
+            writeln!(stdin, "--tile 4/7 --outfile {}", served_tile.display()).unwrap();
+            writeln!(stdin, "--tile 9/7 --outfile x.exr").unwrap();
+            writeln!(stdin, "--spp-range 3..8 --outfile {}", served_range.display()).unwrap();
+            drop(stdin);
+            let out = server.wait_with_output().unwrap();
+            assert!(out.status.success());
+            let replies = String::from_utf8_lossy(&out.stdout);
+            let lines: Vec<&str> = replies.lines().collect();
+            assert_eq!(lines.len(), 3, "{replies}");
+            assert_eq!(lines[0], "ok");
+            assert!(lines[1].starts_with("error: --tile \"9/7\""), "{replies}");
+            assert_eq!(lines[2], "ok");
+            assert_eq!(differing_pixels(&served_tile, &tiles[4]), "0", "served tile");
+            assert_eq!(differing_pixels(&served_range, &ranges[0]), "0", "served range");
+
             // A missing tile, a doubled tile: clear errors.
             let out = rpbrt()
                 .args(["imgtool", "assemble", "--outfile"])
