@@ -11,10 +11,11 @@ import sys
 import tarfile
 import tempfile
 import time
+import uuid
 from typing import Callable, Dict, List, Optional, Sequence, TextIO
 
 from .plan import Part
-from .task import RenderTaskError, TaskSpec, render_part
+from .task import RenderTaskError, TaskSpec, close_session, render_part
 
 #: Scenes whose folder is at most this large are shipped with the tasks
 #: when shipping is "auto"; larger ones are read by path.
@@ -142,6 +143,7 @@ def render_frames(
     if len(scenes) != len(outfiles):
         raise FarmError("one output file per scene is needed")
     local_rpbrt = find_rpbrt(rpbrt)
+    session = uuid.uuid4().hex
     futures = []
     meta: Dict[object, tuple] = {}
     for frame, scene in enumerate(scenes):
@@ -160,7 +162,7 @@ def render_frames(
         for part in parts:
             label = f"{os.path.basename(scene)}: {part.label()}"
             spec = TaskSpec(worker_rpbrt, scene_ref, tuple(extra_args), tuple(part.rpbrt_args()),
-                            label, archive_id, reuse)
+                            label, archive_id, reuse, session)
             fut = client.submit(
                 render_part,
                 spec,
@@ -192,6 +194,12 @@ def render_frames(
     except BaseException:
         client.cancel(futures)
         raise
+    finally:
+        if reuse:
+            try:
+                client.run(close_session, session)
+            except Exception:
+                pass  # workers gone: their processes ended with them
 
     written = []
     for frame, outfile in enumerate(outfiles):

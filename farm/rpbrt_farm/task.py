@@ -46,6 +46,10 @@ class TaskSpec:
     archive_id: Optional[str] = None
     #: Keep one rpbrt process per scene on the worker (parse once).
     reuse: bool = True
+    #: The render these parts belong to: processes are shared only within
+    #: one render (a scene edited between renders is parsed anew) and
+    #: closed by close_session when it ends.
+    session: str = ""
 
 
 def _find_rpbrt(path: Optional[str]) -> str:
@@ -138,8 +142,21 @@ def _shutdown() -> None:
         shutil.rmtree(d, ignore_errors=True)
 
 
+def close_session(session: str) -> int:
+    """Ends this worker's rpbrt processes of render ``session``; returns
+    how many were closed (run on every worker when a render ends)."""
+    with _lock:
+        keys = [k for k in _idle if k[0] == session]
+        servers = [s for k in keys for s in _idle.pop(k)]
+        for s in servers:
+            _all_servers.remove(s)
+    for s in servers:
+        s.close()
+    return len(servers)
+
+
 def _serve(rpbrt: str, scene: str, spec: TaskSpec, outfile: str) -> None:
-    key = (rpbrt, scene, spec.args)
+    key = (spec.session, rpbrt, scene, spec.args)
     with _lock:
         pool = _idle.setdefault(key, [])
         server = pool.pop() if pool else None
