@@ -444,7 +444,12 @@ fn tiles_and_sample_ranges_join_into_the_full_render() {
             let mut stdin = server.stdin.take().unwrap();
             writeln!(stdin, "--tile 4/7 --outfile {}", served_tile.display()).unwrap();
             writeln!(stdin, "--tile 9/7 --outfile x.exr").unwrap();
-            writeln!(stdin, "--spp-range 3..8 --outfile {}", served_range.display()).unwrap();
+            writeln!(
+                stdin,
+                "--spp-range 3..8 --outfile {}",
+                served_range.display()
+            )
+            .unwrap();
             drop(stdin);
             let out = server.wait_with_output().unwrap();
             assert!(out.status.success());
@@ -454,8 +459,16 @@ fn tiles_and_sample_ranges_join_into_the_full_render() {
             assert_eq!(lines[0], "ok");
             assert!(lines[1].starts_with("error: --tile \"9/7\""), "{replies}");
             assert_eq!(lines[2], "ok");
-            assert_eq!(differing_pixels(&served_tile, &tiles[4]), "0", "served tile");
-            assert_eq!(differing_pixels(&served_range, &ranges[0]), "0", "served range");
+            assert_eq!(
+                differing_pixels(&served_tile, &tiles[4]),
+                "0",
+                "served tile"
+            );
+            assert_eq!(
+                differing_pixels(&served_range, &ranges[0]),
+                "0",
+                "served range"
+            );
 
             // A missing tile, a doubled tile: clear errors.
             let out = rpbrt()

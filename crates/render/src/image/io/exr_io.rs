@@ -82,7 +82,37 @@ fn from_matrix(m: &[[f32; 4]; 4]) -> [f32; 16] {
     r
 }
 
+/// Checks the headers' claims before the decoder allocates for them: a
+/// corrupted size or channel count must be an error, not an allocation
+/// that aborts the process.
+fn check_headers(data: &[u8]) -> FmtResult<()> {
+    let meta = std::panic::catch_unwind(|| {
+        exr::meta::MetaData::read_from_buffered(Cursor::new(data), false)
+    })
+    .map_err(|_| "EXR header decoder failed on malformed data".to_string())?
+    .map_err(|e| e.to_string())?;
+    let mut total: u64 = 0;
+    for h in &meta.headers {
+        let (w, hgt) = (h.layer_size.0 as u64, h.layer_size.1 as u64);
+        super::check_resolution(
+            w.min(i64::MAX as u64) as i64,
+            hgt.min(i64::MAX as u64) as i64,
+        )?;
+        let channels = h.channels.list.len() as u64;
+        total = total.saturating_add((w * hgt).saturating_mul(channels.max(1)));
+    }
+    // Every sample is decoded to at most four bytes.
+    if total > super::MAX_PIXELS * 4 {
+        return Err(format!(
+            "EXR file claims {total} samples, more than the supported {}",
+            super::MAX_PIXELS * 4
+        ));
+    }
+    Ok(())
+}
+
 pub(super) fn read(data: &[u8]) -> FmtResult<ImageAndMetadata> {
+    check_headers(data)?;
     // The exr crate is defensive, but a panic inside it must not escape to the caller.
     let decoded = std::panic::catch_unwind(|| {
         exr::prelude::read()
