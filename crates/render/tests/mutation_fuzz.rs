@@ -6,7 +6,8 @@
 //! a scene or located diagnostics.
 //!
 //! Without `../shared` the test mutates a built-in scene only. The number
-//! of mutations per scene is `RPBRT_FUZZ_ITERS` (default 150).
+//! of mutations per scene is `RPBRT_FUZZ_ITERS` (default 150); with
+//! `RPBRT_FUZZ_SECONDS` it runs rounds of fresh seeds for that long.
 //! Crashes it ever finds are kept below as regression tests.
 
 use rpbrt_render::film::FilmOverrides;
@@ -269,12 +270,37 @@ fn mutated_scenes_never_panic() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(150);
-    for (k, (name, bytes, dir)) in scenes().into_iter().enumerate() {
-        let mut rng = Rng::new(0x5eed + k as u64, 0);
-        for _ in 0..iters {
-            let m = mutate(&bytes, &mut rng);
-            run_one(&name, &m, &dir);
+    // With RPBRT_FUZZ_SECONDS, keep going over fresh seeds until that much
+    // time has passed, and print the count.
+    let budget = std::env::var("RPBRT_FUZZ_SECONDS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .map(std::time::Duration::from_secs);
+    let start = std::time::Instant::now();
+    let inputs = scenes();
+    let mut total = 0u64;
+    let mut round = 0u64;
+    loop {
+        for (k, (name, bytes, dir)) in inputs.iter().enumerate() {
+            let mut rng = Rng::new(0x5eed + k as u64, round);
+            for _ in 0..iters {
+                let m = mutate(bytes, &mut rng);
+                run_one(name, &m, dir);
+                total += 1;
+            }
         }
+        round += 1;
+        match budget {
+            Some(b) if start.elapsed() < b => continue,
+            _ => break,
+        }
+    }
+    if budget.is_some() {
+        println!(
+            "scene fuzz: {total} mutated scenes over {} inputs in {:.0} s",
+            inputs.len(),
+            start.elapsed().as_secs_f64()
+        );
     }
 }
 
