@@ -10,6 +10,7 @@
 pub mod assemble;
 pub mod builder;
 pub mod entities;
+pub mod files;
 mod materials;
 pub mod names;
 pub mod options;
@@ -37,19 +38,40 @@ pub struct BuildOptions {
     pub render_coord_sys: RenderingCoordinateSystem,
     /// Parser limits.
     pub parse: ParseOptions,
+    /// Leave out the check that every input file the scene names exists
+    /// ([`files::missing_files`]); creation then reports a missing file
+    /// when it opens it.
+    pub skip_file_check: bool,
 }
 
 fn finish(
     builder: SceneBuilder,
     result: Result<Diagnostics, Diagnostics>,
+    options: &BuildOptions,
 ) -> Result<(SceneDescription, Diagnostics), Diagnostics> {
+    // Every missing input file is reported in this one run, beside any
+    // errors of the parse (a missing Include among them).
     match result {
-        Ok(diags) => {
+        Ok(mut diags) => {
             let mut scene = builder.finish();
+            let missing = if options.skip_file_check {
+                Vec::new()
+            } else {
+                files::missing_files(&scene)
+            };
+            if !missing.is_empty() {
+                diags.items.extend(missing);
+                return Err(diags);
+            }
             scene.diagnostics = diags.items.clone();
             Ok((scene, diags))
         }
-        Err(diags) => Err(diags),
+        Err(mut diags) => {
+            if !options.skip_file_check {
+                diags.items.extend(files::missing_files(&builder.finish()));
+            }
+            Err(diags)
+        }
     }
 }
 
@@ -63,7 +85,7 @@ pub fn build_scene(
 ) -> Result<(SceneDescription, Diagnostics), Diagnostics> {
     let mut builder = SceneBuilder::new(options.render_coord_sys);
     let result = Parser::new(options.parse.clone()).parse_files(paths, &mut builder);
-    finish(builder, result)
+    finish(builder, result, options)
 }
 
 /// Builds the description of scene text held in memory, reported as file
@@ -79,7 +101,7 @@ pub fn build_scene_from_str(
         Path::new("."),
         &mut builder,
     );
-    finish(builder, result)
+    finish(builder, result, options)
 }
 
 /// Builds the description of scene bytes held in memory as if they were
@@ -94,5 +116,5 @@ pub fn build_scene_from_bytes(
     let mut builder = SceneBuilder::new(options.render_coord_sys);
     let result =
         Parser::new(options.parse.clone()).parse_bytes(name, Arc::from(bytes), dir, &mut builder);
-    finish(builder, result)
+    finish(builder, result, options)
 }

@@ -22,7 +22,12 @@ use crate::texture::{NamedTextures, TextureOptions};
 /// the tests count from the line after it).
 fn build(text: &str) -> SceneDescription {
     let full = format!("WorldBegin\n{text}");
-    match build_scene_from_str(&full, &BuildOptions::default()) {
+    // Creation's own errors for missing files are tested here.
+    let opts = BuildOptions {
+        skip_file_check: true,
+        ..Default::default()
+    };
+    match build_scene_from_str(&full, &opts) {
         Ok((s, _)) => s,
         Err(d) => panic!("{}", d.render()),
     }
