@@ -641,6 +641,32 @@ fn plan(header: &Header) -> Result<Plan, PlyErrorKind> {
     })
 }
 
+/// The warning naming the properties and elements the mesh does not use
+/// (colours, confidences, materials ...), which are skipped.
+fn unused_properties(header: &Header, plan: &Plan) -> Option<String> {
+    let mut unused = Vec::new();
+    for (e, el) in header.elements.iter().enumerate() {
+        if e == plan.vertex {
+            let layout = &plan.vertex_layout;
+            for (p, prop) in el.props.iter().enumerate() {
+                if layout.slots[p].is_none() {
+                    unused.push(format!("{}.{}", el.name, prop.name));
+                }
+            }
+        } else if e == plan.face {
+            let layout = &plan.face_layout;
+            for (p, prop) in el.props.iter().enumerate() {
+                if p != layout.indices && Some(p) != layout.face_index {
+                    unused.push(format!("{}.{}", el.name, prop.name));
+                }
+            }
+        } else {
+            unused.push(format!("element \"{}\"", el.name));
+        }
+    }
+    (!unused.is_empty()).then(|| format!("ignored unused PLY data: {}", unused.join(", ")))
+}
+
 /// Reads a binary body; returns the number of bytes after the last element.
 fn read_binary<R: BufRead, const BE: bool>(
     input: &mut Input<R>,
@@ -783,6 +809,9 @@ pub(super) fn parse_reader<R: BufRead>(
         warnings.push(format!(
             "{non_finite} vertices have non-finite (NaN or infinite) coordinates"
         ));
+    }
+    if let Some(w) = unused_properties(&header, &plan) {
+        warnings.push(w);
     }
     let mut face_indices = Vec::new();
     if plan.face_layout.face_index.is_some() {

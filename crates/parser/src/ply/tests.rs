@@ -128,7 +128,10 @@ fn rich_file_in_every_format() {
         assert_eq!(m.tri_indices, vec![0, 1, 2, 0, 1, 2, 0, 2, 3, 0, 3, 4]);
         assert_eq!(m.quad_indices, vec![0, 1, 3, 2]);
         assert_eq!(m.face_indices, vec![10, 12, 12, 12, 11]);
-        assert_eq!(m.warnings.len(), 2, "{:?}", m.warnings);
+        assert_eq!(m.warnings.len(), 3, "{:?}", m.warnings);
+        assert!(m.warnings.iter().any(|w| w.contains(
+            "ignored unused PLY data: vertex.confidence, vertex.tags, element \"material\", face.flags"
+        )));
         assert!(m.warnings.iter().any(|w| w.contains("fans")));
         assert!(m.warnings.iter().any(|w| w.contains("fewer than 3")));
     }
@@ -338,7 +341,7 @@ fn faces_before_vertices_and_general_layouts() {
         assert_eq!(m.tri_indices, vec![0, 1, 2]);
         assert_eq!(m.quad_indices, vec![0, 1, 3, 2]);
         assert!(m.face_indices.is_empty());
-        assert!(m.warnings.is_empty(), "{:?}", m.warnings);
+        assert_eq!(m.warnings, ["ignored unused PLY data: vertex.extra"]);
     }
 }
 
@@ -948,4 +951,18 @@ fn gzip_files_stream_with_the_same_errors() {
         }
     }
     std::fs::remove_file(&path).unwrap();
+}
+
+#[test]
+fn unused_properties_and_elements_are_named_in_one_warning() {
+    let text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float confidence\nproperty uchar red\nelement face 1\nproperty list uchar int vertex_indices\nproperty int flags\nelement material 1\nproperty float shininess\nend_header\n0 0 0 0.5 1\n1 0 0 0.5 1\n0 1 0 0.5 1\n3 0 1 2 7\n2.5\n";
+    let m = super::parse_ply(text.as_bytes()).expect("mesh");
+    assert_eq!(m.tri_indices, vec![0, 1, 2]);
+    let w: Vec<&String> = m.warnings.iter().filter(|w| w.contains("unused")).collect();
+    assert_eq!(w.len(), 1, "{:?}", m.warnings);
+    assert!(
+        w[0].contains("vertex.confidence, vertex.red, face.flags, element \"material\""),
+        "{}",
+        w[0]
+    );
 }
