@@ -943,3 +943,35 @@ fn average_of_images_counts_infinities_as_zero_and_refuses_mismatches() {
         .contains("channels"));
     assert!(average(&[]).is_err());
 }
+
+/// Found by the data-file fuzzer: an EXR whose data window claims a vast
+/// image made the decoder allocate hundreds of terabytes and abort the
+/// process. The header is now checked first.
+#[test]
+fn exr_with_a_vast_data_window_is_an_error() {
+    let im = Image::new(
+        PixelFormat::Float,
+        Point2i::new(4, 2),
+        &["R", "G", "B"],
+        ColorEncoding::Linear,
+    );
+    let path = std::env::temp_dir().join(format!("rpbrt-vast-{}.exr", std::process::id()));
+    im.write(&path, &ImageMetadata::default()).unwrap();
+    let mut bytes = std::fs::read(&path).unwrap();
+    let _ = std::fs::remove_file(&path);
+    let key = b"dataWindow\0box2i\0";
+    let at = bytes
+        .windows(key.len())
+        .position(|w| w == key)
+        .expect("a data window")
+        + key.len()
+        + 4;
+    // xMax and yMax of the box.
+    bytes[at + 8..at + 12].copy_from_slice(&0x3FFF_FFFFi32.to_le_bytes());
+    bytes[at + 12..at + 16].copy_from_slice(&0x3FFF_FFFFi32.to_le_bytes());
+    let e = Image::read_from_bytes(&bytes, "vast.exr", None).expect_err("vast");
+    assert!(
+        e.to_string().contains("too large") || e.to_string().contains("invalid"),
+        "{e}"
+    );
+}
