@@ -205,7 +205,10 @@ mod tests {
             let uv = Point2f::new(rng.uniform_float(), rng.uniform_float() * 0.98 + 0.01);
             let back = direction_to_equirect(equirect_to_direction(uv));
             let du = (back.x - uv.x).abs().min(1.0 - (back.x - uv.x).abs());
-            assert!(du < 1e-4 && (back.y - uv.y).abs() < 1e-4, "{uv:?} -> {back:?}");
+            assert!(
+                du < 1e-4 && (back.y - uv.y).abs() < 1e-4,
+                "{uv:?} -> {back:?}"
+            );
         }
     }
 
@@ -227,7 +230,10 @@ mod tests {
                 let want = f(w);
                 for (c, want) in want.iter().enumerate() {
                     let got = ea.get_channel(Point2i::new(x, y), c, WrapMode::Clamp.into());
-                    assert!((got - want).abs() < 0.03, "({x}, {y}) c{c}: {got} vs {want}");
+                    assert!(
+                        (got - want).abs() < 0.03,
+                        "({x}, {y}) c{c}: {got} vs {want}"
+                    );
                 }
             }
         }
