@@ -610,3 +610,60 @@ fn imgtool_makeequiarea_converts_lat_long_maps() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/ll.exr"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `imgtool makesky` (pbrt-v4's): an equal-area Hosek–Wilkie sky with the
+/// parameters in the metadata; out-of-range parameters are refused.
+#[test]
+fn imgtool_makesky_writes_an_equal_area_sky() {
+    use rpbrt_render::image::Image;
+    let dir = std::env::temp_dir().join(format!("rpbrt-cli-makesky-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("sky.exr");
+    let run = rpbrt()
+        .args([
+            "imgtool",
+            "makesky",
+            "--resolution",
+            "16",
+            "--elevation",
+            "30",
+        ])
+        .args(["--turbidity", "4", "--albedo", "0.2", "--outfile"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let im = Image::read(&out, None).unwrap();
+    assert_eq!(
+        im.image.resolution(),
+        rpbrt_render::geometry::Point2i::new(16, 16)
+    );
+    assert_eq!(im.metadata.color_space.as_deref(), Some("aces2065-1"));
+    for (flag, value) in [
+        ("--albedo", "1.5"),
+        ("--turbidity", "1"),
+        ("--elevation", "-5"),
+        ("--resolution", "0"),
+        ("--albedo", "x"),
+    ] {
+        let run = rpbrt()
+            .args(["imgtool", "makesky", flag, value, "--outfile"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert_eq!(run.status.code(), Some(1), "{flag} {value}");
+        assert!(
+            String::from_utf8_lossy(&run.stderr).contains(flag),
+            "{flag} {value}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+    }
+    let run = rpbrt().args(["imgtool", "makesky"]).output().unwrap();
+    assert_eq!(run.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("--outfile"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -12,6 +12,7 @@ mod convert;
 mod diff;
 mod info;
 mod makeequiarea;
+mod makesky;
 mod merge;
 
 /// A command: its name, one-line summary, usage text and entry point.
@@ -59,6 +60,12 @@ const COMMANDS: &[Command] = &[
         summary: "convert a lat-long environment map to pbrt-v4's equal-area square",
         usage: makeequiarea::USAGE,
         run: makeequiarea::run,
+    },
+    Command {
+        name: "makesky",
+        summary: "make a Hosek-Wilkie sky environment map (equal-area)",
+        usage: makesky::USAGE,
+        run: makesky::run,
     },
     Command {
         name: "merge",

@@ -4,7 +4,8 @@
 //!
 //! Reading and writing files lives in [`io`]; MIP-mapped filtering in [`mipmap`]; the
 //! comparisons and statistics behind `imgtool` in [`ops`]; pbrt-v3 latitude–longitude
-//! environment maps to pbrt-v4's equal-area square in [`equiarea`].
+//! environment maps to pbrt-v4's equal-area square in [`equiarea`]; the Hosek–Wilkie sky
+//! model behind `imgtool makesky` in [`sky`].
 
 pub mod assemble;
 mod encoding;
@@ -13,6 +14,7 @@ pub mod io;
 pub mod mipmap;
 pub mod ops;
 mod resample;
+pub mod sky;
 #[cfg(test)]
 mod tests;
 
