@@ -540,6 +540,8 @@ fn sample_ranges_are_refused_where_they_cannot_merge() {
         e.contains("\"sppm\" integrator does not take samples pixel by pixel"),
         "{e}"
     );
+}
+
 /// `imgtool makeequiarea` (pbrt-v4's): a latitude–longitude map to an
 /// equal-area square, default resolution the input's width, `--resolution`
 /// and a positional or `--outfile` output.
