@@ -16,6 +16,7 @@
 //!
 //! The data carry this notice:
 //!
+//! ```text
 //! This source is published under the following 3-clause BSD license.
 //!
 //! Copyright (c) 2012 - 2013, Lukas Hosek and Alexander Wilkie
@@ -43,6 +44,7 @@
 //! ON ANY THEORY OF LIABILITY, WHETHER IN CONTRACT, STRICT LIABILITY, OR TORT
 //! (INCLUDING NEGLIGENCE OR OTHERWISE) ARISING IN ANY WAY OUT OF THE USE OF THIS
 //! SOFTWARE, EVEN IF ADVISED OF THE POSSIBILITY OF SUCH DAMAGE.
+//! ```
 
 #![allow(clippy::excessive_precision, clippy::unreadable_literal)]
 
