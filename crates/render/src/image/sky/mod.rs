@@ -7,7 +7,7 @@
 //! The model's state holds, per 40 nm band, nine sky-dome parameters and a
 //! mean radiance, each a quintic Bézier in the cube root of the normalised
 //! solar elevation, blended linearly in turbidity and ground albedo
-//! ([`data`] holds the fitted control points). Sky radiance at a view
+//! (`data.rs` holds the fitted control points). Sky radiance at a view
 //! direction of zenith angle θ and angle γ from the sun follows the
 //! extended Perez formula; the solar disc adds a per-band polynomial in the
 //! view elevation times a limb-darkening polynomial, zero outside the disc
