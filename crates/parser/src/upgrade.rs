@@ -364,6 +364,8 @@ pub fn upgrade_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) ->
         return e.finish();
     }
     e.remove_all("samples", &["integer"]);
+    // pbrt-v3's lights (the infinite light among them) read "nsamples".
+    e.remove_all("nsamples", &["integer"]);
     let has_map = e.get("mapname", &["string"]).is_some();
     if has_map && name == "infinite" && !e.rgb_into_scale("L", &mut scale) {
         let l = e.get("L", &SPECTRUM_TYPES).map(|p| p.loc.clone());

@@ -34,7 +34,7 @@ fn make(name: &str, params: Vec<ParsedParameter>) -> Vec<Shape> {
     let xf = Transform::rotate(30.0, Vector3f::new(1.0, 1.0, 0.0));
     let dict = ParameterDictionary::new(params);
     let at = loc();
-    match create_shapes(name, &ParamReader::plain(&dict, &at), &xf, false) {
+    match create_shapes(name, &ParamReader::plain(&dict, &at), &xf, false, None) {
         Ok(shapes) => shapes,
         Err(e) => panic!("benchmark shape {name}: {}", e.message),
     }

@@ -11,6 +11,8 @@ mod average;
 mod convert;
 mod diff;
 mod info;
+mod makeequiarea;
+mod makesky;
 mod merge;
 
 /// A command: its name, one-line summary, usage text and entry point.
@@ -52,6 +54,18 @@ const COMMANDS: &[Command] = &[
         summary: "print resolution, channels and statistics",
         usage: info::USAGE,
         run: info::run,
+    },
+    Command {
+        name: "makeequiarea",
+        summary: "convert a lat-long environment map to pbrt-v4's equal-area square",
+        usage: makeequiarea::USAGE,
+        run: makeequiarea::run,
+    },
+    Command {
+        name: "makesky",
+        summary: "make a Hosek-Wilkie sky environment map (equal-area)",
+        usage: makesky::USAGE,
+        run: makesky::run,
     },
     Command {
         name: "merge",

@@ -138,6 +138,16 @@ fn lights() {
         &loc(1),
     );
     assert_eq!(names(&u), ["string filename"]);
+    // pbrt-v3's infinite light takes "nsamples"; pbrt-v4 has no use for it.
+    let u = upgrade_light(
+        "infinite",
+        vec![
+            s("string", "mapname", &["a.exr"]),
+            ParsedParameter::new("integer", "nsamples", loc(1)),
+        ],
+        &loc(1),
+    );
+    assert_eq!(names(&u), ["string filename"]);
     let u = upgrade_area_light(
         "area",
         vec![

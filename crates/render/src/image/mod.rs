@@ -3,14 +3,18 @@
 //! book section 10.4.1 "Image Texture Memory Management" and appendix B.5 "Images").
 //!
 //! Reading and writing files lives in [`io`]; MIP-mapped filtering in [`mipmap`]; the
-//! comparisons and statistics behind `imgtool` in [`ops`].
+//! comparisons and statistics behind `imgtool` in [`ops`]; pbrt-v3 latitude–longitude
+//! environment maps to pbrt-v4's equal-area square in [`equiarea`]; the Hosek–Wilkie sky
+//! model behind `imgtool makesky` in [`sky`].
 
 pub mod assemble;
 mod encoding;
+pub mod equiarea;
 pub mod io;
 pub mod mipmap;
 pub mod ops;
 mod resample;
+pub mod sky;
 #[cfg(test)]
 mod tests;
 

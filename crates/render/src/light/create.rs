@@ -17,6 +17,7 @@ use super::{
     UniformInfiniteLight,
 };
 use crate::camera::CameraTransform;
+use crate::image::equiarea::{env_map_layout, equirect_to_equal_area, EnvMapLayout};
 use crate::image::{Image, WrapMode, WrapMode2D};
 use crate::params::{unknown_type, ParamReader};
 use crate::shape::{Shape, ShapeMethods};
@@ -119,13 +120,16 @@ fn rgb_image(
 
 /// Creates the light of a `LightSource` directive in `medium`, with
 /// unused-parameter warnings. `camera_transform` takes infinite-light
-/// portals, given in world space, into render space.
+/// portals, given in world space, into render space. `pbrt_v3` says the
+/// directive was written for pbrt-v3 (an `infinite` light's image is then
+/// a latitude–longitude map).
 pub fn create_light(
     name: &str,
     lp: &ParamReader,
     render_from_light: &AnimatedTransform,
     medium: Option<MediumId>,
     camera_transform: &CameraTransform,
+    pbrt_v3: bool,
 ) -> Result<Light, Diagnostic> {
     let cs = lp.color_space();
     let loc = lp.loc();
@@ -300,7 +304,7 @@ pub fn create_light(
                 scene: SceneSphere::default(),
             })
         }
-        "infinite" => create_infinite(lp, render_from_light, camera_transform)?,
+        "infinite" => create_infinite(lp, render_from_light, camera_transform, pbrt_v3)?,
         other => return Err(unknown_type("light", other, LIGHT_NAMES, loc)),
     };
     Ok(light)
@@ -349,10 +353,56 @@ fn goniometric_image(im: &Image, filename: &str, loc: &FileLoc) -> Result<Image,
     }
 }
 
+/// An infinite light's map in pbrt-v4's equal-area layout. A pbrt-v3 map
+/// (`pbrt_v3`) or a 2:1 one is a latitude–longitude map: it is resampled
+/// (at pbrt-v4 `makeequiarea`'s default resolution, the map's width) with a
+/// located warning. A square map of a pbrt-v4 file is used as it is; any
+/// other shape is a located error.
+fn equal_area_env_map(
+    lp: &ParamReader,
+    image: Image,
+    filename: &str,
+    floc: &FileLoc,
+    pbrt_v3: bool,
+) -> Result<Image, Diagnostic> {
+    let res = image.resolution();
+    match env_map_layout(res) {
+        None => Err(Diagnostic::error(
+            floc.clone(),
+            format!(
+                "{filename}: environment map resolution ({}, {}) is neither square (pbrt-v4's \
+                 equal-area layout) nor 2:1 (a latitude-longitude map)",
+                res.x, res.y
+            ),
+        )),
+        Some(EnvMapLayout::EqualArea) if !pbrt_v3 => Ok(image),
+        Some(_) => {
+            let n = res.x;
+            let why = if pbrt_v3 {
+                "a pbrt-v3 \"mapname\""
+            } else {
+                "2:1"
+            };
+            lp.warn_located(
+                floc.clone(),
+                format!(
+                    "{filename}: {}x{} latitude-longitude environment map ({why}) resampled to the \
+                     {n}x{n} equal-area map pbrt-v4 needs, with pbrt-v3's orientation; convert it \
+                     once with \"rpbrt imgtool makeequiarea\" to skip this",
+                    res.x, res.y
+                ),
+            );
+            equirect_to_equal_area(&image, n)
+                .map_err(|e| Diagnostic::error(floc.clone(), format!("{filename}: {e}")))
+        }
+    }
+}
+
 fn create_infinite(
     lp: &ParamReader,
     render_from_light: Transform,
     camera_transform: &CameraTransform,
+    pbrt_v3: bool,
 ) -> Result<Light, Diagnostic> {
     let cs = lp.color_space();
     let loc = lp.loc();
@@ -389,17 +439,8 @@ fn create_infinite(
     let floc = lp.param_loc("filename");
     let (im, ics) = read_image(lp, &filename)?;
     let image = rgb_image(&im, &filename, "infinite", &floc)?;
+    let image = equal_area_env_map(lp, image, &filename, &floc, pbrt_v3)?;
     let res = image.resolution();
-    if res.x != res.y || res.x <= 0 {
-        return Err(Diagnostic::error(
-            floc,
-            format!(
-                "{filename}: image resolution ({}, {}) is non-square; it is unlikely to be an \
-                 equal-area environment map",
-                res.x, res.y
-            ),
-        ));
-    }
     let mut scale = normalize_scale(scale, &ics.illuminant_spectrum(), "image colour space", loc)?;
     if e_v > 0.0 {
         // Illuminance on an upward-facing (light-space +z) patch: each

@@ -13,6 +13,7 @@ use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary, ParsedParameter};
 use super::*;
 use crate::camera::CameraTransform;
 
+mod envmap;
 mod le;
 use crate::image::Image;
 use crate::params::ParamReader;
@@ -51,6 +52,7 @@ pub(crate) struct LightEntity {
     pub name: String,
     pub params: ParameterDictionary,
     pub render_from_object: AnimatedTransform,
+    pub pbrt_v3: bool,
 }
 
 /// A light and its warnings, unused parameters included.
@@ -61,7 +63,7 @@ pub(crate) fn create_light(
 ) -> Result<(Light, Vec<Diagnostic>), Diagnostic> {
     let at = FileLoc::new(Arc::from("test.pbrt"), 1, 1);
     let r = ParamReader::plain(&e.params, &at);
-    let light = super::create_light(&e.name, &r, &e.render_from_object, medium, ct)?;
+    let light = super::create_light(&e.name, &r, &e.render_from_object, medium, ct, e.pbrt_v3)?;
     Ok((light, r.finish()))
 }
 
@@ -79,6 +81,7 @@ fn entity(name: &str, params: Vec<ParsedParameter>) -> LightEntity {
         name: name.to_string(),
         params: ParameterDictionary::new(params),
         render_from_object: AnimatedTransform::fixed(Transform::identity()),
+        pbrt_v3: false,
     }
 }
 
@@ -750,17 +753,21 @@ fn image_infinite_from_file_illuminance_and_square_check() {
         * spectrum_to_photometric(&cs.illuminant_spectrum());
     assert!(rel_eq(e, 2.0, 1e-3), "{e}");
 
+    // Neither square nor 2:1: an error at the file name.
     let nonsquare = dir.join("wide.pfm");
-    Image::from_f32(vec![1.0; 4 * 2 * 3], Point2i::new(4, 2), &["R", "G", "B"])
+    Image::from_f32(vec![1.0; 3 * 2 * 3], Point2i::new(3, 2), &["R", "G", "B"])
         .unwrap()
         .write(&nonsquare, &Default::default())
         .unwrap();
+    let p = file(&nonsquare);
+    let line = p.loc.line;
     let err = create_light(
-        &entity("infinite", vec![file(&nonsquare)]),
+        &entity("infinite", vec![p]),
         None,
         &CameraTransform::default(),
     )
     .unwrap_err();
-    assert!(format!("{err:?}").contains("non-square"));
+    assert!(err.message.contains("neither square"), "{}", err.message);
+    assert_eq!(line_of(&err), Some(line));
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -324,6 +324,7 @@ pub fn create_scene(
             &l.render_from_object,
             medium_of(&l.medium),
             camera_transform,
+            l.pbrt_v3,
         );
         if let Some(light) = p.finish(r, light) {
             lights.push(light);

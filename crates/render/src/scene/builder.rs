@@ -729,6 +729,10 @@ impl ParserTarget for SceneBuilder {
 
     fn light_source(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
         self.verify_world("LightSource", &loc)?;
+        // Only pbrt-v3 names an infinite light's image "mapname".
+        let pbrt_v3 = params
+            .iter()
+            .any(|p| p.name == "mapname" && p.ty == "string");
         let (name, params) = self.upgraded(upgrade::upgrade_light, name, params, &loc);
         EntityKind::Light.check(&name, &loc)?;
         let attrs = self.state.light_attributes.clone();
@@ -737,6 +741,7 @@ impl ParserTarget for SceneBuilder {
             base,
             render_from_object: self.render_from_object(),
             medium: self.state.outside_medium.clone(),
+            pbrt_v3,
         };
         self.scene.lights.push(light);
         Ok(())

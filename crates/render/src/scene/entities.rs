@@ -135,6 +135,9 @@ pub struct LightSceneEntity {
     pub render_from_object: AnimatedTransform,
     /// The medium the light is in (the current outside medium).
     pub medium: String,
+    /// Written in pbrt-v3's form: an `infinite` light's `mapname` (now
+    /// `filename`) names a latitude–longitude map.
+    pub pbrt_v3: bool,
 }
 
 /// Whether a texture gives numbers or spectra.

@@ -10,16 +10,19 @@ use rpbrt_parser::Diagnostic;
 
 use super::assemble::Problems;
 use super::entities::{
-    AnimatedShapeSceneEntity, MaterialRef, SceneDescription, SceneEntity, ShapeSceneEntity,
+    AnimatedShapeSceneEntity, MaterialRef, OptionValue, SceneDescription, SceneEntity,
+    ShapeSceneEntity,
 };
 use crate::light::{create_area_light, Light};
 use crate::material::MaterialSet;
 use crate::params::ParamReader;
 use crate::primitive::{Alpha, GeometricPrimitive, MediumInterface, Primitive};
-use crate::shape::create::create_shapes;
+use crate::shape::create::{create_shapes, Displacement};
 use crate::shape::Shape;
-use crate::texture::{FloatTexture, NamedTextures, TextureParams};
+use crate::texture::{FloatTexture, NamedTextures, TextureEvalContext, TextureParams};
+use rpbrt_geometry::float::Float;
 use rpbrt_geometry::transform::Transform;
+use rpbrt_geometry::tuple::{Point2f, Point3f};
 
 /// What shapes are turned into primitives with.
 pub(super) struct ShapeContext<'a> {
@@ -63,6 +66,15 @@ pub(super) fn at_origin(s: &AnimatedShapeSceneEntity) -> ShapeSceneEntity {
     }
 }
 
+/// The scene's `displacementedgescale` option (pbrt-v4's
+/// `--displacement-edge-scale`; default 1).
+fn displacement_edge_scale(desc: &SceneDescription) -> Float {
+    match desc.option("displacementedgescale") {
+        Some(OptionValue::Float(v)) if *v > 0.0 => *v,
+        _ => 1.0,
+    }
+}
+
 /// Creates the primitives of one shape entity into `out`, with its area
 /// lights appended to `lights`.
 pub(super) fn create_primitives(
@@ -73,11 +85,38 @@ pub(super) fn create_primitives(
     out: &mut Vec<Primitive>,
 ) {
     let tp = TextureParams::new(reader(&s.base), cx.textures);
+    // pbrt-v4 reads a displacement texture for `plymesh` alone.
+    let displacement = if s.base.name == "plymesh" {
+        match tp.float_texture_opt("displacement") {
+            Ok(t) => t,
+            Err(e) => {
+                problems.errors.push(e);
+                problems.warnings.extend(tp.take_warnings());
+                return;
+            }
+        }
+    } else {
+        None
+    };
+    let eval = |p: Point3f, uv: Point2f| match &displacement {
+        // pbrt-v4 evaluates it at the object-space vertex and its uv.
+        Some(t) => t.evaluate(&TextureEvalContext {
+            p,
+            uv,
+            ..TextureEvalContext::default()
+        }),
+        None => 0.0,
+    };
+    let displace = Displacement {
+        eval: &eval,
+        edge_scale: displacement_edge_scale(cx.desc),
+    };
     let shapes = create_shapes(
         &s.base.name,
         &tp,
         &s.render_from_object,
         s.attributes.reverse_orientation,
+        displacement.as_ref().map(|_| &displace),
     );
     let Some(shapes) = problems.keep_going(&tp, shapes) else {
         return;
@@ -222,7 +261,7 @@ pub fn create_scene_shapes(desc: &SceneDescription) -> SceneShapes {
     let mut out = SceneShapes::default();
     let mut add = |base: &SceneEntity, xf: &Transform, ro: bool| {
         let r = reader(base);
-        match create_shapes(&base.name, &r, xf, ro) {
+        match create_shapes(&base.name, &r, xf, ro, None) {
             Ok(shapes) => out.shapes.extend(shapes),
             Err(e) => out.diagnostics.push(e),
         }

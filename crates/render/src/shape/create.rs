@@ -5,6 +5,7 @@
 
 use super::bilinear::{self, BilinearPatchMesh};
 use super::curve::create_curves;
+use super::displace::{displace, triangulate, DisplacedMesh};
 use super::loopsubdiv::loop_subdivide;
 use super::triangle::{self, TriangleMesh};
 use super::{Cone, Cylinder, Disk, Hyperboloid, Paraboloid, Shape, ShapeError, Sphere};
@@ -55,16 +56,29 @@ fn indices(sp: &ParamReader, name: &str) -> Result<Vec<u32>, Diagnostic> {
         .collect()
 }
 
+/// A `plymesh` shape's `displacement` texture, looked up by the caller
+/// (who has the scene's textures): its value at an object-space point and
+/// uv, and the scene's `displacementedgescale` option.
+pub struct Displacement<'a> {
+    /// The texture's value at (p, uv).
+    pub eval: &'a (dyn Fn(Point3f, Point2f) -> Float + Sync),
+    /// Multiplies the shape's `edgelength`.
+    pub edge_scale: Float,
+}
+
 /// Creates the shapes of one `Shape "name" ...` directive (a mesh gives
 /// one per triangle or patch); file names resolve against the scene file
-/// they were written in. Warnings (skipped degenerate elements...) go to
-/// `sp`; unused parameters are the caller's to report, since primitives
-/// and area lights read some of the same parameters.
+/// they were written in. `displacement` is the `plymesh` shape's
+/// displacement texture (`None`: the directive names none, or the caller
+/// has no textures, which is then an error). Warnings (skipped degenerate
+/// elements...) go to `sp`; unused parameters are the caller's to report,
+/// since primitives and area lights read some of the same parameters.
 pub fn create_shapes(
     name: &str,
     sp: &ParamReader,
     render_from_object: &Transform,
     reverse_orientation: bool,
+    displacement: Option<&Displacement>,
 ) -> Result<Vec<Shape>, Diagnostic> {
     let loc = sp.loc();
     let mut out = Vec::new();
@@ -169,17 +183,62 @@ pub fn create_shapes(
                     "\"plymesh\" shape: \"filename\" is required",
                 ));
             }
-            if let Some(d) = sp.texture_name("displacement")? {
+            let edge_length = f("edgelength", 1.0)?;
+            if !(edge_length > 0.0 && edge_length.is_finite()) {
                 return Err(sp.error_at(
-                    "displacement",
-                    format!("\"plymesh\" shape: displacement texture \"{d}\" is not supported yet"),
+                    "edgelength",
+                    format!("\"plymesh\" shape: \"edgelength\" {edge_length} must be positive"),
                 ));
             }
+            let displacement = match (sp.texture_name("displacement")?, displacement) {
+                (None, _) => None,
+                (Some(_), Some(d)) => Some(d),
+                (Some(t), None) => {
+                    return Err(sp.error_at(
+                        "displacement",
+                        format!(
+                            "\"plymesh\" shape: displacement texture \"{t}\" needs the \
+                             scene's textures, which geometry-only creation does not make"
+                        ),
+                    ))
+                }
+            };
             let path = sp.resolve("filename", &file);
             let mesh = rpbrt_parser::ply::read_ply(&path)
                 .map_err(|e| Diagnostic::error(loc.clone(), format!("\"plymesh\" shape: {e}")))?;
             for w in &mesh.warnings {
                 sp.warn(format!("{}: {w}", path.display()));
+            }
+            if let Some(d) = displacement {
+                let (indices, face_indices) =
+                    triangulate(&mesh.tri_indices, &mesh.quad_indices, &mesh.face_indices);
+                let m = DisplacedMesh {
+                    indices,
+                    p: mesh.positions.iter().map(|&a| Point3f::from(a)).collect(),
+                    n: mesh.normals.iter().map(|&a| Normal3f::from(a)).collect(),
+                    uv: mesh.uvs.iter().map(|&a| Point2f::from(a)).collect(),
+                    face_indices,
+                };
+                let m = displace(m, &rfo, edge_length * d.edge_scale, d.eval).map_err(|e| {
+                    Diagnostic::error(
+                        loc.clone(),
+                        format!("\"plymesh\" shape: {}: {e}", path.display()),
+                    )
+                })?;
+                push_triangles(
+                    &mut out,
+                    sp,
+                    &rfo,
+                    ro,
+                    m.indices,
+                    m.p,
+                    Vec::new(),
+                    m.n,
+                    m.uv,
+                    m.face_indices,
+                    name,
+                )?;
+                return Ok(out);
             }
             let p: Vec<Point3f> = mesh.positions.iter().map(|&a| Point3f::from(a)).collect();
             let n: Vec<Normal3f> = mesh.normals.iter().map(|&a| Normal3f::from(a)).collect();
@@ -346,4 +405,144 @@ fn push_patches(
             .map(Shape::BilinearPatch),
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rpbrt_parser::ply::{write_ply, PlyMesh};
+    use rpbrt_parser::{ParameterDictionary, ParsedParameter};
+    use std::sync::Arc;
+
+    fn at(line: u32) -> FileLoc {
+        FileLoc::new(Arc::from("test.pbrt"), line, 7)
+    }
+
+    /// A unit square in z = 0 as one quad, uv = (x, y), written to a PLY.
+    fn square_ply(tag: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("rpbrt-displace-{tag}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("square.ply");
+        let mesh = PlyMesh {
+            positions: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ],
+            uvs: vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+            quad_indices: vec![0, 1, 3, 2],
+            ..PlyMesh::default()
+        };
+        write_ply(&path, &mesh).unwrap();
+        path
+    }
+
+    fn plymesh_params(path: &std::path::Path, edge: Option<f32>) -> Vec<ParsedParameter> {
+        let mut v = vec![
+            ParsedParameter::with_strings(
+                "string",
+                "filename",
+                at(2),
+                vec![path.display().to_string()],
+            ),
+            ParsedParameter::with_strings("texture", "displacement", at(3), vec!["d".into()]),
+        ];
+        if let Some(e) = edge {
+            v.push(ParsedParameter::with_floats(
+                "float",
+                "edgelength",
+                at(4),
+                vec![e],
+            ));
+        }
+        v
+    }
+
+    #[test]
+    fn displaced_plymesh_matches_the_explicitly_displaced_surface() {
+        let path = square_ply("surface");
+        let dict = ParameterDictionary::new(plymesh_params(&path, Some(0.1)));
+        let loc = at(1);
+        let sp = ParamReader::plain(&dict, &loc);
+        let f = |u: Float, v: Float| 0.1 * (2.0 * rpbrt_geometry::PI * u).sin() * v;
+        let eval = |p: Point3f, uv: Point2f| {
+            assert!((p.x - uv.x).abs() < 1e-6 && (p.y - uv.y).abs() < 1e-6);
+            f(uv.x, uv.y)
+        };
+        // Rendering space is twice object space; with the edge scale of
+        // one half, edges end below 0.05 there.
+        let xf = Transform::scale(2.0, 2.0, 2.0);
+        let d = Displacement {
+            eval: &eval,
+            edge_scale: 0.5,
+        };
+        let shapes = create_shapes("plymesh", &sp, &xf, false, Some(&d)).unwrap();
+        assert!(shapes.len() > 1000, "{} triangles", shapes.len());
+        let mut area = 0.0;
+        for s in &shapes {
+            let Shape::Triangle(t) = s else {
+                panic!("displaced meshes are triangles")
+            };
+            assert!(t.mesh.n.is_some(), "normals are recomputed");
+            let v = t.mesh.vertices(t.tri_index as usize);
+            for k in 0..3 {
+                // Every vertex lies on the displaced surface z = f(x, y)
+                // (object space: rendering space halved).
+                let o = Point3f::new(v[k].x / 2.0, v[k].y / 2.0, v[k].z / 2.0);
+                assert!((o.z - f(o.x, o.y)).abs() < 1e-5, "{o:?}");
+                // The flat mesh's edges (the displacement is along z) are
+                // shorter than the edge length in rendering space.
+                let w = v[(k + 1) % 3] - v[k];
+                assert!((w.x * w.x + w.y * w.y).sqrt() < 0.05 + 1e-6);
+            }
+            let e1 = v[1] - v[0];
+            let e2 = v[2] - v[0];
+            area += (e1.x * e2.y - e1.y * e2.x).abs() / 2.0;
+        }
+        // The triangles tile the 2 × 2 square exactly once.
+        assert!((area - 4.0).abs() < 1e-3, "{area}");
+        assert!(sp.take_warnings().is_empty());
+        let _ = std::fs::remove_dir_all(path.parent().unwrap());
+    }
+
+    #[test]
+    fn displacement_errors_are_located() {
+        let path = square_ply("errors");
+        let eval = |_: Point3f, _: Point2f| 0.0;
+        let d = Displacement {
+            eval: &eval,
+            edge_scale: 1.0,
+        };
+        let loc = at(1);
+        for bad in [0.0, -1.0, f32::NAN] {
+            let dict = ParameterDictionary::new(plymesh_params(&path, Some(bad)));
+            let sp = ParamReader::plain(&dict, &loc);
+            let e =
+                create_shapes("plymesh", &sp, &Transform::identity(), false, Some(&d)).unwrap_err();
+            assert!(e.message.contains("edgelength"), "{}", e.message);
+            assert_eq!(e.loc.as_ref().map(|l| l.line), Some(4), "{e:?}");
+        }
+        // Without the scene's textures, a displacement texture is refused
+        // at its parameter.
+        let dict = ParameterDictionary::new(plymesh_params(&path, None));
+        let sp = ParamReader::plain(&dict, &loc);
+        let e = create_shapes("plymesh", &sp, &Transform::identity(), false, None).unwrap_err();
+        assert!(e.message.contains("displacement"), "{}", e.message);
+        assert_eq!(e.loc.as_ref().map(|l| l.line), Some(3), "{e:?}");
+        // A mesh without uvs cannot be displaced (pbrt-v4 requires them).
+        let no_uv = path.with_file_name("nouv.ply");
+        let mesh = PlyMesh {
+            positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]],
+            tri_indices: vec![0, 1, 2],
+            ..PlyMesh::default()
+        };
+        write_ply(&no_uv, &mesh).unwrap();
+        let dict = ParameterDictionary::new(plymesh_params(&no_uv, None));
+        let sp = ParamReader::plain(&dict, &loc);
+        let e = create_shapes("plymesh", &sp, &Transform::identity(), false, Some(&d)).unwrap_err();
+        assert!(e.message.contains("uvs"), "{}", e.message);
+        assert_eq!(e.loc.as_ref().map(|l| l.line), Some(1), "{e:?}");
+        let _ = std::fs::remove_dir_all(path.parent().unwrap());
+    }
 }

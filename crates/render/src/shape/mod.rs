@@ -31,6 +31,7 @@ pub mod create;
 pub mod curve;
 pub mod cylinder;
 pub mod disk;
+pub mod displace;
 pub mod hyperboloid;
 pub mod loopsubdiv;
 pub mod paraboloid;

@@ -352,6 +352,7 @@ fn entity(params: Vec<ParsedParameter>) -> LightEntity {
         name: "infinite".to_string(),
         params: ParameterDictionary::new(params),
         render_from_object: AnimatedTransform::fixed(Transform::identity()),
+        pbrt_v3: false,
     }
 }
 
