@@ -1,6 +1,16 @@
-//! Image comparison, statistics and simple edits behind `rpbrt imgtool` (pbrt-v4
-//! `cmd/imgtool.cpp` diff/info/convert; `Image::MSE`, `Image::Average`). Functions
-//! return data; formatting for the terminal belongs to the CLI.
+//! Image comparison, statistics and processing behind `rpbrt imgtool`
+//! (pbrt-v4 `cmd/imgtool.cpp`; `Image::MSE`, `Image::Average`). Functions
+//! return data; formatting for the terminal belongs to the CLI. This file
+//! holds `diff`, `average` and `info`; the other commands' work lives in
+//! one submodule per topic.
+
+pub mod color;
+pub mod compose;
+pub mod convert;
+pub mod falsecolor;
+pub mod filter;
+pub mod metrics;
+mod viridis;
 
 use std::fmt;
 
