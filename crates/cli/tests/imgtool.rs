@@ -103,30 +103,58 @@ fn missing_files_and_unknown_options_are_clear_errors() {
     let out = d.join("o.exr");
     let out = out.to_str().unwrap();
     for args in [
-        vec!["bloom", "--level", "1", "--outfile", out, "/nonexistent.exr"],
+        vec![
+            "bloom",
+            "--level",
+            "1",
+            "--outfile",
+            out,
+            "/nonexistent.exr",
+        ],
         vec!["cat", "/nonexistent.exr"],
         vec!["convert", "/nonexistent.exr", out],
         vec!["diff", "/nonexistent.exr", "/nonexistent2.exr"],
-        vec!["error", "--reference", "/nonexistent.exr", "/nonexistent/r-"],
+        vec![
+            "error",
+            "--reference",
+            "/nonexistent.exr",
+            "/nonexistent/r-",
+        ],
         vec!["falsecolor", "--outfile", out, "/nonexistent.exr"],
         vec!["info", "/nonexistent.exr"],
         vec!["makeemitters", "/nonexistent.exr"],
         vec!["scalenormalmap", "--outfile", out, "/nonexistent.exr"],
         vec!["splitn", "--outfile", out, "/nonexistent.exr"],
-        vec!["whitebalance", "--temperature", "3000", "--outfile", out, "/nonexistent.exr"],
+        vec![
+            "whitebalance",
+            "--temperature",
+            "3000",
+            "--outfile",
+            out,
+            "/nonexistent.exr",
+        ],
     ] {
         fails_with(&imgtool(&args), "nonexistent");
     }
     for c in COMMANDS {
         fails_with(&imgtool(&[c, "--frobnicate", "x"]), "frobnicate");
     }
-    fails_with(&imgtool(&["convert", "--scale", "x", "a.exr"]), "not a number");
-    fails_with(&imgtool(&["convert", "--crop", "1,2", "a.exr"]), "4 comma-separated");
+    fails_with(
+        &imgtool(&["convert", "--scale", "x", "a.exr"]),
+        "not a number",
+    );
+    fails_with(
+        &imgtool(&["convert", "--crop", "1,2", "a.exr"]),
+        "4 comma-separated",
+    );
     fails_with(&imgtool(&["convert", "a.exr"]), "--outfile");
     fails_with(&imgtool(&["bloom", "a.exr"]), "--outfile");
     fails_with(&imgtool(&["diff", "a.exr"]), "--reference");
     fails_with(&imgtool(&["error", "a-"]), "--reference");
-    fails_with(&imgtool(&["diff", "--metric", "PSNR", "a", "b"]), "--metric");
+    fails_with(
+        &imgtool(&["diff", "--metric", "PSNR", "a", "b"]),
+        "--metric",
+    );
     fails_with(&imgtool(&["diff", "--metric", "FLIP", "a", "b"]), "FLIP");
 }
 
@@ -169,15 +197,31 @@ fn diff_reports_by_default_and_follows_pbrt_v4_with_a_metric() {
     assert_eq!(o.status.code(), Some(1));
     let s = stdout(&o);
     assert!(s.contains("Images differ"), "{s}");
-    assert!(s.contains("avg = 2.500000 / 1.500000 (66.666667% delta), MAE = 1.000000"), "{s}");
+    assert!(
+        s.contains("avg = 2.500000 / 1.500000 (66.666667% delta), MAE = 1.000000"),
+        "{s}"
+    );
     close(&read(&err).to_f32_vec(), &[0.0, 0.0, 2.0, 2.0]);
     // Within the tolerance: not reported.
     let o = imgtool(&["diff", "--difftol", "70", "--reference", &b, &a]);
     assert_eq!(o.status.code(), Some(0));
     // Channels and crop: only G of the second pixel differs by 2.
-    let o = imgtool(&["diff", "--channels", "G", "--crop", "1,2,0,1", "--metric", "MSE", &a, &b]);
+    let o = imgtool(&[
+        "diff",
+        "--channels",
+        "G",
+        "--crop",
+        "1,2,0,1",
+        "--metric",
+        "MSE",
+        &a,
+        &b,
+    ]);
     assert!(stdout(&o).contains("MSE = 4.000000"), "{}", stdout(&o));
-    fails_with(&imgtool(&["diff", "--channels", "B", &a, &b]), "does not have \"B\"");
+    fails_with(
+        &imgtool(&["diff", "--channels", "B", &a, &b]),
+        "does not have \"B\"",
+    );
     let c = write(&d.join("c.exr"), &[1.0, 2.0], 1, 1, &["R", "G"]);
     fails_with(&imgtool(&["diff", &a, &c]), "doesn't match");
     fails_with(&imgtool(&["diff", "--crop", "0,5,0,1", &a, &b]), "outside");
@@ -186,20 +230,53 @@ fn diff_reports_by_default_and_follows_pbrt_v4_with_a_metric() {
 #[test]
 fn convert_applies_pbrt_v4_options() {
     let d = dir("convert");
-    let i = write(&d.join("i.exr"), &[4.0, 2.0, 1.0, 0.5, 0.25, 0.0], 2, 1, &["R", "G", "B"]);
+    let i = write(
+        &d.join("i.exr"),
+        &[4.0, 2.0, 1.0, 0.5, 0.25, 0.0],
+        2,
+        1,
+        &["R", "G", "B"],
+    );
     let out = d.join("o.exr");
-    let o = imgtool(&["convert", "--clamp", "2", "--scale", "2", "--outfile", out.to_str().unwrap(), &i]);
+    let o = imgtool(&[
+        "convert",
+        "--clamp",
+        "2",
+        "--scale",
+        "2",
+        "--outfile",
+        out.to_str().unwrap(),
+        &i,
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     close(&read(&out).to_f32_vec(), &[4.0, 2.0, 1.0, 1.0, 0.5, 0.0]);
     // --exposure 1 is --scale 2; the output may follow the input; crop
     // keeps the second pixel; flip of one row changes nothing.
     let out2 = d.join("o2.pfm");
-    let o = imgtool(&["convert", "--exposure", "1", "--crop", "1,2,0,1", "--flipy", &i, out2.to_str().unwrap()]);
+    let o = imgtool(&[
+        "convert",
+        "--exposure",
+        "1",
+        "--crop",
+        "1,2,0,1",
+        "--flipy",
+        &i,
+        out2.to_str().unwrap(),
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     close(&read(&out2).to_f32_vec(), &[1.0, 0.5, 0.0]);
     // Reinhard with max luminance 2: pixel 2's lum is 0.25, its scale
     // (1 + 0.25/4) / 1.25 = 0.85.
-    let o = imgtool(&["convert", "--tonemap", "--maxluminance", "2", "--channels", "R,G,B", &i, out2.to_str().unwrap()]);
+    let o = imgtool(&[
+        "convert",
+        "--tonemap",
+        "--maxluminance",
+        "2",
+        "--channels",
+        "R,G,B",
+        &i,
+        out2.to_str().unwrap(),
+    ]);
     assert_eq!(o.status.code(), Some(0));
     let v = read(&out2).to_f32_vec();
     close(&v[3..], &[0.425, 0.2125, 0.0]);
@@ -208,10 +285,19 @@ fn convert_applies_pbrt_v4_options() {
         "doesn't have channels \"Q\"",
     );
     fails_with(
-        &imgtool(&["convert", "--colorspace", "nope", &i, out2.to_str().unwrap()]),
+        &imgtool(&[
+            "convert",
+            "--colorspace",
+            "nope",
+            &i,
+            out2.to_str().unwrap(),
+        ]),
         "color space unknown",
     );
-    fails_with(&imgtool(&["convert", "--repeatpix", "0", &i, out2.to_str().unwrap()]), "--repeatpix");
+    fails_with(
+        &imgtool(&["convert", "--repeatpix", "0", &i, out2.to_str().unwrap()]),
+        "--repeatpix",
+    );
 }
 
 #[test]
@@ -246,7 +332,10 @@ fn error_estimates_mean_error_with_an_interval() {
         "no matching filenames",
     );
     write(&d.join("r-4.exr"), &[1.0], 1, 1, &["Y"]);
-    fails_with(&imgtool(&["error", "--reference", &r, base.to_str().unwrap()]), "r-4.exr");
+    fails_with(
+        &imgtool(&["error", "--reference", &r, base.to_str().unwrap()]),
+        "r-4.exr",
+    );
 }
 
 #[test]
@@ -254,14 +343,23 @@ fn cat_info_and_falsecolor() {
     let d = dir("cat");
     let i = write(&d.join("i.exr"), &[3.0, 1.0, 2.0], 3, 1, &["Y"]);
     let o = imgtool(&["cat", &i]);
-    assert_eq!(stdout(&o), "(0, 0): 3.000000\n(1, 0): 1.000000\n(2, 0): 2.000000\n");
+    assert_eq!(
+        stdout(&o),
+        "(0, 0): 3.000000\n(1, 0): 1.000000\n(2, 0): 2.000000\n"
+    );
     let o = imgtool(&["cat", "--sort", &i]);
-    assert_eq!(stdout(&o), "(1, 0): 1.000000\n(2, 0): 2.000000\n(0, 0): 3.000000\n");
+    assert_eq!(
+        stdout(&o),
+        "(1, 0): 1.000000\n(2, 0): 2.000000\n(0, 0): 3.000000\n"
+    );
     let o = imgtool(&["cat", "--csv", &i]);
     assert_eq!(stdout(&o), "3.000000\n1.000000\n2.000000\n");
     let o = imgtool(&["cat", "--list", &i]);
     assert_eq!(stdout(&o), "3.000000 1.000000 2.000000 \n");
-    fails_with(&imgtool(&["cat", "--sort", "--csv", &i]), "don't make sense");
+    fails_with(
+        &imgtool(&["cat", "--sort", "--csv", &i]),
+        "don't make sense",
+    );
 
     let o = imgtool(&["info", &i]);
     let s = stdout(&o);
@@ -276,7 +374,10 @@ fn cat_info_and_falsecolor() {
     let v = read(&f).to_f32_vec();
     // Pixel 0 is the maximum: viridis' last entry (0.993248, 0.906157,
     // 0.143936) sRGB-decoded: 0.98471, 0.79965, 0.01824 (half floats).
-    assert!((v[0] - 0.98471).abs() < 1e-3 && (v[1] - 0.79965).abs() < 1e-3, "{v:?}");
+    assert!(
+        (v[0] - 0.98471).abs() < 1e-3 && (v[1] - 0.79965).abs() < 1e-3,
+        "{v:?}"
+    );
     let o = imgtool(&["falsecolor", "--ramp", "--outfile", f.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(0));
     assert_eq!(read(&f).resolution(), Point2i::new(10, 300));
@@ -288,7 +389,20 @@ fn bloom_normal_maps_white_balance_splitn_and_emitters() {
     let i = write(&d.join("i.exr"), &[0.5, 4.0, 0.5], 3, 1, &["Y"]);
     let out = d.join("o.exr");
     let os = out.to_str().unwrap();
-    let o = imgtool(&["bloom", "--level", "1", "--width", "3", "--iterations", "1", "--scale", "0.5", "--outfile", os, &i]);
+    let o = imgtool(&[
+        "bloom",
+        "--level",
+        "1",
+        "--width",
+        "3",
+        "--iterations",
+        "1",
+        "--scale",
+        "0.5",
+        "--outfile",
+        os,
+        &i,
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     // Radius 1, sigma 0.5: side weight e^-2 / (1 + 2 e^-2).
     let e = (-2.0f32).exp();
@@ -299,25 +413,78 @@ fn bloom_normal_maps_white_balance_splitn_and_emitters() {
     let n = write(&d.join("n.exr"), &[0.8, 0.5, 0.9], 1, 1, &["R", "G", "B"]);
     let o = imgtool(&["scalenormalmap", "--scale", "0.5", "--outfile", os, &n]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    close(&read(&out).to_f32_vec(), &[0.65, 0.5, (1.0 + 0.91f32.sqrt()) / 2.0]);
-    fails_with(&imgtool(&["scalenormalmap", "--outfile", os, &i]), "R, G, B");
+    close(
+        &read(&out).to_f32_vec(),
+        &[0.65, 0.5, (1.0 + 0.91f32.sqrt()) / 2.0],
+    );
+    fails_with(
+        &imgtool(&["scalenormalmap", "--outfile", os, &i]),
+        "R, G, B",
+    );
 
     // Balancing for D65 in sRGB (whose white is D65) changes little.
-    let o = imgtool(&["whitebalance", "--primaries", "0.3127,0.329", "--outfile", os, &n]);
+    let o = imgtool(&[
+        "whitebalance",
+        "--primaries",
+        "0.3127,0.329",
+        "--outfile",
+        os,
+        &n,
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let v = read(&out).to_f32_vec();
-    assert!((v[0] - 0.8).abs() < 1e-3 && (v[2] - 0.9).abs() < 1e-3, "{v:?}");
+    assert!(
+        (v[0] - 0.8).abs() < 1e-3 && (v[2] - 0.9).abs() < 1e-3,
+        "{v:?}"
+    );
     fails_with(
-        &imgtool(&["whitebalance", "--illuminant", "D65", "--temperature", "5000", "--outfile", os, &n]),
+        &imgtool(&[
+            "whitebalance",
+            "--illuminant",
+            "D65",
+            "--temperature",
+            "5000",
+            "--outfile",
+            os,
+            &n,
+        ]),
         "only provide one",
     );
-    fails_with(&imgtool(&["whitebalance", "--illuminant", "Q9", "--outfile", os, &n]), "illuminant unknown");
-    fails_with(&imgtool(&["whitebalance", "--outfile", os, &n]), "must provide one");
+    fails_with(
+        &imgtool(&["whitebalance", "--illuminant", "Q9", "--outfile", os, &n]),
+        "illuminant unknown",
+    );
+    fails_with(
+        &imgtool(&["whitebalance", "--outfile", os, &n]),
+        "must provide one",
+    );
 
-    let a = write(&d.join("a.exr"), &[1.0; 30 * 20 * 3], 30, 20, &["R", "G", "B"]);
-    let b = write(&d.join("b.exr"), &[2.0; 30 * 20 * 3], 30, 20, &["R", "G", "B"]);
+    let a = write(
+        &d.join("a.exr"),
+        &[1.0; 30 * 20 * 3],
+        30,
+        20,
+        &["R", "G", "B"],
+    );
+    let b = write(
+        &d.join("b.exr"),
+        &[2.0; 30 * 20 * 3],
+        30,
+        20,
+        &["R", "G", "B"],
+    );
     let s = d.join("s.exr");
-    let o = imgtool(&["splitn", "--cropsize", "4", "--crop", "5,5", "--outfile", s.to_str().unwrap(), &a, &b]);
+    let o = imgtool(&[
+        "splitn",
+        "--cropsize",
+        "4",
+        "--crop",
+        "5,5",
+        "--outfile",
+        s.to_str().unwrap(),
+        &a,
+        &b,
+    ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(d.join("crops-s.exr").exists());
     let v = read(&s).to_f32_vec();
@@ -325,13 +492,25 @@ fn bloom_normal_maps_white_balance_splitn_and_emitters() {
     let at = |x: usize, y: usize| v[(y * 30 + x) * 3];
     assert_eq!((at(9, 19), at(10, 19), at(16, 19)), (1.0, 0.0, 2.0));
     let c = write(&d.join("c.exr"), &[1.0; 3], 1, 1, &["R", "G", "B"]);
-    fails_with(&imgtool(&["splitn", "--outfile", s.to_str().unwrap(), &a, &c]), "c.exr");
+    fails_with(
+        &imgtool(&["splitn", "--outfile", s.to_str().unwrap(), &a, &c]),
+        "c.exr",
+    );
 
-    let e = write(&d.join("e.exr"), &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0], 2, 1, &["R", "G", "B"]);
+    let e = write(
+        &d.join("e.exr"),
+        &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0],
+        2,
+        1,
+        &["R", "G", "B"],
+    );
     let o = imgtool(&["makeemitters", &e]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let s = stdout(&o);
-    assert!(s.contains("AreaLightSource \"diffuse\" \"rgb L\" [ 1.000000 2.000000 3.000000 ]"), "{s}");
+    assert!(
+        s.contains("AreaLightSource \"diffuse\" \"rgb L\" [ 1.000000 2.000000 3.000000 ]"),
+        "{s}"
+    );
     assert!(
         s.contains("\"point3 P\" [ 1.000000 1.000000 0 0.000000 1.000000 0 1.000000 0.000000 0 0.000000 0.000000 0 ]"),
         "{s}"

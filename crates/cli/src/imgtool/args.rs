@@ -130,7 +130,10 @@ impl<'a> Args<'a> {
 }
 
 /// The crop window of `--crop x0,x1,y0,y1`.
-pub(crate) fn crop(a: &mut Args, flag: &str) -> Result<Option<rpbrt_render::geometry::Bounds2i>, String> {
+pub(crate) fn crop(
+    a: &mut Args,
+    flag: &str,
+) -> Result<Option<rpbrt_render::geometry::Bounds2i>, String> {
     let c = a.ints(flag, 4)?;
     Ok(rpbrt_render::image::ops::convert::crop_window([
         c[0], c[1], c[2], c[3],
@@ -182,10 +185,17 @@ mod tests {
 
     #[test]
     fn flags_take_values_inline_or_next_and_negative_numbers_are_values() {
-        let v: Vec<String> = ["--scale=2", "-gamma", "-0.5", "--flipy", "in.exr", "--bw=false"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
+        let v: Vec<String> = [
+            "--scale=2",
+            "-gamma",
+            "-0.5",
+            "--flipy",
+            "in.exr",
+            "--bw=false",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
         let mut a = Args::new("convert", &v);
         let mut seen = Vec::new();
         while let Some(x) = a.next_arg() {

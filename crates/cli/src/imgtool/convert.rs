@@ -86,7 +86,8 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     let to_exr = Path::new(&output)
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-    let c = convert(&im.image, &im.metadata, &o, to_exr).map_err(|e| a.err(format!("{input}: {e}")))?;
+    let c =
+        convert(&im.image, &im.metadata, &o, to_exr).map_err(|e| a.err(format!("{input}: {e}")))?;
     for w in &c.warnings {
         eprintln!("rpbrt imgtool convert: warning: {input}: {w}");
     }

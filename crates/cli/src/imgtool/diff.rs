@@ -55,16 +55,24 @@ pub fn run(argv: &[String]) -> Result<(), String> {
                 "outfile" => outfile = Some(a.value(&f)?),
                 "channels" => {
                     let v = a.value(&f)?;
-                    channels = Some(v.split(',').map(|s| s.trim().to_string()).collect::<Vec<_>>());
+                    channels = Some(
+                        v.split(',')
+                            .map(|s| s.trim().to_string())
+                            .collect::<Vec<_>>(),
+                    );
                 }
                 "crop" => window = crop(&mut a, &f)?,
                 "metric" => {
                     let v = a.value(&f)?;
                     if v.eq_ignore_ascii_case("FLIP") {
-                        return Err(a.err("the FLIP metric is not implemented in rpbrt; use MSE, MAE or MRSE"));
+                        return Err(a.err(
+                            "the FLIP metric is not implemented in rpbrt; use MSE, MAE or MRSE",
+                        ));
                     }
                     metric = Some(Metric::parse(&v).ok_or_else(|| {
-                        a.err(format!("{v}: --metric must be \"MAE\", \"MSE\" or \"MRSE\""))
+                        a.err(format!(
+                            "{v}: --metric must be \"MAE\", \"MSE\" or \"MRSE\""
+                        ))
                     })?);
                 }
                 "difftol" => difftol = Some(a.f32(&f)?),
@@ -89,7 +97,9 @@ pub fn run(argv: &[String]) -> Result<(), String> {
         image = image
             .crop(w)
             .map_err(|e| a.err(format!("{image_file}: {e}")))?;
-        refim = refim.crop(w).map_err(|e| a.err(format!("{ref_file}: {e}")))?;
+        refim = refim
+            .crop(w)
+            .map_err(|e| a.err(format!("{ref_file}: {e}")))?;
     }
     let (ra, rb) = (image.resolution(), refim.resolution());
     if ra != rb {

@@ -38,7 +38,9 @@ pub fn run(argv: &[String]) -> Result<(), String> {
                 "metric" => {
                     let v = a.value(&f)?;
                     metric = Metric::parse(&v).ok_or_else(|| {
-                        a.err(format!("{v}: --metric must be \"MAE\", \"MSE\", or \"MRSE\""))
+                        a.err(format!(
+                            "{v}: --metric must be \"MAE\", \"MSE\", or \"MRSE\""
+                        ))
                     })?;
                 }
                 _ => return Err(a.unknown(&f)),
@@ -51,7 +53,9 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     let reference = reference.ok_or_else(|| a.err("must provide --reference file"))?;
     let mut refim = load_md(&reference)?.image;
     if let Some(w) = window {
-        refim = refim.crop(w).map_err(|e| a.err(format!("{reference}: {e}")))?;
+        refim = refim
+            .crop(w)
+            .map_err(|e| a.err(format!("{reference}: {e}")))?;
     }
     let skip: Vec<&Path> = [Some(reference.as_str()), errorfile.as_deref()]
         .into_iter()

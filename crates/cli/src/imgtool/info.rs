@@ -48,7 +48,9 @@ fn metadata_lines(md: &ImageMetadata) -> Vec<String> {
         let h = (t / 3600.0).floor();
         let m = ((t - h * 3600.0) / 60.0).floor();
         let s = t - h * 3600.0 - m * 60.0;
-        l.push(format!("render time: {h}h {m}m {s:.2}s (total {total:.2}s)"));
+        l.push(format!(
+            "render time: {h}h {m}m {s:.2}s (total {total:.2}s)"
+        ));
     }
     if let Some(m) = &md.camera_from_world {
         l.push(format!("camera from world: {}", matrix(m)));

@@ -31,7 +31,8 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     let infile = infile.ok_or_else(|| a.err("missing image filename"))?;
     let image = load(&infile)?;
     let emitters = make_emitters(&image, rate).map_err(|e| a.err(format!("{infile}: {e}")))?;
-    let mut out = String::from("AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\n");
+    let mut out =
+        String::from("AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\n");
     for e in emitters {
         out += &format!(
             "AreaLightSource \"diffuse\" \"rgb L\" [ {:.6} {:.6} {:.6} ]\n",

@@ -46,7 +46,8 @@ pub fn run(argv: &[String]) -> Result<(), String> {
         return Err(a.err("can only provide one of --illuminant, --primaries, --temperature"));
     }
     let src = if let Some(name) = &illuminant {
-        illuminant_white(name).ok_or_else(|| a.err(format!("stdillum-{name}: illuminant unknown")))?
+        illuminant_white(name)
+            .ok_or_else(|| a.err(format!("stdillum-{name}: illuminant unknown")))?
     } else if temperature > 0.0 {
         temperature_white(temperature)
     } else if let Some(xy) = xy {

@@ -5,8 +5,8 @@
 
 use std::sync::Arc;
 
-use crate::image::{Image, ImageError, ImageMetadata};
 use crate::film::{daylight_illuminant, white_balance};
+use crate::image::{Image, ImageError, ImageMetadata};
 use crate::spectrum::{named_spectrum, spectrum_to_xyz, RgbColorSpace, Spectrum};
 
 /// The chromaticity (xy) of pbrt-v4's standard illuminant `name` (the
@@ -34,7 +34,7 @@ pub fn white_balance_image(
     let rgb = image
         .get_channel_desc(&["R", "G", "B"])
         .ok_or_else(|| ImageError::Invalid("image doesn't have R, G, B channels".into()))?;
-    if !(src_white[1] > 0.0) || !src_white[0].is_finite() {
+    if src_white[1].is_nan() || src_white[1] <= 0.0 || !src_white[0].is_finite() {
         return Err(ImageError::Invalid(format!(
             "white point ({}, {}) is not a valid chromaticity",
             src_white[0], src_white[1]
@@ -49,8 +49,8 @@ pub fn white_balance_image(
     let mut out = image.clone();
     for (p, px) in image.to_f32_vec().chunks_exact(nc).enumerate() {
         let v = m.apply([px[rgb.offset[0]], px[rgb.offset[1]], px[rgb.offset[2]]]);
-        for k in 0..3 {
-            out.set_value_at(p * nc + rgb.offset[k], v[k]);
+        for (&o, vk) in rgb.offset.iter().zip(v) {
+            out.set_value_at(p * nc + o, vk);
         }
     }
     Ok(out)
@@ -83,7 +83,8 @@ mod tests {
 
     #[test]
     fn balancing_from_the_spaces_own_white_changes_nothing() {
-        let im = Image::from_f32(vec![0.2, 0.5, 0.9], Point2i::new(1, 1), &["R", "G", "B"]).unwrap();
+        let im =
+            Image::from_f32(vec![0.2, 0.5, 0.9], Point2i::new(1, 1), &["R", "G", "B"]).unwrap();
         let w = RgbColorSpace::srgb().w;
         let o = white_balance_image(&im, &ImageMetadata::default(), w)
             .unwrap()
@@ -98,30 +99,44 @@ mod tests {
         // An RGB whose chromaticity is illuminant A's becomes neutral.
         let a = illuminant_white("A").unwrap();
         // Illuminant A: x = 0.44757, y = 0.40745.
-        assert!((a[0] - 0.44757).abs() < 2e-3 && (a[1] - 0.40745).abs() < 2e-3, "{a:?}");
+        assert!(
+            (a[0] - 0.44757).abs() < 2e-3 && (a[1] - 0.40745).abs() < 2e-3,
+            "{a:?}"
+        );
         let cs = RgbColorSpace::srgb();
         let xyz = crate::spectrum::XYZ::from_xyy(a, 1.0);
         let rgb = cs.to_rgb(xyz);
-        let im = Image::from_f32(vec![rgb.r, rgb.g, rgb.b], Point2i::new(1, 1), &["R", "G", "B"])
-            .unwrap();
+        let im = Image::from_f32(
+            vec![rgb.r, rgb.g, rgb.b],
+            Point2i::new(1, 1),
+            &["R", "G", "B"],
+        )
+        .unwrap();
         let o = white_balance_image(&im, &ImageMetadata::default(), a)
             .unwrap()
             .to_f32_vec();
-        assert!((o[0] - o[1]).abs() < 1e-3 && (o[1] - o[2]).abs() < 1e-3, "{o:?}");
+        assert!(
+            (o[0] - o[1]).abs() < 1e-3 && (o[1] - o[2]).abs() < 1e-3,
+            "{o:?}"
+        );
         assert!(illuminant_white("nope").is_none());
     }
 
     #[test]
     fn daylight_6504k_is_d65() {
         let w = temperature_white(6504.0);
-        assert!((w[0] - 0.3127).abs() < 2e-3 && (w[1] - 0.3290).abs() < 2e-3, "{w:?}");
+        assert!(
+            (w[0] - 0.3127).abs() < 2e-3 && (w[1] - 0.3290).abs() < 2e-3,
+            "{w:?}"
+        );
     }
 
     #[test]
     fn normal_map_slopes_scale() {
         // Normal (0.6, 0, 0.8) encoded (0.8, 0.5, 0.9); scale 0.5 gives
         // x = 0.3, z = sqrt(1 - 0.09) = 0.953939.
-        let im = Image::from_f32(vec![0.8, 0.5, 0.9], Point2i::new(1, 1), &["R", "G", "B"]).unwrap();
+        let im =
+            Image::from_f32(vec![0.8, 0.5, 0.9], Point2i::new(1, 1), &["R", "G", "B"]).unwrap();
         let o = scale_normal_map(&im, 0.5).unwrap().to_f32_vec();
         assert!((o[0] - 0.65).abs() < 1e-6);
         assert!((o[1] - 0.5).abs() < 1e-6);

@@ -36,8 +36,8 @@ fn fill_box(image: &mut Image, b: Bounds2i, rgb: [f32; 3]) {
     for y in b.p_min.y.max(0)..b.p_max.y.min(res.y) {
         for x in b.p_min.x.max(0)..b.p_max.x.min(res.x) {
             let i = (y as usize * res.x as usize + x as usize) * nc;
-            for k in 0..3 {
-                image.set_value_at(i + desc.offset[k], rgb[k]);
+            for (&o, &c) in desc.offset.iter().zip(&rgb) {
+                image.set_value_at(i + o, c);
             }
         }
     }
@@ -198,7 +198,8 @@ pub fn splitn(
             for dy in 0..crop_size {
                 for dx in 0..crop_size {
                     let src = ((c.y + dy) as usize * w + (c.x + dx) as usize) * nc;
-                    let dst = ((inner.y + dy) as usize * xres as usize + (inner.x + dx) as usize) * 3;
+                    let dst =
+                        ((inner.y + dy) as usize * xres as usize + (inner.x + dx) as usize) * 3;
                     for kk in 0..3 {
                         crops_image.set_value_at(dst + kk, vals[k][src + desc.offset[kk]]);
                     }
@@ -273,7 +274,11 @@ pub fn make_emitters(image: &Image, downsample: i32) -> Result<Vec<PixelEmitter>
 /// The pixels of `image` with their coordinates in the full image (offset
 /// by the metadata's data window), in scanline order or, with `sort`, by
 /// increasing channel average (pbrt-v4 `cat`).
-pub fn pixel_listing(image: &Image, metadata: &ImageMetadata, sort: bool) -> Vec<(Point2i, Vec<f32>)> {
+pub fn pixel_listing(
+    image: &Image,
+    metadata: &ImageMetadata,
+    sort: bool,
+) -> Vec<(Point2i, Vec<f32>)> {
     let res = image.resolution();
     let origin = metadata
         .pixel_bounds
@@ -302,8 +307,12 @@ mod tests {
 
     fn flat(v: f32, w: i32, h: i32) -> (Image, ImageMetadata) {
         (
-            Image::from_f32(vec![v; (w * h * 3) as usize], Point2i::new(w, h), &["R", "G", "B"])
-                .unwrap(),
+            Image::from_f32(
+                vec![v; (w * h * 3) as usize],
+                Point2i::new(w, h),
+                &["R", "G", "B"],
+            )
+            .unwrap(),
             ImageMetadata::default(),
         )
     }
@@ -364,7 +373,10 @@ mod tests {
         let e = make_emitters(&im, 1).unwrap();
         assert_eq!(e.len(), 2);
         assert_eq!(e[0].rgb, [1.0, 2.0, 3.0]);
-        assert_eq!(e[0].corners, [[1.0, 1.0], [0.0, 1.0], [1.0, 0.0], [0.0, 0.0]]);
+        assert_eq!(
+            e[0].corners,
+            [[1.0, 1.0], [0.0, 1.0], [1.0, 0.0], [0.0, 0.0]]
+        );
         assert_eq!(e[1].corners[1], [-1.0, 1.0]);
         // Downsampled by 2: one emitter, the mean.
         let e = make_emitters(&im, 2).unwrap();

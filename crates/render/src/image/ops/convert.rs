@@ -103,7 +103,10 @@ pub fn crop_window(c: [i32; 4]) -> Option<Bounds2i> {
 
 /// Whether `a` lies within `b`.
 fn inside(a: &Bounds2i, b: &Bounds2i) -> bool {
-    a.p_min.x >= b.p_min.x && a.p_min.y >= b.p_min.y && a.p_max.x <= b.p_max.x && a.p_max.y <= b.p_max.y
+    a.p_min.x >= b.p_min.x
+        && a.p_min.y >= b.p_min.y
+        && a.p_max.x <= b.p_max.x
+        && a.p_max.y <= b.p_max.y
 }
 
 fn fmt_bounds(b: &Bounds2i) -> String {
@@ -201,7 +204,10 @@ pub fn convert(
         }
         md.full_resolution = Some(full);
         md.pixel_bounds = Some(crop);
-        let origin = metadata.pixel_bounds.map(|b| b.p_min).unwrap_or(Point2i::new(0, 0));
+        let origin = metadata
+            .pixel_bounds
+            .map(|b| b.p_min)
+            .unwrap_or(Point2i::new(0, 0));
         let local = Bounds2i {
             p_min: Point2i::new(crop.p_min.x - origin.x, crop.p_min.y - origin.y),
             p_max: Point2i::new(crop.p_max.x - origin.x, crop.p_max.y - origin.y),
@@ -233,9 +239,9 @@ pub fn convert(
                 "{name}: color space unknown (known: ACES2065-1, Rec2020, DCI-P3, sRGB)"
             ))
         })?;
-        let rgb = im.get_channel_desc(&["R", "G", "B"]).ok_or_else(|| {
-            ImageError::Invalid("image doesn't have R, G, B channels".into())
-        })?;
+        let rgb = im
+            .get_channel_desc(&["R", "G", "B"])
+            .ok_or_else(|| ImageError::Invalid("image doesn't have R, G, B channels".into()))?;
         let src = RgbColorSpace::get(metadata.color_space_name()).unwrap_or(RgbColorSpace::srgb());
         let m = convert_rgb_color_space(src, dest);
         for px in v.chunks_exact_mut(nc) {
@@ -444,7 +450,10 @@ mod tests {
         assert_eq!(&o[0..3], &[9.0, 10.0, 11.0]);
         assert_eq!(&o[12..15], &[3.0, 4.0, 5.0]);
         let pb = c.metadata.pixel_bounds.unwrap();
-        assert_eq!((pb.p_min, pb.p_max), (Point2i::new(2, 0), Point2i::new(4, 4)));
+        assert_eq!(
+            (pb.p_min, pb.p_max),
+            (Point2i::new(2, 0), Point2i::new(4, 4))
+        );
         assert_eq!(c.metadata.full_resolution, Some(Point2i::new(4, 4)));
         // Outside the data window is an error.
         let bad = ConvertOptions {
@@ -456,12 +465,28 @@ mod tests {
 
     #[test]
     fn channels_are_selected_and_aovs_dropped_for_ldr_output() {
-        let im = Image::from_f32(vec![1.0, 2.0, 3.0, 4.0], Point2i::new(1, 1), &["R", "G", "B", "Pz"])
-            .unwrap();
-        let c = convert(&im, &ImageMetadata::default(), &ConvertOptions::default(), false).unwrap();
+        let im = Image::from_f32(
+            vec![1.0, 2.0, 3.0, 4.0],
+            Point2i::new(1, 1),
+            &["R", "G", "B", "Pz"],
+        )
+        .unwrap();
+        let c = convert(
+            &im,
+            &ImageMetadata::default(),
+            &ConvertOptions::default(),
+            false,
+        )
+        .unwrap();
         assert_eq!(c.image.channel_names(), ["R", "G", "B"]);
         assert_eq!(c.warnings.len(), 1);
-        let c = convert(&im, &ImageMetadata::default(), &ConvertOptions::default(), true).unwrap();
+        let c = convert(
+            &im,
+            &ImageMetadata::default(),
+            &ConvertOptions::default(),
+            true,
+        )
+        .unwrap();
         assert_eq!(c.image.n_channels(), 4);
         let opts = ConvertOptions {
             channels: Some(vec!["Pz".into(), "R".into()]),
@@ -490,7 +515,10 @@ mod tests {
             assert!((x - 1.0).abs() < 1e-4, "{o:?}");
         }
         // sRGB red in Rec.2020 (BT.2087's matrix): 0.6274, 0.0691, 0.0164.
-        assert!((o[3] - 0.6274).abs() < 2e-3 && (o[4] - 0.0691).abs() < 2e-3, "{o:?}");
+        assert!(
+            (o[3] - 0.6274).abs() < 2e-3 && (o[4] - 0.0691).abs() < 2e-3,
+            "{o:?}"
+        );
         assert!((o[5] - 0.0164).abs() < 2e-3, "{o:?}");
         assert_eq!(c.metadata.color_space.as_deref(), Some("rec2020"));
         let bad = ConvertOptions {

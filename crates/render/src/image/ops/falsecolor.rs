@@ -5,9 +5,9 @@
 use rpbrt_geometry::Point2i;
 
 use super::viridis::VIRIDIS;
-use crate::image::{Image, PixelFormat};
 use crate::image::encoding::srgb_to_linear;
 use crate::image::ColorEncoding;
+use crate::image::{Image, PixelFormat};
 
 /// The image pbrt-v4's `--ramp` shows: 10×300 pixels, one channel "Y",
 /// running from 1 at the top row to 0 at the bottom.
@@ -57,7 +57,12 @@ pub fn false_color(image: &Image, max_value: Option<f32>, plus_minus: bool) -> I
     let max_value = max_value.unwrap_or_else(|| max_abs_average(image));
     let nc = image.n_channels().max(1);
     let res = image.resolution();
-    let mut out = Image::new(PixelFormat::Half, res, &["R", "G", "B"], ColorEncoding::Linear);
+    let mut out = Image::new(
+        PixelFormat::Half,
+        res,
+        &["R", "G", "B"],
+        ColorEncoding::Linear,
+    );
     for (p, px) in image.to_f32_vec().chunks_exact(nc).enumerate() {
         let rel = px.iter().sum::<f32>() / nc as f32 / max_value;
         let rgb = if plus_minus {
@@ -99,8 +104,8 @@ mod tests {
 
     #[test]
     fn plus_minus_colours_sign() {
-        let im = Image::from_f32(vec![2.0, -1.0, 0.0, -4.0], Point2i::new(2, 1), &["A", "B"])
-            .unwrap();
+        let im =
+            Image::from_f32(vec![2.0, -1.0, 0.0, -4.0], Point2i::new(2, 1), &["A", "B"]).unwrap();
         // Averages 0.5 and -2; max |avg| is 2: 0.25 → green, -1 → red.
         let o = false_color(&im, None, true).to_f32_vec();
         assert_eq!(o[0], 0.0);

@@ -16,7 +16,12 @@ fn gaussian(x: f32, mu: f32, sigma: f32) -> f32 {
 /// Gaussian of standard deviation `sigma` over 2 `half_width` + 1 pixels
 /// (weights normalised; pixels beyond the edge repeat the edge, pbrt-v4's
 /// clamp wrapping).
-pub fn gaussian_filter(image: &Image, desc: &ImageChannelDesc, half_width: i32, sigma: f32) -> Image {
+pub fn gaussian_filter(
+    image: &Image,
+    desc: &ImageChannelDesc,
+    half_width: i32,
+    sigma: f32,
+) -> Image {
     let hw = half_width.max(0);
     let mut wts: Vec<f32> = (0..2 * hw + 1)
         .map(|d| gaussian((d - hw) as f32, 0.0, sigma))

@@ -4,8 +4,8 @@
 //! set of independent renders with a confidence interval from their
 //! spread, and the per-pixel variance image.
 
-use crate::image::{Image, ImageError, PixelFormat};
 use crate::image::ColorEncoding;
+use crate::image::{Image, ImageError, PixelFormat};
 
 /// An error metric of `imgtool diff` and `imgtool error`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -181,8 +181,8 @@ pub struct ErrorEstimate {
 /// Student's t 97.5% quantiles for 1 to 30 degrees of freedom.
 const T_975: [f64; 30] = [
     12.7062, 4.3027, 3.1824, 2.7764, 2.5706, 2.4469, 2.3646, 2.3060, 2.2622, 2.2281, 2.2010,
-    2.1788, 2.1604, 2.1448, 2.1314, 2.1199, 2.1098, 2.1009, 2.0930, 2.0860, 2.0796, 2.0739,
-    2.0687, 2.0639, 2.0595, 2.0555, 2.0518, 2.0484, 2.0452, 2.0423,
+    2.1788, 2.1604, 2.1448, 2.1314, 2.1199, 2.1098, 2.1009, 2.0930, 2.0860, 2.0796, 2.0739, 2.0687,
+    2.0639, 2.0595, 2.0555, 2.0518, 2.0484, 2.0452, 2.0423,
 ];
 
 /// The 97.5% quantile of Student's t distribution with `dof` degrees of
@@ -215,7 +215,9 @@ pub fn estimate_error(
     metric: Metric,
 ) -> Result<ErrorEstimate, ImageError> {
     let Some(first) = images.first() else {
-        return Err(ImageError::Invalid("no images to estimate error from".into()));
+        return Err(ImageError::Invalid(
+            "no images to estimate error from".into(),
+        ));
     };
     let nc = first.n_channels();
     let res = reference.resolution();
