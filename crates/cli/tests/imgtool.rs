@@ -517,3 +517,54 @@ fn bloom_normal_maps_white_balance_splitn_and_emitters() {
     );
     fails_with(&imgtool(&["makeemitters", &i]), "R, G, and B");
 }
+
+#[test]
+fn spectral_channel_names_with_commas_can_be_selected() {
+    let d = dir("spectral");
+    let i = write(
+        &d.join("s.exr"),
+        &[1.0, 2.0, 3.0, 0.5, 0.25],
+        1,
+        1,
+        &["R", "G", "B", "S0.418,750nm", "S0.431,250nm"],
+    );
+    let out = d.join("o.exr");
+    let o = imgtool(&[
+        "convert",
+        "--channels",
+        "S0.431,250nm,R",
+        &i,
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let im = read(&out);
+    let desc = im.get_channel_desc(&["S0.431,250nm", "R"]).unwrap();
+    assert_eq!(im.select_channels(&desc).to_f32_vec(), vec![0.25, 1.0]);
+    let o = imgtool(&[
+        "diff",
+        "--channels",
+        "S0.418,750nm",
+        "--metric",
+        "MSE",
+        &i,
+        &i,
+    ]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
+
+#[test]
+fn a_closed_output_pipe_is_not_a_panic() {
+    use std::process::Stdio;
+    let d = dir("pipe");
+    let i = write(&d.join("big.exr"), &vec![0.5; 200 * 200], 200, 200, &["Y"]);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_rpbrt"))
+        .args(["imgtool", "cat", &i])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(!stderr(&o).contains("panicked"));
+}

@@ -1,7 +1,7 @@
 //! `imgtool cat`: print an image's pixel values (pbrt-v4's `cat`).
 
 use super::args::{Arg, Args};
-use super::load_md;
+use super::{emit, load_md};
 use rpbrt_render::image::ops::compose::pixel_listing;
 
 /// Usage of `imgtool cat`.
@@ -67,6 +67,5 @@ pub fn run(argv: &[String]) -> Result<(), String> {
             }
         }
     }
-    print!("{out}");
-    Ok(())
+    emit(&out)
 }

@@ -4,6 +4,7 @@
 use super::args::{crop, Arg, Args};
 use super::{load_md, save};
 use rpbrt_render::image::ops::convert::{convert, ConvertOptions};
+use rpbrt_render::image::ops::split_channel_list;
 use std::path::Path;
 
 /// Usage of `imgtool convert`.
@@ -41,17 +42,14 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     let mut a = Args::new("convert", argv);
     let mut o = ConvertOptions::default();
     let mut exposure = 0.0f32;
-    let mut outfile = None;
+    let (mut outfile, mut channels) = (None, None);
     let mut files = Vec::new();
     while let Some(arg) = a.next_arg() {
         match arg {
             Arg::Flag(f) => match f.to_ascii_lowercase().as_str() {
                 "acesfilmic" | "aces-filmic" => o.aces_filmic = a.bool(&f)?,
                 "bw" => o.bw = a.bool(&f)?,
-                "channels" => {
-                    let v = a.value(&f)?;
-                    o.channels = Some(v.split(',').map(|s| s.trim().to_string()).collect());
-                }
+                "channels" => channels = Some(a.value(&f)?),
                 "clamp" => o.clamp = a.f32(&f)?,
                 "colorspace" => o.color_space = Some(a.value(&f)?),
                 "crop" => o.crop = crop(&mut a, &f)?,
@@ -83,6 +81,9 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     }
     o.scale *= exposure.exp2();
     let im = load_md(&input)?;
+    if let Some(spec) = channels {
+        o.channels = Some(split_channel_list(&spec, im.image.channel_names()));
+    }
     let to_exr = Path::new(&output)
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("exr"));

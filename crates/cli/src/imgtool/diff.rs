@@ -4,10 +4,11 @@
 //! otherwise a summary and status 1.
 
 use super::args::{crop, Arg, Args};
-use super::{load_md, save};
+use super::{emit, load_md, save};
 use rpbrt_render::image::ops::metrics::{metric_error, zero_infinities, Metric};
-use rpbrt_render::image::ops::{diff, worst_block, BLOCK_SIZE};
+use rpbrt_render::image::ops::{diff, split_channel_list, worst_block, BLOCK_SIZE};
 use rpbrt_render::image::{Image, ImageAndMetadata};
+use std::fmt::Write as _;
 
 /// Usage of `imgtool diff`.
 pub const USAGE: &str = "\
@@ -53,14 +54,7 @@ pub fn run(argv: &[String]) -> Result<(), String> {
             Arg::Flag(f) => match f.as_str() {
                 "reference" => reference = Some(a.value(&f)?),
                 "outfile" => outfile = Some(a.value(&f)?),
-                "channels" => {
-                    let v = a.value(&f)?;
-                    channels = Some(
-                        v.split(',')
-                            .map(|s| s.trim().to_string())
-                            .collect::<Vec<_>>(),
-                    );
-                }
+                "channels" => channels = Some(a.value(&f)?),
                 "crop" => window = crop(&mut a, &f)?,
                 "metric" => {
                     let v = a.value(&f)?;
@@ -90,7 +84,10 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     };
     let im = load_md(&image_file)?;
     let rf = load_md(&ref_file)?;
-    let chans = channels.unwrap_or_else(|| im.image.channel_names().to_vec());
+    let chans = match channels {
+        Some(spec) => split_channel_list(&spec, im.image.channel_names()),
+        None => im.image.channel_names().to_vec(),
+    };
     let mut image = select(&im, &image_file, &chans)?;
     let mut refim = select(&rf, &ref_file, &chans)?;
     if let Some(w) = window {
@@ -149,52 +146,57 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     if tol > 0.0 && delta.abs() <= tol as f64 {
         return Ok(());
     }
-    println!(
-        "Images differ:\n\t{image_file} {ref_file}\n\tavg = {ia:.6} / {ra:.6} ({delta:.6}% delta), {} = {:.6}",
+    emit(&format!(
+        "Images differ:\n\t{image_file} {ref_file}\n\tavg = {ia:.6} / {ra:.6} ({delta:.6}% delta), {} = {:.6}\n",
         metric.name(),
         e.average()
-    );
+    ))?;
     Err(String::new())
 }
 
 /// Prints rpbrt's default report.
 fn report(a: &Image, b: &Image) -> Result<(), String> {
+    let mut o = String::new();
     let s = diff(a, b).map_err(|e| format!("diff: {e}"))?;
     let ratio = |x: f64, y: f64| if y != 0.0 { x / y } else { f64::NAN };
-    println!("channels: {}", s.channels.join(","));
-    println!("MSE: {:.6e}", s.mse);
-    println!("relative MSE: {:.6e}", s.rel_mse);
-    println!(
+    let _ = writeln!(o, "channels: {}", s.channels.join(","));
+    let _ = writeln!(o, "MSE: {:.6e}", s.mse);
+    let _ = writeln!(o, "relative MSE: {:.6e}", s.rel_mse);
+    let _ = writeln!(
+        o,
         "relative MSE (worst 0.1% dropped): {:.6e}",
         s.rel_mse_trimmed
     );
-    println!(
+    let _ = writeln!(
+        o,
         "mean: {:.6} (reference {:.6}, ratio {:.4})",
         s.mean_a,
         s.mean_b,
         ratio(s.mean_a, s.mean_b)
     );
-    println!(
+    let _ = writeln!(o,
         "mean clamped at the reference's 99.9th percentile ({:.6}): {:.6} (reference {:.6}, ratio {:.4})",
         s.clamp_value,
         s.clamped_mean_a,
         s.clamped_mean_b,
         ratio(s.clamped_mean_a, s.clamped_mean_b)
     );
-    println!(
+    let _ = writeln!(
+        o,
         "median pixel brightness: {:.6} (reference {:.6}, ratio {:.4})",
         s.median_a,
         s.median_b,
         ratio(s.median_a, s.median_b)
     );
     if let Some(w) = worst_block(a, b, BLOCK_SIZE).map_err(|e| format!("diff: {e}"))? {
-        println!(
+        let _ =
+            writeln!(o,
             "worst {BLOCK_SIZE}x{BLOCK_SIZE} block: z {:.2} (mean ratio {:.4}, block at {}, {})",
             w.z, w.ratio, w.at.x, w.at.y
         );
     }
-    println!("max |difference|: {:.6e}", s.max_abs_diff);
-    println!("differing pixels: {}", s.differing_pixels);
-    println!("non-finite terms: {}", s.non_finite);
-    Ok(())
+    let _ = writeln!(o, "max |difference|: {:.6e}", s.max_abs_diff);
+    let _ = writeln!(o, "differing pixels: {}", s.differing_pixels);
+    let _ = writeln!(o, "non-finite terms: {}", s.non_finite);
+    emit(&o)
 }

@@ -4,7 +4,7 @@
 
 use super::args::{crop, fmt_g, Arg, Args};
 use super::average::matching_filenames;
-use super::{load_md, save};
+use super::{emit, load_md, save};
 use rpbrt_render::image::ops::metrics::{estimate_error, Metric};
 use rpbrt_render::image::ImageMetadata;
 use std::path::Path;
@@ -100,20 +100,20 @@ pub fn run(argv: &[String]) -> Result<(), String> {
             None => a.err(m),
         }
     })?;
-    println!("{} estimate = {}", metric.name(), fmt_g(e.mean, 9));
+    let mut out = format!("{} estimate = {}\n", metric.name(), fmt_g(e.mean, 9));
     if images.len() > 1 {
-        println!(
-            "95% confidence interval: [{}, {}] (standard error {}, {} images)",
+        out += &format!(
+            "95% confidence interval: [{}, {}] (standard error {}, {} images)\n",
             fmt_g(e.ci95.0, 6),
             fmt_g(e.ci95.1, 6),
             fmt_g(e.std_error, 6),
             images.len()
         );
     } else {
-        println!("95% confidence interval: needs at least two images (1 image)");
+        out += "95% confidence interval: needs at least two images (1 image)\n";
     }
-    if let Some(out) = errorfile {
-        save(&e.variance_image, &out, &ImageMetadata::default())?;
+    if let Some(f) = errorfile {
+        save(&e.variance_image, &f, &ImageMetadata::default())?;
     }
-    Ok(())
+    emit(&out)
 }

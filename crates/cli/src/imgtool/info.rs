@@ -1,7 +1,7 @@
 //! `imgtool info`: resolution, metadata and channel statistics of images
 //! (pbrt-v4's `info`).
 
-use super::load_md;
+use super::{emit, load_md};
 use rpbrt_render::image::ops::info;
 use rpbrt_render::image::ImageMetadata;
 
@@ -84,11 +84,12 @@ pub fn run(args: &[String]) -> Result<(), String> {
     }
     for f in args {
         let im = load_md(f)?;
-        println!("{f}:");
+        let mut s = format!("{f}:\n");
         for l in metadata_lines(&im.metadata) {
-            println!("  {l}");
+            s += &format!("  {l}\n");
         }
-        print!("{}", info(&im.image));
+        s += &info(&im.image).to_string();
+        emit(&s)?;
     }
     Ok(())
 }

@@ -2,7 +2,7 @@
 //! (pbrt-v4's `makeemitters`).
 
 use super::args::{Arg, Args};
-use super::load;
+use super::{emit, load};
 use rpbrt_render::image::ops::compose::make_emitters;
 
 /// Usage of `imgtool makeemitters`.
@@ -45,6 +45,5 @@ pub fn run(argv: &[String]) -> Result<(), String> {
         );
     }
     out += "AttributeEnd\n";
-    print!("{out}");
-    Ok(())
+    emit(&out)
 }

@@ -128,6 +128,18 @@ fn overview() -> String {
     s
 }
 
+/// Writes `s` to standard output; a closed pipe (`| head`) is not an error.
+pub(crate) fn emit(s: &str) -> Result<(), String> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(s.as_bytes()).and_then(|_| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(format!("writing to standard output: {e}"))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Reads an image, with the file name in any error.
 pub(crate) fn load(path: &str) -> Result<Image, String> {
     load_md(path).map(|im| im.image)
@@ -158,15 +170,9 @@ pub fn run(args: &[String]) -> ExitCode {
     let rest = &args[1..];
     let result = match cmd.as_str() {
         "help" | "--help" | "-h" => match rest.first() {
-            None => {
-                print!("{}", overview());
-                Ok(())
-            }
+            None => emit(&overview()),
             Some(name) => match find(name) {
-                Some(c) => {
-                    print!("{}", c.usage);
-                    Ok(())
-                }
+                Some(c) => emit(c.usage),
                 None => Err(format!(
                     "unknown imgtool command \"{name}\"\n\n{}",
                     overview()
@@ -174,10 +180,7 @@ pub fn run(args: &[String]) -> ExitCode {
             },
         },
         name => match find(name) {
-            Some(c) if rest.iter().any(|a| a == "--help" || a == "-h") => {
-                print!("{}", c.usage);
-                Ok(())
-            }
+            Some(c) if rest.iter().any(|a| a == "--help" || a == "-h") => emit(c.usage),
             Some(c) => (c.run)(rest),
             None => Err(format!(
                 "unknown imgtool command \"{name}\"\n\n{}",
