@@ -3,6 +3,9 @@
 use std::path::PathBuf;
 use std::process::Command;
 
+/// `rpbrt imgtool`'s commands, each against hand-computed results.
+mod imgtool;
+
 fn rpbrt() -> Command {
     Command::new(env!("CARGO_BIN_EXE_rpbrt"))
 }

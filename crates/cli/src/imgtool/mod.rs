@@ -2,18 +2,27 @@
 //! command, each with its `USAGE` and `run`; the numbers come from
 //! `rpbrt_render::image::ops`, these modules only parse arguments and print.
 
-use rpbrt_render::image::Image;
+use rpbrt_render::image::{Image, ImageAndMetadata, ImageMetadata};
 use std::path::Path;
 use std::process::ExitCode;
 
+mod args;
 mod assemble;
 mod average;
+mod bloom;
+mod cat;
 mod convert;
 mod diff;
+mod error;
+mod falsecolor;
 mod info;
+mod makeemitters;
 mod makeequiarea;
 mod makesky;
 mod merge;
+mod scalenormalmap;
+mod splitn;
+mod whitebalance;
 
 /// A command: its name, one-line summary, usage text and entry point.
 struct Command {
@@ -38,8 +47,20 @@ const COMMANDS: &[Command] = &[
         run: average::run,
     },
     Command {
+        name: "bloom",
+        summary: "add a bloom around bright pixels",
+        usage: bloom::USAGE,
+        run: bloom::run,
+    },
+    Command {
+        name: "cat",
+        summary: "print pixel values",
+        usage: cat::USAGE,
+        run: cat::run,
+    },
+    Command {
         name: "convert",
-        summary: "convert an image's format, exposure, orientation",
+        summary: "convert format; scale, tone map, crop, recolour",
         usage: convert::USAGE,
         run: convert::run,
     },
@@ -50,10 +71,28 @@ const COMMANDS: &[Command] = &[
         run: diff::run,
     },
     Command {
+        name: "error",
+        summary: "mean error of renders against a reference, with a 95% interval",
+        usage: error::USAGE,
+        run: error::run,
+    },
+    Command {
+        name: "falsecolor",
+        summary: "false-colour image of pixel magnitudes",
+        usage: falsecolor::USAGE,
+        run: falsecolor::run,
+    },
+    Command {
         name: "info",
-        summary: "print resolution, channels and statistics",
+        summary: "print resolution, metadata and channel statistics",
         usage: info::USAGE,
         run: info::run,
+    },
+    Command {
+        name: "makeemitters",
+        summary: "scene text: a quad emitter per pixel",
+        usage: makeemitters::USAGE,
+        run: makeemitters::run,
     },
     Command {
         name: "makeequiarea",
@@ -73,6 +112,24 @@ const COMMANDS: &[Command] = &[
         usage: merge::USAGE,
         run: merge::run,
     },
+    Command {
+        name: "scalenormalmap",
+        summary: "scale a normal map's slopes",
+        usage: scalenormalmap::USAGE,
+        run: scalenormalmap::run,
+    },
+    Command {
+        name: "splitn",
+        summary: "composite of slanted strips of images, with crops",
+        usage: splitn::USAGE,
+        run: splitn::run,
+    },
+    Command {
+        name: "whitebalance",
+        summary: "white balance for an illuminant, white point or temperature",
+        usage: whitebalance::USAGE,
+        run: whitebalance::run,
+    },
 ];
 
 /// The overview printed by `rpbrt imgtool help`.
@@ -85,10 +142,32 @@ fn overview() -> String {
     s
 }
 
+/// Writes `s` to standard output; a closed pipe (`| head`) is not an error.
+pub(crate) fn emit(s: &str) -> Result<(), String> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(s.as_bytes()).and_then(|_| out.flush()) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => {
+            Err(format!("writing to standard output: {e}"))
+        }
+        _ => Ok(()),
+    }
+}
+
 /// Reads an image, with the file name in any error.
 pub(crate) fn load(path: &str) -> Result<Image, String> {
-    Image::read(Path::new(path), None)
-        .map(|im| im.image)
+    load_md(path).map(|im| im.image)
+}
+
+/// Reads an image and its metadata, with the file name in any error.
+pub(crate) fn load_md(path: &str) -> Result<ImageAndMetadata, String> {
+    Image::read(Path::new(path), None).map_err(|e| e.to_string())
+}
+
+/// Writes an image (format by extension), with the file name in any error.
+pub(crate) fn save(image: &Image, path: &str, metadata: &ImageMetadata) -> Result<(), String> {
+    image
+        .write(Path::new(path), metadata)
         .map_err(|e| e.to_string())
 }
 
@@ -105,15 +184,9 @@ pub fn run(args: &[String]) -> ExitCode {
     let rest = &args[1..];
     let result = match cmd.as_str() {
         "help" | "--help" | "-h" => match rest.first() {
-            None => {
-                print!("{}", overview());
-                Ok(())
-            }
+            None => emit(&overview()),
             Some(name) => match find(name) {
-                Some(c) => {
-                    print!("{}", c.usage);
-                    Ok(())
-                }
+                Some(c) => emit(c.usage),
                 None => Err(format!(
                     "unknown imgtool command \"{name}\"\n\n{}",
                     overview()
@@ -121,10 +194,7 @@ pub fn run(args: &[String]) -> ExitCode {
             },
         },
         name => match find(name) {
-            Some(c) if rest.iter().any(|a| a == "--help" || a == "-h") => {
-                print!("{}", c.usage);
-                Ok(())
-            }
+            Some(c) if rest.iter().any(|a| a == "--help" || a == "-h") => emit(c.usage),
             Some(c) => (c.run)(rest),
             None => Err(format!(
                 "unknown imgtool command \"{name}\"\n\n{}",
@@ -134,6 +204,8 @@ pub fn run(args: &[String]) -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // A command that printed its own verdict (pbrt-v4's diff).
+        Err(e) if e.is_empty() => ExitCode::FAILURE,
         Err(e) => {
             eprintln!("rpbrt imgtool: error: {e}");
             ExitCode::FAILURE

@@ -975,3 +975,18 @@ fn exr_with_a_vast_data_window_is_an_error() {
         "{e}"
     );
 }
+
+#[test]
+fn channel_lists_keep_commas_of_spectral_names() {
+    use crate::image::ops::split_channel_list;
+    let avail: Vec<String> = ["R", "G", "S0.418,750nm", "S0.431,250nm"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    assert_eq!(
+        split_channel_list("R,S0.418,750nm,G", &avail),
+        ["R", "S0.418,750nm", "G"]
+    );
+    assert_eq!(split_channel_list("Q,R", &avail), ["Q", "R"]);
+    assert_eq!(split_channel_list("S0.418", &avail), ["S0.418"]);
+}

@@ -1,6 +1,7 @@
 //! OpenEXR through the `exr` crate: any channels, half or float, with pbrt-v4's
-//! metadata attributes (pbrt-v4 `ReadEXR`, `WriteEXR`). The first layer of a multi-layer
-//! file is read; channels of mixed sample types are read as float.
+//! metadata attributes (pbrt-v4 `ReadEXR`, `WriteEXR`). Of a multi-part file, every part
+//! of the first part's size is read, a named part's channels as "<part>.<channel>";
+//! channels of mixed sample types are read as float.
 
 use std::collections::HashMap;
 use std::io::Cursor;
@@ -130,18 +131,40 @@ pub(super) fn read(data: &[u8]) -> FmtResult<ImageAndMetadata> {
     let layer = decoded.layer_data.first().ok_or("EXR file has no layers")?;
     let (w, h) = (layer.size.0, layer.size.1);
     let res = super::check_resolution(w as i64, h as i64)?;
-    let channels = &layer.channel_data.list;
+    // Every layer (part) of the first one's size contributes its channels;
+    // a named layer's channels are called "<layer>.<channel>", OpenEXR's
+    // multi-layer naming, unless they already carry that prefix.
+    let mut channels: Vec<(String, &FlatSamples)> = Vec::new();
+    for l in &decoded.layer_data {
+        if l.size != layer.size || l.attributes.layer_position != layer.attributes.layer_position {
+            continue;
+        }
+        let prefix = l.attributes.layer_name.as_ref().map(|n| n.to_string());
+        for c in &l.channel_data.list {
+            let name = c.name.to_string();
+            let name = match &prefix {
+                Some(p) if !p.is_empty() && !name.starts_with(&format!("{p}.")) => {
+                    format!("{p}.{name}")
+                }
+                _ => name,
+            };
+            if channels.iter().any(|(n, _)| *n == name) {
+                return Err(format!("EXR file has channel \"{name}\" twice"));
+            }
+            channels.push((name, &c.sample_data));
+        }
+    }
     if channels.is_empty() {
         return Err("EXR layer has no channels".into());
     }
-    let names: Vec<String> = channels.iter().map(|c| c.name.to_string()).collect();
+    let names: Vec<String> = channels.iter().map(|(n, _)| n.clone()).collect();
     let nc = channels.len();
     let npix = w * h;
     let all_half = channels
         .iter()
-        .all(|c| matches!(c.sample_data, FlatSamples::F16(_)));
-    for c in channels {
-        let len = match &c.sample_data {
+        .all(|(_, c)| matches!(c, FlatSamples::F16(_)));
+    for (_, c) in &channels {
+        let len = match c {
             FlatSamples::F16(v) => v.len(),
             FlatSamples::F32(v) => v.len(),
             FlatSamples::U32(v) => v.len(),
@@ -152,8 +175,8 @@ pub(super) fn read(data: &[u8]) -> FmtResult<ImageAndMetadata> {
     }
     let image = if all_half {
         let mut px = vec![f16::ZERO; npix * nc];
-        for (ci, c) in channels.iter().enumerate() {
-            if let FlatSamples::F16(v) = &c.sample_data {
+        for (ci, (_, c)) in channels.iter().enumerate() {
+            if let FlatSamples::F16(v) = c {
                 for (i, &s) in v.iter().enumerate() {
                     px[i * nc + ci] = s;
                 }
@@ -162,9 +185,9 @@ pub(super) fn read(data: &[u8]) -> FmtResult<ImageAndMetadata> {
         Image::from_f16(px, res, &names)
     } else {
         let mut px = vec![0.0f32; npix * nc];
-        for (ci, c) in channels.iter().enumerate() {
+        for (ci, (_, c)) in channels.iter().enumerate() {
             for i in 0..npix {
-                px[i * nc + ci] = match &c.sample_data {
+                px[i * nc + ci] = match c {
                     FlatSamples::F16(v) => v[i].to_f32(),
                     FlatSamples::F32(v) => v[i],
                     FlatSamples::U32(v) => v[i] as f32,
@@ -306,4 +329,57 @@ pub(super) fn write(image: &Image, md: &ImageMetadata) -> FmtResult<Vec<u8>> {
         .to_buffered(&mut buf)
         .map_err(|e| e.to_string())?;
     Ok(buf.into_inner())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use exr::prelude::{ImageAttributes, WritableImage};
+
+    fn layer(name: &str, chans: &[(&str, [f32; 2])]) -> Layer<AnyChannels<FlatSamples>> {
+        let list: SmallVec<[AnyChannel<FlatSamples>; 4]> = chans
+            .iter()
+            .map(|(n, v)| AnyChannel::new(Text::new_or_panic(*n), FlatSamples::F32(v.to_vec())))
+            .collect();
+        Layer::new(
+            Vec2(2, 1),
+            LayerAttributes::named(Text::new_or_panic(name)),
+            Encoding::UNCOMPRESSED,
+            AnyChannels::sort(list),
+        )
+    }
+
+    #[test]
+    fn multi_part_files_read_every_layer_with_prefixed_names() {
+        let layers: SmallVec<[_; 2]> = [
+            layer("diffuse", &[("R", [1.0, 2.0]), ("G", [3.0, 4.0])]),
+            layer("specular", &[("specular.B", [5.0, 6.0])]),
+        ]
+        .into_iter()
+        .collect();
+        let im = exr::image::Image::from_layers(
+            ImageAttributes::new(IntegerBounds::from_dimensions(Vec2(2, 1))),
+            layers,
+        );
+        let mut buf = Cursor::new(Vec::new());
+        im.write().non_parallel().to_buffered(&mut buf).unwrap();
+        let r = read(&buf.into_inner()).unwrap();
+        assert_eq!(
+            r.image.channel_names(),
+            ["diffuse.G", "diffuse.R", "specular.B"]
+        );
+        assert_eq!(r.image.to_f32_vec(), vec![3.0, 1.0, 5.0, 4.0, 2.0, 6.0]);
+    }
+
+    #[test]
+    fn spectral_channel_names_round_trip() {
+        let names = ["R", "G", "B", "S0.418,750nm", "S0.431,250nm"];
+        let vals: Vec<f32> = (0..10).map(|i| i as f32).collect();
+        let im = Image::from_f32(vals, Point2i::new(2, 1), &names).unwrap();
+        let bytes = write(&im, &ImageMetadata::default()).unwrap();
+        let r = read(&bytes).unwrap();
+        let desc = r.image.get_channel_desc(&names).unwrap();
+        let back = r.image.select_channels(&desc);
+        assert_eq!(back.to_f32_vec(), im.to_f32_vec());
+    }
 }

@@ -1,12 +1,42 @@
-//! Image comparison, statistics and simple edits behind `rpbrt imgtool` (pbrt-v4
-//! `cmd/imgtool.cpp` diff/info/convert; `Image::MSE`, `Image::Average`). Functions
-//! return data; formatting for the terminal belongs to the CLI.
+//! Image comparison, statistics and processing behind `rpbrt imgtool`
+//! (pbrt-v4 `cmd/imgtool.cpp`; `Image::MSE`, `Image::Average`). Functions
+//! return data; formatting for the terminal belongs to the CLI. This file
+//! holds `diff`, `average` and `info`; the other commands' work lives in
+//! one submodule per topic.
+
+pub mod color;
+pub mod compose;
+pub mod convert;
+pub mod falsecolor;
+pub mod filter;
+pub mod metrics;
+mod viridis;
 
 use std::fmt;
 
 use rpbrt_geometry::Point2i;
 
 use super::{ColorEncoding, Image, ImageError, PixelFormat};
+
+/// Splits a comma-separated channel list (pbrt-v4's `--channels`) into
+/// names, keeping the commas inside channel names that have them (the
+/// spectral film's "S0.418,750nm"): at each piece the longest run of
+/// comma-joined pieces naming one of `available` is taken, otherwise the
+/// piece alone (an unknown name the caller reports).
+pub fn split_channel_list(spec: &str, available: &[String]) -> Vec<String> {
+    let pieces: Vec<&str> = spec.split(',').map(str::trim).collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < pieces.len() {
+        let take = (i + 1..=pieces.len())
+            .rev()
+            .find(|&j| available.iter().any(|a| *a == pieces[i..j].join(",")))
+            .unwrap_or(i + 1);
+        out.push(pieces[i..take].join(","));
+        i = take;
+    }
+    out
+}
 
 /// Differences between two images of the same resolution and channels.
 #[derive(Clone, Debug, PartialEq)]
