@@ -207,8 +207,15 @@ impl FilmCore {
             return RGB::new(0.0, 0.0, 0.0);
         }
         let i = self.pixels.index(p);
+        self.rgb_from_sums(i, self.pixels.rgb[i], splat_scale)
+    }
+
+    /// Output RGB of pixel index `i` whose weighted sensor-RGB sums and
+    /// weight sum are `px` (the film's own, or with a tile's added).
+    #[inline]
+    fn rgb_from_sums(&self, i: usize, px: [f64; 4], splat_scale: Float) -> RGB {
         partial::resolve_rgb(
-            self.pixels.rgb[i],
+            px,
             [0, 1, 2].map(|c| self.splat_rgb.get(3 * i + c)),
             splat_scale,
             self.filter_integral,
@@ -546,6 +553,40 @@ impl Film {
     pub fn get_pixel_rgb(&self, p: Point2i, splat_scale: Float) -> RGB {
         self.core().get_pixel_rgb(p, splat_scale)
     }
+    /// The film's output RGB as it stands, with the sums of `tiles` (not
+    /// yet merged) added to their pixels: what [`Film::get_image`] would
+    /// give for R, G and B after merging them (unclamped), as
+    /// `3 × width × height` values over the active bounds
+    /// ([`Film::active_bounds`]), rows from the top. For watching a
+    /// render while a wave runs: the film is only read.
+    pub fn rgb_snapshot<'t>(
+        &self,
+        tiles: impl IntoIterator<Item = &'t FilmTile>,
+        splat_scale: Float,
+    ) -> Vec<f32> {
+        let c = self.core();
+        let b = c.active;
+        let d = b.diagonal();
+        let width = d.x.max(0) as usize;
+        let mut out = Vec::with_capacity(3 * b.area().max(0) as usize);
+        for p in b.iter() {
+            let i = c.pixels.index(p);
+            let rgb = c.rgb_from_sums(i, c.pixels.rgb[i], splat_scale);
+            out.extend_from_slice(&[rgb.r, rgb.g, rgb.b]);
+        }
+        for t in tiles {
+            for p in t.pixels.bounds.intersect(&b).iter() {
+                let (i, j) = (c.pixels.index(p), t.pixels.index(p));
+                let (a, o) = (c.pixels.rgb[i], t.pixels.rgb[j]);
+                let sums = [a[0] + o[0], a[1] + o[1], a[2] + o[2], a[3] + o[3]];
+                let rgb = c.rgb_from_sums(i, sums, splat_scale);
+                let k = 3 * ((p.y - b.p_min.y) as usize * width + (p.x - b.p_min.x) as usize);
+                out[k..k + 3].copy_from_slice(&[rgb.r, rgb.g, rgb.b]);
+            }
+        }
+        out
+    }
+
     /// Output RGB of radiance `l` (pbrt-v4 `ToOutputRGB`, used by SPPM).
     pub fn to_output_rgb(&self, l: SampledSpectrum, lambda: &SampledWavelengths) -> RGB {
         let c = self.core();

@@ -52,7 +52,9 @@ pub use function::{FunctionIntegrator, TestFunction};
 pub use lightpath::LightPathIntegrator;
 pub use mlt::MltIntegrator;
 pub use path::PathIntegrator;
-pub use render::{Progress, ProgressFn, RenderError, RenderOptions, RenderStats};
+pub use render::{
+    Progress, ProgressFn, RenderError, RenderObserver, RenderOptions, RenderStats, Snapshot,
+};
 pub use scene::{RayCounters, Scene};
 pub use simple::{AmbientOcclusionIntegrator, RandomWalkIntegrator, SimplePathIntegrator};
 pub use simplevolpath::SimpleVolPathIntegrator;

@@ -5,6 +5,7 @@
 //! draws the progress bar from [`Progress`] reports.
 
 use crate::image::ImageError;
+use rpbrt_geometry::float::Float;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -31,6 +32,48 @@ pub struct RenderOptions {
     /// carries the film's sums ([`crate::film::merge_sample_ranges`]).
     /// Integrators that do not render pixel samples refuse it.
     pub sample_range: Option<crate::film::SampleRange>,
+    /// Someone watching the image as it refines (`--preview`,
+    /// `--display-server`). `None` costs nothing; otherwise the loops ask
+    /// [`RenderObserver::wants_image`] after each unit of work and hand
+    /// over a [`Snapshot`] when it says yes, and always at the end.
+    pub observer: Option<Arc<dyn RenderObserver>>,
+}
+
+/// The image of a render in progress, as the film would write its R, G
+/// and B channels now.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    /// Width in pixels (the film's active bounds: its pixel bounds, or
+    /// the part of them `--tile` renders).
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// `3 × width × height` output-RGB values, rows from the top.
+    pub rgb: Vec<f32>,
+    /// Samples per pixel (SPPM: iterations) that every pixel has; pixels
+    /// of tiles finished in the running wave have more.
+    pub spp: i32,
+    /// True for the final image, the one written to the file.
+    pub done: bool,
+}
+
+/// Watches a render as it runs (the command line's live view and tev
+/// client). Called from worker threads: both methods must be quick, and
+/// [`RenderObserver::image`] should hand the snapshot on rather than work
+/// on it.
+pub trait RenderObserver: Send + Sync {
+    /// Whether a new snapshot is wanted now. Asked after every tile (MLT
+    /// chain, SPPM iteration); `wave_end` is true when a wave of samples
+    /// has just completed.
+    fn wants_image(&self, wave_end: bool) -> bool;
+    /// A new snapshot.
+    fn image(&self, snapshot: Snapshot);
+}
+
+impl std::fmt::Debug for dyn RenderObserver {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("RenderObserver")
+    }
 }
 
 impl RenderOptions {
@@ -40,6 +83,37 @@ impl RenderOptions {
         self.interrupt
             .as_ref()
             .is_some_and(|f| f.load(Ordering::Relaxed))
+    }
+
+    /// The observer, when there is one and it wants a snapshot now.
+    #[inline]
+    pub(crate) fn observer_wanting(&self, wave_end: bool) -> Option<&dyn RenderObserver> {
+        self.observer.as_deref().filter(|o| o.wants_image(wave_end))
+    }
+
+    /// Hands the final image to the observer, if any.
+    pub(crate) fn observe_final(&self, film: &crate::film::Film, spp: i32, splat_scale: Float) {
+        if let Some(o) = &self.observer {
+            o.image(snapshot(film, std::iter::empty(), spp, splat_scale, true));
+        }
+    }
+}
+
+/// A snapshot of `film` with `tiles` (finished, not yet merged) added.
+pub(crate) fn snapshot<'t>(
+    film: &crate::film::Film,
+    tiles: impl IntoIterator<Item = &'t crate::film::FilmTile>,
+    spp: i32,
+    splat_scale: Float,
+    done: bool,
+) -> Snapshot {
+    let d = film.active_bounds().diagonal();
+    Snapshot {
+        width: d.x.max(0) as usize,
+        height: d.y.max(0) as usize,
+        rgb: film.rgb_snapshot(tiles, splat_scale),
+        spp,
+        done,
     }
 }
 
@@ -207,7 +281,7 @@ pub(crate) fn write_partial(
 pub(crate) fn write_film(
     film: &crate::film::Film,
     metadata: &crate::image::ImageMetadata,
-    splat_scale: rpbrt_geometry::float::Float,
+    splat_scale: Float,
 ) -> Result<(), RenderError> {
     film.write_image(metadata, splat_scale)
         .map_err(|source| RenderError::WriteImage {

@@ -3,14 +3,16 @@
 //! section 1.3.4): image tiles rendered in parallel, samples taken in waves:
 //! pbrt-v4's doubling waves when partial images or per-wave MSE are asked
 //! for, otherwise one sample per pixel and then the rest. Ctrl-C is checked
-//! at every pixel; progress is counted per tile.
+//! at every pixel; progress is counted per tile. An observer
+//! ([`RenderOptions::observer`]) may take snapshots after any tile: the
+//! film of the completed waves with the running wave's finished tiles.
 //!
 //! The loop is generic over the [`TileIntegrator`]: each integrator gets
 //! its own copy, with its per-sample work called directly.
 
 use super::render::{
-    thread_pool, with_progress, write_film, write_partial, ProgressFn, RenderError, RenderOptions,
-    RenderStats,
+    snapshot, thread_pool, with_progress, write_film, write_partial, ProgressFn, RenderError,
+    RenderOptions, RenderStats,
 };
 use super::Scene;
 use crate::camera::CameraSample;
@@ -362,6 +364,22 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
                             .lock()
                             .unwrap_or_else(|e| e.into_inner())
                             .push((index, tile));
+                        if let Some(o) = opts.observer_wanting(false) {
+                            // Splats so far: those of the completed waves
+                            // and of the tiles applied in this one.
+                            let applied = splats.applied() as f64 / tile_list.len().max(1) as f64;
+                            let spp_now = (wave_start - first) as f64
+                                + (wave_end - wave_start) as f64 * applied;
+                            let scale = if spp_now > 0.0 {
+                                (1.0 / spp_now) as Float
+                            } else {
+                                1.0
+                            };
+                            let done = finished.lock().unwrap_or_else(|e| e.into_inner());
+                            let tiles = done.iter().map(|(_, t)| t);
+                            let spp = wave_start - first;
+                            o.image(snapshot(&scene_ref.film, tiles, spp, scale, false));
+                        }
                     }
                 };
                 pool.broadcast(|_| work());
@@ -377,6 +395,19 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
             }
             wave_start = wave_end;
             (wave_end, next_wave_size) = next_wave(wave_end, next_wave_size, last, progressive);
+            if wave_start < last {
+                if let Some(o) = opts.observer_wanting(true) {
+                    let none = std::iter::empty();
+                    let scale = splat_scale(wave_start - first);
+                    o.image(snapshot(
+                        &scene.film,
+                        none,
+                        wave_start - first,
+                        scale,
+                        false,
+                    ));
+                }
+            }
             if let Some(reference) = &opts.mse_reference {
                 let mut md = ImageMetadata::default();
                 let image = scene
@@ -401,6 +432,11 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
     if let Some(&(_, mse)) = mse_per_wave.last() {
         metadata.mse = Some(mse as f32);
     }
+    opts.observe_final(
+        &scene.film,
+        wave_start - first,
+        splat_scale(wave_start - first),
+    );
     if let Some(range) = opts.sample_range {
         if interrupted {
             // The interrupted wave's samples are in the sums: they would

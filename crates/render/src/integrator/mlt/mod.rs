@@ -16,7 +16,8 @@ use super::bdpt::{
     connect_bdpt, generate_camera_subpath, generate_light_subpath, Vertex, WalkOptions,
 };
 use super::render::{
-    thread_pool, with_progress, write_film, ProgressFn, RenderError, RenderOptions, RenderStats,
+    snapshot, thread_pool, with_progress, write_film, ProgressFn, RenderError, RenderOptions,
+    RenderStats,
 };
 use super::Scene;
 use crate::camera::CameraSample;
@@ -260,6 +261,18 @@ pub(crate) fn render(
                 done.fetch_add(taken % 4096, Ordering::Relaxed);
                 mutations_done.fetch_add(taken, Ordering::Relaxed);
                 splats.submit(&films, i, buf);
+                if let Some(o) = opts.observer_wanting(false) {
+                    // The chains applied so far (in order) made this many
+                    // mutations: the sum of the per-chain counts above.
+                    let applied = splats.applied() as u64;
+                    let made = applied * n_total_mutations / n_chains as u64;
+                    if made > 0 {
+                        let scale = (b * sample_area as f64 / made as f64) as Float;
+                        let spp = (made / sample_area.max(1)) as i32;
+                        let none = std::iter::empty();
+                        o.image(snapshot(&scene_ref.film, none, spp, scale, false));
+                    }
+                }
             }
         });
         Ok((mutations_done.load(Ordering::Relaxed), b))
@@ -276,6 +289,7 @@ pub(crate) fn render(
     } else {
         b * sample_area as f64 / taken as f64
     };
+    opts.observe_final(&scene_ref.film, it.mutations_per_pixel, scale as Float);
     write_film(&scene_ref.film, metadata, scale as Float)?;
     Ok(RenderStats {
         render_time,

@@ -19,7 +19,7 @@
 mod grid;
 mod photon;
 
-use super::render::{with_progress, ProgressFn, RenderError, RenderOptions, RenderStats};
+use super::render::{with_progress, ProgressFn, RenderError, RenderOptions, RenderStats, Snapshot};
 use super::tile::camera_ray;
 use super::{sample_ld, skip_intersection, RayCounters, Scene, VertexOrigins};
 use crate::bxdf::{BxDFReflTransFlags, TransportMode, BSDF};
@@ -366,12 +366,11 @@ pub(crate) fn render(
     let mut iterations_done = 0;
     let mut interrupted = false;
     let mut mse_per_wave = Vec::new();
-    let write = |pixels: &[SppmPixel],
+    let write = |image: Image,
                  iterations_done: i32,
                  metadata: &ImageMetadata,
                  mse_per_wave: &mut Vec<(i32, f64)>|
      -> Result<(), RenderError> {
-        let image = sppm_image(pixels, resolution, iterations_done, photons_per_iteration);
         let mut md = metadata.clone();
         md.render_time_seconds = Some(start.elapsed().as_secs_f32());
         md.samples_per_pixel = Some(iterations_done);
@@ -505,8 +504,29 @@ pub(crate) fn render(
             });
             iterations_done = iter + 1;
             let stop = opts.interrupted();
-            if stop || writes_after(iterations_done, n_iterations) {
-                write(&pixels, iterations_done, metadata, &mut mse_per_wave)?;
+            // The last image always goes to the observer; others when it
+            // asks.
+            let last = stop || iterations_done == n_iterations;
+            let observer = if last {
+                opts.observer.as_deref()
+            } else {
+                opts.observer_wanting(true)
+            };
+            let writes = stop || writes_after(iterations_done, n_iterations);
+            if writes || observer.is_some() {
+                let image = sppm_image(&pixels, resolution, iterations_done, photons_per_iteration);
+                if let Some(o) = observer {
+                    o.image(Snapshot {
+                        width: resolution.x.max(0) as usize,
+                        height: resolution.y.max(0) as usize,
+                        rgb: image.as_f32().map(<[f32]>::to_vec).unwrap_or_default(),
+                        spp: iterations_done,
+                        done: last,
+                    });
+                }
+                if writes {
+                    write(image, iterations_done, metadata, &mut mse_per_wave)?;
+                }
             }
             if stop {
                 interrupted = iterations_done < n_iterations;
