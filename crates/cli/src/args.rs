@@ -49,6 +49,11 @@ pub struct Options {
     pub mse_reference_image: Option<String>,
     /// `--mse-reference-out`.
     pub mse_reference_out: Option<String>,
+    /// `--preview [ADDR]`: serve a live view of the render over HTTP
+    /// (`127.0.0.1:0`, a free loopback port, when no address is given).
+    pub preview: Option<std::net::SocketAddr>,
+    /// `--display-server host:port`: stream the image to tev.
+    pub display_server: Option<String>,
     /// `--format`: print the scene back as canonical pbrt-v4 text.
     pub format: bool,
     /// `--upgrade`: print a pbrt-v3 scene as pbrt-v4 text.
@@ -82,11 +87,15 @@ Rendering options:
   --disable-pixel-jitter       Always sample pixels at their centres.
   --disable-texture-filtering  Point-sample all textures.
   --disable-wavelength-jitter  Always sample the same four wavelengths of light.
+  --display-server <host:port> Stream the image as it renders to the tev viewer.
   --force-diffuse              Replace every material with a diffuse one.
   --mse-reference-image <file> Compute the MSE against this image while rendering.
   --mse-reference-out <file>   Write the MSE per sample count to this file.
   --nthreads <n>               Use n threads (default: all cores).
   --outfile <file>             Write the image here (overrides the Film's filename).
+  --preview [<addr>]           Watch the render in a browser: serves a live view on
+                               127.0.0.1 (a free port, the URL printed) or on <addr>
+                               (e.g. 0.0.0.0:8000; reachable from the network then).
   --pixelbounds <x0,x1,y0,y1>  Render only these pixels.
   --quick                      Reduced quality for a fast preview.
   --quiet                      No progress bar or informational messages.
@@ -149,6 +158,56 @@ fn parse_four<T: std::str::FromStr + Copy + Default>(
         *o = parse_num(flag, p)?;
     }
     Ok(out)
+}
+
+/// Whether an argument after `--preview` is its address rather than a
+/// scene file: a port number, or anything ending in `:<port>`.
+fn looks_like_address(arg: &str) -> bool {
+    let port = arg.rsplit_once(':').map_or(arg, |(_, p)| p);
+    !arg.starts_with('-') && !port.is_empty() && port.bytes().all(|b| b.is_ascii_digit())
+}
+
+/// `--preview`'s address: `ip:port`, `[ipv6]:port`, `localhost:port` or a
+/// bare port (on 127.0.0.1).
+pub fn parse_preview_address(v: &str) -> Result<std::net::SocketAddr, ArgError> {
+    use std::net::{IpAddr, Ipv4Addr, SocketAddr};
+    let bad = |why: &str| ArgError(format!("--preview: \"{v}\" {why}"));
+    if let Ok(port) = v.parse::<u16>() {
+        return Ok(SocketAddr::from((Ipv4Addr::LOCALHOST, port)));
+    }
+    if let Ok(a) = v.parse::<SocketAddr>() {
+        return Ok(a);
+    }
+    match v.rsplit_once(':') {
+        Some((host, port)) => {
+            let port: u16 = port
+                .parse()
+                .map_err(|_| bad("has no valid port (0 to 65535)"))?;
+            let ip = match host {
+                "localhost" => IpAddr::V4(Ipv4Addr::LOCALHOST),
+                _ => host.parse::<IpAddr>().map_err(|_| {
+                    bad("is not an address: expected ip:port (e.g. 127.0.0.1:8000) or a port")
+                })?,
+            };
+            Ok(SocketAddr::new(ip, port))
+        }
+        None => Err(bad(
+            "is not an address: expected ip:port (e.g. 127.0.0.1:8000) or a port",
+        )),
+    }
+}
+
+/// `--display-server`'s `host:port` (the host is looked up when
+/// connecting, as pbrt-v4 does).
+fn parse_display_server(v: &str) -> Result<(), ArgError> {
+    match v.rsplit_once(':') {
+        Some((host, port)) if !host.is_empty() && port.parse::<u16>().is_ok_and(|p| p > 0) => {
+            Ok(())
+        }
+        _ => Err(ArgError(format!(
+            "--display-server: expected \"host:port\" (e.g. localhost:14158), got \"{v}\""
+        ))),
+    }
 }
 
 /// Parses the arguments after the program name.
@@ -280,6 +339,29 @@ pub fn parse_args(args: &[String]) -> Result<Options, ArgError> {
             }
             "msereferenceimage" => o.mse_reference_image = Some(value(&mut i)?),
             "msereferenceout" => o.mse_reference_out = Some(value(&mut i)?),
+            "preview" => {
+                // The address is optional: taken from "=ADDR" or from the
+                // next argument when that reads as an address or a port.
+                let given = match &inline {
+                    Some(v) => Some(v.clone()),
+                    None => match args.get(i) {
+                        Some(next) if looks_like_address(next) => {
+                            i += 1;
+                            Some(next.clone())
+                        }
+                        _ => None,
+                    },
+                };
+                o.preview = Some(match given {
+                    Some(v) => parse_preview_address(&v)?,
+                    None => std::net::SocketAddr::from(([127, 0, 0, 1], 0)),
+                });
+            }
+            "displayserver" => {
+                let v = value(&mut i)?;
+                parse_display_server(&v)?;
+                o.display_server = Some(v);
+            }
             "format" => o.format = true,
             "upgrade" => o.upgrade = true,
             "toply" => o.toply = true,
@@ -337,6 +419,48 @@ mod tests {
         assert_eq!(p(&["--tile", "3/16"]).unwrap().tile, Some((3, 16)));
         assert_eq!(p(&["--spp-range=8..16"]).unwrap().spp_range, Some((8, 16)));
         assert!(p(&["--pixelbounds", "5,1,0,1"]).is_err());
+    }
+
+    #[test]
+    fn preview_address_is_optional() {
+        let local = |port| std::net::SocketAddr::from(([127, 0, 0, 1], port));
+        let o = p(&["--preview", "scene.pbrt"]).unwrap();
+        assert_eq!(o.preview, Some(local(0)));
+        assert_eq!(o.files, ["scene.pbrt"]);
+        let o = p(&["--preview", "0.0.0.0:8000", "scene.pbrt"]).unwrap();
+        assert_eq!(
+            o.preview,
+            Some(std::net::SocketAddr::from(([0, 0, 0, 0], 8000)))
+        );
+        assert_eq!(o.files, ["scene.pbrt"]);
+        assert_eq!(p(&["--preview=8001"]).unwrap().preview, Some(local(8001)));
+        assert_eq!(
+            p(&["--preview", "localhost:9"]).unwrap().preview,
+            Some(local(9))
+        );
+        let o = p(&["--preview", "[::1]:8000"]).unwrap();
+        assert_eq!(o.preview, Some("[::1]:8000".parse().unwrap()));
+        // A flag after it is not its address.
+        let o = p(&["--preview", "--quiet", "s.pbrt"]).unwrap();
+        assert!(o.preview.is_some() && o.quiet);
+        for bad in [
+            "--preview=nowhere",
+            "--preview=1.2.3:80",
+            "--preview=127.0.0.1:99999",
+        ] {
+            let e = p(&[bad]).unwrap_err();
+            assert!(e.0.starts_with("--preview: "), "{e}");
+        }
+    }
+
+    #[test]
+    fn display_server_needs_host_and_port() {
+        let o = p(&["--display-server", "localhost:14158", "s.pbrt"]).unwrap();
+        assert_eq!(o.display_server.as_deref(), Some("localhost:14158"));
+        for bad in ["localhost", ":14158", "host:port", "host:0"] {
+            assert!(p(&["--display-server", bad]).is_err(), "{bad}");
+        }
+        assert!(p(&["--display-server"]).is_err());
     }
 
     #[test]

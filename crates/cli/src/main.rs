@@ -4,7 +4,10 @@
 
 mod args;
 mod imgtool;
+mod preview;
 mod serve;
+mod tev;
+mod watch;
 
 use rpbrt_parser::{parse_files, FormattingTarget};
 use rpbrt_render::accel::Aggregate;
@@ -100,6 +103,34 @@ fn peak_memory_bytes() -> Option<u64> {
 /// with its location, and the exit status is 1 on any error.
 fn render_command(opts: &args::Options) -> ExitCode {
     let t0 = Instant::now();
+    let watching = opts.preview.is_some() || opts.display_server.is_some();
+    if watching && opts.serve_parts {
+        eprintln!(
+            "rpbrt: error: --preview and --display-server watch one render, not --serve-parts"
+        );
+        return ExitCode::FAILURE;
+    }
+    // Watching: the server binds before the scene loads, so that a port
+    // in use fails at once.
+    let watch = watching.then(|| Arc::new(watch::Watch::new()));
+    let server = match (opts.preview, &watch) {
+        (Some(addr), Some(w)) => match preview::Preview::start(addr, Arc::clone(w)) {
+            Ok(p) => {
+                let everywhere = if p.addr().ip().is_unspecified() {
+                    " (all interfaces)"
+                } else {
+                    ""
+                };
+                eprintln!("rpbrt: preview at {}{everywhere}", p.url());
+                Some(p)
+            }
+            Err(e) => {
+                eprintln!("rpbrt: error: {e}");
+                return ExitCode::FAILURE;
+            }
+        },
+        _ => None,
+    };
     let mut build = BuildOptions::default();
     if let Some(r) = opts
         .render_coord_sys
@@ -210,6 +241,21 @@ fn render_command(opts: &args::Options) -> ExitCode {
         sample_range: opts
             .spp_range
             .map(|(start, end)| SampleRange { start, end }),
+        observer: watch
+            .as_ref()
+            .map(|w| Arc::clone(w) as Arc<dyn rpbrt_render::integrator::RenderObserver>),
+    };
+    let tev = match (&watch, &opts.display_server) {
+        (Some(w), Some(address)) => {
+            w.set_title(scene.film.filename());
+            let title = format!("{} ({})", scene.film.filename(), std::process::id());
+            Some(tev::spawn(address, &title, Arc::clone(w)))
+        }
+        (Some(w), None) => {
+            w.set_title(scene.film.filename());
+            None
+        }
+        _ => None,
     };
     if opts.serve_parts {
         return serve::run(&integrator, &mut scene, render_opts);
@@ -218,6 +264,9 @@ fn render_command(opts: &args::Options) -> ExitCode {
     // The progress bar, redrawn in place on each report.
     let show_progress = !opts.quiet && std::io::stderr().is_terminal();
     let draw_progress = |p: Progress| {
+        if let Some(w) = &watch {
+            w.progress(p);
+        }
         if show_progress {
             eprint!("{}", progress_line(p));
             let _ = std::io::stderr().flush();
@@ -227,6 +276,16 @@ fn render_command(opts: &args::Options) -> ExitCode {
     if show_progress {
         // Below the bar's last state.
         eprintln!();
+    }
+    if let Some(w) = &watch {
+        w.finish();
+    }
+    if let Some(t) = tev {
+        let _ = t.join();
+    }
+    if let Some(p) = &server {
+        // A page watching gets the final image before the process ends.
+        p.linger();
     }
     let stats = match result {
         Ok(s) => s,

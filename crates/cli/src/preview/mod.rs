@@ -1,0 +1,404 @@
+//! `--preview`: a live view of the render in the browser. A small HTTP
+//! server (standard library only: a few GET routes, one short-lived
+//! thread per connection, `Connection: close`) serves
+//!
+//! - `/`: the page ([`PAGE`]), which polls `/status` four times a second,
+//!   fetches `/image` when a newer snapshot is there, and tone-maps it
+//!   into a canvas itself (exposure, linear / sRGB / ACES-like), shows the
+//!   film's float value under the cursor, progress and ETA, and saves the
+//!   image (PNG as shown, PFM as the film's floats) without the server;
+//! - `/status`: JSON: the snapshot's number, size and samples per pixel,
+//!   whether it is the final image, the progress and the ETA;
+//! - `/image`: the latest snapshot, [`IMAGE_HEADER`] bytes of header then
+//!   RGB `f32` values (see [`encode_image`]).
+//!
+//! The server is stateless towards the browser, so a page closed and
+//! reopened mid-render picks up where the render is. It binds to loopback
+//! unless given another address, and then refuses requests whose `Host`
+//! is not a loopback name (DNS rebinding). When the render ends the
+//! process waits (at most [`FINAL_GRACE`]) until a page that was watching
+//! has the final image, then exits: the page keeps showing it and can
+//! still save it.
+
+use crate::watch::{Frame, Watch};
+use std::io::{BufRead, BufReader, Write};
+use std::net::{SocketAddr, TcpListener, TcpStream};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// The page.
+pub const PAGE: &str = include_str!("page.html");
+/// Size of the `/image` header: `RPV1`, then width, height, channels
+/// (3), samples per pixel, a done flag (1: the final image) as `u32`, and
+/// the snapshot's number as `u64`, all little-endian.
+pub const IMAGE_HEADER: usize = 32;
+/// How long the process waits after the render for a watching page to
+/// fetch the final image.
+pub const FINAL_GRACE: Duration = Duration::from_secs(5);
+/// Most connections served at once; more are closed unanswered.
+const MAX_CONNECTIONS: usize = 32;
+/// Longest request head read.
+const MAX_HEAD: usize = 16 * 1024;
+/// How long a client may take to send its request or read the answer.
+const CLIENT_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// Why the server could not start.
+#[derive(Debug)]
+pub struct StartError(pub String);
+
+impl std::fmt::Display for StartError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+/// The running server.
+pub struct Preview {
+    addr: SocketAddr,
+    shared: Arc<Shared>,
+}
+
+/// What the connection threads share.
+struct Shared {
+    watch: Arc<Watch>,
+    port: u16,
+    /// Only loopback `Host`s are served.
+    loopback: bool,
+    /// Set once `/image` served the final image, and once `/status`
+    /// said the render had finished.
+    final_image_served: AtomicBool,
+    final_status_served: AtomicBool,
+    connections: AtomicUsize,
+}
+
+impl Preview {
+    /// Binds `addr` and serves `watch` from a thread of its own.
+    pub fn start(addr: SocketAddr, watch: Arc<Watch>) -> Result<Self, StartError> {
+        let listener = TcpListener::bind(addr).map_err(|e| {
+            StartError(match e.kind() {
+                std::io::ErrorKind::AddrInUse => format!(
+                    "--preview: {addr} is already in use; give another port, or none for a \
+                     free one"
+                ),
+                std::io::ErrorKind::AddrNotAvailable => {
+                    format!("--preview: {addr} is not an address of this machine")
+                }
+                _ => format!("--preview: cannot listen on {addr}: {e}"),
+            })
+        })?;
+        let addr = listener
+            .local_addr()
+            .map_err(|e| StartError(format!("--preview: {e}")))?;
+        let shared = Arc::new(Shared {
+            watch,
+            port: addr.port(),
+            loopback: addr.ip().is_loopback(),
+            final_image_served: AtomicBool::new(false),
+            final_status_served: AtomicBool::new(false),
+            connections: AtomicUsize::new(0),
+        });
+        let s = Arc::clone(&shared);
+        std::thread::spawn(move || accept_loop(listener, s));
+        Ok(Preview { addr, shared })
+    }
+
+    /// The address served.
+    pub fn addr(&self) -> SocketAddr {
+        self.addr
+    }
+
+    /// The page's URL.
+    pub fn url(&self) -> String {
+        format!("http://{}/", self.addr)
+    }
+
+    /// After the render (the watch finished): waits until a page that was
+    /// watching has the final image and knows the render has ended, at
+    /// most [`FINAL_GRACE`]. Returns at once when nobody watches.
+    pub fn linger(&self) {
+        let t0 = Instant::now();
+        while t0.elapsed() < FINAL_GRACE && self.shared.watch.viewer_recent() {
+            let has_frame = self.shared.watch.state().frame.is_some();
+            let image = self.shared.final_image_served.load(Ordering::Relaxed) || !has_frame;
+            if image && self.shared.final_status_served.load(Ordering::Relaxed) {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+}
+
+fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
+    for stream in listener.incoming() {
+        let Ok(stream) = stream else {
+            // Out of descriptors and the like: let it pass.
+            std::thread::sleep(Duration::from_millis(10));
+            continue;
+        };
+        if shared.connections.fetch_add(1, Ordering::Relaxed) >= MAX_CONNECTIONS {
+            shared.connections.fetch_sub(1, Ordering::Relaxed);
+            continue;
+        }
+        let s = Arc::clone(&shared);
+        let spawned = std::thread::Builder::new()
+            .name("preview-http".into())
+            .spawn(move || {
+                // Errors are the client's going away: nothing to report.
+                let _ = serve(stream, &s);
+                s.connections.fetch_sub(1, Ordering::Relaxed);
+            });
+        if spawned.is_err() {
+            shared.connections.fetch_sub(1, Ordering::Relaxed);
+        }
+    }
+}
+
+/// A parsed request head.
+#[derive(Debug, PartialEq)]
+struct Request {
+    method: String,
+    path: String,
+    host: Option<String>,
+}
+
+/// Reads a request head (request line and headers) of at most
+/// [`MAX_HEAD`] bytes.
+fn read_request(r: &mut impl BufRead) -> Result<Request, &'static str> {
+    let mut head = Vec::new();
+    loop {
+        let before = head.len();
+        let limit = (MAX_HEAD - head.len()) as u64 + 1;
+        let n = std::io::Read::take(&mut *r, limit)
+            .read_until(b'\n', &mut head)
+            .map_err(|_| "unreadable request")?;
+        if n == 0 {
+            return Err("incomplete request");
+        }
+        if head.len() > MAX_HEAD {
+            return Err("request head too large");
+        }
+        let line = &head[before..];
+        if line == b"\r\n" || line == b"\n" {
+            break;
+        }
+    }
+    let text = std::str::from_utf8(&head).map_err(|_| "request is not text")?;
+    let mut lines = text.lines();
+    let mut first = lines.next().unwrap_or("").split_whitespace();
+    let (Some(method), Some(target), Some(version)) = (first.next(), first.next(), first.next())
+    else {
+        return Err("malformed request line");
+    };
+    if !version.starts_with("HTTP/1.") {
+        return Err("unsupported HTTP version");
+    }
+    let host = lines.find_map(|l| {
+        let (name, value) = l.split_once(':')?;
+        name.trim()
+            .eq_ignore_ascii_case("host")
+            .then(|| value.trim().to_string())
+    });
+    let path = target.split(['?', '#']).next().unwrap_or("/").to_string();
+    Ok(Request {
+        method: method.to_string(),
+        path,
+        host,
+    })
+}
+
+/// Whether a `Host` header names this machine's loopback at `port`.
+fn loopback_host(host: &str, port: u16) -> bool {
+    let (name, rest) = match host.strip_prefix('[') {
+        Some(v6) => match v6.split_once(']') {
+            Some((name, rest)) => (name, rest),
+            None => return false,
+        },
+        None => match host.rsplit_once(':') {
+            Some((name, _)) => (name, &host[name.len()..]),
+            None => (host, ""),
+        },
+    };
+    let port_ok = match rest.strip_prefix(':') {
+        Some(p) => p.parse::<u16>() == Ok(port),
+        None => rest.is_empty() && port == 80,
+    };
+    port_ok
+        && (name.eq_ignore_ascii_case("localhost")
+            || name
+                .parse::<std::net::IpAddr>()
+                .is_ok_and(|ip| ip.is_loopback()))
+}
+
+fn respond(
+    w: &mut impl Write,
+    status: &str,
+    content_type: &str,
+    body: &[u8],
+    head_only: bool,
+) -> std::io::Result<()> {
+    write!(
+        w,
+        "HTTP/1.1 {status}\r\nContent-Type: {content_type}\r\nContent-Length: {}\r\n\
+         Cache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
+        body.len()
+    )?;
+    if !head_only {
+        w.write_all(body)?;
+    }
+    w.flush()
+}
+
+fn serve(stream: TcpStream, shared: &Shared) -> std::io::Result<()> {
+    stream.set_read_timeout(Some(CLIENT_TIMEOUT))?;
+    stream.set_write_timeout(Some(CLIENT_TIMEOUT))?;
+    let mut reader = BufReader::new(stream.try_clone()?);
+    let mut out = std::io::BufWriter::new(stream);
+    let text = "text/plain; charset=utf-8";
+    let req = match read_request(&mut reader) {
+        Ok(r) => r,
+        Err(why) => return respond(&mut out, "400 Bad Request", text, why.as_bytes(), false),
+    };
+    if shared.loopback
+        && !req
+            .host
+            .as_deref()
+            .is_some_and(|h| loopback_host(h, shared.port))
+    {
+        let why = b"this server answers only requests addressed to the loopback interface";
+        return respond(&mut out, "403 Forbidden", text, why, false);
+    }
+    let head_only = req.method == "HEAD";
+    if req.method != "GET" && !head_only {
+        return respond(&mut out, "405 Method Not Allowed", text, b"GET only", false);
+    }
+    match req.path.as_str() {
+        "/" | "/index.html" => respond(
+            &mut out,
+            "200 OK",
+            "text/html; charset=utf-8",
+            PAGE.as_bytes(),
+            head_only,
+        ),
+        "/status" => {
+            shared.watch.viewer_seen();
+            let (json, finished) = {
+                let s = shared.watch.state();
+                (status_json(&s, std::process::id()), s.finished)
+            };
+            respond(
+                &mut out,
+                "200 OK",
+                "application/json",
+                json.as_bytes(),
+                head_only,
+            )?;
+            if finished && !head_only {
+                shared.final_status_served.store(true, Ordering::Relaxed);
+            }
+            Ok(())
+        }
+        "/image" => {
+            shared.watch.viewer_seen();
+            let frame = shared.watch.state().frame.clone();
+            match frame {
+                Some(f) => {
+                    respond(
+                        &mut out,
+                        "200 OK",
+                        "application/octet-stream",
+                        &encode_image(&f),
+                        head_only,
+                    )?;
+                    if f.snapshot.done && !head_only {
+                        shared.final_image_served.store(true, Ordering::Relaxed);
+                    }
+                    Ok(())
+                }
+                None => respond(&mut out, "404 Not Found", text, b"no image yet", head_only),
+            }
+        }
+        "/favicon.ico" => respond(&mut out, "204 No Content", text, b"", true),
+        _ => respond(&mut out, "404 Not Found", text, b"not found", head_only),
+    }
+}
+
+/// `/image`'s bytes for a frame: the [`IMAGE_HEADER`]-byte header, then
+/// `3 × width × height` little-endian `f32`s, rows from the top.
+pub fn encode_image(f: &Frame) -> Vec<u8> {
+    let s = &f.snapshot;
+    let mut b = Vec::with_capacity(IMAGE_HEADER + 4 * s.rgb.len());
+    b.extend_from_slice(b"RPV1");
+    for v in [
+        s.width as u32,
+        s.height as u32,
+        3,
+        s.spp.max(0) as u32,
+        s.done as u32,
+    ] {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    b.extend_from_slice(&f.version.to_le_bytes());
+    for v in &s.rgb {
+        b.extend_from_slice(&v.to_le_bytes());
+    }
+    b
+}
+
+/// A JSON string literal.
+fn json_string(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            c if (c as u32) < 0x20 || c == '<' || c == '>' => {
+                out.push_str(&format!("\\u{:04x}", c as u32))
+            }
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// `/status`'s JSON for the watch's state.
+fn status_json(s: &crate::watch::State, id: u32) -> String {
+    let (version, width, height, spp, done) = match &s.frame {
+        Some(f) => (
+            f.version,
+            f.snapshot.width,
+            f.snapshot.height,
+            f.snapshot.spp,
+            f.snapshot.done,
+        ),
+        None => (0, 0, 0, 0, false),
+    };
+    let (work_done, total, elapsed) = s
+        .progress
+        .map_or((0, 0, 0.0), |p| (p.done, p.total, p.elapsed.as_secs_f64()));
+    let frac = if total > 0 {
+        work_done as f64 / total as f64
+    } else {
+        0.0
+    };
+    let eta = if frac > 0.0 && !s.finished {
+        format!("{:.3}", elapsed / frac - elapsed)
+    } else if s.finished {
+        "0".to_string()
+    } else {
+        "null".to_string()
+    };
+    format!(
+        "{{\"id\":{id},\"title\":{},\"version\":{version},\"width\":{width},\
+         \"height\":{height},\"spp\":{spp},\"done\":{done},\"finished\":{},\
+         \"progress\":{{\"done\":{work_done},\"total\":{total},\"fraction\":{frac:.6},\
+         \"elapsed\":{elapsed:.3},\"eta\":{eta}}}}}",
+        json_string(&s.title),
+        s.finished
+    )
+}
+
+#[cfg(test)]
+mod tests;
