@@ -98,14 +98,20 @@ fn every_loop_hands_over_snapshots_and_the_final_image() {
         let written = render(&text, 2, Some(Arc::clone(&rec)));
         let snaps = rec.0.lock().unwrap();
         let (last, during) = snaps.split_last().expect("no snapshot");
-        assert!(!during.is_empty(), "{integrator}: no snapshot while rendering");
+        assert!(
+            !during.is_empty(),
+            "{integrator}: no snapshot while rendering"
+        );
         // The final image comes once, last, and is the image written.
         assert!(last.done && during.iter().all(|s| !s.done), "{integrator}");
         assert_eq!((last.width, last.height), (W, H), "{integrator}");
         assert_eq!(last.rgb, written, "{integrator}");
         for s in during {
             assert_eq!((s.width, s.height, s.rgb.len()), (W, H, 3 * W * H));
-            assert!(s.rgb.iter().all(|v| v.is_finite() && *v >= 0.0), "{integrator}");
+            assert!(
+                s.rgb.iter().all(|v| v.is_finite() && *v >= 0.0),
+                "{integrator}"
+            );
         }
         assert!(
             snaps.windows(2).all(|w| w[0].spp <= w[1].spp),
@@ -114,7 +120,10 @@ fn every_loop_hands_over_snapshots_and_the_final_image() {
         // Splats are scaled by the work done so far: the last snapshot
         // before the end is already near the answer (1).
         let m = mean(&during[during.len() - 1].rgb);
-        assert!((m - 1.0).abs() < 0.2, "{integrator}: mean {m} just before the end");
+        assert!(
+            (m - 1.0).abs() < 0.2,
+            "{integrator}: mean {m} just before the end"
+        );
         assert!((mean(written.as_slice()) - 1.0).abs() < 0.1, "{integrator}");
     }
 }
