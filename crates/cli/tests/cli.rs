@@ -30,6 +30,8 @@ fn help_lists_flags() {
         "--format",
         "--upgrade",
         "--toply",
+        "--preview",
+        "--display-server",
         "imgtool",
     ] {
         assert!(s.contains(flag), "{flag} missing from --help");
