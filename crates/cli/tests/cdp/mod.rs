@@ -42,11 +42,8 @@ pub struct Browser {
 impl Browser {
     /// Starts `chromium` headless on `url`, with a fresh profile.
     pub fn launch(chromium: &Path, url: &str) -> Browser {
-        let profile = std::env::temp_dir().join(format!(
-            "rpbrt-chromium-{}-{}",
-            std::process::id(),
-            Instant::now().elapsed().as_nanos()
-        ));
+        // One browser per test process.
+        let profile = std::env::temp_dir().join(format!("rpbrt-chromium-{}", std::process::id()));
         let mut child = Command::new(chromium)
             .args([
                 "--headless",
