@@ -354,6 +354,28 @@ pub fn upgrade_material(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc)
     e.finish()
 }
 
+/// The pbrt-v3 materials pbrt-v4 dropped that a renderer reading pbrt-v3
+/// files directly can still build (rpbrt does): `--upgrade` must map them
+/// to something pbrt-v4 reads, rendering need not.
+pub const NATIVE_V3_MATERIALS: &[&str] = &["disney", "fourier"];
+
+/// [`upgrade_material`] for a renderer that implements
+/// [`NATIVE_V3_MATERIALS`]: those keep their name and parameters (only the
+/// parameter types and pbrt-v3's `bumpmap` are renamed); every other
+/// material is upgraded as `--upgrade` does.
+pub fn upgrade_material_for_render(
+    name: &str,
+    params: Vec<ParsedParameter>,
+    loc: &FileLoc,
+) -> Upgraded {
+    if NATIVE_V3_MATERIALS.contains(&name) {
+        let mut e = Edit::new(name, params, loc);
+        e.rename("bumpmap", "displacement");
+        return e.finish();
+    }
+    upgrade_material(name, params, loc)
+}
+
 /// Upgrades a `LightSource`.
 pub fn upgrade_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
     let mut e = Edit::new(name, params, loc);

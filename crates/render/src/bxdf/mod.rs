@@ -18,6 +18,7 @@ mod bsdf;
 mod conductor;
 mod dielectric;
 mod diffuse;
+mod disney;
 mod hair;
 mod layered;
 pub mod measured;
@@ -25,11 +26,14 @@ mod microfacet;
 mod scattering;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_v3;
 
 pub use bsdf::BSDF;
 pub use conductor::ConductorBxDF;
 pub use dielectric::{DielectricBxDF, ThinDielectricBxDF};
 pub use diffuse::{DiffuseBxDF, DiffuseTransmissionBxDF, NormalizedFresnelBxDF};
+pub use disney::{DisneyBxDF, DisneyParams};
 pub use hair::HairBxDF;
 pub use layered::{CoatedConductorBxDF, CoatedDiffuseBxDF, LayeredBxDF};
 pub use measured::{MeasuredBxDF, MeasuredBxDFData};
@@ -316,6 +320,8 @@ pub enum BxDF {
     NormalizedFresnel(NormalizedFresnelBxDF),
     /// Tabulated measured reflectance (RGL `.bsdf` data).
     Measured(MeasuredBxDF),
+    /// pbrt-v3's Disney BSDF.
+    Disney(DisneyBxDF),
 }
 
 macro_rules! dispatch {
@@ -331,6 +337,7 @@ macro_rules! dispatch {
             BxDF::Hair($b) => $e,
             BxDF::NormalizedFresnel($b) => $e,
             BxDF::Measured($b) => $e,
+            BxDF::Disney($b) => $e,
         }
     };
 }
@@ -393,6 +400,7 @@ impl BxDF {
             BxDF::Hair(_) => "HairBxDF",
             BxDF::NormalizedFresnel(_) => "NormalizedFresnelBxDF",
             BxDF::Measured(_) => "MeasuredBxDF",
+            BxDF::Disney(_) => "DisneyBxDF",
         }
     }
 
