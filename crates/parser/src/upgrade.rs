@@ -385,9 +385,16 @@ pub fn upgrade_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) ->
         e.error(l.as_ref(), "in pbrt-v4 a light's \"scale\" is a \"float\"; a non-uniform spectrum cannot be converted".into());
         return e.finish();
     }
-    e.remove_all("samples", &["integer"]);
-    // pbrt-v3's lights (the infinite light among them) read "nsamples".
-    e.remove_all("nsamples", &["integer"]);
+    // pbrt-v3's light sample counts ("samples", or "nsamples" on infinite
+    // and area lights) only set how many shadow rays its "directlighting"
+    // integrator traces per light: the noise, never the expected image.
+    for n in ["samples", "nsamples"] {
+        e.remove_all(n, &["integer", "float"]);
+    }
+    // pbrt-v3 accepted "exinfinite" as another name of "infinite".
+    if name == "exinfinite" {
+        e.name = "infinite".into();
+    }
     let has_map = e.get("mapname", &["string"]).is_some();
     if has_map && name == "infinite" && !e.rgb_into_scale("L", &mut scale) {
         let l = e.get("L", &SPECTRUM_TYPES).map(|p| p.loc.clone());
@@ -416,13 +423,27 @@ pub fn upgrade_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) ->
         let p = e.float("scale", &[scale * old]);
         e.front.insert(0, p);
     }
-    if e.get("L", &SPECTRUM_TYPES).is_some() || e.get("I", &SPECTRUM_TYPES).is_some() {
+    warn_if_normalized(&mut e);
+    e.finish()
+}
+
+/// Warns when a light's `L` or `I` is a `spectrum` or `blackbody`:
+/// pbrt-v4 scales those to unit luminance where pbrt-v3 used them as they
+/// are (its blackbody peaks at 1), so the light's brightness changes. An
+/// RGB value keeps its brightness: pbrt-v4 divides by the luminance of the
+/// colour space's illuminant only, which the RGB-to-spectrum conversion
+/// multiplies in.
+fn warn_if_normalized(e: &mut Edit) {
+    let p = e
+        .get("L", &["spectrum", "blackbody"])
+        .or_else(|| e.get("I", &["spectrum", "blackbody"]));
+    if let Some(p) = p {
+        let (loc, ty, name) = (p.loc.clone(), p.ty.clone(), p.name.clone());
         e.warn(
-            None,
-            "pbrt-v4 normalizes light spectra to unit luminance; brightness may differ from pbrt-v3 (adjust \"scale\" or use \"power\")".into(),
+            Some(&loc),
+            format!("pbrt-v4 normalizes a light's \"{ty} {name}\" to unit luminance, pbrt-v3 did not: brightness differs from pbrt-v3 (adjust \"scale\" or use \"power\")"),
         );
     }
-    e.finish()
 }
 
 /// Upgrades an `AreaLightSource` (`area` → `diffuse`).
@@ -438,7 +459,10 @@ pub fn upgrade_area_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLo
     if name == "area" {
         e.name = "diffuse".into();
     }
-    e.remove_all("nsamples", &["integer"]);
+    warn_if_normalized(&mut e);
+    for n in ["samples", "nsamples"] {
+        e.remove_all(n, &["integer", "float"]);
+    }
     if scale != 1.0 {
         let old = e
             .remove("scale", &["float"])
@@ -731,8 +755,84 @@ pub fn upgrade_shape(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) ->
             e.add_front(p);
         }
     }
+    if name == "heightfield" {
+        upgrade_heightfield(&mut e);
+    }
     e.rename("Kd", "reflectance");
     e.finish()
+}
+
+/// pbrt-v3's `heightfield` (pbrt-v3 `shapes/heightfield.cpp`), which
+/// pbrt-v4 dropped, as the triangle mesh pbrt-v3 built from it: `nu` × `nv`
+/// heights `Pz` over the unit square (x fastest), the vertex (x, y) at
+/// (x/(nu−1), y/(nv−1), Pz) with the same uv, two triangles per cell.
+fn upgrade_heightfield(e: &mut Edit) {
+    let one_int = |e: &Edit, n: &str| e.get(n, &["integer"]).and_then(|p| p.ints.first().copied());
+    let (nu, nv) = (one_int(e, "nu"), one_int(e, "nv"));
+    let z = e
+        .get("Pz", &["float"])
+        .map(|p| (p.floats.clone(), p.loc.clone()));
+    let (Some(nu), Some(nv), Some((z, zloc))) = (nu, nv, z) else {
+        e.error(
+            None,
+            "\"heightfield\" needs \"integer nu\", \"integer nv\" and \"float Pz\"".into(),
+        );
+        return;
+    };
+    if nu < 2 || nv < 2 {
+        e.error(
+            None,
+            format!("\"heightfield\" needs at least 2 × 2 heights (nu {nu}, nv {nv})"),
+        );
+        return;
+    }
+    let (nu, nv) = (nu as usize, nv as usize);
+    if nu.checked_mul(nv) != Some(z.len()) {
+        e.error(
+            Some(&zloc),
+            format!(
+                "\"heightfield\" has {} \"Pz\" values; nu × nv = {nu} × {nv} expected",
+                z.len()
+            ),
+        );
+        return;
+    }
+    for n in ["nu", "nv", "Pz"] {
+        e.remove_all(n, &["integer", "float"]);
+    }
+    let mut p = Vec::with_capacity(3 * z.len());
+    let mut uv = Vec::with_capacity(2 * z.len());
+    for y in 0..nv {
+        for x in 0..nu {
+            let (s, t) = (x as f32 / (nu - 1) as f32, y as f32 / (nv - 1) as f32);
+            p.extend([s, t, z[y * nu + x]]);
+            uv.extend([s, t]);
+        }
+    }
+    let vert = |x: usize, y: usize| (x + y * nu) as i32;
+    let mut indices = Vec::with_capacity(6 * (nu - 1) * (nv - 1));
+    for y in 0..nv - 1 {
+        for x in 0..nu - 1 {
+            indices.extend([vert(x, y), vert(x + 1, y), vert(x + 1, y + 1)]);
+            indices.extend([vert(x, y), vert(x + 1, y + 1), vert(x, y + 1)]);
+        }
+    }
+    e.name = "trianglemesh".into();
+    let mut ip = ParsedParameter::new("integer", "indices", e.loc.clone());
+    ip.ints = indices;
+    e.add_front(ip);
+    e.add_front(ParsedParameter::with_floats(
+        "point3",
+        "P",
+        e.loc.clone(),
+        p,
+    ));
+    e.add_front(ParsedParameter::with_floats(
+        "point2",
+        "uv",
+        e.loc.clone(),
+        uv,
+    ));
 }
 
 #[cfg(test)]

@@ -19,6 +19,7 @@ mod conductor;
 mod dielectric;
 mod diffuse;
 mod disney;
+pub mod fourier;
 mod hair;
 mod layered;
 pub mod measured;
@@ -34,6 +35,7 @@ pub use conductor::ConductorBxDF;
 pub use dielectric::{DielectricBxDF, ThinDielectricBxDF};
 pub use diffuse::{DiffuseBxDF, DiffuseTransmissionBxDF, NormalizedFresnelBxDF};
 pub use disney::{DisneyBxDF, DisneyParams};
+pub use fourier::{FourierBSDFTable, FourierBxDF, FourierError};
 pub use hair::HairBxDF;
 pub use layered::{CoatedConductorBxDF, CoatedDiffuseBxDF, LayeredBxDF};
 pub use measured::{MeasuredBxDF, MeasuredBxDFData};
@@ -322,6 +324,8 @@ pub enum BxDF {
     Measured(MeasuredBxDF),
     /// pbrt-v3's Disney BSDF.
     Disney(DisneyBxDF),
+    /// pbrt-v3's tabulated Fourier BSDF.
+    Fourier(FourierBxDF),
 }
 
 macro_rules! dispatch {
@@ -338,6 +342,7 @@ macro_rules! dispatch {
             BxDF::NormalizedFresnel($b) => $e,
             BxDF::Measured($b) => $e,
             BxDF::Disney($b) => $e,
+            BxDF::Fourier($b) => $e,
         }
     };
 }
@@ -401,6 +406,7 @@ impl BxDF {
             BxDF::NormalizedFresnel(_) => "NormalizedFresnelBxDF",
             BxDF::Measured(_) => "MeasuredBxDF",
             BxDF::Disney(_) => "DisneyBxDF",
+            BxDF::Fourier(_) => "FourierBSDF",
         }
     }
 

@@ -12,7 +12,7 @@ use rpbrt_parser::Diagnostic;
 
 use super::coated::LayerSettings;
 use super::*;
-use crate::bxdf::MeasuredBxDFData;
+use crate::bxdf::{FourierBSDFTable, MeasuredBxDFData};
 use crate::image::Image;
 use crate::params::unknown_type;
 use crate::spectrum::{
@@ -30,6 +30,7 @@ pub const MATERIAL_NAMES: &[&str] = &[
     "diffuse",
     "diffusetransmission",
     "disney",
+    "fourier",
     "hair",
     "interface",
     "measured",
@@ -258,6 +259,23 @@ pub fn create_material(
         })),
         "hair" => create_hair(tp)?,
         "disney" => create_disney(tp, cache)?,
+        "fourier" => {
+            let file = tp.string("bsdffile", "")?;
+            if file.is_empty() {
+                return Err(Diagnostic::error(
+                    tp.loc().clone(),
+                    "\"fourier\" material: \"bsdffile\" must be provided",
+                ));
+            }
+            let loc = tp.param_loc("bsdffile");
+            let path = tp.resolve("bsdffile", &file);
+            let table = FourierBSDFTable::cached(&path)
+                .map_err(|e| Diagnostic::error(loc.clone(), format!("{}: {e}", path.display())))?;
+            Material::Fourier(Box::new(FourierMaterial {
+                table,
+                perturbation: perturbation(tp, cache)?,
+            }))
+        }
         "mix" => create_mix(tp, visible)?,
         "subsurface" => create_subsurface(tp, cache)?,
         "measured" => {

@@ -30,6 +30,7 @@ mod create;
 mod dielectric;
 mod diffuse;
 mod disney;
+mod fourier;
 mod hair;
 mod measured;
 mod mix;
@@ -45,6 +46,7 @@ pub use create::{create_material, NormalMapCache, MATERIAL_NAMES};
 pub use dielectric::{DielectricMaterial, ThinDielectricMaterial};
 pub use diffuse::{DiffuseMaterial, DiffuseTransmissionMaterial};
 pub use disney::DisneyMaterial;
+pub use fourier::FourierMaterial;
 pub use hair::{HairAbsorption, HairMaterial};
 pub use measured::MeasuredMaterial;
 pub use mix::MixMaterial;
@@ -196,6 +198,8 @@ pub enum Material {
     Measured(Box<MeasuredMaterial>),
     /// pbrt-v3's Disney BSDF.
     Disney(Box<DisneyMaterial>),
+    /// pbrt-v3's tabulated Fourier BSDF.
+    Fourier(Box<FourierMaterial>),
 }
 
 impl Material {
@@ -222,6 +226,7 @@ impl Material {
             Material::Subsurface(m) => Some(m.get_bxdf(ctx, lambda)),
             Material::Measured(m) => Some(m.get_bxdf(ctx, lambda)),
             Material::Disney(m) => Some(m.get_bxdf(ctx, lambda)),
+            Material::Fourier(m) => Some(m.get_bxdf(ctx, lambda)),
         }
     }
 
@@ -239,6 +244,7 @@ impl Material {
             Material::Subsurface(m) => Some(&m.perturbation),
             Material::Measured(m) => Some(&m.perturbation),
             Material::Disney(m) => Some(&m.perturbation),
+            Material::Fourier(m) => Some(&m.perturbation),
             Material::Hair(_) | Material::Mix(_) | Material::Interface => None,
         }
     }
@@ -271,6 +277,7 @@ impl Material {
             Material::Subsurface(_) => "subsurface",
             Material::Measured(_) => "measured",
             Material::Disney(_) => "disney",
+            Material::Fourier(_) => "fourier",
         }
     }
 }
