@@ -34,8 +34,9 @@ struct Rendered {
 /// thread; errors come back as their rendered messages.
 fn render(tag: &str, text: &str) -> Result<Rendered, String> {
     let d = dir();
+    // Named by its full path, so that file parameters resolve against `d`.
     let (desc, diags) = build_scene_from_bytes(
-        &format!("{tag}.pbrt"),
+        &d.join(format!("{tag}.pbrt")).display().to_string(),
         text.as_bytes(),
         &d,
         &BuildOptions::default(),
@@ -174,9 +175,11 @@ fn cases() -> Vec<Case> {
         case("texture dots", ("", "Texture \"t\" \"color\" \"dots\" \"float uscale\" 6 \"float vscale\" 6\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\""), ("", "Texture \"t\" \"spectrum\" \"dots\" \"float uscale\" 6 \"float vscale\" 6\nMaterial \"diffuse\" \"texture reflectance\" \"t\"\nShape \"sphere\"")),
         case("texture marble", ("", "Texture \"t\" \"color\" \"marble\" \"float scale\" 3\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\""), ("", "Texture \"t\" \"spectrum\" \"marble\" \"float scale\" 3\nMaterial \"diffuse\" \"texture reflectance\" \"t\"\nShape \"sphere\"")),
         case("texture float fbm wrinkled windy", ("", "Texture \"a\" \"float\" \"fbm\"\nTexture \"b\" \"float\" \"wrinkled\"\nTexture \"w\" \"float\" \"windy\"\nTexture \"m\" \"float\" \"mix\" \"texture tex1\" \"a\" \"texture tex2\" \"b\" \"texture amount\" \"w\"\nMaterial \"plastic\" \"texture roughness\" \"m\"\nShape \"sphere\""), ("", "Texture \"a\" \"float\" \"fbm\"\nTexture \"b\" \"float\" \"wrinkled\"\nTexture \"w\" \"float\" \"windy\"\nTexture \"m\" \"float\" \"mix\" \"texture tex1\" \"a\" \"texture tex2\" \"b\" \"texture amount\" \"w\"\nMaterial \"coateddiffuse\" \"texture roughness\" \"m\"\nShape \"sphere\"")),
-        native("texture color fbm", ("", "Texture \"t\" \"color\" \"fbm\"\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\"")),
-        native("texture color wrinkled", ("", "Texture \"t\" \"color\" \"wrinkled\"\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\"")),
-        native("texture color windy", ("", "Texture \"t\" \"color\" \"windy\"\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\"")),
+        // pbrt-v3's spectrum noise textures are the float value in every
+        // channel: in pbrt-v4 terms, white scaled by the float texture.
+        case("texture color fbm", ("", "Texture \"t\" \"color\" \"fbm\" \"integer octaves\" 4\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\""), ("", "Texture \"f\" \"float\" \"fbm\" \"integer octaves\" 4\nTexture \"t\" \"spectrum\" \"scale\" \"rgb tex\" [ 1 1 1 ] \"texture scale\" \"f\"\nMaterial \"diffuse\" \"texture reflectance\" \"t\"\nShape \"sphere\"")),
+        case("texture color wrinkled", ("", "Texture \"t\" \"color\" \"wrinkled\" \"float roughness\" 0.3\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\""), ("", "Texture \"f\" \"float\" \"wrinkled\" \"float roughness\" 0.3\nTexture \"t\" \"spectrum\" \"scale\" \"rgb tex\" [ 1 1 1 ] \"texture scale\" \"f\"\nMaterial \"diffuse\" \"texture reflectance\" \"t\"\nShape \"sphere\"")),
+        case("texture color windy", ("", "Texture \"t\" \"color\" \"windy\"\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\""), ("", "Texture \"f\" \"float\" \"windy\"\nTexture \"t\" \"spectrum\" \"scale\" \"rgb tex\" [ 1 1 1 ] \"texture scale\" \"f\"\nMaterial \"diffuse\" \"texture reflectance\" \"t\"\nShape \"sphere\"")),
         native("texture uv", ("", "Texture \"t\" \"color\" \"uv\"\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\"")),
         // ---- lights and area lights
         case("light point", ("", "LightSource \"point\" \"color I\" [ 3 3 3 ] \"point from\" [ 0 1 3 ]\nShape \"sphere\""), ("", "LightSource \"point\" \"rgb I\" [ 3 3 3 ] \"point3 from\" [ 0 1 3 ]\nShape \"sphere\"")),
@@ -224,6 +227,83 @@ fn cases() -> Vec<Case> {
 }
 
 /// Renders a case; the failure message if it fails.
+/// A 2 × 2 RGB image, a one-triangle PLY mesh, a two-surface lens and a
+/// Fourier BSDF table, written next to the scenes.
+fn write_files() {
+    let d = dir();
+    let mut pfm = b"PF\n2 2\n-1\n".to_vec();
+    for v in [
+        1.0f32, 0.5, 0.2, 0.2, 0.5, 1.0, 0.5, 0.5, 0.5, 1.0, 1.0, 1.0,
+    ] {
+        pfm.extend_from_slice(&v.to_le_bytes());
+    }
+    std::fs::write(d.join("img.pfm"), pfm).unwrap();
+    std::fs::write(
+        d.join("mesh.ply"),
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n-1 -1 0\n1 -1 0\n0 1 0\n3 0 1 2\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("lens.dat"),
+        "# radius thickness eta aperture\n20 4 1.5 10\n0 30 1 8\n",
+    )
+    .unwrap();
+    let table = fourier_table();
+    std::fs::write(d.join("smooth.bsdf"), &table).unwrap();
+    std::fs::write(d.join("truncated.bsdf"), &table[..table.len() / 2]).unwrap();
+}
+
+/// A Fourier BSDF file (pbrt-v3's `SCATFUN` format): f = c |μi| |μo|
+/// (1 + ½ cos φ) on both sides, albedo 0.8 |cos θo|, one channel.
+fn fourier_table() -> Vec<u8> {
+    let n = 21;
+    let mu: Vec<f32> = (0..n)
+        .map(|i| -1.0 + 2.0 * i as f32 / (n - 1) as f32)
+        .collect();
+    let c = 0.8 * 3.0 / (4.0 * std::f32::consts::PI);
+    let (mut a, mut pairs, mut cdf) = (Vec::new(), Vec::new(), Vec::new());
+    for &mo in &mu {
+        // Running integral of a0 = c μi² |μo| over μi (exact for this
+        // quadratic, as the Catmull–Rom integral is).
+        for &mi in &mu {
+            pairs.push((a.len() as i32, 2i32));
+            let y = c * mi * mi * mo.abs();
+            a.extend([y, 0.5 * y]);
+            cdf.push(c * mo.abs() * (mi.powi(3) + 1.0) / 3.0);
+        }
+    }
+    let mut out = b"SCATFUN\x01".to_vec();
+    for v in [1, n as i32, a.len() as i32, 2, 1, 1, 0, 0, 0] {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out.extend_from_slice(&1.0f32.to_le_bytes());
+    out.extend_from_slice(&[0; 16]);
+    for v in mu.iter().chain(&cdf) {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    for (o, l) in pairs {
+        out.extend_from_slice(&o.to_le_bytes());
+        out.extend_from_slice(&l.to_le_bytes());
+    }
+    for v in &a {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out
+}
+
+/// The pbrt-v3 types that read files.
+fn file_cases() -> Vec<Case> {
+    vec![
+        case("shape plymesh", ("", "Shape \"plymesh\" \"string filename\" \"mesh.ply\""), ("", "Shape \"plymesh\" \"string filename\" \"mesh.ply\"")),
+        case("texture imagemap", ("", "Texture \"t\" \"color\" \"imagemap\" \"string filename\" \"img.pfm\" \"bool trilinear\" \"true\" \"float gamma\" 2.2\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\""), ("", "Texture \"t\" \"spectrum\" \"imagemap\" \"string encoding\" \"gamma 2.2\" \"string filter\" \"trilinear\" \"string filename\" \"img.pfm\"\nMaterial \"diffuse\" \"texture reflectance\" \"t\"\nShape \"sphere\"")),
+        case("light goniometric", ("", "LightSource \"goniometric\" \"color I\" [ 2 2 2 ] \"string mapname\" \"img.pfm\"\nTranslate 0 0 -2\nShape \"sphere\""), ("", "LightSource \"goniometric\" \"string filename\" \"img.pfm\" \"rgb I\" [ 2 2 2 ]\nTranslate 0 0 -2\nShape \"sphere\"")),
+        case("light projection", ("", "LightSource \"projection\" \"string mapname\" \"img.pfm\" \"float fov\" 60\nTranslate 0 0 3\nShape \"sphere\""), ("", "LightSource \"projection\" \"string filename\" \"img.pfm\" \"float fov\" 60\nTranslate 0 0 3\nShape \"sphere\"")),
+        case("light infinite map", ("", "LightSource \"infinite\" \"string mapname\" \"img.pfm\" \"color L\" [ 0.5 0.5 0.5 ]\nShape \"sphere\""), ("", "LightSource \"infinite\" \"float scale\" 0.5 \"string filename\" \"img.pfm\"\nShape \"sphere\"")),
+        case("camera realistic", ("Camera \"realistic\" \"string lensfile\" \"lens.dat\" \"float aperturediameter\" 5 \"float focusdistance\" 5 \"bool simpleweighting\" \"true\"", SPHERE), ("Camera \"realistic\" \"string lensfile\" \"lens.dat\" \"float aperturediameter\" 5 \"float focusdistance\" 5", SPHERE)),
+        native("material fourier", ("", "Material \"fourier\" \"string bsdffile\" \"smooth.bsdf\"\nShape \"sphere\"")),
+    ]
+}
+
 fn check_case(c: &Case) -> Result<Rendered, String> {
     let tag = c.name.replace(' ', "-");
     let v3 = render(&tag, &scene(true, &tag, c.v3.0, c.v3.1))
@@ -253,4 +333,75 @@ fn check_case(c: &Case) -> Result<Rendered, String> {
 fn every_pbrt_v3_type_renders_as_its_upgrade() {
     let failures: Vec<String> = cases().iter().filter_map(|c| check_case(c).err()).collect();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn native_pbrt_v3_types_behave_as_pbrt_v3_defines_them() {
+    write_files();
+    let mean = |c: &Case| {
+        let r = check_case(c).unwrap_or_else(|e| panic!("{e}"));
+        r.pixels.iter().map(|&v| v as f64).sum::<f64>() / r.pixels.len() as f64
+    };
+    // Disney: not the diffuse material pbrt-v4's --upgrade substitutes,
+    // and no approximation warning.
+    let disney = "Material \"disney\" \"color color\" [ 0.5 0.5 0.5 ] \"float metallic\" 1 \"float roughness\" 0.2\nShape \"sphere\"";
+    let d = render("disney", &scene(true, "disney", "", disney)).unwrap();
+    let m = render(
+        "disney",
+        &scene(
+            true,
+            "disney",
+            "",
+            "Material \"matte\" \"color Kd\" [ 0.5 0.5 0.5 ]\nShape \"sphere\"",
+        ),
+    )
+    .unwrap();
+    assert_ne!(d.pixels, m.pixels);
+    assert!(
+        d.warnings.iter().all(|w| !w.contains("approximated")),
+        "{:?}",
+        d.warnings
+    );
+    // Fourier: the table's sphere is lit; a truncated table is a located
+    // error naming the file.
+    let f = mean(&native(
+        "fourier",
+        (
+            "",
+            "Material \"fourier\" \"string bsdffile\" \"smooth.bsdf\"\nShape \"sphere\"",
+        ),
+    ));
+    assert!(f > 0.0);
+    let e = render(
+        "bad",
+        &scene(
+            true,
+            "bad",
+            "",
+            "Material \"fourier\" \"string bsdffile\" \"truncated.bsdf\"\nShape \"sphere\"",
+        ),
+    )
+    .err()
+    .expect("truncated table");
+    assert!(
+        e.contains("truncated.bsdf") && e.contains("truncated Fourier BSDF file"),
+        "{e}"
+    );
+    let e = render(
+        "bad",
+        &scene(true, "bad", "", "Material \"fourier\"\nShape \"sphere\""),
+    )
+    .err()
+    .expect("no file");
+    assert!(e.contains("bsdffile"), "{e}");
+    // The uv texture is (u, v, 0): on a quad with uv over [0,1]², the
+    // same colours as pbrt-v4's bilerp from black through red and green
+    // to yellow, up to the RGB-to-spectrum curves of the blends (close).
+    let quad = "Shape \"trianglemesh\" \"point P\" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0 ] \"integer indices\" [ 0 1 2 0 2 3 ] \"float uv\" [ 0 0 1 0 1 1 0 1 ]";
+    let uv = mean(&native("uv", ("", Box::leak(format!("Texture \"t\" \"color\" \"uv\"\nMaterial \"matte\" \"texture Kd\" \"t\"\n{quad}").into_boxed_str()))));
+    let bilerp = mean(&native("bilerp", ("", Box::leak(format!("Texture \"t\" \"color\" \"bilerp\" \"color v00\" [ 0 0 0 ] \"color v10\" [ 1 0 0 ] \"color v01\" [ 0 1 0 ] \"color v11\" [ 1 1 0 ]\nMaterial \"matte\" \"texture Kd\" \"t\"\n{quad}").into_boxed_str()))));
+    assert!(
+        (uv - bilerp).abs() < 0.1 * bilerp,
+        "uv {uv} vs bilerp {bilerp}"
+    );
 }
