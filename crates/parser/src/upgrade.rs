@@ -194,6 +194,41 @@ impl Edit {
     }
 }
 
+/// Warns where pbrt-v4's replacement of a pbrt-v3 material renders
+/// differently from pbrt-v3's model (the mapping is pbrt-v4's `--upgrade`'s
+/// either way): a different reflection model, pbrt-v3's roughness remapping
+/// (a polynomial in log roughness, where pbrt-v4 takes the square root), or
+/// a dropped parameter such as `matte`'s Oren–Nayar `sigma`.
+fn approximation_warning(e: &mut Edit, name: &str) {
+    let nonzero = |e: &Edit, n: &str| {
+        e.get(n, &["texture"]).is_some()
+            || e.get(n, &["float"])
+                .is_some_and(|p| p.floats.iter().any(|&v| v != 0.0))
+    };
+    let rough = ["roughness", "uroughness", "vroughness"]
+        .iter()
+        .any(|n| nonzero(e, n));
+    let what = match name {
+        "plastic" | "substrate" | "uber" => Some("its reflection model differs"),
+        "translucent" => Some("its glossy reflection and transmission are dropped"),
+        "kdsubsurface" => Some("its specular interface differs"),
+        // pbrt-v3's metal defaults to roughness 0.01, remapped.
+        "metal" => Some("its roughness is remapped differently"),
+        "mirror" => Some("its reflectance varies with angle in pbrt-v4"),
+        "glass" if rough => Some("its roughness is remapped differently"),
+        "matte" if nonzero(e, "sigma") => Some("pbrt-v4 has no Oren–Nayar \"sigma\""),
+        _ => None,
+    };
+    // Uber and plastic without a specular part become "diffuse", exactly.
+    let plain = matches!(name, "uber" | "plastic") && e.uniform_rgb("Ks") == Some(0.0);
+    if let (Some(what), false) = (what, plain) {
+        e.warn(
+            None,
+            format!("pbrt-v3's \"{name}\" material is approximated as pbrt-v4's --upgrade does: {what}, so the image differs from pbrt-v3's"),
+        );
+    }
+}
+
 /// Upgrades a `Material` (or the `"string type"` of a `MakeNamedMaterial`).
 pub fn upgrade_material(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
     let mut e = Edit::new(name, params, loc);
@@ -213,6 +248,7 @@ pub fn upgrade_material(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc)
         }
     }
     e.rename("bumpmap", "displacement");
+    approximation_warning(&mut e, name);
     match name {
         "uber" => {
             e.name = "coateddiffuse".into();
