@@ -256,7 +256,7 @@ fn write_files() {
 /// A Fourier BSDF file (pbrt-v3's `SCATFUN` format): f = c |μi| |μo|
 /// (1 + ½ cos φ) on both sides, albedo 0.8 |cos θo|, one channel.
 fn fourier_table() -> Vec<u8> {
-    let n = 21;
+    let n: i32 = 21;
     let mu: Vec<f32> = (0..n)
         .map(|i| -1.0 + 2.0 * i as f32 / (n - 1) as f32)
         .collect();
@@ -273,7 +273,7 @@ fn fourier_table() -> Vec<u8> {
         }
     }
     let mut out = b"SCATFUN\x01".to_vec();
-    for v in [1, n as i32, a.len() as i32, 2, 1, 1, 0, 0, 0] {
+    for v in [1, n, a.len() as i32, 2, 1, 1, 0, 0, 0] {
         out.extend_from_slice(&v.to_le_bytes());
     }
     out.extend_from_slice(&1.0f32.to_le_bytes());
@@ -297,7 +297,7 @@ fn file_cases() -> Vec<Case> {
         case("shape plymesh", ("", "Shape \"plymesh\" \"string filename\" \"mesh.ply\""), ("", "Shape \"plymesh\" \"string filename\" \"mesh.ply\"")),
         case("texture imagemap", ("", "Texture \"t\" \"color\" \"imagemap\" \"string filename\" \"img.pfm\" \"bool trilinear\" \"true\" \"float gamma\" 2.2\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\""), ("", "Texture \"t\" \"spectrum\" \"imagemap\" \"string encoding\" \"gamma 2.2\" \"string filter\" \"trilinear\" \"string filename\" \"img.pfm\"\nMaterial \"diffuse\" \"texture reflectance\" \"t\"\nShape \"sphere\"")),
         case("light goniometric", ("", "LightSource \"goniometric\" \"color I\" [ 2 2 2 ] \"string mapname\" \"img.pfm\"\nTranslate 0 0 -2\nShape \"sphere\""), ("", "LightSource \"goniometric\" \"string filename\" \"img.pfm\" \"rgb I\" [ 2 2 2 ]\nTranslate 0 0 -2\nShape \"sphere\"")),
-        case("light projection", ("", "LightSource \"projection\" \"string mapname\" \"img.pfm\" \"float fov\" 60\nTranslate 0 0 3\nShape \"sphere\""), ("", "LightSource \"projection\" \"string filename\" \"img.pfm\" \"float fov\" 60\nTranslate 0 0 3\nShape \"sphere\"")),
+        case("light projection", ("", "AttributeBegin\nRotate 180 0 1 0\nLightSource \"projection\" \"string mapname\" \"img.pfm\" \"float fov\" 60\nAttributeEnd\nTranslate 0 0 -2\nShape \"sphere\""), ("", "AttributeBegin\nRotate 180 0 1 0\nLightSource \"projection\" \"string filename\" \"img.pfm\" \"float fov\" 60\nAttributeEnd\nTranslate 0 0 -2\nShape \"sphere\"")),
         case("light infinite map", ("", "LightSource \"infinite\" \"string mapname\" \"img.pfm\" \"color L\" [ 0.5 0.5 0.5 ]\nShape \"sphere\""), ("", "LightSource \"infinite\" \"float scale\" 0.5 \"string filename\" \"img.pfm\"\nShape \"sphere\"")),
         case("camera realistic", ("Camera \"realistic\" \"string lensfile\" \"lens.dat\" \"float aperturediameter\" 5 \"float focusdistance\" 5 \"bool simpleweighting\" \"true\"", SPHERE), ("Camera \"realistic\" \"string lensfile\" \"lens.dat\" \"float aperturediameter\" 5 \"float focusdistance\" 5", SPHERE)),
         native("material fourier", ("", "Material \"fourier\" \"string bsdffile\" \"smooth.bsdf\"\nShape \"sphere\"")),
@@ -331,7 +331,12 @@ fn check_case(c: &Case) -> Result<Rendered, String> {
 
 #[test]
 fn every_pbrt_v3_type_renders_as_its_upgrade() {
-    let failures: Vec<String> = cases().iter().filter_map(|c| check_case(c).err()).collect();
+    write_files();
+    let failures: Vec<String> = cases()
+        .iter()
+        .chain(&file_cases())
+        .filter_map(|c| check_case(c).err())
+        .collect();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 

@@ -401,12 +401,8 @@ impl DisneyBxDF {
     /// One lobe's sampling density (each lobe checks its own side).
     fn lobe_pdf(&self, lobe: u8, wo: Vector3f, wi: Vector3f) -> Float {
         match lobe {
-            DIFFUSE | FAKE_SS | RETRO | SHEEN => {
-                if same_hemisphere(wo, wi) {
-                    cosine_hemisphere_pdf(abs_cos_theta(wi))
-                } else {
-                    0.0
-                }
+            DIFFUSE | FAKE_SS | RETRO | SHEEN if same_hemisphere(wo, wi) => {
+                cosine_hemisphere_pdf(abs_cos_theta(wi))
             }
             SPECULAR => {
                 if !same_hemisphere(wo, wi) {
@@ -460,13 +456,7 @@ impl DisneyBxDF {
                 let dwh_dwi = (eta * eta * dot(wi, wh) / (sqrt_denom * sqrt_denom)).abs();
                 self.trans_distribution().pdf(wo, wh) * dwh_dwi
             }
-            DIFF_TRANS => {
-                if same_hemisphere(wo, wi) {
-                    0.0
-                } else {
-                    cosine_hemisphere_pdf(abs_cos_theta(wi))
-                }
-            }
+            DIFF_TRANS if !same_hemisphere(wo, wi) => cosine_hemisphere_pdf(abs_cos_theta(wi)),
             _ => 0.0,
         }
     }
