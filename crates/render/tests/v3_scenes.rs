@@ -298,7 +298,9 @@ fn file_cases() -> Vec<Case> {
         case("texture imagemap", ("", "Texture \"t\" \"color\" \"imagemap\" \"string filename\" \"img.pfm\" \"bool trilinear\" \"true\" \"float gamma\" 2.2\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\""), ("", "Texture \"t\" \"spectrum\" \"imagemap\" \"string encoding\" \"gamma 2.2\" \"string filter\" \"trilinear\" \"string filename\" \"img.pfm\"\nMaterial \"diffuse\" \"texture reflectance\" \"t\"\nShape \"sphere\"")),
         case("light goniometric", ("", "LightSource \"goniometric\" \"color I\" [ 2 2 2 ] \"string mapname\" \"img.pfm\"\nTranslate 0 0 -2\nShape \"sphere\""), ("", "LightSource \"goniometric\" \"string filename\" \"img.pfm\" \"rgb I\" [ 2 2 2 ]\nTranslate 0 0 -2\nShape \"sphere\"")),
         case("light projection", ("", "AttributeBegin\nRotate 180 0 1 0\nLightSource \"projection\" \"string mapname\" \"img.pfm\" \"float fov\" 60\nAttributeEnd\nTranslate 0 0 -2\nShape \"sphere\""), ("", "AttributeBegin\nRotate 180 0 1 0\nLightSource \"projection\" \"string filename\" \"img.pfm\" \"float fov\" 60\nAttributeEnd\nTranslate 0 0 -2\nShape \"sphere\"")),
-        case("light infinite map", ("", "LightSource \"infinite\" \"string mapname\" \"img.pfm\" \"color L\" [ 0.5 0.5 0.5 ]\nShape \"sphere\""), ("", "LightSource \"infinite\" \"float scale\" 0.5 \"string filename\" \"img.pfm\"\nShape \"sphere\"")),
+        // pbrt-v3's `mapname` is a latitude–longitude map, resampled to
+        // pbrt-v4's equal-area square on load (not pbrt-v4's `filename`).
+        native("light infinite map", ("", "LightSource \"infinite\" \"string mapname\" \"img.pfm\" \"color L\" [ 0.5 0.5 0.5 ]\nShape \"sphere\"")),
         case("camera realistic", ("Camera \"realistic\" \"string lensfile\" \"lens.dat\" \"float aperturediameter\" 5 \"float focusdistance\" 5 \"bool simpleweighting\" \"true\"", SPHERE), ("Camera \"realistic\" \"string lensfile\" \"lens.dat\" \"float aperturediameter\" 5 \"float focusdistance\" 5", SPHERE)),
         native("material fourier", ("", "Material \"fourier\" \"string bsdffile\" \"smooth.bsdf\"\nShape \"sphere\"")),
     ]
