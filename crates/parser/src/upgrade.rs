@@ -194,6 +194,41 @@ impl Edit {
     }
 }
 
+/// Warns where pbrt-v4's replacement of a pbrt-v3 material renders
+/// differently from pbrt-v3's model (the mapping is pbrt-v4's `--upgrade`'s
+/// either way): a different reflection model, pbrt-v3's roughness remapping
+/// (a polynomial in log roughness, where pbrt-v4 takes the square root), or
+/// a dropped parameter such as `matte`'s Oren–Nayar `sigma`.
+fn approximation_warning(e: &mut Edit, name: &str) {
+    let nonzero = |e: &Edit, n: &str| {
+        e.get(n, &["texture"]).is_some()
+            || e.get(n, &["float"])
+                .is_some_and(|p| p.floats.iter().any(|&v| v != 0.0))
+    };
+    let rough = ["roughness", "uroughness", "vroughness"]
+        .iter()
+        .any(|n| nonzero(e, n));
+    let what = match name {
+        "plastic" | "substrate" | "uber" => Some("its reflection model differs"),
+        "translucent" => Some("its glossy reflection and transmission are dropped"),
+        "kdsubsurface" => Some("its specular interface differs"),
+        // pbrt-v3's metal defaults to roughness 0.01, remapped.
+        "metal" => Some("its roughness is remapped differently"),
+        "mirror" => Some("its reflectance varies with angle in pbrt-v4"),
+        "glass" if rough => Some("its roughness is remapped differently"),
+        "matte" if nonzero(e, "sigma") => Some("pbrt-v4 has no Oren–Nayar \"sigma\""),
+        _ => None,
+    };
+    // Uber and plastic without a specular part become "diffuse", exactly.
+    let plain = matches!(name, "uber" | "plastic") && e.uniform_rgb("Ks") == Some(0.0);
+    if let (Some(what), false) = (what, plain) {
+        e.warn(
+            None,
+            format!("pbrt-v3's \"{name}\" material is approximated as pbrt-v4's --upgrade does: {what}, so the image differs from pbrt-v3's"),
+        );
+    }
+}
+
 /// Upgrades a `Material` (or the `"string type"` of a `MakeNamedMaterial`).
 pub fn upgrade_material(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
     let mut e = Edit::new(name, params, loc);
@@ -213,6 +248,7 @@ pub fn upgrade_material(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc)
         }
     }
     e.rename("bumpmap", "displacement");
+    approximation_warning(&mut e, name);
     match name {
         "uber" => {
             e.name = "coateddiffuse".into();
@@ -354,6 +390,28 @@ pub fn upgrade_material(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc)
     e.finish()
 }
 
+/// The pbrt-v3 materials pbrt-v4 dropped that a renderer reading pbrt-v3
+/// files directly can still build (rpbrt does): `--upgrade` must map them
+/// to something pbrt-v4 reads, rendering need not.
+pub const NATIVE_V3_MATERIALS: &[&str] = &["disney", "fourier"];
+
+/// [`upgrade_material`] for a renderer that implements
+/// [`NATIVE_V3_MATERIALS`]: those keep their name and parameters (only the
+/// parameter types and pbrt-v3's `bumpmap` are renamed); every other
+/// material is upgraded as `--upgrade` does.
+pub fn upgrade_material_for_render(
+    name: &str,
+    params: Vec<ParsedParameter>,
+    loc: &FileLoc,
+) -> Upgraded {
+    if NATIVE_V3_MATERIALS.contains(&name) {
+        let mut e = Edit::new(name, params, loc);
+        e.rename("bumpmap", "displacement");
+        return e.finish();
+    }
+    upgrade_material(name, params, loc)
+}
+
 /// Upgrades a `LightSource`.
 pub fn upgrade_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
     let mut e = Edit::new(name, params, loc);
@@ -363,9 +421,16 @@ pub fn upgrade_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) ->
         e.error(l.as_ref(), "in pbrt-v4 a light's \"scale\" is a \"float\"; a non-uniform spectrum cannot be converted".into());
         return e.finish();
     }
-    e.remove_all("samples", &["integer"]);
-    // pbrt-v3's lights (the infinite light among them) read "nsamples".
-    e.remove_all("nsamples", &["integer"]);
+    // pbrt-v3's light sample counts ("samples", or "nsamples" on infinite
+    // and area lights) only set how many shadow rays its "directlighting"
+    // integrator traces per light: the noise, never the expected image.
+    for n in ["samples", "nsamples"] {
+        e.remove_all(n, &["integer", "float"]);
+    }
+    // pbrt-v3 accepted "exinfinite" as another name of "infinite".
+    if name == "exinfinite" {
+        e.name = "infinite".into();
+    }
     let has_map = e.get("mapname", &["string"]).is_some();
     if has_map && name == "infinite" && !e.rgb_into_scale("L", &mut scale) {
         let l = e.get("L", &SPECTRUM_TYPES).map(|p| p.loc.clone());
@@ -394,13 +459,27 @@ pub fn upgrade_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) ->
         let p = e.float("scale", &[scale * old]);
         e.front.insert(0, p);
     }
-    if e.get("L", &SPECTRUM_TYPES).is_some() || e.get("I", &SPECTRUM_TYPES).is_some() {
+    warn_if_normalized(&mut e);
+    e.finish()
+}
+
+/// Warns when a light's `L` or `I` is a `spectrum` or `blackbody`:
+/// pbrt-v4 scales those to unit luminance where pbrt-v3 used them as they
+/// are (its blackbody peaks at 1), so the light's brightness changes. An
+/// RGB value keeps its brightness: pbrt-v4 divides by the luminance of the
+/// colour space's illuminant only, which the RGB-to-spectrum conversion
+/// multiplies in.
+fn warn_if_normalized(e: &mut Edit) {
+    let p = e
+        .get("L", &["spectrum", "blackbody"])
+        .or_else(|| e.get("I", &["spectrum", "blackbody"]));
+    if let Some(p) = p {
+        let (loc, ty, name) = (p.loc.clone(), p.ty.clone(), p.name.clone());
         e.warn(
-            None,
-            "pbrt-v4 normalizes light spectra to unit luminance; brightness may differ from pbrt-v3 (adjust \"scale\" or use \"power\")".into(),
+            Some(&loc),
+            format!("pbrt-v4 normalizes a light's \"{ty} {name}\" to unit luminance, pbrt-v3 did not: brightness differs from pbrt-v3 (adjust \"scale\" or use \"power\")"),
         );
     }
-    e.finish()
 }
 
 /// Upgrades an `AreaLightSource` (`area` → `diffuse`).
@@ -416,7 +495,10 @@ pub fn upgrade_area_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLo
     if name == "area" {
         e.name = "diffuse".into();
     }
-    e.remove_all("nsamples", &["integer"]);
+    warn_if_normalized(&mut e);
+    for n in ["samples", "nsamples"] {
+        e.remove_all(n, &["integer", "float"]);
+    }
     if scale != 1.0 {
         let old = e
             .remove("scale", &["float"])
@@ -709,8 +791,84 @@ pub fn upgrade_shape(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) ->
             e.add_front(p);
         }
     }
+    if name == "heightfield" {
+        upgrade_heightfield(&mut e);
+    }
     e.rename("Kd", "reflectance");
     e.finish()
+}
+
+/// pbrt-v3's `heightfield` (pbrt-v3 `shapes/heightfield.cpp`), which
+/// pbrt-v4 dropped, as the triangle mesh pbrt-v3 built from it: `nu` × `nv`
+/// heights `Pz` over the unit square (x fastest), the vertex (x, y) at
+/// (x/(nu−1), y/(nv−1), Pz) with the same uv, two triangles per cell.
+fn upgrade_heightfield(e: &mut Edit) {
+    let one_int = |e: &Edit, n: &str| e.get(n, &["integer"]).and_then(|p| p.ints.first().copied());
+    let (nu, nv) = (one_int(e, "nu"), one_int(e, "nv"));
+    let z = e
+        .get("Pz", &["float"])
+        .map(|p| (p.floats.clone(), p.loc.clone()));
+    let (Some(nu), Some(nv), Some((z, zloc))) = (nu, nv, z) else {
+        e.error(
+            None,
+            "\"heightfield\" needs \"integer nu\", \"integer nv\" and \"float Pz\"".into(),
+        );
+        return;
+    };
+    if nu < 2 || nv < 2 {
+        e.error(
+            None,
+            format!("\"heightfield\" needs at least 2 × 2 heights (nu {nu}, nv {nv})"),
+        );
+        return;
+    }
+    let (nu, nv) = (nu as usize, nv as usize);
+    if nu.checked_mul(nv) != Some(z.len()) {
+        e.error(
+            Some(&zloc),
+            format!(
+                "\"heightfield\" has {} \"Pz\" values; nu × nv = {nu} × {nv} expected",
+                z.len()
+            ),
+        );
+        return;
+    }
+    for n in ["nu", "nv", "Pz"] {
+        e.remove_all(n, &["integer", "float"]);
+    }
+    let mut p = Vec::with_capacity(3 * z.len());
+    let mut uv = Vec::with_capacity(2 * z.len());
+    for y in 0..nv {
+        for x in 0..nu {
+            let (s, t) = (x as f32 / (nu - 1) as f32, y as f32 / (nv - 1) as f32);
+            p.extend([s, t, z[y * nu + x]]);
+            uv.extend([s, t]);
+        }
+    }
+    let vert = |x: usize, y: usize| (x + y * nu) as i32;
+    let mut indices = Vec::with_capacity(6 * (nu - 1) * (nv - 1));
+    for y in 0..nv - 1 {
+        for x in 0..nu - 1 {
+            indices.extend([vert(x, y), vert(x + 1, y), vert(x + 1, y + 1)]);
+            indices.extend([vert(x, y), vert(x + 1, y + 1), vert(x, y + 1)]);
+        }
+    }
+    e.name = "trianglemesh".into();
+    let mut ip = ParsedParameter::new("integer", "indices", e.loc.clone());
+    ip.ints = indices;
+    e.add_front(ip);
+    e.add_front(ParsedParameter::with_floats(
+        "point3",
+        "P",
+        e.loc.clone(),
+        p,
+    ));
+    e.add_front(ParsedParameter::with_floats(
+        "point2",
+        "uv",
+        e.loc.clone(),
+        uv,
+    ));
 }
 
 #[cfg(test)]

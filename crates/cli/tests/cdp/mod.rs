@@ -267,6 +267,15 @@ impl Page {
     /// Calls `method` and returns its result (events in between are
     /// dropped); a protocol error fails the test.
     pub fn call(&mut self, method: &str, params: Value) -> Value {
+        match self.try_call(method, params) {
+            Ok(v) => v,
+            Err(reply) => panic!("{method}: {reply}"),
+        }
+    }
+
+    /// Calls `method`: its result, or the whole reply when it is a
+    /// protocol error (e.g. no execution context while a page loads).
+    pub fn try_call(&mut self, method: &str, params: Value) -> Result<Value, Value> {
         let id = self.next_id;
         self.next_id += 1;
         let msg = json!({ "id": id, "method": method, "params": params });
@@ -274,8 +283,10 @@ impl Page {
         loop {
             let reply: Value = serde_json::from_str(&self.ws.recv_text()).expect("CDP JSON");
             if reply["id"] == id {
-                assert!(reply.get("error").is_none(), "{method}: {reply}");
-                return reply["result"].clone();
+                if reply.get("error").is_some() {
+                    return Err(reply);
+                }
+                return Ok(reply["result"].clone());
             }
         }
     }
@@ -313,7 +324,17 @@ impl Page {
     ) -> Value {
         let t0 = Instant::now();
         loop {
-            let v = self.eval(expression);
+            // While a page (re)loads there may be no context to evaluate
+            // in, or its script may not have run yet: poll again.
+            let r = self.try_call(
+                "Runtime.evaluate",
+                json!({ "expression": expression, "returnByValue": true, "awaitPromise": true }),
+            );
+            let v = match r {
+                Ok(r) if r.get("exceptionDetails").is_none() => r["result"]["value"].clone(),
+                Ok(r) => r["exceptionDetails"].clone(),
+                Err(reply) => reply,
+            };
             if done(&v) {
                 return v;
             }

@@ -47,14 +47,17 @@ fn materials() {
         &loc(1),
     );
     assert_eq!(u.name, "coateddiffuse");
-    assert_eq!(u.diagnostics.len(), 1); // Ks dropped with a warning
-    assert_eq!(u.diagnostics[0].loc.as_ref().map(|l| l.line), Some(2));
+    // The model differs (a warning at the directive) and Ks is dropped
+    // (a warning at the parameter).
+    assert_eq!(u.diagnostics.len(), 2);
+    assert!(u.diagnostics[0].message.contains("approximated"));
+    assert_eq!(u.diagnostics[1].loc.as_ref().map(|l| l.line), Some(2));
     let u = upgrade_material(
         "substrate",
         vec![f("rgb", "Ks", &[1.; 3]), f("rgb", "Kd", &[0.3; 3])],
         &loc(1),
     );
-    assert_eq!((u.name.as_str(), u.diagnostics.len()), ("coateddiffuse", 0));
+    assert_eq!((u.name.as_str(), u.diagnostics.len()), ("coateddiffuse", 1));
     assert_eq!(names(&u), ["rgb reflectance"]);
     let u = upgrade_material(
         "uber",
@@ -354,4 +357,32 @@ fn pbrt_v4_mix_is_left_alone() {
         .params
         .iter()
         .any(|p| p.name == "amount" && p.floats == [0.3]));
+}
+
+#[test]
+fn approximate_material_mappings_warn_exact_ones_do_not() {
+    let warns = |name: &str, params: Vec<ParsedParameter>| {
+        upgrade_material(name, params, &loc(1))
+            .diagnostics
+            .iter()
+            .any(|d| d.message.contains("approximated"))
+    };
+    assert!(!warns("matte", vec![f("rgb", "Kd", &[0.5; 3])]));
+    assert!(warns("matte", vec![f("float", "sigma", &[20.])]));
+    assert!(!warns("glass", vec![f("float", "index", &[1.4])]));
+    assert!(warns("glass", vec![f("float", "roughness", &[0.1])]));
+    assert!(!warns("plastic", vec![f("rgb", "Ks", &[0.; 3])]));
+    assert!(!warns("uber", vec![f("rgb", "Ks", &[0.; 3])]));
+    for m in [
+        "plastic",
+        "substrate",
+        "uber",
+        "translucent",
+        "metal",
+        "mirror",
+        "kdsubsurface",
+    ] {
+        assert!(warns(m, vec![]), "{m}");
+    }
+    assert!(!warns("mix", vec![]));
 }

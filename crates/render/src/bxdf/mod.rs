@@ -18,6 +18,8 @@ mod bsdf;
 mod conductor;
 mod dielectric;
 mod diffuse;
+mod disney;
+pub mod fourier;
 mod hair;
 mod layered;
 pub mod measured;
@@ -25,11 +27,15 @@ mod microfacet;
 mod scattering;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_v3;
 
 pub use bsdf::BSDF;
 pub use conductor::ConductorBxDF;
 pub use dielectric::{DielectricBxDF, ThinDielectricBxDF};
 pub use diffuse::{DiffuseBxDF, DiffuseTransmissionBxDF, NormalizedFresnelBxDF};
+pub use disney::{DisneyBxDF, DisneyParams};
+pub use fourier::{FourierBSDFTable, FourierBxDF, FourierError};
 pub use hair::HairBxDF;
 pub use layered::{CoatedConductorBxDF, CoatedDiffuseBxDF, LayeredBxDF};
 pub use measured::{MeasuredBxDF, MeasuredBxDFData};
@@ -316,6 +322,10 @@ pub enum BxDF {
     NormalizedFresnel(NormalizedFresnelBxDF),
     /// Tabulated measured reflectance (RGL `.bsdf` data).
     Measured(MeasuredBxDF),
+    /// pbrt-v3's Disney BSDF.
+    Disney(DisneyBxDF),
+    /// pbrt-v3's tabulated Fourier BSDF.
+    Fourier(FourierBxDF),
 }
 
 macro_rules! dispatch {
@@ -331,6 +341,8 @@ macro_rules! dispatch {
             BxDF::Hair($b) => $e,
             BxDF::NormalizedFresnel($b) => $e,
             BxDF::Measured($b) => $e,
+            BxDF::Disney($b) => $e,
+            BxDF::Fourier($b) => $e,
         }
     };
 }
@@ -393,6 +405,8 @@ impl BxDF {
             BxDF::Hair(_) => "HairBxDF",
             BxDF::NormalizedFresnel(_) => "NormalizedFresnelBxDF",
             BxDF::Measured(_) => "MeasuredBxDF",
+            BxDF::Disney(_) => "DisneyBxDF",
+            BxDF::Fourier(_) => "FourierBSDF",
         }
     }
 

@@ -11,11 +11,11 @@ use crate::rng::Rng;
 use crate::sampling::{sample_uniform_sphere, UNIFORM_SPHERE_PDF};
 use crate::spectrum::SampledSpectrum;
 
-fn u2(rng: &mut Rng) -> Point2f {
+pub(super) fn u2(rng: &mut Rng) -> Point2f {
     Point2f::new(rng.uniform_float(), rng.uniform_float())
 }
 
-fn rand_dir(rng: &mut Rng) -> Vector3f {
+pub(super) fn rand_dir(rng: &mut Rng) -> Vector3f {
     sample_uniform_sphere(u2(rng))
 }
 
@@ -82,7 +82,7 @@ fn exact_models() -> Vec<(String, BxDF)> {
     v
 }
 
-fn approx(a: Float, b: Float, rel: Float) -> bool {
+pub(super) fn approx(a: Float, b: Float, rel: Float) -> bool {
     (a - b).abs() <= rel * a.abs().max(b.abs()).max(1e-3)
 }
 
@@ -180,7 +180,13 @@ fn rough_dielectric_transmission_is_adjoint() {
 }
 
 /// ∫ f |cos θi| dωi estimated with `sample_f`, in the given mode.
-fn albedo(b: &BxDF, wo: Vector3f, mode: TransportMode, n: usize, rng: &mut Rng) -> SampledSpectrum {
+pub(super) fn albedo(
+    b: &BxDF,
+    wo: Vector3f,
+    mode: TransportMode,
+    n: usize,
+    rng: &mut Rng,
+) -> SampledSpectrum {
     let mut sum = SampledSpectrum::new(0.0);
     for _ in 0..n {
         let uc = rng.uniform_float();
@@ -576,7 +582,7 @@ fn integrate_pdf_cells(b: &BxDF, wo: Vector3f) -> Vec<f64> {
     out
 }
 
-fn chi2_test(name: &str, b: &BxDF, seed: u64) {
+pub(super) fn chi2_test(name: &str, b: &BxDF, seed: u64) {
     const N: usize = 200_000;
     const RUNS: usize = 3;
     let significance = 1.0 - (1.0f64 - 0.01).powf(1.0 / RUNS as f64);

@@ -12,7 +12,7 @@ use rpbrt_parser::Diagnostic;
 
 use super::coated::LayerSettings;
 use super::*;
-use crate::bxdf::MeasuredBxDFData;
+use crate::bxdf::{FourierBSDFTable, MeasuredBxDFData};
 use crate::image::Image;
 use crate::params::unknown_type;
 use crate::spectrum::{
@@ -29,6 +29,8 @@ pub const MATERIAL_NAMES: &[&str] = &[
     "dielectric",
     "diffuse",
     "diffusetransmission",
+    "disney",
+    "fourier",
     "hair",
     "interface",
     "measured",
@@ -256,6 +258,24 @@ pub fn create_material(
             perturbation: perturbation(tp, cache)?,
         })),
         "hair" => create_hair(tp)?,
+        "disney" => create_disney(tp, cache)?,
+        "fourier" => {
+            let file = tp.string("bsdffile", "")?;
+            if file.is_empty() {
+                return Err(Diagnostic::error(
+                    tp.loc().clone(),
+                    "\"fourier\" material: \"bsdffile\" must be provided",
+                ));
+            }
+            let loc = tp.param_loc("bsdffile");
+            let path = tp.resolve("bsdffile", &file);
+            let table = FourierBSDFTable::cached(&path)
+                .map_err(|e| Diagnostic::error(loc.clone(), format!("{}: {e}", path.display())))?;
+            Material::Fourier(Box::new(FourierMaterial {
+                table,
+                perturbation: perturbation(tp, cache)?,
+            }))
+        }
         "mix" => create_mix(tp, visible)?,
         "subsurface" => create_subsurface(tp, cache)?,
         "measured" => {
@@ -277,6 +297,48 @@ pub fn create_material(
         }
         _ => return Err(unknown_type("material", ty, MATERIAL_NAMES, tp.loc())),
     })
+}
+
+/// pbrt-v3's `CreateDisneyMaterial`: every parameter a texture, with
+/// pbrt-v3's defaults.
+fn create_disney(tp: &TextureParams, cache: &mut NormalMapCache) -> Result<Material, Diagnostic> {
+    let f = |name: &str, default: Float| tp.float_texture(name, default);
+    let eta = tp.checked_float_texture(
+        "eta",
+        1.5,
+        |v| v > 0.0,
+        "index of refraction must be positive",
+    )?;
+    // pbrt-v3 replaces the diffuse lobe of a non-thin surface with its
+    // Disney BSSRDF when "scatterdistance" is not black; rpbrt has no
+    // Disney BSSRDF and keeps the diffuse lobe.
+    let thin = tp.bool("thin", false)?;
+    if let Some(sd) = tp.spectrum_texture_opt("scatterdistance", SpectrumType::Unbounded)? {
+        let black = matches!(&*sd, SpectrumTexture::Constant(s) if s.max_value() == 0.0);
+        if !black && !thin {
+            tp.warn_at(
+                "scatterdistance",
+                "pbrt-v3's Disney subsurface scattering is not implemented; the diffuse lobe is used instead",
+            );
+        }
+    }
+    Ok(Material::Disney(Box::new(DisneyMaterial {
+        color: tp.spectrum_texture("color", Spectrum::constant(0.5), SpectrumType::Albedo)?,
+        metallic: f("metallic", 0.0)?,
+        eta,
+        roughness: f("roughness", 0.5)?,
+        specular_tint: f("speculartint", 0.0)?,
+        anisotropic: f("anisotropic", 0.0)?,
+        sheen: f("sheen", 0.0)?,
+        sheen_tint: f("sheentint", 0.5)?,
+        clearcoat: f("clearcoat", 0.0)?,
+        clearcoat_gloss: f("clearcoatgloss", 1.0)?,
+        spec_trans: f("spectrans", 0.0)?,
+        thin,
+        flatness: f("flatness", 0.0)?,
+        diff_trans: f("difftrans", 1.0)?,
+        perturbation: perturbation(tp, cache)?,
+    })))
 }
 
 fn create_hair(tp: &TextureParams) -> Result<Material, Diagnostic> {

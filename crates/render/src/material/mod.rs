@@ -29,6 +29,8 @@ mod conductor;
 mod create;
 mod dielectric;
 mod diffuse;
+mod disney;
+mod fourier;
 mod hair;
 mod measured;
 mod mix;
@@ -43,6 +45,8 @@ pub use conductor::{ConductorMaterial, ConductorSpectra};
 pub use create::{create_material, NormalMapCache, MATERIAL_NAMES};
 pub use dielectric::{DielectricMaterial, ThinDielectricMaterial};
 pub use diffuse::{DiffuseMaterial, DiffuseTransmissionMaterial};
+pub use disney::DisneyMaterial;
+pub use fourier::FourierMaterial;
 pub use hair::{HairAbsorption, HairMaterial};
 pub use measured::MeasuredMaterial;
 pub use mix::MixMaterial;
@@ -192,6 +196,10 @@ pub enum Material {
     Subsurface(Box<SubsurfaceMaterial>),
     /// Tabulated measured reflectance.
     Measured(Box<MeasuredMaterial>),
+    /// pbrt-v3's Disney BSDF.
+    Disney(Box<DisneyMaterial>),
+    /// pbrt-v3's tabulated Fourier BSDF.
+    Fourier(Box<FourierMaterial>),
 }
 
 impl Material {
@@ -217,6 +225,8 @@ impl Material {
             Material::Mix(_) | Material::Interface => None,
             Material::Subsurface(m) => Some(m.get_bxdf(ctx, lambda)),
             Material::Measured(m) => Some(m.get_bxdf(ctx, lambda)),
+            Material::Disney(m) => Some(m.get_bxdf(ctx, lambda)),
+            Material::Fourier(m) => Some(m.get_bxdf(ctx, lambda)),
         }
     }
 
@@ -233,6 +243,8 @@ impl Material {
             Material::CoatedConductor(m) => Some(&m.perturbation),
             Material::Subsurface(m) => Some(&m.perturbation),
             Material::Measured(m) => Some(&m.perturbation),
+            Material::Disney(m) => Some(&m.perturbation),
+            Material::Fourier(m) => Some(&m.perturbation),
             Material::Hair(_) | Material::Mix(_) | Material::Interface => None,
         }
     }
@@ -264,6 +276,8 @@ impl Material {
             Material::Interface => "interface",
             Material::Subsurface(_) => "subsurface",
             Material::Measured(_) => "measured",
+            Material::Disney(_) => "disney",
+            Material::Fourier(_) => "fourier",
         }
     }
 }

@@ -679,7 +679,8 @@ impl ParserTarget for SceneBuilder {
 
     fn material(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
         self.verify_world("Material", &loc)?;
-        let (name, params) = self.upgraded(upgrade::upgrade_material, name, params, &loc);
+        let (name, params) =
+            self.upgraded(upgrade::upgrade_material_for_render, name, params, &loc);
         EntityKind::Material.check(&name, &loc)?;
         let attrs = self.state.material_attributes.clone();
         let entity = self.entity_with(name, params, &attrs, loc);
@@ -702,7 +703,8 @@ impl ParserTarget for SceneBuilder {
                 format!("no parameter \"string type\" found for named material \"{name}\""),
             ));
         };
-        let (ty, mut params) = self.upgraded(upgrade::upgrade_material, &ty, params, &loc);
+        let (ty, mut params) =
+            self.upgraded(upgrade::upgrade_material_for_render, &ty, params, &loc);
         EntityKind::Material.check(&ty, &ty_loc)?;
         if !self.named_material_names.insert(name.to_string()) {
             return Err(Diagnostic::error(

@@ -234,18 +234,23 @@ pub const FLOAT_TEXTURE_NAMES: &[&str] = &[
     "windy",
     "wrinkled",
 ];
-/// The spectrum texture classes [`create_spectrum_texture`] knows, sorted.
+/// The spectrum texture classes [`create_spectrum_texture`] knows, sorted
+/// (`fbm`, `uv`, `windy` and `wrinkled` are pbrt-v3's).
 pub const SPECTRUM_TEXTURE_NAMES: &[&str] = &[
     "bilerp",
     "checkerboard",
     "constant",
     "directionmix",
     "dots",
+    "fbm",
     "imagemap",
     "marble",
     "mix",
     "ptex",
     "scale",
+    "uv",
+    "windy",
+    "wrinkled",
 ];
 
 /// Every texture class, float or spectrum, sorted (what the `Texture`
@@ -262,6 +267,7 @@ pub const TEXTURE_NAMES: &[&str] = &[
     "mix",
     "ptex",
     "scale",
+    "uv",
     "windy",
     "wrinkled",
 ];
@@ -484,6 +490,14 @@ pub fn create_spectrum_texture(
         "ptex" => SpectrumTexture::Ptex(SpectrumPtexTexture {
             base: ptex_base(def, tp)?,
             spectrum_type: ty,
+        }),
+        // pbrt-v3's spectrum versions of the noise textures: the float
+        // value in every channel.
+        "fbm" | "wrinkled" | "windy" => {
+            SpectrumTexture::Grey(create_float_texture(def, tp, cache, options)?)
+        }
+        "uv" => SpectrumTexture::Uv(UvTexture {
+            mapping: TextureMapping2D::create(tp, &rft)?,
         }),
         other => {
             return Err(unknown_type(

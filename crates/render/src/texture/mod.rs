@@ -166,6 +166,12 @@ pub enum SpectrumTexture {
     Image(SpectrumImageTexture),
     /// A Ptex file.
     Ptex(SpectrumPtexTexture),
+    /// pbrt-v3's `uv` texture.
+    Uv(UvTexture),
+    /// A float texture as a grey spectrum (pbrt-v3's spectrum `fbm`,
+    /// `wrinkled` and `windy`, which return the float value in every
+    /// channel).
+    Grey(FloatTextureRef),
 }
 
 impl SpectrumTexture {
@@ -187,6 +193,8 @@ impl SpectrumTexture {
             SpectrumTexture::Marble(t) => t.evaluate(ctx, lambda),
             SpectrumTexture::Image(t) => t.evaluate(ctx, lambda),
             SpectrumTexture::Ptex(t) => t.evaluate(ctx, lambda),
+            SpectrumTexture::Uv(t) => t.evaluate(ctx, lambda),
+            SpectrumTexture::Grey(t) => SampledSpectrum::new(t.evaluate(ctx)),
         }
     }
 }

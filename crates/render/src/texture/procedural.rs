@@ -550,3 +550,30 @@ impl MarbleTexture {
             .sample(lambda)
     }
 }
+
+/// pbrt-v3's `uv` spectrum texture, which pbrt-v4 dropped: the fractional
+/// parts of the mapped (s, t) as red and green.
+#[derive(Clone, Debug)]
+pub struct UvTexture {
+    /// The 2-D mapping.
+    pub mapping: TextureMapping2D,
+}
+
+impl UvTexture {
+    /// The RGB at a point: (s − ⌊s⌋, t − ⌊t⌋, 0).
+    pub fn rgb(&self, ctx: &TextureEvalContext) -> RGB {
+        let st = self.mapping.map(ctx).st;
+        RGB::new(st.x - st.x.floor(), st.y - st.y.floor(), 0.0)
+    }
+
+    /// The value at a point.
+    #[inline]
+    pub fn evaluate(
+        &self,
+        ctx: &TextureEvalContext,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        Spectrum::RgbAlbedo(RgbAlbedoSpectrum::new(RgbColorSpace::srgb(), self.rgb(ctx)))
+            .sample(lambda)
+    }
+}
