@@ -1,5 +1,6 @@
 //! `imgtool assemble`: join crops (tiles) of one image into the whole.
 
+use super::args::{Arg, Args};
 use rpbrt_render::image::assemble::assemble;
 use rpbrt_render::image::{Image, ImageMetadata};
 use std::path::Path;
@@ -20,35 +21,24 @@ pub(crate) fn load_with_metadata(path: &str) -> Result<(Image, ImageMetadata), S
         .map_err(|e| e.to_string())
 }
 
-/// The `--outfile` value and the other arguments.
+/// The `--outfile` value and the input files of `assemble` / `merge`.
 pub(crate) fn outfile_and_files(
-    cmd: &str,
+    cmd: &'static str,
     args: &[String],
 ) -> Result<(String, Vec<String>), String> {
+    let mut a = Args::new(cmd, args);
     let mut outfile = None;
     let mut files = Vec::new();
-    let mut i = 0;
-    while i < args.len() {
-        let a = args[i].as_str();
-        if let Some(v) = a
-            .strip_prefix("--outfile=")
-            .or_else(|| a.strip_prefix("-outfile="))
-        {
-            outfile = Some(v.to_string());
-            i += 1;
-        } else if a == "--outfile" || a == "-outfile" {
-            outfile = Some(args.get(i + 1).ok_or("--outfile needs a file")?.clone());
-            i += 2;
-        } else if a.starts_with('-') {
-            return Err(format!("{cmd}: {a}: unknown argument"));
-        } else {
-            files.push(a.to_string());
-            i += 1;
+    while let Some(arg) = a.next_arg() {
+        match arg {
+            Arg::Flag(f) if f == "outfile" => outfile = Some(a.value(&f)?),
+            Arg::Flag(f) => return Err(a.unknown(&f)),
+            Arg::Positional(p) => files.push(p),
         }
     }
-    let outfile = outfile.ok_or(format!("{cmd}: must provide --outfile."))?;
+    let outfile = outfile.ok_or_else(|| a.err("must provide --outfile."))?;
     if files.is_empty() {
-        return Err(format!("{cmd}: no input images."));
+        return Err(a.err("no input images."));
     }
     Ok((outfile, files))
 }

@@ -1,5 +1,6 @@
 //! `imgtool average`: pbrt-v4's average of images sharing a filename base.
 
+use super::args::{Arg, Args};
 use super::load;
 use rpbrt_render::image::ops::average;
 use rpbrt_render::image::ImageMetadata;
@@ -38,23 +39,17 @@ pub(crate) fn matching_filenames(base: &str) -> Result<Vec<std::path::PathBuf>, 
 
 /// Runs `imgtool average`.
 pub fn run(args: &[String]) -> Result<(), String> {
+    let mut a = Args::new("average", args);
     let mut outfile: Option<String> = None;
     let mut base: Option<String> = None;
-    let mut i = 0;
-    while i < args.len() {
-        match args[i].as_str() {
-            "--outfile" | "-outfile" => {
-                outfile = Some(args.get(i + 1).ok_or("--outfile needs a file")?.clone());
-                i += 2;
+    while let Some(arg) = a.next_arg() {
+        match arg {
+            Arg::Flag(f) if f == "outfile" => outfile = Some(a.value(&f)?),
+            Arg::Flag(f) => return Err(a.unknown(&f)),
+            Arg::Positional(p) if base.is_some() => {
+                return Err(a.err(format!("{p}: excess argument")))
             }
-            a if a.starts_with('-') => return Err(format!("average: {a}: unknown argument")),
-            a => {
-                if base.is_some() {
-                    return Err(format!("average: {a}: excess argument"));
-                }
-                base = Some(a.to_string());
-                i += 1;
-            }
+            Arg::Positional(p) => base = Some(p),
         }
     }
     let base = base.ok_or("average: must provide base filename.")?;
