@@ -4,60 +4,88 @@ against Mitsuba 3 rendering the same box (mi.cornell_box(), 256x256, 64 spp,
 independent sampler, max_depth 8 = pbrt maxdepth 7), in the same run.
 
     pip install mitsuba
-    python3 bench/cbox_vs_mitsuba.py [--variant scalar_spectral] [--threads 2]
+    apt-get install libllvm19      # for the LLVM variants
+    python3 bench/cbox_vs_mitsuba.py [--variants scalar_spectral,llvm_ad_spectral] [--threads 2]
 
-Prints one RESULT line. Mitsuba is timed on its render call after a warm-up
-render (as the issue asks); rpbrt is timed as a whole process.
+Prints one RESULT line with every variant's time and its ratio to rpbrt's.
+Each Mitsuba variant is timed on its render call after a warm-up render (the
+LLVM variants JIT-compile there); rpbrt is timed as a whole process, the
+median of --repeat runs interleaved with Mitsuba's (the machine drifts).
+DRJIT_LIBLLVM_PATH defaults to Debian's libLLVM-19.so when it exists (Dr.Jit's
+default LLVM lookup aborts on this machine).
 """
 import argparse
 import os
+import statistics
 import subprocess
-import sys
 import time
+
+LLVM19 = "/usr/lib/x86_64-linux-gnu/libLLVM-19.so"
+if "DRJIT_LIBLLVM_PATH" not in os.environ and os.path.exists(LLVM19):
+    os.environ["DRJIT_LIBLLVM_PATH"] = LLVM19
 
 here = os.path.dirname(os.path.abspath(__file__))
 root = os.path.dirname(here)
 scene = os.path.join(root, "..", "shared", "scenes", "mitsuba-cbox", "cbox.pbrt")
 
 ap = argparse.ArgumentParser()
-ap.add_argument("--variant", default="scalar_spectral")
+ap.add_argument("--variants", default="scalar_spectral,llvm_ad_spectral")
 ap.add_argument("--threads", type=int, default=2)
 ap.add_argument("--spp", type=int, default=64)
+ap.add_argument("--repeat", type=int, default=3)
+ap.add_argument("--rpbrt", default=os.path.join(root, "target", "release", "rpbrt"))
 args = ap.parse_args()
 
-binary = os.path.join(root, "target", "release", "rpbrt")
-if not os.path.exists(binary):
+if not os.path.exists(args.rpbrt):
     subprocess.run(["cargo", "build", "--release", "-q"], cwd=root, check=True)
 
-out = os.path.join("/tmp", "rpbrt-cbox-bench.exr")
-t0 = time.perf_counter()
-subprocess.run([binary, "--quiet", "--nthreads", str(args.threads), "--spp", str(args.spp),
-                "--outfile", out, scene], check=True)
-t_rpbrt = time.perf_counter() - t0
 
+def time_rpbrt():
+    out = os.path.join("/tmp", "rpbrt-cbox-bench.exr")
+    t0 = time.perf_counter()
+    subprocess.run([args.rpbrt, "--quiet", "--nthreads", str(args.threads), "--spp",
+                    str(args.spp), "--outfile", out, scene], check=True)
+    return time.perf_counter() - t0
+
+
+import drjit as dr  # noqa: E402
 import mitsuba as mi  # noqa: E402
 
-mi.set_variant(args.variant)
-try:
-    import drjit as dr
-    dr.set_thread_count(args.threads)
-except Exception:
-    pass
-d = mi.cornell_box()
-d["sensor"]["film"]["width"] = 256
-d["sensor"]["film"]["height"] = 256
-d["sensor"]["sampler"] = {"type": "independent", "sample_count": args.spp}
-d["integrator"] = {"type": "path", "max_depth": 8}
-s = mi.load_dict(d)
-mi.render(s, spp=args.spp)  # warm-up (JIT compilation for the LLVM variants)
-t0 = time.perf_counter()
-img = mi.render(s, spp=args.spp)
-try:
-    dr.eval(img)
-    dr.sync_thread()
-except Exception:
-    pass
-t_mi = time.perf_counter() - t0
 
-print(f"RESULT scene=mitsuba-cbox spp={args.spp} threads={args.threads} rpbrt_s={t_rpbrt:.2f} "
-      f"mitsuba_{args.variant}_s={t_mi:.2f} ratio_mitsuba_over_rpbrt={t_mi / t_rpbrt:.2f}")
+def mitsuba_renderer(variant):
+    mi.set_variant(variant)
+    dr.set_thread_count(args.threads)
+    d = mi.cornell_box()
+    d["sensor"]["film"]["width"] = 256
+    d["sensor"]["film"]["height"] = 256
+    d["sensor"]["sampler"] = {"type": "independent", "sample_count": args.spp}
+    d["integrator"] = {"type": "path", "max_depth": 8}
+    s = mi.load_dict(d)
+
+    def render(seed):
+        mi.set_variant(variant)
+        t0 = time.perf_counter()
+        img = mi.render(s, spp=args.spp, seed=seed)
+        dr.eval(img)
+        dr.sync_thread()
+        return time.perf_counter() - t0
+
+    render(0)  # warm-up: JIT compilation for the LLVM variants
+    return render
+
+
+variants = [v for v in args.variants.split(",") if v]
+renderers = {v: mitsuba_renderer(v) for v in variants}
+times = {"rpbrt": []}
+times.update({v: [] for v in variants})
+for i in range(args.repeat):
+    times["rpbrt"].append(time_rpbrt())
+    for v in variants:
+        times[v].append(renderers[v](i + 1))
+
+med = {k: statistics.median(v) for k, v in times.items()}
+fields = [f"scene=mitsuba-cbox spp={args.spp} threads={args.threads} repeat={args.repeat}",
+          f"rpbrt_s={med['rpbrt']:.2f}"]
+for v in variants:
+    fields.append(f"mitsuba_{v}_s={med[v]:.2f} ratio_{v}_over_rpbrt={med[v] / med['rpbrt']:.2f}")
+print("RESULT " + " ".join(fields))
