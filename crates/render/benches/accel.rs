@@ -15,10 +15,30 @@
 //! `intersect_triangle` on the caller's triangle array, so only traversal
 //! differs. Output: one `RESULT` line per mesh, structure and thread count.
 //!
+//! Every mesh is then benchmarked again as `<mesh>-closed`: inside a closed,
+//! tessellated cube around it with the camera inside, so that (nearly) all
+//! bounce rays hit something, as in an interior scene; in the open sets
+//! most bounce rays escape.
+//!
+//! With `--features embree` (needs the system's Embree 3, Debian's
+//! `libembree-dev`), Embree is benchmarked on the same triangles and rays
+//! as `accel=embree`: `rtcIntersect1` on both sets, `rtcOccluded1` for
+//! shadow rays, and `rtcIntersect8` / `rtcIntersect16` on the camera rays in
+//! 4×2 / 4×4 pixel tiles (`packet8_coherent_mrays_s`,
+//! `packet16_coherent_mrays_s`). Embree uses its own (SIMD) triangle tests.
+//!
+//! `RPBRT_ACCEL_BENCH_RES=500` shrinks the camera (and so every ray set) and
+//! `RPBRT_ACCEL_BENCH_THREADS=1` limits the thread counts, for short runs.
+//!
 //! The kd-tree and grid trace a subset of the rays (`SLOW_RAYS`, every k-th
 //! ray of each set) to keep the run short; their Mrays/s are computed from
 //! the rays actually traced. `RPBRT_ACCEL_BENCH_ONLY=bvh4,obvhs` restricts
-//! the structures, `RPBRT_ACCEL_BENCH_MESH=terrain` the meshes.
+//! the structures (`embree` included), `RPBRT_ACCEL_BENCH_MESH=terrain` the meshes
+//! (prefixes: `killeroo-closed` only the closed killeroo).
+
+#[cfg(feature = "embree")]
+#[path = "accel/embree.rs"]
+mod embree_bench;
 
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
@@ -37,7 +57,24 @@ use std::time::Instant;
 
 type Tri = [Point3f; 3];
 
-const RES: usize = 1000;
+/// Camera resolution (rays per set: its square); `RPBRT_ACCEL_BENCH_RES`
+/// overrides it (a multiple of 4, for the packet tiles).
+fn res() -> usize {
+    std::env::var("RPBRT_ACCEL_BENCH_RES")
+        .ok()
+        .and_then(|s| s.parse::<usize>().ok())
+        .map_or(1000, |r| r.max(4) / 4 * 4)
+}
+
+/// Build and trace thread counts: `RPBRT_ACCEL_BENCH_THREADS=1` (a comma
+/// list) overrides the default 1 and 2.
+fn thread_counts() -> Vec<usize> {
+    std::env::var("RPBRT_ACCEL_BENCH_THREADS")
+        .ok()
+        .map(|s| s.split(',').filter_map(|t| t.parse().ok()).collect::<Vec<usize>>())
+        .filter(|v| !v.is_empty())
+        .unwrap_or(vec![1, 2])
+}
 /// Rays per set for the slow structures (kd-tree, grid).
 const SLOW_RAYS: usize = 100_000;
 
@@ -154,6 +191,47 @@ fn terrain() -> Mesh {
     }
 }
 
+/// `mesh` inside a closed cube (each face a 32×32 grid of quads, two
+/// triangles each) centred on its bounds, with half-side twice the radius
+/// of its bounding sphere: the benchmark camera (at 1.7 radii) sits
+/// inside, so camera rays that miss the mesh hit a wall and bounce rays
+/// (almost) always hit something, as in a closed room.
+fn enclosed(mesh: &Mesh) -> Mesh {
+    let mut b = Bounds3f::empty();
+    for t in &mesh.tris {
+        b = b.union(&tri_bounds(t));
+    }
+    let c = b.p_min + (b.p_max - b.p_min) * 0.5;
+    let h = (b.p_max - b.p_min).length();
+    const N: usize = 32;
+    let mut tris = mesh.tris.clone();
+    for axis in 0..3 {
+        for side in [-1.0 as Float, 1.0] {
+            // The face at `c[axis] + side·h`, spanned by the other axes.
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            let corner = |i: usize, j: usize| {
+                let mut p = [c.x, c.y, c.z];
+                p[axis] += side * h;
+                p[u] += h * (2.0 * i as Float / N as Float - 1.0);
+                p[v] += h * (2.0 * j as Float / N as Float - 1.0);
+                Point3f::new(p[0], p[1], p[2])
+            };
+            for i in 0..N {
+                for j in 0..N {
+                    let (p00, p10) = (corner(i, j), corner(i + 1, j));
+                    let (p01, p11) = (corner(i, j + 1), corner(i + 1, j + 1));
+                    tris.push([p00, p10, p11]);
+                    tris.push([p00, p11, p01]);
+                }
+            }
+        }
+    }
+    Mesh {
+        name: format!("{}-closed", mesh.name),
+        tris,
+    }
+}
+
 fn tri_bounds(t: &Tri) -> Bounds3f {
     Bounds3f::new(t[0], t[1]).union_point(t[2])
 }
@@ -178,11 +256,12 @@ fn camera_rays(b: &Bounds3f) -> Vec<Ray> {
     let fwd = -view;
     let frame = Frame::from_z(fwd);
     let tan_half = (0.5 as Float).tan() * 0.8; // ~46° field of view
-    let mut rays = Vec::with_capacity(RES * RES);
-    for y in 0..RES {
-        for x in 0..RES {
-            let sx = (2.0 * (x as Float + 0.5) / RES as Float - 1.0) * tan_half;
-            let sy = (1.0 - 2.0 * (y as Float + 0.5) / RES as Float) * tan_half;
+    let res = res();
+    let mut rays = Vec::with_capacity(res * res);
+    for y in 0..res {
+        for x in 0..res {
+            let sx = (2.0 * (x as Float + 0.5) / res as Float - 1.0) * tan_half;
+            let sy = (1.0 - 2.0 * (y as Float + 0.5) / res as Float) * tan_half;
             let d = frame.from_local(Vector3f::new(sx, sy, 1.0)).normalize();
             rays.push(Ray::new(eye, d));
         }
@@ -284,15 +363,51 @@ fn obvhs_ray(r: &Ray, t_max: Float) -> obvhs::ray::Ray {
     )
 }
 
-fn print_result(mesh: &str, accel: &str, threads: usize, v: [f64; 4], default: bool) {
+fn print_result(mesh: &str, accel: &str, threads: usize, v: [f64; 4], extra: &str) {
     println!(
-        "RESULT mesh={mesh} accel={accel} threads={threads} build_mprims_s={:.2} coherent_mrays_s={:.2} incoherent_mrays_s={:.2} shadow_mrays_s={:.2}{}",
-        v[0],
-        v[1],
-        v[2],
-        v[3],
-        if default { " default=yes" } else { "" }
+        "RESULT mesh={mesh} accel={accel} threads={threads} build_mprims_s={:.2} coherent_mrays_s={:.2} incoherent_mrays_s={:.2} shadow_mrays_s={:.2}{extra}",
+        v[0], v[1], v[2], v[3],
     );
+}
+
+/// The camera rays regrouped into `tw`×`th` pixel tiles (tile after tile,
+/// row-major inside each), the order packet tracers take them in.
+#[cfg_attr(not(feature = "embree"), allow(dead_code))]
+fn tiled(cam: &[Ray], tw: usize, th: usize) -> Vec<Ray> {
+    let res = (cam.len() as f64).sqrt().round() as usize;
+    let mut out = Vec::with_capacity(cam.len());
+    for ty in (0..res).step_by(th) {
+        for tx in (0..res).step_by(tw) {
+            for y in ty..(ty + th).min(res) {
+                for x in tx..(tx + tw).min(res) {
+                    out.push(cam[y * res + x]);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Runs `f` over consecutive groups of `n` rays split across `threads`;
+/// returns Mrays/s and the hits `f` reports.
+#[cfg_attr(not(feature = "embree"), allow(dead_code))]
+fn run_groups<F>(rays: &[Ray], n: usize, threads: usize, f: F) -> (f64, usize)
+where
+    F: Fn(&[Ray]) -> usize + Sync,
+{
+    let t0 = Instant::now();
+    let chunk = rays.len().div_ceil(threads).div_ceil(n) * n;
+    let hits: usize = std::thread::scope(|s| {
+        let hs: Vec<_> = rays
+            .chunks(chunk.max(n))
+            .map(|c| {
+                let f = &f;
+                s.spawn(move || c.chunks(n).map(f).sum::<usize>())
+            })
+            .collect();
+        hs.into_iter().map(|h| h.join().unwrap_or(0)).sum()
+    });
+    (rays.len() as f64 / t0.elapsed().as_secs_f64() / 1e6, hits)
 }
 
 /// The rpbrt structures benchmarked: (name, parameters).
@@ -340,7 +455,7 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
         } else {
             (cam.clone(), bounce.clone())
         };
-        for threads in [1, 2] {
+        for &threads in &thread_counts() {
             let t0 = Instant::now();
             let a = Accelerator::build_with_threads(&bounds, &params, threads);
             let build = n / t0.elapsed().as_secs_f64() / 1e6;
@@ -376,18 +491,17 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
                     100.0 * ih as f64 / bounce_set.len() as f64
                 );
             }
-            print_result(
-                &mesh.name,
-                name,
-                threads,
-                [build, c, i, s],
-                params == default_params,
-            );
+            let default = if params == default_params {
+                " default=yes"
+            } else {
+                ""
+            };
+            print_result(&mesh.name, name, threads, [build, c, i, s], default);
         }
     }
 
     if wanted("obvhs") {
-        for threads in [1, 2] {
+        for &threads in &thread_counts() {
             let (bvh, secs) = build_obvhs(&bounds, threads);
             let build = n / secs / 1e6;
             let closest = |r: &Ray| {
@@ -406,7 +520,36 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
             let (c, _) = run(&cam, threads, closest);
             let (i, _) = run(&bounce, threads, closest);
             let (s, _) = run(&bounce, threads, any);
-            print_result(&mesh.name, "obvhs", threads, [build, c, i, s], false);
+            print_result(&mesh.name, "obvhs", threads, [build, c, i, s], "");
+        }
+    }
+
+    #[cfg(feature = "embree")]
+    if wanted("embree") {
+        for &threads in &thread_counts() {
+            let (scene, secs) = match embree_bench::EmbreeScene::build(tris, threads) {
+                Ok(s) => s,
+                Err(e) => {
+                    eprintln!("skipping embree: {e}");
+                    break;
+                }
+            };
+            let build = n / secs / 1e6;
+            let closest = |r: &Ray| scene.intersect1(r).is_some();
+            let (c, _) = run(&cam, threads, closest);
+            let (i, ih) = run(&bounce, threads, closest);
+            let (s, _) = run(&bounce, threads, |r| scene.occluded1(r));
+            let (p8, _) = run_groups(&tiled(&cam, 4, 2), 8, threads, |g| scene.intersect8(g));
+            let (p16, h16) = run_groups(&tiled(&cam, 4, 4), 16, threads, |g| scene.intersect16(g));
+            if threads == 1 {
+                eprintln!(
+                    "  embree: {:.0}% of incoherent rays hit, {:.0}% of camera rays",
+                    100.0 * ih as f64 / bounce.len() as f64,
+                    100.0 * h16 as f64 / cam.len() as f64
+                );
+            }
+            let extra = format!(" packet8_coherent_mrays_s={p8:.2} packet16_coherent_mrays_s={p16:.2}");
+            print_result(&mesh.name, "embree", threads, [build, c, i, s], &extra);
         }
     }
 }
@@ -423,6 +566,13 @@ fn main() {
             .as_ref()
             .is_none_or(|o| o.iter().any(|s| name.starts_with(s.as_str())))
     };
+    // Loading: also the meshes whose closed variant is wanted.
+    let want_load = |name: &str| {
+        only_mesh.as_ref().is_none_or(|o| {
+            o.iter()
+                .any(|s| name.starts_with(s.as_str()) || s.starts_with(name))
+        })
+    };
     // The bench runs from the crate directory; `shared` sits beside the
     // workspace root.
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
@@ -432,13 +582,13 @@ fn main() {
     let mut meshes = Vec::new();
     match &shared {
         Some(shared) => {
-            if want_mesh("killeroo") {
+            if want_load("killeroo") {
                 match killeroo(shared) {
                     Ok(m) => meshes.push(m),
                     Err(e) => eprintln!("skipping killeroo: {e}"),
                 }
             }
-            if want_mesh("water") {
+            if want_load("water") {
                 let dir = shared.join("scenes/water-caustic/models");
                 let mut plys: Vec<_> = std::fs::read_dir(&dir)
                     .map(|d| d.filter_map(|e| e.ok().map(|e| e.path())).collect())
@@ -457,10 +607,14 @@ fn main() {
             eprintln!("../shared/scenes not found: skipping the killeroo and water-caustic meshes")
         }
     }
-    if want_mesh("terrain") {
+    if want_load("terrain") {
         meshes.push(terrain());
     }
-    for m in &meshes {
-        bench_mesh(m, &only);
+    // Each mesh again inside a closed box, where bounce rays hit.
+    let closed: Vec<Mesh> = meshes.iter().map(enclosed).collect();
+    for m in meshes.iter().chain(&closed) {
+        if want_mesh(&m.name) {
+            bench_mesh(m, &only);
+        }
     }
 }
