@@ -81,6 +81,10 @@ const SLOW_RAYS: usize = 100_000;
 struct Mesh {
     name: String,
     tris: Vec<Tri>,
+    /// The bounds the camera frames (the inner mesh's for a closed
+    /// variant, so that the camera sits inside the enclosure); `None`: all
+    /// triangles.
+    view: Option<Bounds3f>,
 }
 
 fn tris_from_indexed(p: &[Point3f], idx: &[u32]) -> Vec<Tri> {
@@ -122,6 +126,7 @@ fn killeroo(shared: &Path) -> Result<Mesh, String> {
     Ok(Mesh {
         name: "killeroo".into(),
         tris: tris_from_indexed(&sub.p, &sub.indices),
+        view: None,
     })
 }
 
@@ -143,6 +148,7 @@ fn ply_mesh(path: &Path) -> Result<Mesh, String> {
     Ok(Mesh {
         name: format!("water-{stem}"),
         tris: tris_from_indexed(&p, &idx),
+        view: None,
     })
 }
 
@@ -188,6 +194,7 @@ fn terrain() -> Mesh {
     Mesh {
         name: "terrain".into(),
         tris: tris_from_indexed(&p, &idx),
+        view: None,
     }
 }
 
@@ -229,6 +236,7 @@ fn enclosed(mesh: &Mesh) -> Mesh {
     Mesh {
         name: format!("{}-closed", mesh.name),
         tris,
+        view: Some(b),
     }
 }
 
@@ -437,7 +445,7 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
     for b in &bounds {
         total = total.union(b);
     }
-    let cam = camera_rays(&total);
+    let cam = camera_rays(&mesh.view.unwrap_or(total));
     let reference = Accelerator::build(&bounds, &AccelParams::default());
     let bounce = bounce_rays(tris, &reference, &cam);
     drop(reference);
