@@ -12,7 +12,8 @@
 //! rate with that many build threads.
 //!
 //! Every structure, obvhs' CWBVH included, calls the same hit closure:
-//! `intersect_triangle` on the caller's triangle array, so only traversal
+//! `intersect_prepared_triangle` on the caller's triangle array (with the
+//! per-ray `TriangleRay`, as the renderer does), so only traversal
 //! differs. Output: one `RESULT` line per mesh, structure and thread count.
 //!
 //! Every mesh is then benchmarked again as `<mesh>-closed`: inside a closed,
@@ -51,7 +52,9 @@ use rpbrt_render::rng::Rng;
 use rpbrt_render::sampling::sample_cosine_hemisphere;
 use rpbrt_render::scene::{build_scene_from_str, BuildOptions};
 use rpbrt_render::shape::loopsubdiv::loop_subdivide;
-use rpbrt_render::shape::triangle::intersect_triangle;
+use rpbrt_render::shape::triangle::{
+    intersect_prepared_triangle, triangle_is_nondegenerate, TriangleRay,
+};
 use std::path::Path;
 use std::time::Instant;
 
@@ -87,9 +90,12 @@ struct Mesh {
     view: Option<Bounds3f>,
 }
 
+/// The triangles of an indexed mesh, less degenerate ones (which the
+/// renderer leaves out of its triangle fast path too).
 fn tris_from_indexed(p: &[Point3f], idx: &[u32]) -> Vec<Tri> {
     idx.chunks_exact(3)
         .map(|c| [p[c[0] as usize], p[c[1] as usize], p[c[2] as usize]])
+        .filter(|t| triangle_is_nondegenerate(t[0], t[1], t[2]))
         .collect()
 }
 
@@ -244,11 +250,14 @@ fn tri_bounds(t: &Tri) -> Bounds3f {
     Bounds3f::new(t[0], t[1]).union_point(t[2])
 }
 
-/// The shared primitive test: `Some(t)` for a hit strictly before `t_max`.
+/// The shared primitive test, as the renderer's `PrimitiveAggregate` runs
+/// it: the watertight test with the ray's permutation and shear computed
+/// once per ray (`tr`). `Some(t)` for a hit strictly before `t_max`.
+/// (Degenerate triangles were dropped when the mesh was made.)
 #[inline(always)]
-fn hit_tri(tris: &[Tri], p: u32, ray: &Ray, t_max: Float) -> Option<Float> {
+fn hit_tri(tris: &[Tri], tr: &TriangleRay, p: u32, t_max: Float) -> Option<Float> {
     let t = &tris[p as usize];
-    match intersect_triangle(ray, t_max, t[0], t[1], t[2]) {
+    match intersect_prepared_triangle(tr, t_max, t[0], t[1], t[2]) {
         Some((th, ..)) if th < t_max => Some(th),
         _ => None,
     }
@@ -282,8 +291,8 @@ fn camera_rays(b: &Bounds3f) -> Vec<Ray> {
 fn bounce_rays(tris: &[Tri], accel: &Accelerator, cam: &[Ray]) -> Vec<Ray> {
     let mut hits = Vec::new();
     for r in cam {
-        if let Some((p, t)) = accel.intersect(r, Float::INFINITY, |p, r, t| hit_tri(tris, p, r, t))
-        {
+        let tr = TriangleRay::new(r);
+        if let Some((p, t)) = accel.intersect(r, Float::INFINITY, |p, _, t| hit_tri(tris, &tr, p, t)) {
             let tri = &tris[p as usize];
             let mut n = cross(tri[1] - tri[0], tri[2] - tri[0]).normalize();
             if dot(n, r.d) > 0.0 {
@@ -468,12 +477,14 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
             let a = Accelerator::build_with_threads(&bounds, &params, threads);
             let build = n / t0.elapsed().as_secs_f64() / 1e6;
             let closest = |r: &Ray| {
-                a.intersect(r, Float::INFINITY, |p, r, t| hit_tri(tris, p, r, t))
+                let tr = TriangleRay::new(r);
+                a.intersect(r, Float::INFINITY, |p, _, t| hit_tri(tris, &tr, p, t))
                     .is_some()
             };
             let any = |r: &Ray| {
-                a.intersect_p(r, Float::INFINITY, |p, r, t| {
-                    hit_tri(tris, p, r, t).is_some()
+                let tr = TriangleRay::new(r);
+                a.intersect_p(r, Float::INFINITY, |p, _, t| {
+                    hit_tri(tris, &tr, p, t).is_some()
                 })
             };
             let (c, _) = run(&cam_set, threads, closest);
@@ -485,9 +496,10 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
                     let mut k = 0usize;
                     let sample = subset(rays, 20_000);
                     for r in &sample {
-                        a.intersect(r, Float::INFINITY, |p, r, t| {
+                        let tr = TriangleRay::new(r);
+                        a.intersect(r, Float::INFINITY, |p, _, t| {
                             k += 1;
-                            hit_tri(tris, p, r, t)
+                            hit_tri(tris, &tr, p, t)
                         });
                     }
                     k as f64 / sample.len() as f64
@@ -513,16 +525,18 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
             let (bvh, secs) = build_obvhs(&bounds, threads);
             let build = n / secs / 1e6;
             let closest = |r: &Ray| {
+                let tr = TriangleRay::new(r);
                 let mut hit = obvhs::ray::RayHit::none();
                 bvh.ray_traverse(obvhs_ray(r, Float::INFINITY), &mut hit, |ray, id| {
                     let p = bvh.primitive_indices[id];
-                    hit_tri(tris, p, r, ray.tmax).unwrap_or(Float::INFINITY)
+                    hit_tri(tris, &tr, p, ray.tmax).unwrap_or(Float::INFINITY)
                 })
             };
             let any = |r: &Ray| {
+                let tr = TriangleRay::new(r);
                 !bvh.ray_traverse_miss(obvhs_ray(r, Float::INFINITY), |ray, id| {
                     let p = bvh.primitive_indices[id];
-                    hit_tri(tris, p, r, ray.tmax).unwrap_or(Float::INFINITY)
+                    hit_tri(tris, &tr, p, ray.tmax).unwrap_or(Float::INFINITY)
                 })
             };
             let (c, _) = run(&cam, threads, closest);
