@@ -74,7 +74,11 @@ fn res() -> usize {
 fn thread_counts() -> Vec<usize> {
     std::env::var("RPBRT_ACCEL_BENCH_THREADS")
         .ok()
-        .map(|s| s.split(',').filter_map(|t| t.parse().ok()).collect::<Vec<usize>>())
+        .map(|s| {
+            s.split(',')
+                .filter_map(|t| t.parse().ok())
+                .collect::<Vec<usize>>()
+        })
         .filter(|v| !v.is_empty())
         .unwrap_or(vec![1, 2])
 }
@@ -292,7 +296,9 @@ fn bounce_rays(tris: &[Tri], accel: &Accelerator, cam: &[Ray]) -> Vec<Ray> {
     let mut hits = Vec::new();
     for r in cam {
         let tr = TriangleRay::new(r);
-        if let Some((p, t)) = accel.intersect(r, Float::INFINITY, |p, _, t| hit_tri(tris, &tr, p, t)) {
+        if let Some((p, t)) =
+            accel.intersect(r, Float::INFINITY, |p, _, t| hit_tri(tris, &tr, p, t))
+        {
             let tri = &tris[p as usize];
             let mut n = cross(tri[1] - tri[0], tri[2] - tri[0]).normalize();
             if dot(n, r.d) > 0.0 {
@@ -570,7 +576,8 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
                     100.0 * h16 as f64 / cam.len() as f64
                 );
             }
-            let extra = format!(" packet8_coherent_mrays_s={p8:.2} packet16_coherent_mrays_s={p16:.2}");
+            let extra =
+                format!(" packet8_coherent_mrays_s={p8:.2} packet16_coherent_mrays_s={p16:.2}");
             print_result(&mesh.name, "embree", threads, [build, c, i, s], &extra);
         }
     }

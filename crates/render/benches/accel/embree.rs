@@ -135,14 +135,8 @@ impl EmbreeScene {
                 12,
                 3 * n,
             ) as *mut f32;
-            let ix = rtcSetNewGeometryBuffer(
-                geom,
-                RTCBufferType::INDEX,
-                0,
-                RTCFormat::UINT3,
-                12,
-                n,
-            ) as *mut u32;
+            let ix = rtcSetNewGeometryBuffer(geom, RTCBufferType::INDEX, 0, RTCFormat::UINT3, 12, n)
+                as *mut u32;
             check(device, "rtcSetNewGeometryBuffer")?;
             if v.is_null() || ix.is_null() {
                 return Err("embree: no geometry buffer".into());
@@ -220,7 +214,14 @@ impl EmbreeScene {
     /// `rtcIntersect16` on up to sixteen coherent rays; returns how many
     /// hit.
     pub fn intersect16(&self, rays: &[Ray]) -> usize {
-        packet!(self, rays, 16, RTCRayHit16, RTCRay16, RTCHit16, rtcIntersect16)
+        packet!(
+            self,
+            rays,
+            16,
+            RTCRayHit16,
+            RTCRay16,
+            RTCHit16,
+            rtcIntersect16
+        )
     }
 }
-
