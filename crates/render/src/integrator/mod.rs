@@ -119,7 +119,7 @@ impl Integrator {
         }
         // One match per render: each arm runs a loop built for its
         // integrator (no dispatch per ray).
-        match self {
+        let mut result = match self {
             Integrator::Path(i) => {
                 tile::render_tiles(&tile::RayTiles(i), scene, opts, metadata, progress)
             }
@@ -146,7 +146,13 @@ impl Integrator {
                 tile::render_tiles(&tile::RayTiles(i), scene, opts, metadata, progress)
             }
             Integrator::Function(i) => function::render(i, scene, opts, progress),
+        };
+        if let Ok(stats) = &mut result {
+            stats
+                .warnings
+                .extend(crate::texture::ptex::take_lookup_warnings());
         }
+        result
     }
 
     /// The integrator's name in scene files.

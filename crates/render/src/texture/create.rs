@@ -202,7 +202,7 @@ fn ptex_base(def: &TextureDef, tp: &ParamReader) -> Result<PtexTextureBase, Diag
     };
     let scale = tp.float("scale", 1.0)?;
     let path = tp.resolve("filename", &filename);
-    let file = load_ptex(&path).map_err(|e| {
+    let (file, fresh) = load_ptex(&path).map_err(|e| {
         tp.error_at(
             "filename",
             format!(
@@ -211,6 +211,16 @@ fn ptex_base(def: &TextureDef, tp: &ParamReader) -> Result<PtexTextureBase, Diag
             ),
         )
     })?;
+    if fresh && file.bad_adjacency > 0 {
+        tp.warn_at(
+            "filename",
+            format!(
+                "\"{}\": {} face adjacency entries name faces or edges the file does not have; those edges are filtered as borders",
+                path.display(),
+                file.bad_adjacency
+            ),
+        );
+    }
     Ok(PtexTextureBase {
         filename: path.display().to_string(),
         file,

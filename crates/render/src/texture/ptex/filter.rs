@@ -16,7 +16,11 @@
 //! mode. At real borders (no neighbour) the file's border mode applies
 //! (clamp, black or periodic), as in Ptex.
 
-use super::reader::{PtexBorderMode, PtexFace, PtexFile, FLAG_NEIGHBORHOOD_CONSTANT, FLAG_SUBFACE};
+use std::sync::atomic::Ordering;
+
+use super::reader::{
+    PtexBorderMode, PtexFace, PtexFile, PtexMeshType, FLAG_NEIGHBORHOOD_CONSTANT, FLAG_SUBFACE,
+};
 
 /// The most taps along one axis (4 filter widths of 1 to 2 texels, plus
 /// rounding to even pairs).
@@ -277,8 +281,14 @@ impl PtexFile {
         let nc = self.nchannels;
         out[..nc].fill(0.0);
         let Some(f) = usize::try_from(face).ok().and_then(|i| self.faces.get(i)) else {
+            self.bad_lookups.fetch_add(1, Ordering::Relaxed);
+            self.bad_face.store(face as i64, Ordering::Relaxed);
             return;
         };
+        if self.mesh_type == PtexMeshType::Triangle {
+            self.eval_triangle(out, face as usize, u, v, dudx, dvdx, dudy, dvdy);
+            return;
+        }
         if f.flags & FLAG_NEIGHBORHOOD_CONSTANT != 0 || f.is_constant() {
             out[..nc].copy_from_slice(&f.constant);
             return;

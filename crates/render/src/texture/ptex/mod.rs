@@ -1,8 +1,14 @@
 //! Ptex textures (pbrt-v4 `PtexTextureBase`, `FloatPtexTexture`,
 //! `SpectrumPtexTexture` in `textures.h/.cpp`): per-face textures looked up
 //! by the shape's face index and (u, v), read from Ptex files by our own
-//! [`reader`] and filtered by [`filter`] (the cubic B-spline pbrt-v4
-//! requests, within the face).
+//! [`reader`] and filtered as the Ptex library filters for pbrt-v4's
+//! request: the cubic B-spline on quad meshes ([`filter`]), the
+//! elliptical Gaussian on triangle meshes ([`triangle`]), both carried
+//! across face edges into the neighbours the file names.
+//!
+//! Lookups with a face index the file does not have give zero, as in
+//! pbrt-v4 (where Ptex leaves the result unset); they are counted per file
+//! and reported after the render by [`take_lookup_warnings`].
 //!
 //! As in pbrt-v4, the filtered value goes through the texture's colour
 //! encoding by way of 8 bits when the encoding is not linear (default
@@ -13,11 +19,13 @@ pub mod filter;
 pub mod reader;
 #[cfg(test)]
 mod tests;
+pub mod triangle;
 
 pub use reader::{PtexBorderMode, PtexDataType, PtexFace, PtexFile, PtexMeshType};
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex, OnceLock, Weak};
 
 use super::TextureEvalContext;
@@ -28,27 +36,29 @@ use crate::spectrum::{
 };
 use rpbrt_geometry::float::Float;
 
-/// Loads a Ptex file, or returns the copy already in memory (files stay
-/// shared while any texture holds them). Triangle meshes and channel
-/// counts other than 1 and 3 are errors, as pbrt-v4 only looks up those.
-pub fn load_ptex(path: &Path) -> Result<Arc<PtexFile>, String> {
+/// The files in memory, by canonical path (weak: files stay while any
+/// texture holds them).
+fn cache() -> &'static Mutex<HashMap<PathBuf, Weak<PtexFile>>> {
     static CACHE: OnceLock<Mutex<HashMap<PathBuf, Weak<PtexFile>>>> = OnceLock::new();
-    let cache = CACHE.get_or_init(Default::default);
+    CACHE.get_or_init(Default::default)
+}
+
+/// Loads a Ptex file, or returns the copy already in memory (files stay
+/// shared while any texture holds them); the flag is true when the file
+/// was read now (so its warnings are new). Channel counts other than 1
+/// and 3 are errors, as pbrt-v4 only looks up those.
+pub fn load_ptex(path: &Path) -> Result<(Arc<PtexFile>, bool), String> {
+    let cache = cache();
     let key = std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf());
     if let Some(f) = cache
         .lock()
         .ok()
         .and_then(|m| m.get(&key).and_then(Weak::upgrade))
     {
-        return Ok(f);
+        return Ok((f, false));
     }
     let file = PtexFile::read(path)?;
     let name = path.display();
-    if file.mesh_type == PtexMeshType::Triangle {
-        return Err(format!(
-            "\"{name}\": ptex triangle meshes are not supported (quad meshes only)"
-        ));
-    }
     if file.nchannels != 1 && file.nchannels != 3 {
         return Err(format!(
             "\"{name}\": {} channels; only one and three channel ptex textures are supported",
@@ -60,7 +70,32 @@ pub fn load_ptex(path: &Path) -> Result<Arc<PtexFile>, String> {
         m.retain(|_, w| w.strong_count() > 0);
         m.insert(key, Arc::downgrade(&file));
     }
-    Ok(file)
+    Ok((file, true))
+}
+
+/// One warning per Ptex file in memory that was looked up with face
+/// indices it does not have since the last call (the counts are reset).
+pub fn take_lookup_warnings() -> Vec<String> {
+    let Ok(m) = cache().lock() else {
+        return Vec::new();
+    };
+    let mut files: Vec<Arc<PtexFile>> = m.values().filter_map(Weak::upgrade).collect();
+    drop(m);
+    files.sort_by(|a, b| a.filename.cmp(&b.filename));
+    files
+        .iter()
+        .filter_map(|f| {
+            let n = f.bad_lookups.swap(0, Ordering::Relaxed);
+            let face = f.bad_face.swap(0, Ordering::Relaxed);
+            (n > 0).then(|| {
+                format!(
+                    "\"{}\": {n} ptex lookups used face indices outside the file's {} faces (e.g. {face}) and gave zero; the mesh's \"faceIndices\" do not match the file",
+                    f.filename,
+                    f.faces.len()
+                )
+            })
+        })
+        .collect()
 }
 
 /// What float and spectrum Ptex textures share (pbrt-v4

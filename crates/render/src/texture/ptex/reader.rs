@@ -21,6 +21,7 @@
 
 use std::io::Read;
 use std::path::Path;
+use std::sync::atomic::{AtomicI64, AtomicU64};
 use std::sync::OnceLock;
 
 use half::f16;
@@ -100,6 +101,9 @@ pub struct PtexFace {
     /// Summed-area table of the texels (built on the first minified
     /// lookup), (ures + 1) × (vres + 1) × channels.
     pub(super) sat: OnceLock<Box<[f64]>>,
+    /// Reduced resolutions of a triangle face's texels (built on the
+    /// first lookup that needs one), halving from level 0 down to 1 × 1.
+    pub(super) reductions: OnceLock<Box<[Box<[f32]>]>>,
 }
 
 impl PtexFace {
@@ -112,6 +116,11 @@ impl PtexFace {
     #[inline]
     pub fn vres(&self) -> usize {
         1 << self.vlog2
+    }
+    /// The id of the neighbour's edge across edge `eid`.
+    #[inline]
+    pub fn adj_edge(&self, eid: usize) -> usize {
+        ((self.adj_edges >> (2 * (eid & 3))) & 3) as usize
     }
     /// Whether the face is stored as one value.
     #[inline]
@@ -137,6 +146,14 @@ pub struct PtexFile {
     pub border: [PtexBorderMode; 2],
     /// The faces, by face id.
     pub faces: Vec<PtexFace>,
+    /// Adjacency entries that named a face outside the file (or, on a
+    /// triangle mesh, an edge id other than 0, 1, 2); each was read as a
+    /// border.
+    pub bad_adjacency: usize,
+    /// Lookups with a face index outside the file, since the last report.
+    pub bad_lookups: AtomicU64,
+    /// The last such face index.
+    pub bad_face: AtomicI64,
 }
 
 const MAGIC: u32 = u32::from_le_bytes(*b"Ptex");
@@ -613,6 +630,7 @@ impl PtexFile {
         }
 
         let mut faces = Vec::with_capacity(nfaces);
+        let mut bad_adjacency = 0;
         for (id, info) in infos.iter().enumerate() {
             let what = format!("face {id}");
             let mut b = Bytes::new(info);
@@ -621,15 +639,29 @@ impl PtexFile {
             let adj_edges = b.u8()?;
             let flags = b.u8()?;
             let mut adj_faces = [0i32; 4];
-            for a in &mut adj_faces {
+            let nedges = if mesh_type == PtexMeshType::Triangle { 3 } else { 4 };
+            for (e, a) in adj_faces.iter_mut().enumerate() {
                 *a = b.u32()? as i32;
-                if *a >= nfaces as i32 {
+                if e >= nedges {
                     *a = -1;
+                    continue;
+                }
+                let bad_edge = nedges == 3 && (adj_edges >> (2 * e)) & 3 == 3;
+                // -1 means no neighbour; anything else outside the file is
+                // damage.
+                if *a < -1 || *a >= nfaces as i32 || (*a >= 0 && bad_edge) {
+                    *a = -1;
+                    bad_adjacency += 1;
                 }
             }
             if ulog2 > MAX_RES_LOG2 || vlog2 > MAX_RES_LOG2 {
                 return Err(format!(
                     "{what}: resolution 2^{ulog2} x 2^{vlog2} is out of range (log2 at most {MAX_RES_LOG2})"
+                ));
+            }
+            if mesh_type == PtexMeshType::Triangle && ulog2 != vlog2 {
+                return Err(format!(
+                    "{what}: triangle face with resolution 2^{ulog2} x 2^{vlog2} (triangle faces are 2^n x 2^n)"
                 ));
             }
             let mut constant = std::mem::take(&mut constants[id]);
@@ -664,6 +696,7 @@ impl PtexFile {
                 constant,
                 texels,
                 sat: OnceLock::new(),
+                reductions: OnceLock::new(),
             });
         }
         Ok(PtexFile {
@@ -674,6 +707,9 @@ impl PtexFile {
             alpha_channel,
             border,
             faces,
+            bad_adjacency,
+            bad_lookups: AtomicU64::new(0),
+            bad_face: AtomicI64::new(0),
         })
     }
 }

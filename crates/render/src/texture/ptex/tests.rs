@@ -11,7 +11,7 @@ use std::io::Write;
 
 /// How the writer stores a face.
 #[derive(Clone, Copy, PartialEq)]
-enum Store {
+pub(super) enum Store {
     Zipped,
     DiffZipped,
     /// Tiled with 2^n × 2^n tiles; tile 0 is stored constant-encoded when
@@ -21,13 +21,13 @@ enum Store {
     ConstantFlag,
 }
 
-struct TestFace {
-    ulog2: u8,
-    vlog2: u8,
+pub(super) struct TestFace {
+    pub(super) ulog2: u8,
+    pub(super) vlog2: u8,
     /// Interleaved texels.
-    texels: Vec<f32>,
-    store: Store,
-    adj: [i32; 4],
+    pub(super) texels: Vec<f32>,
+    pub(super) store: Store,
+    pub(super) adj: [i32; 4],
 }
 
 fn zip(data: &[u8]) -> Vec<u8> {
@@ -107,14 +107,28 @@ fn fdh(size: usize, enc: u32) -> [u8; 4] {
 
 /// Writes a one-level quad Ptex file.
 fn write_ptex(faces: &[TestFace], dt: PtexDataType, nc: usize, border: [u32; 2]) -> Vec<u8> {
+    write_ptex_mesh(faces, dt, nc, border, false, &[])
+}
+
+/// Writes a one-level Ptex file of triangles or quads; `edges[i]` is face
+/// i's packed adjacent-edge byte (0 where missing).
+pub(super) fn write_ptex_mesh(
+    faces: &[TestFace],
+    dt: PtexDataType,
+    nc: usize,
+    border: [u32; 2],
+    triangles: bool,
+    edges: &[u8],
+) -> Vec<u8> {
     let mut infos = Vec::new();
     let mut consts = Vec::new();
     let mut hdrs = Vec::new();
     let mut blocks = Vec::new();
-    for f in faces {
+    for (i, f) in faces.iter().enumerate() {
         let (w, h) = (1usize << f.ulog2, 1usize << f.vlog2);
         let constant = f.store == Store::ConstantFlag;
-        infos.extend([f.ulog2, f.vlog2, 0, if constant { 1 } else { 0 }]);
+        let e = edges.get(i).copied().unwrap_or(0);
+        infos.extend([f.ulog2, f.vlog2, e, if constant { 1 } else { 0 }]);
         for a in f.adj {
             infos.extend(a.to_le_bytes());
         }
@@ -184,7 +198,7 @@ fn write_ptex(faces: &[TestFace], dt: PtexDataType, nc: usize, border: [u32; 2])
     let mut out = Vec::new();
     out.extend(b"Ptex");
     out.extend(1u32.to_le_bytes());
-    out.extend(1u32.to_le_bytes()); // quads
+    out.extend(u32::from(!triangles).to_le_bytes()); // 0: triangles, 1: quads
     let dtv: u32 = match dt {
         PtexDataType::U8 => 0,
         PtexDataType::U16 => 1,
