@@ -490,8 +490,17 @@ fn black_border_darkens_and_periodic_wraps() {
     }];
     let per =
         PtexFile::parse(&write_ptex(&faces, PtexDataType::Float, 1, [2, 2]), "p.ptx").unwrap();
+    // Periodic wraps the lookup coordinate; as in Ptex, taps past a
+    // border without a neighbour fold onto the edge texel (a periodic
+    // file wraps its filter through its adjacency).
     per.eval(&mut out, 0, 0.5 / 4.0, 0.5, 0.0, 0.0, 0.0, 0.0);
-    assert!((out[0] - 3.0 / 6.0 - 1.0 / 6.0).abs() < 1e-5, "{}", out[0]);
+    assert!((out[0] - 1.0 / 6.0).abs() < 1e-5, "{}", out[0]);
+    let mut wrapped = [0.0f32; 3];
+    per.eval(&mut wrapped, 0, 1.0 + 0.5 / 4.0, 0.5, 0.0, 0.0, 0.0, 0.0);
+    assert!((wrapped[0] - out[0]).abs() < 1e-6, "{}", wrapped[0]);
+    // Black: a lookup a face or more outside is black.
+    black.eval(&mut out, 0, 2.5, 0.5, 0.0, 0.0, 0.0, 0.0);
+    assert_eq!(out[0], 0.0);
 }
 
 #[test]
