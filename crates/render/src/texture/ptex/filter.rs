@@ -866,3 +866,6 @@ impl PtexFile {
         }
     }
 }
+
+#[cfg(test)]
+mod tests;
