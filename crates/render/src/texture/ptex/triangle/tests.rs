@@ -288,3 +288,90 @@ fn bad_adjacency_and_damage_never_panic() {
         }
     }
 }
+
+/// Renders `text` (whose film writes `out`); returns the pixels (RGB,
+/// row-major from the top) and the render's warnings.
+fn render(text: &str, out: &std::path::Path) -> (Vec<f32>, Vec<String>) {
+    use crate::scene::assemble::{create_scene, CreateOptions};
+    use crate::scene::{build_scene_from_str, BuildOptions};
+    let (desc, _) = build_scene_from_str(text, &BuildOptions::default())
+        .unwrap_or_else(|d| panic!("{}", d.render()));
+    let created = create_scene(&desc, &CreateOptions::default()).unwrap_or_else(|e| {
+        panic!("{:?}", e.iter().map(|d| d.message.clone()).collect::<Vec<_>>())
+    });
+    assert!(created.warnings.is_empty(), "{:?}", created.warnings);
+    let mut scene = created.scene;
+    let mut md = crate::image::ImageMetadata::default();
+    let stats = created
+        .integrator
+        .render(&mut scene, &Default::default(), &mut md, &|_| {})
+        .unwrap();
+    let im = crate::image::Image::read(out, None).unwrap().image;
+    assert_eq!(im.n_channels(), 3);
+    (im.to_f32_vec(), stats.warnings)
+}
+
+#[test]
+fn renders_a_triangle_mesh_with_a_ptex_texture() {
+    // A square of two triangles, each with its own vertices and the uvs
+    // (0,0), (1,0), (0,1) at its corners, so uv is the Ptex barycentric;
+    // their second edges are the shared diagonal. Face 0 (lower left)
+    // reflects 0.2, face 1 (upper right) 0.8, under a uniform white sky:
+    // the image is the reflectance.
+    let dir = std::env::temp_dir().join(format!("rpbrt-ptextri-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let ptx = dir.join("square.ptx");
+    let faces = [
+        face(3, 0.2, Store::Zipped, [-1, 1, -1]),
+        face(3, 0.8, Store::Zipped, [-1, 0, -1]),
+    ];
+    let e = [edges([0, 1, 0]), edges([0, 1, 0])];
+    std::fs::write(
+        &ptx,
+        write_ptex_mesh(&faces, PtexDataType::Float, 1, [0, 0], true, &e),
+    )
+    .unwrap();
+    let scene = |out: &std::path::Path, face_indices: &str| {
+        format!(
+            "LookAt 0 0 -1  0 0 0  0 1 0\n\
+             Camera \"orthographic\" \"float screenwindow\" [ -1 1 -1 1 ]\n\
+             Sampler \"zsobol\" \"integer pixelsamples\" 64\n\
+             Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 16 \"string filename\" \"{}\"\n\
+             Integrator \"path\" \"integer maxdepth\" 1\n\
+             WorldBegin\n\
+             LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\n\
+             Texture \"r\" \"spectrum\" \"ptex\" \"string filename\" \"{}\" \"string encoding\" \"linear\"\n\
+             Material \"diffuse\" \"texture reflectance\" \"r\"\n\
+             Shape \"trianglemesh\" \"point3 P\" [ -2 -2 0  2 -2 0  -2 2 0   2 2 0  -2 2 0  2 -2 0 ]\n\
+               \"point2 uv\" [ 0 0  1 0  0 1   0 0  1 0  0 1 ]\n\
+               \"integer indices\" [ 0 1 2  3 4 5 ] \"integer faceIndices\" [ {face_indices} ]\n",
+            out.display(),
+            ptx.display()
+        )
+    };
+    let out = dir.join("square.exr");
+    let (px, warnings) = render(&scene(&out, "0 1"), &out);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    // Looking down +z with +y up, +x is to the right (pbrt's camera space
+    // is left-handed): the lower-left triangle (x + y < 0) is the image's
+    // lower left.
+    let at = |x: usize, y: usize, c: usize| px[(y * 16 + x) * 3 + c];
+    for c in 0..3 {
+        for (x, y, e) in [(1, 14, 0.2), (3, 12, 0.2), (14, 1, 0.8), (12, 2, 0.8)] {
+            let v = at(x, y, c);
+            assert!((v - e).abs() < 0.04 * e, "pixel ({x}, {y}) channel {c}: {v} vs {e}");
+        }
+    }
+    let mean = px.iter().map(|&v| v as f64).sum::<f64>() / px.len() as f64;
+    assert!((mean - 0.5).abs() < 0.02, "mean {mean}");
+
+    // Face indices the file does not have: zero reflectance there, and one
+    // warning after the render naming the file.
+    let out2 = dir.join("bad.exr");
+    let (px, warnings) = render(&scene(&out2, "0 7"), &out2);
+    assert!(px[(2 * 16 + 13) * 3] < 1e-3, "{}", px[(2 * 16 + 13) * 3]);
+    let ours: Vec<_> = warnings.iter().filter(|w| w.contains("square.ptx")).collect();
+    assert_eq!(ours.len(), 1, "{warnings:?}");
+    assert!(ours[0].contains("outside the file's 2 faces"), "{}", ours[0]);
+    std::fs::remove_dir_all(&dir).ok();
+}
