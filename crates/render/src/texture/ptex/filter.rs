@@ -149,7 +149,10 @@ impl Axis {
             self.len = 0;
             return;
         };
-        let last = self.w[..self.len].iter().rposition(|&x| x != 0.0).unwrap_or(first);
+        let last = self.w[..self.len]
+            .iter()
+            .rposition(|&x| x != 0.0)
+            .unwrap_or(first);
         self.w.copy_within(first..=last, 0);
         self.start += first as i32;
         self.len = last + 1 - first;
@@ -644,7 +647,7 @@ impl<'a> Quad<'a> {
         let mut prev_sub = af.flags & FLAG_SUBFACE != 0;
         let mut corners = [(0usize, 0usize); MAX_VALENCE];
         let mut ncorners: i32 = 0;
-        for i in 0..MAX_VALENCE {
+        for (i, slot) in corners.iter_mut().enumerate() {
             let prev = afid;
             afid = af.adj_faces[aeid];
             aeid = (af.adj_edge(aeid) + 1) % 4;
@@ -659,7 +662,7 @@ impl<'a> Quad<'a> {
                 break;
             };
             af = next;
-            corners[i] = (afid as usize, aeid);
+            *slot = (afid as usize, aeid);
             let sub = af.flags & FLAG_SUBFACE != 0;
             if prev_sub && !sub && af.adj_faces[(aeid + 3) % 4] == prev {
                 // A subface "tee": the corner is on the main face.
@@ -857,7 +860,7 @@ impl PtexFile {
         };
         q.split_and_apply(k, faceid, 0);
         let weight = q.weight;
-        if !(weight > 0.0) || !weight.is_finite() {
+        if weight.is_nan() || weight <= 0.0 || weight.is_infinite() {
             out[..nc].copy_from_slice(&f.constant);
             return;
         }

@@ -639,7 +639,11 @@ impl PtexFile {
             let adj_edges = b.u8()?;
             let flags = b.u8()?;
             let mut adj_faces = [0i32; 4];
-            let nedges = if mesh_type == PtexMeshType::Triangle { 3 } else { 4 };
+            let nedges = if mesh_type == PtexMeshType::Triangle {
+                3
+            } else {
+                4
+            };
             for (e, a) in adj_faces.iter_mut().enumerate() {
                 *a = b.u32()? as i32;
                 if e >= nedges {

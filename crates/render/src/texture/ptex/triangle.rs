@@ -149,33 +149,114 @@ impl TriKernel {
         let w = 1.0 - u - v;
         let (u1, v1, w1, u2, v2, w2) = (self.u1, self.v1, self.w1, self.u2, self.v2, self.w2);
         match (eid, aeid) {
-            (0, 0) => self.set(1.0 - u, -v, 1.0 - u2, -v2, 1.0 - w2, 1.0 - u1, -v1, 1.0 - w1),
+            (0, 0) => self.set(
+                1.0 - u,
+                -v,
+                1.0 - u2,
+                -v2,
+                1.0 - w2,
+                1.0 - u1,
+                -v1,
+                1.0 - w1,
+            ),
             (0, 1) => {
-                self.set(1.0 - w, 1.0 - u, 1.0 - w2, 1.0 - u2, -v2, 1.0 - w1, 1.0 - u1, -v1);
+                self.set(
+                    1.0 - w,
+                    1.0 - u,
+                    1.0 - w2,
+                    1.0 - u2,
+                    -v2,
+                    1.0 - w1,
+                    1.0 - u1,
+                    -v1,
+                );
                 self.rotate1();
             }
             (0, _) => {
-                self.set(-v, 1.0 - w, -v2, 1.0 - w2, 1.0 - u2, -v1, 1.0 - w1, 1.0 - u1);
+                self.set(
+                    -v,
+                    1.0 - w,
+                    -v2,
+                    1.0 - w2,
+                    1.0 - u2,
+                    -v1,
+                    1.0 - w1,
+                    1.0 - u1,
+                );
                 self.rotate2();
             }
             (1, 0) => {
-                self.set(1.0 - v, -w, 1.0 - v2, -w2, 1.0 - u2, 1.0 - v1, -w1, 1.0 - u1);
+                self.set(
+                    1.0 - v,
+                    -w,
+                    1.0 - v2,
+                    -w2,
+                    1.0 - u2,
+                    1.0 - v1,
+                    -w1,
+                    1.0 - u1,
+                );
                 self.rotate2();
             }
-            (1, 1) => self.set(1.0 - u, 1.0 - v, 1.0 - u2, 1.0 - v2, -w2, 1.0 - u1, 1.0 - v1, -w1),
+            (1, 1) => self.set(
+                1.0 - u,
+                1.0 - v,
+                1.0 - u2,
+                1.0 - v2,
+                -w2,
+                1.0 - u1,
+                1.0 - v1,
+                -w1,
+            ),
             (1, _) => {
-                self.set(-w, 1.0 - u, -w2, 1.0 - u2, 1.0 - v2, -w1, 1.0 - u1, 1.0 - v1);
+                self.set(
+                    -w,
+                    1.0 - u,
+                    -w2,
+                    1.0 - u2,
+                    1.0 - v2,
+                    -w1,
+                    1.0 - u1,
+                    1.0 - v1,
+                );
                 self.rotate1();
             }
             (_, 0) => {
-                self.set(1.0 - w, -u, 1.0 - w2, -u2, 1.0 - v2, 1.0 - w1, -u1, 1.0 - v1);
+                self.set(
+                    1.0 - w,
+                    -u,
+                    1.0 - w2,
+                    -u2,
+                    1.0 - v2,
+                    1.0 - w1,
+                    -u1,
+                    1.0 - v1,
+                );
                 self.rotate1();
             }
             (_, 1) => {
-                self.set(1.0 - v, 1.0 - w, 1.0 - v2, 1.0 - w2, -u2, 1.0 - v1, 1.0 - w1, -u1);
+                self.set(
+                    1.0 - v,
+                    1.0 - w,
+                    1.0 - v2,
+                    1.0 - w2,
+                    -u2,
+                    1.0 - v1,
+                    1.0 - w1,
+                    -u1,
+                );
                 self.rotate2();
             }
-            (_, _) => self.set(-u, 1.0 - v, -u2, 1.0 - v2, 1.0 - w2, -u1, 1.0 - v1, 1.0 - w1),
+            (_, _) => self.set(
+                -u,
+                1.0 - v,
+                -u2,
+                1.0 - v2,
+                1.0 - w2,
+                -u1,
+                1.0 - v1,
+                1.0 - w1,
+            ),
         }
     }
 }
@@ -429,7 +510,7 @@ impl PtexFile {
         };
         a.split_and_apply(k, face, 0);
         let weight = a.weight;
-        if !(weight > 0.0) || !weight.is_finite() {
+        if weight.is_nan() || weight <= 0.0 || weight.is_infinite() {
             out[..nc].copy_from_slice(&f.constant);
             return;
         }

@@ -136,12 +136,7 @@ fn constant_grid_stays_constant_and_damage_never_panics() {
                 vlog2: 4 - l,
                 texels: vec![0.625; 16],
                 store: Store::Zipped,
-                adj: [
-                    id(i, j + 2),
-                    id(i + 1, j),
-                    id(i, j + 1),
-                    id(i + 2, j),
-                ],
+                adj: [id(i, j + 2), id(i + 1, j), id(i, j + 1), id(i + 2, j)],
             });
         }
     }
@@ -155,7 +150,11 @@ fn constant_grid_stays_constant_and_damage_never_panics() {
         let d = [0.0, 0.01, 0.1, 0.3, 2.0][rng.uniform_bounded(5) as usize];
         let (a, b) = (d * rng.uniform_float(), d * rng.uniform_float());
         torus.eval(&mut out, face, u, v, a, b, -b, a);
-        assert!((out[0] - 0.625).abs() < 1e-5, "face {face} ({u}, {v}) {d}: {}", out[0]);
+        assert!(
+            (out[0] - 0.625).abs() < 1e-5,
+            "face {face} ({u}, {v}) {d}: {}",
+            out[0]
+        );
     }
     // Random adjacency, edges and subface flags: never panics.
     for _ in 0..3000 {

@@ -58,7 +58,11 @@ fn constant_texture_is_constant_everywhere() {
     ];
     for _ in 0..200 {
         let (u, v) = (rng.uniform_float(), rng.uniform_float());
-        points.push(if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) });
+        points.push(if u + v > 1.0 {
+            (1.0 - u, 1.0 - v)
+        } else {
+            (u, v)
+        });
     }
     for f in 0..4 {
         for &(u, v) in &points {
@@ -243,7 +247,10 @@ fn bad_adjacency_and_damage_never_panic() {
         file.eval(&mut out, face, 0.5, 0.5, 0.0, 0.0, 0.0, 0.0);
         assert_eq!(out[0], 0.0);
     }
-    assert_eq!(file.bad_lookups.load(std::sync::atomic::Ordering::Relaxed), 3);
+    assert_eq!(
+        file.bad_lookups.load(std::sync::atomic::Ordering::Relaxed),
+        3
+    );
     // A triangle face must be square.
     let faces = [TestFace {
         ulog2: 2,
@@ -258,7 +265,12 @@ fn bad_adjacency_and_damage_never_panic() {
     // Random damage to a tetrahedron: errors or values, never panics.
     let tet = {
         let adj = [[1, 2, 3], [3, 2, 0], [1, 3, 0], [0, 2, 1]];
-        let e = [edges([2, 2, 0]), edges([2, 0, 0]), edges([1, 1, 1]), edges([2, 1, 0])];
+        let e = [
+            edges([2, 2, 0]),
+            edges([2, 0, 0]),
+            edges([1, 1, 1]),
+            edges([2, 1, 0]),
+        ];
         let faces: Vec<TestFace> = (0..4)
             .map(|i| {
                 let mut f = face(i as u8, 0.5, Store::Zipped, adj[i]);
@@ -283,7 +295,16 @@ fn bad_adjacency_and_damage_never_panic() {
                 for (u, v, d) in [(0.0, 0.0, 0.0), (0.5, 0.5, 0.3), (0.9, 0.05, 2.0)] {
                     f.eval(&mut out, face, u, v, d, 0.0, 0.0, d);
                 }
-                f.eval(&mut out, face, f32::NAN, 0.2, f32::INFINITY, 0.0, 0.0, f32::NAN);
+                f.eval(
+                    &mut out,
+                    face,
+                    f32::NAN,
+                    0.2,
+                    f32::INFINITY,
+                    0.0,
+                    0.0,
+                    f32::NAN,
+                );
             }
         }
     }
@@ -297,7 +318,10 @@ fn render(text: &str, out: &std::path::Path) -> (Vec<f32>, Vec<String>) {
     let (desc, _) = build_scene_from_str(text, &BuildOptions::default())
         .unwrap_or_else(|d| panic!("{}", d.render()));
     let created = create_scene(&desc, &CreateOptions::default()).unwrap_or_else(|e| {
-        panic!("{:?}", e.iter().map(|d| d.message.clone()).collect::<Vec<_>>())
+        panic!(
+            "{:?}",
+            e.iter().map(|d| d.message.clone()).collect::<Vec<_>>()
+        )
     });
     assert!(created.warnings.is_empty(), "{:?}", created.warnings);
     let mut scene = created.scene;
@@ -359,7 +383,10 @@ fn renders_a_triangle_mesh_with_a_ptex_texture() {
     for c in 0..3 {
         for (x, y, e) in [(1, 14, 0.2), (3, 12, 0.2), (14, 1, 0.8), (12, 2, 0.8)] {
             let v = at(x, y, c);
-            assert!((v - e).abs() < 0.04 * e, "pixel ({x}, {y}) channel {c}: {v} vs {e}");
+            assert!(
+                (v - e).abs() < 0.04 * e,
+                "pixel ({x}, {y}) channel {c}: {v} vs {e}"
+            );
         }
     }
     let mean = px.iter().map(|&v| v as f64).sum::<f64>() / px.len() as f64;
@@ -370,8 +397,15 @@ fn renders_a_triangle_mesh_with_a_ptex_texture() {
     let out2 = dir.join("bad.exr");
     let (px, warnings) = render(&scene(&out2, "0 7"), &out2);
     assert!(px[(2 * 16 + 13) * 3] < 1e-3, "{}", px[(2 * 16 + 13) * 3]);
-    let ours: Vec<_> = warnings.iter().filter(|w| w.contains("square.ptx")).collect();
+    let ours: Vec<_> = warnings
+        .iter()
+        .filter(|w| w.contains("square.ptx"))
+        .collect();
     assert_eq!(ours.len(), 1, "{warnings:?}");
-    assert!(ours[0].contains("outside the file's 2 faces"), "{}", ours[0]);
+    assert!(
+        ours[0].contains("outside the file's 2 faces"),
+        "{}",
+        ours[0]
+    );
     std::fs::remove_dir_all(&dir).ok();
 }
