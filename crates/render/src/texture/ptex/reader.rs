@@ -14,8 +14,11 @@
 //! (tile resolution, a compressed tile header, then tiles encoded the same
 //! way). Edits appended after the metadata replace faces.
 //!
-//! Only level 0 is read: reductions are box averages of it, computed on
-//! demand by the filter. Every size is checked against the file; damaged
+//! Triangle and quad files share this layout (a triangle face's texels
+//! are a square array, see [`super::triangle`]). Only level 0 is read:
+//! reductions are computed from it on demand by the filters (box averages
+//! on quads, Ptex's four-triangle averages on triangles). Adjacency that
+//! names faces or edges the file lacks is read as a border and counted. Every size is checked against the file; damaged
 //! files are errors naming the file, and decompressed sizes are bounded by
 //! what the file can hold.
 

@@ -409,3 +409,42 @@ fn renders_a_triangle_mesh_with_a_ptex_texture() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn bad_adjacency_is_a_located_warning() {
+    use crate::scene::assemble::{create_scene, CreateOptions};
+    use crate::scene::{build_scene_from_str, BuildOptions};
+    let dir = std::env::temp_dir().join(format!("rpbrt-ptexadj-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let ptx = dir.join("adj.ptx");
+    let faces = [face(1, 0.5, Store::Zipped, [9, -1, -1])];
+    let bytes = write_ptex_mesh(&faces, PtexDataType::U8, 1, [0, 0], true, &[]);
+    std::fs::write(&ptx, bytes).unwrap();
+    let text = format!(
+        "Film \"rgb\" \"string filename\" \"{}\"\nWorldBegin\nTexture \"r\" \"float\" \"ptex\"\n  \"string filename\" \"{}\"\n",
+        dir.join("x.exr").display(),
+        ptx.display()
+    );
+    let (desc, _) = build_scene_from_str(&text, &BuildOptions::default())
+        .unwrap_or_else(|d| panic!("{}", d.render()));
+    let created = create_scene(&desc, &CreateOptions::default()).unwrap_or_else(|e| {
+        panic!(
+            "{:?}",
+            e.iter().map(|d| d.message.clone()).collect::<Vec<_>>()
+        )
+    });
+    let w: Vec<_> = created
+        .warnings
+        .iter()
+        .filter(|d| d.message.contains("adj.ptx"))
+        .collect();
+    assert_eq!(w.len(), 1, "{:?}", created.warnings);
+    assert!(
+        w[0].message.contains("1 face adjacency entries"),
+        "{}",
+        w[0].message
+    );
+    // At the "filename" parameter: line 4.
+    assert_eq!(w[0].loc.as_ref().map(|l| l.line), Some(4), "{:?}", w[0].loc);
+    std::fs::remove_dir_all(&dir).ok();
+}
