@@ -286,10 +286,16 @@ struct Run<'a> {
     stopped: bool,
     warned_transform_begin: bool,
     kept: HashSet<Arc<str>>,
+    /// Whether the target wants comments.
+    comments: bool,
+    /// Comments read but not yet handed to the target: all of them were
+    /// read before the next directive keyword.
+    pending_comments: Vec<(FileLoc, String)>,
 }
 
 impl<'a> Run<'a> {
     fn new(opts: &'a ParseOptions, target: &'a mut dyn ParserTarget) -> Self {
+        let comments = target.wants_comments();
         Run {
             opts,
             target,
@@ -302,6 +308,26 @@ impl<'a> Run<'a> {
             stopped: false,
             warned_transform_begin: false,
             kept: HashSet::new(),
+            comments,
+            pending_comments: Vec::new(),
+        }
+    }
+
+    /// Moves the comments the current file's tokenizer has seen to the
+    /// pending list.
+    fn collect_comments(&mut self) {
+        if self.comments {
+            if let Some(src) = self.stack.last_mut() {
+                self.pending_comments.extend(src.tok.take_comments());
+            }
+        }
+    }
+
+    /// Hands the pending comments to the target.
+    fn flush_comments(&mut self) {
+        for (loc, text) in std::mem::take(&mut self.pending_comments) {
+            let r = self.target.comment(&text, loc);
+            self.drain(r);
         }
     }
 
@@ -331,6 +357,7 @@ impl<'a> Run<'a> {
 
     fn finish(mut self) -> Result<Diagnostics, Diagnostics> {
         if !self.stopped {
+            self.flush_comments();
             let r = self.target.end_of_files();
             self.drain(r);
         }
@@ -393,12 +420,15 @@ impl<'a> Run<'a> {
         })
     }
 
-    fn push(&mut self, src: Source) {
+    fn push(&mut self, mut src: Source) {
         if let Some(d) = src.tok.check_encoding() {
             self.report(d);
             self.keep_source(&src);
             return;
         }
+        // Comments read so far in the including file precede this one's.
+        self.collect_comments();
+        src.tok.set_keep_comments(self.comments);
         self.stack.push(src);
     }
 
@@ -430,7 +460,9 @@ impl<'a> Run<'a> {
             let Some(src) = self.stack.last_mut() else {
                 return Ok(None);
             };
-            match src.tok.next_token() {
+            let r = src.tok.next_token();
+            self.collect_comments();
+            match r {
                 Ok(Some(t)) => return Ok(Some(t)),
                 Ok(None) => {
                     if let Some(src) = self.stack.pop() {
@@ -496,6 +528,8 @@ impl<'a> Run<'a> {
                     continue;
                 }
             };
+            // Every comment read so far was read before this token.
+            self.flush_comments();
             let loc = self.loc(&t);
             let directive = if t.kind == TokenKind::Word {
                 lookup_directive(self.raw(&t))

@@ -6,7 +6,13 @@
 //! in the shortest form that reads back to the same `f32`. Formatting is a
 //! pure function of the directive stream, so formatting formatted output
 //! gives the same bytes. `Include`/`Import` are printed, not followed.
-//! Comments are not preserved.
+//!
+//! Comments are kept, as pbrt-v4's `--format` keeps them: each on a line
+//! of its own at the current indentation. pbrt-v4 prints a comment when
+//! its tokenizer reaches it, which puts a comment that follows a directive
+//! with parameters before that directive (the parser has read past it
+//! looking for more parameters); here every comment stays after the
+//! directive it follows and before the next one.
 
 use std::fmt::Write as _;
 
@@ -564,6 +570,13 @@ impl ParserTarget for FormattingTarget {
         Ok(())
     }
     fn end_of_files(&mut self) -> DirectiveResult {
+        Ok(())
+    }
+    fn wants_comments(&self) -> bool {
+        true
+    }
+    fn comment(&mut self, text: &str, _loc: FileLoc) -> DirectiveResult {
+        self.line(text);
         Ok(())
     }
     fn include(

@@ -159,6 +159,22 @@ pub trait ParserTarget {
         Ok(true)
     }
 
+    /// Whether the target wants the file's `#` comments through
+    /// [`ParserTarget::comment`] (the formatter does; recording them costs
+    /// the scene builder nothing when it does not).
+    fn wants_comments(&self) -> bool {
+        false
+    }
+
+    /// A `#` comment (its text from the `#` to the end of the line), called
+    /// in file order between directives: before the first directive that
+    /// starts after it. A comment inside a directive's parameter list comes
+    /// after that directive.
+    fn comment(&mut self, text: &str, loc: FileLoc) -> DirectiveResult {
+        let _ = (text, loc);
+        Ok(())
+    }
+
     /// Messages the target queued since the last call; the parser calls
     /// this after every directive.
     fn take_diagnostics(&mut self) -> Vec<Diagnostic> {

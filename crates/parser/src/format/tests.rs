@@ -234,3 +234,68 @@ fn toply_writes_large_meshes_and_references_them() {
     assert_eq!(mesh.positions[n + 2], [2.0, 1.0, 0.0]);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn comments_are_kept_in_place_and_formatting_them_is_idempotent() {
+    let text = "# header line 1\n#header line 2   \n\
+LookAt 0 0 5  0 0 0  0 1 0 # eye, look, up\n\
+Camera \"perspective\" \"float fov\" 45\n\
+  # after the camera's parameters\n\
+WorldBegin\n\
+AttributeBegin # a block\n\
+  # inside the block\n\
+  Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 # first vertex\n 1 0 0 0 1 0 ]\n\
+  \"integer indices\" [ 0 1 2 ]\n\
+  # before the end\n\
+AttributeEnd\n\
+# trailing comment\n";
+    let (f1, d1) = format(text, false);
+    assert!(!d1.has_errors(), "{d1}");
+    let expected = [
+        "# header line 1",
+        "#header line 2",
+        "LookAt 0 0 5",
+        "       0 0 0",
+        "       0 1 0",
+        "# eye, look, up",
+        "Camera \"perspective\"",
+        "    \"float fov\" [ 45 ]",
+        "# after the camera's parameters",
+        "",
+        "WorldBegin",
+        "",
+        "AttributeBegin",
+        "    # a block",
+        "    # inside the block",
+        "    Shape \"trianglemesh\"",
+        "        \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ]",
+        "        \"integer indices\" [ 0 1 2 ]",
+        "    # first vertex",
+        "    # before the end",
+        "AttributeEnd",
+        "# trailing comment",
+        "",
+    ]
+    .join("\n");
+    assert_eq!(f1, expected);
+    let (f2, d2) = format(&f1, false);
+    assert!(!d2.has_errors(), "{d2}");
+    assert_eq!(f1, f2);
+    // The upgrade keeps them too.
+    let (u, _) = format(text, true);
+    assert!(u.contains("# after the camera's parameters\n") && u.contains("# trailing comment\n"));
+}
+
+#[test]
+fn a_comment_ends_at_the_end_of_its_line() {
+    // What follows a `#` on its line is comment, the next line is not.
+    let (f, d) = format(
+        "Shape \"sphere\" # r \"float radius\" 2\n\"float radius\" 3\n",
+        false,
+    );
+    assert!(!d.has_errors(), "{d}");
+    assert_eq!(
+        f,
+        "Shape \"sphere\"\n    \"float radius\" [ 3 ]\n# r \"float radius\" 2\n"
+    );
+}
