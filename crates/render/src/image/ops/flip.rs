@@ -305,7 +305,7 @@ fn preprocess(image: &[[f32; 3]], width: usize, height: usize, csf: &Kernel) -> 
     csf.convolve(image, width, height)
         .into_iter()
         .map(|p| {
-            let rgb = xyz_to_linear_rgb(ycxcz_to_xyz(p)).map(|v| v.min(1.0).max(0.0));
+            let rgb = xyz_to_linear_rgb(ycxcz_to_xyz(p)).map(|v| v.clamp(0.0, 1.0));
             hunt(xyz_to_lab(linear_rgb_to_xyz(rgb)))
         })
         .collect()
