@@ -168,6 +168,11 @@ impl SourceMap {
     pub fn is_empty(&self) -> bool {
         self.files.is_empty()
     }
+
+    /// The recorded files and their contents.
+    pub fn into_files(self) -> impl Iterator<Item = (Arc<str>, Arc<[u8]>)> {
+        self.files.into_iter()
+    }
 }
 
 /// A list of diagnostics plus the sources needed to render them.

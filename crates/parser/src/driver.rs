@@ -32,6 +32,10 @@ pub struct ParseOptions {
     pub max_values: usize,
     /// Largest file (after decompression) the parser will read, in bytes.
     pub max_file_bytes: u64,
+    /// Parse `Import`ed files on threads of their own (pbrt-v4 does);
+    /// `false` parses them in place. The target sees the same directives
+    /// in the same order either way.
+    pub parallel_import: bool,
 }
 
 impl Default for ParseOptions {
@@ -42,6 +46,7 @@ impl Default for ParseOptions {
             max_include_depth: 64,
             max_values: 1 << 30,
             max_file_bytes: input::DEFAULT_MAX_FILE_BYTES,
+            parallel_import: true,
         }
     }
 }
@@ -286,10 +291,28 @@ struct Run<'a> {
     stopped: bool,
     warned_transform_begin: bool,
     kept: HashSet<Arc<str>>,
+    /// Whether the target wants comments.
+    comments: bool,
+    /// Comments read but not yet handed to the target: all of them were
+    /// read before the next directive keyword.
+    pending_comments: Vec<(FileLoc, String)>,
+    /// Canonical paths of the files that `Import`ed this run's file (for
+    /// cycle checks and the nesting limit).
+    ancestors: Vec<PathBuf>,
+    /// After the first `Import`: the imports and the directives between
+    /// them, delivered to the target in order once parsing is done.
+    deferred: Vec<import::Segment>,
+    /// This run parses an imported file for another run.
+    is_import: bool,
+    /// Files read whose directives are delivered later (deferred, or parsed
+    /// for an import): kept until it is known whether a diagnostic points
+    /// into them.
+    held: Vec<(Arc<str>, Arc<[u8]>)>,
 }
 
 impl<'a> Run<'a> {
     fn new(opts: &'a ParseOptions, target: &'a mut dyn ParserTarget) -> Self {
+        let comments = target.wants_comments();
         Run {
             opts,
             target,
@@ -302,6 +325,39 @@ impl<'a> Run<'a> {
             stopped: false,
             warned_transform_begin: false,
             kept: HashSet::new(),
+            comments,
+            pending_comments: Vec::new(),
+            ancestors: Vec::new(),
+            deferred: Vec::new(),
+            is_import: false,
+            held: Vec::new(),
+        }
+    }
+
+    /// Where directives go: the target, or after an `Import` the recorder
+    /// of the directives that follow it.
+    fn sink(&mut self) -> &mut dyn ParserTarget {
+        match self.deferred.last_mut() {
+            Some(import::Segment::Main(r)) => r,
+            _ => &mut *self.target,
+        }
+    }
+
+    /// Moves the comments the current file's tokenizer has seen to the
+    /// pending list.
+    fn collect_comments(&mut self) {
+        if self.comments {
+            if let Some(src) = self.stack.last_mut() {
+                self.pending_comments.extend(src.tok.take_comments());
+            }
+        }
+    }
+
+    /// Hands the pending comments to the target.
+    fn flush_comments(&mut self) {
+        for (loc, text) in std::mem::take(&mut self.pending_comments) {
+            let r = self.target.comment(&text, loc);
+            self.drain(r);
         }
     }
 
@@ -331,11 +387,27 @@ impl<'a> Run<'a> {
 
     fn finish(mut self) -> Result<Diagnostics, Diagnostics> {
         if !self.stopped {
+            self.replay_deferred();
+        }
+        if !self.stopped {
+            self.flush_comments();
             let r = self.target.end_of_files();
             self.drain(r);
         }
         while let Some(src) = self.stack.pop() {
             self.keep_source(&src);
+        }
+        // An import hands all its files up; the importer keeps those that
+        // diagnostics point into.
+        for (name, data) in std::mem::take(&mut self.held) {
+            let referenced = self
+                .diags
+                .items
+                .iter()
+                .any(|d| d.loc.as_ref().is_some_and(|l| l.file == name));
+            if self.is_import || referenced {
+                self.diags.sources.insert(name, data);
+            }
         }
         if self.dropped_warnings > 0 {
             self.diags.push(Diagnostic {
@@ -367,6 +439,8 @@ impl<'a> Run<'a> {
             self.diags
                 .sources
                 .insert(name.clone(), src.tok.data().clone());
+        } else if self.is_import || !self.deferred.is_empty() {
+            self.held.push((name.clone(), src.tok.data().clone()));
         }
     }
 
@@ -393,12 +467,15 @@ impl<'a> Run<'a> {
         })
     }
 
-    fn push(&mut self, src: Source) {
+    fn push(&mut self, mut src: Source) {
         if let Some(d) = src.tok.check_encoding() {
             self.report(d);
             self.keep_source(&src);
             return;
         }
+        // Comments read so far in the including file precede this one's.
+        self.collect_comments();
+        src.tok.set_keep_comments(self.comments);
         self.stack.push(src);
     }
 
@@ -430,7 +507,9 @@ impl<'a> Run<'a> {
             let Some(src) = self.stack.last_mut() else {
                 return Ok(None);
             };
-            match src.tok.next_token() {
+            let r = src.tok.next_token();
+            self.collect_comments();
+            match r {
                 Ok(Some(t)) => return Ok(Some(t)),
                 Ok(None) => {
                     if let Some(src) = self.stack.pop() {
@@ -496,6 +575,8 @@ impl<'a> Run<'a> {
                     continue;
                 }
             };
+            // Every comment read so far was read before this token.
+            self.flush_comments();
             let loc = self.loc(&t);
             let directive = if t.kind == TokenKind::Word {
                 lookup_directive(self.raw(&t))
@@ -811,7 +892,7 @@ impl<'a> Run<'a> {
                 return;
             }
         }
-        if self.stack.len() >= self.opts.max_include_depth {
+        if self.stack.len() + self.ancestors.len() >= self.opts.max_include_depth {
             self.report(Diagnostic::error(
                 loc.clone(),
                 format!(
@@ -826,12 +907,15 @@ impl<'a> Run<'a> {
             Some(s) if rel.is_relative() => s.dir.join(rel),
             _ => rel.to_path_buf(),
         };
-        if let Ok(canon) = std::fs::canonicalize(&path) {
-            if self.stack.iter().any(|s| s.canon.as_ref() == Some(&canon)) {
+        let canon = std::fs::canonicalize(&path).ok();
+        if let Some(canon) = &canon {
+            let in_stack = self.stack.iter().any(|s| s.canon.as_ref() == Some(canon));
+            if in_stack || self.ancestors.contains(canon) {
                 let chain: Vec<String> = self
-                    .stack
+                    .ancestors
                     .iter()
-                    .map(|s| s.tok.file_name().to_string())
+                    .map(|p| p.display().to_string())
+                    .chain(self.stack.iter().map(|s| s.tok.file_name().to_string()))
                     .collect();
                 self.report(Diagnostic::error(
                     loc.clone(),
@@ -844,6 +928,10 @@ impl<'a> Run<'a> {
                 return;
             }
         }
+        if kind == IncludeKind::Import {
+            self.start_import(path, canon, loc);
+            return;
+        }
         match self.open(&path) {
             Ok(src) => self.push(src),
             Err(msg) => self.report(Diagnostic::error(loc.clone(), format!("cannot read {msg}"))),
@@ -854,22 +942,22 @@ impl<'a> Run<'a> {
         use Directive as D;
         let l = loc.clone();
         Ok(match d {
-            D::Identity => self.target.identity(loc),
+            D::Identity => self.sink().identity(loc),
             D::Translate => {
                 let v = self.floats::<3>(&l)?;
-                self.target.translate(v, loc)
+                self.sink().translate(v, loc)
             }
             D::Scale => {
                 let v = self.floats::<3>(&l)?;
-                self.target.scale(v, loc)
+                self.sink().scale(v, loc)
             }
             D::Rotate => {
                 let v = self.floats::<4>(&l)?;
-                self.target.rotate(v[0], [v[1], v[2], v[3]], loc)
+                self.sink().rotate(v[0], [v[1], v[2], v[3]], loc)
             }
             D::LookAt => {
                 let v = self.floats::<9>(&l)?;
-                self.target.look_at(
+                self.sink().look_at(
                     [v[0], v[1], v[2]],
                     [v[3], v[4], v[5]],
                     [v[6], v[7], v[8]],
@@ -878,26 +966,26 @@ impl<'a> Run<'a> {
             }
             D::ConcatTransform => {
                 let m = self.matrix(&l)?;
-                self.target.concat_transform(m, loc)
+                self.sink().concat_transform(m, loc)
             }
             D::Transform => {
                 let m = self.matrix(&l)?;
-                self.target.transform(m, loc)
+                self.sink().transform(m, loc)
             }
             D::CoordinateSystem => {
                 let n = self.quoted("a coordinate system name", &l)?;
-                self.target.coordinate_system(&n, loc)
+                self.sink().coordinate_system(&n, loc)
             }
             D::CoordSysTransform => {
                 let n = self.quoted("a coordinate system name", &l)?;
-                self.target.coord_sys_transform(&n, loc)
+                self.sink().coord_sys_transform(&n, loc)
             }
             D::ActiveTransform => {
                 let t = self.next_required("All, StartTime or EndTime", &l)?;
                 match self.raw(&t) {
-                    b"All" => self.target.active_transform_all(loc),
-                    b"StartTime" => self.target.active_transform_start_time(loc),
-                    b"EndTime" => self.target.active_transform_end_time(loc),
+                    b"All" => self.sink().active_transform_all(loc),
+                    b"StartTime" => self.sink().active_transform_start_time(loc),
+                    b"EndTime" => self.sink().active_transform_end_time(loc),
                     _ => {
                         let shown = self.display(&t);
                         return Err(self.fail_at(
@@ -909,12 +997,12 @@ impl<'a> Run<'a> {
             }
             D::TransformTimes => {
                 let v = self.floats::<2>(&l)?;
-                self.target.transform_times(v[0], v[1], loc)
+                self.sink().transform_times(v[0], v[1], loc)
             }
-            D::ReverseOrientation => self.target.reverse_orientation(loc),
+            D::ReverseOrientation => self.sink().reverse_orientation(loc),
             D::ColorSpace => {
                 let n = self.quoted("a color space name", &l)?;
-                self.target.color_space(&n, loc)
+                self.sink().color_space(&n, loc)
             }
             D::PixelFilter
             | D::Film
@@ -931,7 +1019,7 @@ impl<'a> Run<'a> {
             | D::Shape => {
                 let n = self.quoted("a name", &l)?;
                 let p = self.params()?;
-                let t = &mut *self.target;
+                let t = self.sink();
                 match d {
                     D::PixelFilter => t.pixel_filter(&n, p, loc),
                     D::Film => t.film(&n, p, loc),
@@ -958,7 +1046,7 @@ impl<'a> Run<'a> {
                     }
                     None => inside.clone(),
                 };
-                self.target.medium_interface(&inside, &outside, loc)
+                self.sink().medium_interface(&inside, &outside, loc)
             }
             D::Option => {
                 let name = self.quoted("an option name", &l)?;
@@ -971,12 +1059,12 @@ impl<'a> Run<'a> {
                     let shown = self.display(&t);
                     return Err(self.fail_at(t, format!("expected an option value, found {shown}")));
                 };
-                self.target.option(&name, &value, loc)
+                self.sink().option(&name, &value, loc)
             }
-            D::WorldBegin => self.target.world_begin(loc),
-            D::WorldEnd => self.target.world_end(loc),
-            D::AttributeBegin => self.target.attribute_begin(loc),
-            D::AttributeEnd => self.target.attribute_end(loc),
+            D::WorldBegin => self.sink().world_begin(loc),
+            D::WorldEnd => self.sink().world_end(loc),
+            D::AttributeBegin => self.sink().attribute_begin(loc),
+            D::AttributeEnd => self.sink().attribute_end(loc),
             D::TransformBegin | D::TransformEnd => {
                 if !self.warned_transform_begin {
                     self.warned_transform_begin = true;
@@ -986,9 +1074,9 @@ impl<'a> Run<'a> {
                     ));
                 }
                 if d == D::TransformBegin {
-                    self.target.transform_begin(loc)
+                    self.sink().transform_begin(loc)
                 } else {
-                    self.target.transform_end(loc)
+                    self.sink().transform_end(loc)
                 }
             }
             D::Texture => {
@@ -996,20 +1084,20 @@ impl<'a> Run<'a> {
                 let ty = self.quoted("a texture type (\"float\" or \"spectrum\")", &l)?;
                 let class = self.quoted("a texture class", &l)?;
                 let p = self.params()?;
-                self.target.texture(&name, &ty, &class, p, loc)
+                self.sink().texture(&name, &ty, &class, p, loc)
             }
             D::NamedMaterial => {
                 let n = self.quoted("a material name", &l)?;
-                self.target.named_material(&n, loc)
+                self.sink().named_material(&n, loc)
             }
             D::ObjectBegin => {
                 let n = self.quoted("an object name", &l)?;
-                self.target.object_begin(&n, loc)
+                self.sink().object_begin(&n, loc)
             }
-            D::ObjectEnd => self.target.object_end(loc),
+            D::ObjectEnd => self.sink().object_end(loc),
             D::ObjectInstance => {
                 let n = self.quoted("an object name", &l)?;
-                self.target.object_instance(&n, loc)
+                self.sink().object_instance(&n, loc)
             }
             D::Include | D::Import => {
                 let n = self.quoted("a file name", &l)?;
@@ -1027,3 +1115,6 @@ impl<'a> Run<'a> {
 
 #[cfg(test)]
 mod tests;
+
+mod import;
+mod record;

@@ -6,8 +6,28 @@
 //! in the shortest form that reads back to the same `f32`. Formatting is a
 //! pure function of the directive stream, so formatting formatted output
 //! gives the same bytes. `Include`/`Import` are printed, not followed.
-//! Comments are not preserved.
+//!
+//! With `upgrade`, a texture, named material or object defined again
+//! (legal in pbrt-v3, where the later definition wins; an error in
+//! pbrt-v4) is renamed `<name>-renamed-<n>` with pbrt-v4's warning, `n`
+//! counting from 0 per kind. References are renamed to the most recent
+//! definition: texture parameters (of materials, textures and shapes),
+//! `NamedMaterial`, a `mix` material's materials and `ObjectInstance`.
+//! pbrt-v4 renames only the texture parameters of materials and textures
+//! and `ObjectInstance`, so its `NamedMaterial "m"` after a redefinition
+//! would pick the first definition; and it registers a texture's new name
+//! before renaming the texture's own parameters, so a pbrt-v3 texture that
+//! builds on the one it replaces would refer to itself. Both are fixed
+//! here so that the upgraded file renders as the pbrt-v3 one did.
+//!
+//! Comments are kept, as pbrt-v4's `--format` keeps them: each on a line
+//! of its own at the current indentation. pbrt-v4 prints a comment when
+//! its tokenizer reaches it, which puts a comment that follows a directive
+//! with parameters before that directive (the parser has read past it
+//! looking for more parameters); here every comment stays after the
+//! directive it follows and before the next one.
 
+use std::collections::HashMap;
 use std::fmt::Write as _;
 
 use crate::diag::Diagnostic;
@@ -25,6 +45,36 @@ pub struct FormattingTarget {
     upgrade: bool,
     diags: Vec<Diagnostic>,
     toply: Option<ToPly>,
+    /// `--upgrade`'s current name of each texture, named material and
+    /// object instance.
+    renames: [Renames; 3],
+}
+
+/// Which kind of named thing a [`Renames`] table holds.
+#[derive(Clone, Copy)]
+enum Kind {
+    Texture = 0,
+    Material = 1,
+    Object = 2,
+}
+
+impl Kind {
+    /// pbrt-v4's word for the kind in the renaming warning.
+    fn what(self) -> &'static str {
+        match self {
+            Kind::Texture => "texture",
+            Kind::Material => "named material",
+            Kind::Object => "object instance",
+        }
+    }
+}
+
+/// The names defined so far of one kind, each with the name it is printed
+/// under, and how many were renamed.
+#[derive(Clone, Debug, Default)]
+struct Renames {
+    current: HashMap<String, String>,
+    count: usize,
 }
 
 /// Where `--toply` writes meshes, and how many it has written.
@@ -224,6 +274,69 @@ impl FormattingTarget {
             }
             self.indent(1);
             self.out.push_str("]\n");
+        }
+    }
+
+    /// Registers a definition of `name` (under `--upgrade`) and returns the
+    /// name to print: `name`, or a fresh `<name>-renamed-<n>` with a warning
+    /// when it was defined before.
+    fn define(&mut self, kind: Kind, name: &str, loc: &FileLoc) -> String {
+        if !self.upgrade {
+            return name.to_string();
+        }
+        let r = &mut self.renames[kind as usize];
+        let printed = if r.current.contains_key(name) {
+            let new = format!("{name}-renamed-{}", r.count);
+            r.count += 1;
+            self.diags.push(Diagnostic::warning(
+                loc.clone(),
+                format!("{name}: renaming multiply-defined {}", kind.what()),
+            ));
+            new
+        } else {
+            name.to_string()
+        };
+        r.current.insert(name.to_string(), printed.clone());
+        printed
+    }
+
+    /// The name a reference to `name` is printed as: its most recent
+    /// definition's (under `--upgrade`), else `name`.
+    fn reference(&self, kind: Kind, name: &str) -> String {
+        if !self.upgrade {
+            return name.to_string();
+        }
+        self.renames[kind as usize]
+            .current
+            .get(name)
+            .cloned()
+            .unwrap_or_else(|| name.to_string())
+    }
+
+    /// Renames the texture references among `params` (and, with
+    /// `materials`, a `mix` material's material names) to their most
+    /// recent definitions.
+    fn rename_references(&self, params: &mut ParamList, materials: bool) {
+        if !self.upgrade {
+            return;
+        }
+        for p in params.iter_mut() {
+            let kind = if p.ty == "texture" {
+                Kind::Texture
+            } else if materials
+                && p.ty == "string"
+                && matches!(
+                    p.name.as_str(),
+                    "namedmaterial1" | "namedmaterial2" | "materials"
+                )
+            {
+                Kind::Material
+            } else {
+                continue;
+            };
+            for s in p.strings.iter_mut() {
+                *s = self.reference(kind, s);
+            }
         }
     }
 
@@ -465,6 +578,9 @@ impl ParserTarget for FormattingTarget {
         params: ParamList,
         loc: FileLoc,
     ) -> DirectiveResult {
+        let mut params = params;
+        self.rename_references(&mut params, false);
+        let name = self.define(Kind::Texture, name, &loc);
         let (ty, class, params) = if self.upgrade {
             let (ty, u) = upgrade::upgrade_texture(ty, texname, params, &loc);
             let (class, p) = self.take(u);
@@ -474,7 +590,7 @@ impl ParserTarget for FormattingTarget {
         };
         self.line(&format!(
             "Texture {} {} {}",
-            Self::quoted(name),
+            Self::quoted(&name),
             Self::quoted(&ty),
             Self::quoted(&class)
         ));
@@ -482,6 +598,8 @@ impl ParserTarget for FormattingTarget {
         Ok(())
     }
     fn material(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        let mut params = params;
+        self.rename_references(&mut params, true);
         self.simple("Material", name, params, &loc, upgrade::upgrade_material)
     }
     fn make_named_material(
@@ -495,6 +613,8 @@ impl ParserTarget for FormattingTarget {
             return Ok(());
         }
         let mut params = params;
+        self.rename_references(&mut params, true);
+        let name = self.define(Kind::Material, name, &loc);
         let ty = params
             .iter()
             .rposition(|p| p.name == "type" && p.ty == "string")
@@ -510,11 +630,12 @@ impl ParserTarget for FormattingTarget {
             0,
             ParsedParameter::with_strings("string", "type", tloc, vec![new]),
         );
-        self.named("MakeNamedMaterial", name, &p);
+        self.named("MakeNamedMaterial", &name, &p);
         Ok(())
     }
     fn named_material(&mut self, name: &str, _loc: FileLoc) -> DirectiveResult {
-        self.line(&format!("NamedMaterial {}", Self::quoted(name)));
+        let name = self.reference(Kind::Material, name);
+        self.line(&format!("NamedMaterial {}", Self::quoted(&name)));
         Ok(())
     }
     fn light_source(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
@@ -535,6 +656,7 @@ impl ParserTarget for FormattingTarget {
         )
     }
     fn shape(&mut self, name: &str, mut params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.rename_references(&mut params, false);
         if name == "trianglemesh" {
             if let Some(file) = self.mesh_to_ply(&mut params, &loc)? {
                 let mut all = vec![ParsedParameter::with_strings(
@@ -549,8 +671,9 @@ impl ParserTarget for FormattingTarget {
         }
         self.simple("Shape", name, params, &loc, upgrade::upgrade_shape)
     }
-    fn object_begin(&mut self, name: &str, _loc: FileLoc) -> DirectiveResult {
-        self.line(&format!("ObjectBegin {}", Self::quoted(name)));
+    fn object_begin(&mut self, name: &str, loc: FileLoc) -> DirectiveResult {
+        let name = self.define(Kind::Object, name, &loc);
+        self.line(&format!("ObjectBegin {}", Self::quoted(&name)));
         self.depth += 1;
         Ok(())
     }
@@ -560,10 +683,18 @@ impl ParserTarget for FormattingTarget {
         Ok(())
     }
     fn object_instance(&mut self, name: &str, _loc: FileLoc) -> DirectiveResult {
-        self.line(&format!("ObjectInstance {}", Self::quoted(name)));
+        let name = self.reference(Kind::Object, name);
+        self.line(&format!("ObjectInstance {}", Self::quoted(&name)));
         Ok(())
     }
     fn end_of_files(&mut self) -> DirectiveResult {
+        Ok(())
+    }
+    fn wants_comments(&self) -> bool {
+        true
+    }
+    fn comment(&mut self, text: &str, _loc: FileLoc) -> DirectiveResult {
+        self.line(text);
         Ok(())
     }
     fn include(

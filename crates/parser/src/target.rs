@@ -24,8 +24,10 @@ pub type ParamList = Vec<ParsedParameter>;
 pub enum IncludeKind {
     /// `Include "file"`: textual inclusion.
     Include,
-    /// `Import "file"`: pbrt-v4's parallel-parsed inclusion (treated like
-    /// `Include` by this parser).
+    /// `Import "file"`: pbrt-v4's parallel-parsed inclusion: parsed on a
+    /// thread of its own, its directives delivered at the `Import`'s place
+    /// between [`ParserTarget::import_begin`] and
+    /// [`ParserTarget::import_end`].
     Import,
 }
 
@@ -157,6 +159,36 @@ pub trait ParserTarget {
     ) -> Result<bool, Diagnostic> {
         let _ = (filename, kind, loc);
         Ok(true)
+    }
+
+    /// The start of an `Import`ed file's directives, at the `Import`
+    /// directive. pbrt-v4 parses an imported file with a copy of the
+    /// graphics state, so what it changes stays inside it; by default this
+    /// is `attribute_begin` (and [`ParserTarget::import_end`]
+    /// `attribute_end`).
+    fn import_begin(&mut self, loc: FileLoc) -> DirectiveResult {
+        self.attribute_begin(loc)
+    }
+
+    /// The end of an `Import`ed file's directives.
+    fn import_end(&mut self, loc: FileLoc) -> DirectiveResult {
+        self.attribute_end(loc)
+    }
+
+    /// Whether the target wants the file's `#` comments through
+    /// [`ParserTarget::comment`] (the formatter does; recording them costs
+    /// the scene builder nothing when it does not).
+    fn wants_comments(&self) -> bool {
+        false
+    }
+
+    /// A `#` comment (its text from the `#` to the end of the line), called
+    /// in file order between directives: before the first directive that
+    /// starts after it. A comment inside a directive's parameter list comes
+    /// after that directive.
+    fn comment(&mut self, text: &str, loc: FileLoc) -> DirectiveResult {
+        let _ = (text, loc);
+        Ok(())
     }
 
     /// Messages the target queued since the last call; the parser calls

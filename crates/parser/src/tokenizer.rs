@@ -1,7 +1,8 @@
 //! The tokenizer (pbrt-v4 `parser.cpp`, `Tokenizer`; book appendix C).
 //!
 //! Splits a scene file held in memory into words, quoted strings and
-//! brackets, skipping whitespace and `#` comments. Tokens are byte ranges
+//! brackets, skipping whitespace and `#` comments (kept aside on request,
+//! for `--format`). Tokens are byte ranges
 //! into the shared buffer, so nothing is allocated per token; escaped
 //! strings are decoded only when their value is asked for. Numbers are
 //! parsed with a fast exact path and fall back to the standard library.
@@ -61,6 +62,11 @@ pub struct Tokenizer {
     pos: usize,
     line: u32,
     line_start: usize,
+    /// Record comments in `comments` instead of only skipping them.
+    keep_comments: bool,
+    /// Comments met since the last [`Tokenizer::take_comments`]: line,
+    /// column and byte range (from the `#` to the end of the line).
+    comments: Vec<(u32, u32, usize, usize)>,
 }
 
 /// Bytes that end a bare word, as a table so the hot scan is one load.
@@ -100,7 +106,33 @@ impl Tokenizer {
             pos,
             line: 1,
             line_start: 0,
+            keep_comments: false,
+            comments: Vec::new(),
         }
+    }
+
+    /// Makes the tokenizer record the `#` comments it skips, for
+    /// [`Tokenizer::take_comments`].
+    pub fn set_keep_comments(&mut self, keep: bool) {
+        self.keep_comments = keep;
+    }
+
+    /// The comments skipped since the last call (when recording them), in
+    /// file order: where each starts and its text from the `#` to the end
+    /// of the line, trailing whitespace removed.
+    pub fn take_comments(&mut self) -> Vec<(FileLoc, String)> {
+        let data = &self.data;
+        let name = &self.name;
+        self.comments
+            .drain(..)
+            .map(|(line, column, start, end)| {
+                let text = String::from_utf8_lossy(&data[start..end]);
+                (
+                    FileLoc::new(name.clone(), line, column),
+                    text.trim_end().to_string(),
+                )
+            })
+            .collect()
     }
 
     /// Creates a tokenizer over a string (handy for tests and `parse_string`).
@@ -263,8 +295,13 @@ impl Tokenizer {
                 }
                 Some(b' ' | b'\t' | b'\r') => pos += 1,
                 Some(b'#') => {
+                    let start = pos;
                     while pos < len && data[pos] != b'\n' {
                         pos += 1;
+                    }
+                    if self.keep_comments {
+                        let column = saturating_u32(start - self.line_start + 1);
+                        self.comments.push((self.line, column, start, pos));
                     }
                 }
                 Some(_) => break,

@@ -5,6 +5,7 @@
 
 use super::args::{crop, Arg, Args};
 use super::{emit, load_md, save};
+use rpbrt_render::image::ops::flip::{flip, FlipOptions};
 use rpbrt_render::image::ops::metrics::{metric_error, zero_infinities, Metric};
 use rpbrt_render::image::ops::{diff, split_channel_list, worst_block, BLOCK_SIZE};
 use rpbrt_render::image::{Image, ImageAndMetadata};
@@ -27,8 +28,13 @@ options:
     --crop <x0,x1,y0,y1> Crop both images first (a negative x1 or y1 is a size).
     --difftol <v>      Report a difference only when the averages differ by
                        more than <v> percent (0: any difference). Default: 0
-    --metric <name>    MSE, MAE or MRSE ((a-b)^2/(b+0.01)^2). Default: MSE
-    --outfile <name>   Write the image of per-pixel error terms.
+    --metric <name>    MSE, MAE, MRSE ((a-b)^2/(b+0.01)^2) or FLIP (NVIDIA's
+                       LDR FLIP as pbrt-v4 computes it: 3-channel images,
+                       values clamped to [0,1] and taken as sRGB-encoded,
+                       67 pixels per degree; the mean over pixels).
+                       Default: MSE
+    --outfile <name>   Write the image of per-pixel error terms (FLIP: one
+                       channel named Error).
     --reference <name> The reference image (or give it second).
 ";
 
@@ -58,16 +64,15 @@ pub fn run(argv: &[String]) -> Result<(), String> {
                 "crop" => window = crop(&mut a, &f)?,
                 "metric" => {
                     let v = a.value(&f)?;
-                    if v.eq_ignore_ascii_case("FLIP") {
-                        return Err(a.err(
-                            "the FLIP metric is not implemented in rpbrt; use MSE, MAE or MRSE",
-                        ));
-                    }
-                    metric = Some(Metric::parse(&v).ok_or_else(|| {
-                        a.err(format!(
-                            "{v}: --metric must be \"MAE\", \"MSE\" or \"MRSE\""
-                        ))
-                    })?);
+                    metric = Some(if v.eq_ignore_ascii_case("FLIP") {
+                        DiffMetric::Flip
+                    } else {
+                        DiffMetric::Pixel(Metric::parse(&v).ok_or_else(|| {
+                            a.err(format!(
+                                "{v}: --metric must be \"MAE\", \"MSE\", \"MRSE\", or \"FLIP\""
+                            ))
+                        })?)
+                    });
                 }
                 "difftol" => difftol = Some(a.f32(&f)?),
                 _ => return Err(a.unknown(&f)),
@@ -120,7 +125,7 @@ pub fn run(argv: &[String]) -> Result<(), String> {
         }
         return Ok(());
     }
-    let metric = metric.unwrap_or(Metric::Mse);
+    let metric = metric.unwrap_or(DiffMetric::Pixel(Metric::Mse));
     let tol = difftol.unwrap_or(0.0);
     let n = zero_infinities(&mut image);
     if n > 0 {
@@ -135,11 +140,22 @@ pub fn run(argv: &[String]) -> Result<(), String> {
         v.iter().map(|&x| x as f64).sum::<f64>() / v.len().max(1) as f64
     };
     let (ia, ra) = (avg(&image), avg(&refim));
-    let e = metric_error(&image, &refim, metric).map_err(|e| a.err(e))?;
+    let (error_image, error, max_error, name) = match metric {
+        DiffMetric::Pixel(m) => {
+            let e = metric_error(&image, &refim, m).map_err(|e| a.err(e))?;
+            let (avg, max) = (e.average(), e.max());
+            (e.image, avg, max, m.name())
+        }
+        DiffMetric::Flip => {
+            let e = flip(&image, &refim, FlipOptions::default())
+                .map_err(|e| a.err(format!("{ref_file}: {e}")))?;
+            (e.image, e.mean, e.mean, "FLIP")
+        }
+    };
     if let Some(out) = &outfile {
-        save(&e.image, out, &im.metadata)?;
+        save(&error_image, out, &im.metadata)?;
     }
-    if e.max() == 0.0 {
+    if max_error == 0.0 {
         return Ok(());
     }
     let delta = 100.0 * (ia - ra) / ra;
@@ -147,11 +163,18 @@ pub fn run(argv: &[String]) -> Result<(), String> {
         return Ok(());
     }
     emit(&format!(
-        "Images differ:\n\t{image_file} {ref_file}\n\tavg = {ia:.6} / {ra:.6} ({delta:.6}% delta), {} = {:.6}\n",
-        metric.name(),
-        e.average()
+        "Images differ:\n\t{image_file} {ref_file}\n\tavg = {ia:.6} / {ra:.6} ({delta:.6}% delta), {name} = {error:.6}\n"
     ))?;
     Err(String::new())
+}
+
+/// What `--metric` asks for.
+#[derive(Clone, Copy)]
+enum DiffMetric {
+    /// A per-value metric (MSE, MAE, MRSE).
+    Pixel(Metric),
+    /// NVIDIA's FLIP.
+    Flip,
 }
 
 /// Prints rpbrt's default report.

@@ -155,7 +155,60 @@ fn missing_files_and_unknown_options_are_clear_errors() {
         &imgtool(&["diff", "--metric", "PSNR", "a", "b"]),
         "--metric",
     );
-    fails_with(&imgtool(&["diff", "--metric", "FLIP", "a", "b"]), "FLIP");
+}
+
+#[test]
+fn diff_flip_prints_pbrt_v4_summary_and_writes_the_error_channel() {
+    let d = dir("flip");
+    let (w, h) = (12, 10);
+    let grey = vec![0.5f32; 3 * w * h];
+    let mut dot = grey.clone();
+    let centre = 3 * (5 * w + 6);
+    dot[centre..centre + 3].copy_from_slice(&[1.0, 1.0, 1.0]);
+    let a = write(
+        &d.join("a.exr"),
+        &grey,
+        w as i32,
+        h as i32,
+        &["R", "G", "B"],
+    );
+    let b = write(&d.join("b.exr"), &dot, w as i32, h as i32, &["R", "G", "B"]);
+    // Equal: silent, status 0.
+    let o = imgtool(&["diff", "--metric", "flip", &a, &a]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stdout(&o).is_empty());
+    // Different: pbrt-v4's summary with the mean FLIP, and the per-pixel
+    // FLIP in one "Error" channel, largest at the changed pixel.
+    let err = d.join("flip.exr");
+    let o = imgtool(&[
+        "diff",
+        "--metric",
+        "FLIP",
+        "--outfile",
+        err.to_str().unwrap(),
+        &b,
+        &a,
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let e = Image::read(&err, None).unwrap().image;
+    assert_eq!(e.channel_names(), ["Error"]);
+    let v = e.to_f32_vec();
+    let max = v.iter().copied().fold(0.0f32, f32::max);
+    assert_eq!(v[5 * w + 6], max);
+    assert!(max > 0.0 && max <= 1.0);
+    let mean = v.iter().sum::<f32>() / v.len() as f32;
+    let s = stdout(&o);
+    assert!(s.contains(&format!("FLIP = {mean:.6}")), "{s}");
+    assert!(
+        s.contains("avg = 0.504167 / 0.500000 (0.833333% delta)"),
+        "{s}"
+    );
+    // FLIP takes three channels only.
+    let rg = write(&d.join("rg.exr"), &[0.1, 0.2], 1, 1, &["R", "G"]);
+    fails_with(
+        &imgtool(&["diff", "--metric", "FLIP", &rg, &rg]),
+        "only 3 channel",
+    );
 }
 
 #[test]

@@ -154,6 +154,9 @@ impl ParserTarget for Rec {
         self.with_params(format!("AreaLightSource {n}"), p, &loc)
     }
     fn shape(&mut self, n: &str, p: ParamList, loc: FileLoc) -> DirectiveResult {
+        if n == "refused" {
+            return Err(Diagnostic::error(loc, "the target refuses this shape"));
+        }
         self.with_params(format!("Shape {n}"), p, &loc)
     }
     fn object_begin(&mut self, n: &str, loc: FileLoc) -> DirectiveResult {
@@ -442,6 +445,9 @@ fn includes_resolve_relative_to_the_including_file() {
         [
             "WorldBegin @main.pbrt:1:1",
             "Shape sphere [] @a.pbrt:1:1",
+            // The Import, isolated, with nothing left in it.
+            "AttributeBegin @a.pbrt:2:1",
+            "AttributeEnd @a.pbrt:2:1",
             "Shape disk [] @main.pbrt:3:1",
             "EndOfFiles"
         ]
@@ -455,6 +461,121 @@ fn includes_resolve_relative_to_the_including_file() {
         "{}",
         diags.render()
     );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// Parses `main` under `d` with imports in parallel or in place.
+fn parse_with(d: &Path, parallel: bool) -> (Vec<String>, Diagnostics) {
+    let mut r = Rec::default();
+    let opts = ParseOptions {
+        parallel_import: parallel,
+        ..ParseOptions::default()
+    };
+    let res = Parser::new(opts).parse_files(&[d.join("main.pbrt")], &mut r);
+    let diags = match res {
+        Ok(d) | Err(d) => d,
+    };
+    (r.calls, diags)
+}
+
+#[test]
+fn imports_are_delivered_in_place_isolated_whatever_the_threads_do() {
+    let d = temp_dir("import");
+    std::fs::write(
+        d.join("main.pbrt"),
+        "WorldBegin\nShape \"disk\"\nImport \"sub/a.pbrt\"\nTranslate 1 0 0\n\
+         Import \"sub/b.pbrt\"\nShape \"sphere\"\n",
+    )
+    .unwrap();
+    // a changes the transform (which stays inside it), includes a file and
+    // imports another.
+    std::fs::write(
+        d.join("sub/a.pbrt"),
+        "Translate 0 5 0\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n\
+         Include \"deeper/c.pbrt\"\nImport \"deeper/d.pbrt\"\nShape \"cylinder\"\n",
+    )
+    .unwrap();
+    std::fs::write(d.join("sub/b.pbrt"), "MakeNamedMaterial \"m\"\n").unwrap();
+    std::fs::write(d.join("sub/deeper/c.pbrt"), "Material \"diffuse\"\n").unwrap();
+    std::fs::write(d.join("sub/deeper/d.pbrt"), "Shape \"curve\"\n").unwrap();
+    let (par, pd) = parse_with(&d, true);
+    let (seq, sd) = parse_with(&d, false);
+    assert!(!pd.has_errors() && !sd.has_errors(), "{pd} {sd}");
+    assert_eq!(
+        par,
+        [
+            "WorldBegin @main.pbrt:1:1",
+            "Shape disk [] @main.pbrt:2:1",
+            "AttributeBegin @main.pbrt:3:1",
+            "Translate [0.0, 5.0, 0.0] @a.pbrt:1:1",
+            "Shape trianglemesh [point3 P=9] @a.pbrt:2:1",
+            "Material diffuse [] @c.pbrt:1:1",
+            "AttributeBegin @a.pbrt:4:1",
+            "Shape curve [] @d.pbrt:1:1",
+            "AttributeEnd @a.pbrt:4:1",
+            "Shape cylinder [] @a.pbrt:5:1",
+            "AttributeEnd @main.pbrt:3:1",
+            "Translate [1.0, 0.0, 0.0] @main.pbrt:4:1",
+            "AttributeBegin @main.pbrt:5:1",
+            "MakeNamedMaterial m [] @b.pbrt:1:1",
+            "AttributeEnd @main.pbrt:5:1",
+            "Shape sphere [] @main.pbrt:6:1",
+            "EndOfFiles",
+        ]
+    );
+    assert_eq!(par, seq);
+    // Many runs, same stream.
+    for _ in 0..10 {
+        assert_eq!(parse_with(&d, true).0, seq);
+    }
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn errors_in_imported_files_keep_their_locations() {
+    let d = temp_dir("import-err");
+    std::fs::write(
+        d.join("main.pbrt"),
+        "WorldBegin\nImport \"sub/a.pbrt\"\nImport \"sub/missing.pbrt\"\n\
+         Shape \"refused\"\nImport \"sub/open.pbrt\"\nImport \"main.pbrt\"\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("sub/a.pbrt"),
+        "Shape \"sphere\"\n  Shape \"refused\"\nShape \"disk\" \"float r\" [ 1 x ]\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("sub/open.pbrt"),
+        "AttributeBegin\nShape \"sphere\"\n",
+    )
+    .unwrap();
+    for parallel in [true, false] {
+        let (calls, diags) = parse_with(&d, parallel);
+        let e: Vec<String> = diags.iter().map(|d| d.to_string()).collect();
+        let has = |s: &str| e.iter().any(|m| m.contains(s));
+        // The parse error and the target's error inside the import, the
+        // missing file at its Import, the target's error in the main file,
+        // the unclosed block and the cycle, all located.
+        assert!(has("a.pbrt:3:28: error: x: expected a number"), "{e:?}");
+        assert!(
+            has("a.pbrt:2:3: error: the target refuses this shape"),
+            "{e:?}"
+        );
+        assert!(has("main.pbrt:3:1: error: cannot read"), "{e:?}");
+        assert!(
+            has("main.pbrt:4:1: error: the target refuses this shape"),
+            "{e:?}"
+        );
+        assert!(has("open.pbrt:1:1: error: missing end"), "{e:?}");
+        assert!(has("main.pbrt:6:1: error: include cycle"), "{e:?}");
+        // The imported file's text is kept to show the line.
+        let shown = diags.render();
+        assert!(shown.contains("2 |   Shape \"refused\""), "{shown}");
+        assert!(shown.contains("4 | Shape \"refused\""), "{shown}");
+        assert!(calls.contains(&"Shape sphere [] @a.pbrt:1:1".to_string()));
+        assert!(!calls.iter().any(|c| c.contains("open.pbrt")), "{calls:?}");
+    }
     let _ = std::fs::remove_dir_all(&d);
 }
 

@@ -234,3 +234,126 @@ fn toply_writes_large_meshes_and_references_them() {
     assert_eq!(mesh.positions[n + 2], [2.0, 1.0, 0.0]);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn comments_are_kept_in_place_and_formatting_them_is_idempotent() {
+    let text = "# header line 1\n#header line 2   \n\
+LookAt 0 0 5  0 0 0  0 1 0 # eye, look, up\n\
+Camera \"perspective\" \"float fov\" 45\n\
+  # after the camera's parameters\n\
+WorldBegin\n\
+AttributeBegin # a block\n\
+  # inside the block\n\
+  Shape \"trianglemesh\" \"point3 P\" [ 0 0 0 # first vertex\n 1 0 0 0 1 0 ]\n\
+  \"integer indices\" [ 0 1 2 ]\n\
+  # before the end\n\
+AttributeEnd\n\
+# trailing comment\n";
+    let (f1, d1) = format(text, false);
+    assert!(!d1.has_errors(), "{d1}");
+    let expected = [
+        "# header line 1",
+        "#header line 2",
+        "LookAt 0 0 5",
+        "       0 0 0",
+        "       0 1 0",
+        "# eye, look, up",
+        "Camera \"perspective\"",
+        "    \"float fov\" [ 45 ]",
+        "# after the camera's parameters",
+        "",
+        "WorldBegin",
+        "",
+        "AttributeBegin",
+        "    # a block",
+        "    # inside the block",
+        "    Shape \"trianglemesh\"",
+        "        \"point3 P\" [ 0 0 0 1 0 0 0 1 0 ]",
+        "        \"integer indices\" [ 0 1 2 ]",
+        "    # first vertex",
+        "    # before the end",
+        "AttributeEnd",
+        "# trailing comment",
+        "",
+    ]
+    .join("\n");
+    assert_eq!(f1, expected);
+    let (f2, d2) = format(&f1, false);
+    assert!(!d2.has_errors(), "{d2}");
+    assert_eq!(f1, f2);
+    // The upgrade keeps them too.
+    let (u, _) = format(text, true);
+    assert!(u.contains("# after the camera's parameters\n") && u.contains("# trailing comment\n"));
+}
+
+#[test]
+fn a_comment_ends_at_the_end_of_its_line() {
+    // What follows a `#` on its line is comment, the next line is not.
+    let (f, d) = format(
+        "Shape \"sphere\" # r \"float radius\" 2\n\"float radius\" 3\n",
+        false,
+    );
+    assert!(!d.has_errors(), "{d}");
+    assert_eq!(
+        f,
+        "Shape \"sphere\"\n    \"float radius\" [ 3 ]\n# r \"float radius\" 2\n"
+    );
+}
+
+#[test]
+fn upgrade_renames_multiply_defined_names_and_their_references() {
+    let text = r#"WorldBegin
+Texture "t" "float" "constant" "float value" 0.5
+Texture "t" "float" "scale" "texture tex1" "t" "float tex2" 2
+Texture "t" "float" "constant" "float value" 0.25
+Material "matte" "texture sigma" "t" "texture bumpmap" "t"
+MakeNamedMaterial "m" "string type" "matte"
+NamedMaterial "m"
+MakeNamedMaterial "m" "string type" "matte" "texture bumpmap" "t"
+MakeNamedMaterial "mixed" "string type" "mix" "string namedmaterial1" "m" "string namedmaterial2" "other"
+NamedMaterial "m"
+Shape "sphere" "texture alpha" "t"
+ObjectBegin "o"
+ObjectEnd
+ObjectInstance "o"
+ObjectBegin "o"
+ObjectEnd
+ObjectInstance "o"
+ObjectInstance "never-defined"
+"#;
+    let (out, diags) = format(text, true);
+    assert!(!diags.has_errors(), "{diags}");
+    for frag in [
+        "Texture \"t\" \"float\" \"constant\"\n    \"float value\" [ 0.5 ]\n",
+        // The scale builds on the texture it replaces: the first "t".
+        "Texture \"t-renamed-0\" \"float\" \"scale\"\n    \"texture tex\" [ \"t\" ]\n    \"float scale\" [ 2 ]\n",
+        "Texture \"t-renamed-1\" \"float\" \"constant\"\n",
+        "    \"texture displacement\" [ \"t-renamed-1\" ]\n",
+        "MakeNamedMaterial \"m\"\n    \"string type\" [ \"diffuse\" ]\nNamedMaterial \"m\"\n",
+        "MakeNamedMaterial \"m-renamed-0\"\n    \"string type\" [ \"diffuse\" ]\n    \"texture displacement\" [ \"t-renamed-1\" ]\n",
+        "\"string materials\" [ \"other\" \"m-renamed-0\" ]\n",
+        "NamedMaterial \"m-renamed-0\"\nShape \"sphere\"\n    \"texture alpha\" [ \"t-renamed-1\" ]\n",
+        "ObjectBegin \"o\"\nObjectEnd\nObjectInstance \"o\"\nObjectBegin \"o-renamed-0\"\nObjectEnd\nObjectInstance \"o-renamed-0\"\n",
+        "ObjectInstance \"never-defined\"\n",
+    ] {
+        assert!(out.contains(frag), "missing {frag:?} in\n{out}");
+    }
+    let warnings: Vec<String> = diags.iter().map(|d| d.to_string()).collect();
+    for (line, w) in [
+        (3, "t: renaming multiply-defined texture"),
+        (4, "t: renaming multiply-defined texture"),
+        (8, "m: renaming multiply-defined named material"),
+        (15, "o: renaming multiply-defined object instance"),
+    ] {
+        assert!(
+            warnings
+                .iter()
+                .any(|m| m.contains(&format!("<string>:{line}:1: warning: {w}"))),
+            "{line} {w}: {warnings:?}"
+        );
+    }
+    // Without --upgrade nothing is renamed.
+    let (plain, d) = format(text, false);
+    assert!(!plain.contains("renamed"), "{plain}");
+    assert!(!d.iter().any(|m| m.to_string().contains("renaming")));
+}

@@ -593,6 +593,18 @@ impl ParserTarget for SceneBuilder {
         self.pop("AttributeEnd", "AttributeBegin", &loc)
     }
 
+    fn import_begin(&mut self, loc: FileLoc) -> DirectiveResult {
+        // pbrt-v4: an imported file starts from a copy of the graphics
+        // state, and only inside the world block.
+        if self.block == Block::Options {
+            return Err(Diagnostic::error(
+                loc,
+                "Import statement only allowed inside world definition block",
+            ));
+        }
+        self.attribute_begin(loc)
+    }
+
     fn transform_begin(&mut self, loc: FileLoc) -> DirectiveResult {
         self.pushed.push(Pushed::Transform(
             Box::new(self.state.ctm),

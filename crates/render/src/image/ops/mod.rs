@@ -9,6 +9,7 @@ pub mod compose;
 pub mod convert;
 pub mod falsecolor;
 pub mod filter;
+pub mod flip;
 pub mod metrics;
 mod viridis;
 

@@ -590,3 +590,51 @@ fn shared_scenes_build_without_errors() {
     }
     assert!(built > 0, "no scene under {}", root.display());
 }
+
+#[test]
+fn imports_build_the_scene_a_one_thread_parse_builds() {
+    let d = std::env::temp_dir().join(format!("rpbrt-import-scene-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    let main = "Camera \"perspective\"\nWorldBegin\nShape \"sphere\"\nImport \"a.pbrt\"\n\
+        Translate 0 0 1\nImport \"b.pbrt\"\nShape \"disk\"\n";
+    std::fs::write(d.join("main.pbrt"), main).unwrap();
+    std::fs::write(
+        d.join("a.pbrt"),
+        "Translate 5 0 0\nMaterial \"conductor\"\nShape \"sphere\" \"float radius\" 2\n",
+    )
+    .unwrap();
+    std::fs::write(d.join("b.pbrt"), "Shape \"cylinder\"\n").unwrap();
+    let run = |parallel: bool| {
+        let mut o = opts(RenderingCoordinateSystem::World);
+        o.parse.parallel_import = parallel;
+        match build_scene(&[d.join("main.pbrt")], &o) {
+            Ok((s, _)) => s,
+            Err(e) => panic!("{e}"),
+        }
+    };
+    let (par, seq) = (run(true), run(false));
+    let describe = |s: &SceneDescription| format!("{:?}", s.shapes);
+    assert_eq!(describe(&par), describe(&seq));
+    let names: Vec<&str> = par.shapes.iter().map(|s| s.base.name.as_str()).collect();
+    assert_eq!(names, ["sphere", "sphere", "cylinder", "disk"]);
+    // The import's Translate and Material stay inside it.
+    let at = |i: usize| par.shapes[i].render_from_object.apply_point(origin());
+    assert!(close(at(1), 5.0, 0.0, 0.0));
+    assert!(close(at(2), 0.0, 0.0, 1.0));
+    assert!(close(at(3), 0.0, 0.0, 1.0));
+    assert_eq!(
+        par.shapes[0].attributes.material,
+        par.shapes[3].attributes.material
+    );
+    // pbrt-v4 allows Import only in the world block.
+    std::fs::write(d.join("early.pbrt"), "Import \"b.pbrt\"\nWorldBegin\n").unwrap();
+    let o = opts(RenderingCoordinateSystem::World);
+    let e = build_scene(&[d.join("early.pbrt")], &o)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("early.pbrt:1:1: error: Import statement only allowed inside world"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
