@@ -17,6 +17,7 @@
 //! imported file keep their `file:line:col`.
 
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::thread::JoinHandle;
 
 use super::record::Recorder;
@@ -37,6 +38,44 @@ pub(super) enum Segment {
 pub(super) enum Job {
     Thread(JoinHandle<Parsed>),
     Done(Box<Parsed>),
+}
+
+/// Import threads running now, across every parse in the process.
+static IMPORT_THREADS: AtomicUsize = AtomicUsize::new(0);
+
+/// One running import thread's slot; dropping it frees the slot. A file
+/// with thousands of `Import`s parses them on at most
+/// [`max_import_threads`] threads at once: once all are busy, an import is
+/// parsed in place by the thread that reads it.
+struct ImportThread;
+
+impl ImportThread {
+    /// Takes a slot if one is free.
+    fn reserve() -> bool {
+        let max = max_import_threads();
+        IMPORT_THREADS
+            .fetch_update(Ordering::AcqRel, Ordering::Acquire, |n| {
+                (n < max).then_some(n + 1)
+            })
+            .is_ok()
+    }
+}
+
+impl Drop for ImportThread {
+    fn drop(&mut self) {
+        IMPORT_THREADS.fetch_sub(1, Ordering::AcqRel);
+    }
+}
+
+/// Import threads running now.
+#[cfg(test)]
+pub(super) fn import_threads_running() -> usize {
+    IMPORT_THREADS.load(Ordering::Acquire)
+}
+
+/// The most import threads running at once: the machine's parallelism.
+pub(super) fn max_import_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
 /// Parses the file at `path` into a recorder, with `ancestors` (the
@@ -77,18 +116,24 @@ impl Run<'_> {
         ancestors.extend(canon);
         let opts = self.opts.clone();
         let l = loc.clone();
-        let job = if self.opts.parallel_import {
+        let job = if self.opts.parallel_import && ImportThread::reserve() {
             let spawned = std::thread::Builder::new()
                 .name("rpbrt-import".into())
                 .spawn({
                     let (opts, path, ancestors, l) =
                         (opts.clone(), path.clone(), ancestors.clone(), l.clone());
-                    move || parse_import(opts, path, ancestors, l)
+                    move || {
+                        let _slot = ImportThread;
+                        parse_import(opts, path, ancestors, l)
+                    }
                 });
             match spawned {
                 Ok(h) => Job::Thread(h),
                 // No thread to be had: parse it here.
-                Err(_) => Job::Done(Box::new(parse_import(opts, path, ancestors, l))),
+                Err(_) => {
+                    drop(ImportThread);
+                    Job::Done(Box::new(parse_import(opts, path, ancestors, l)))
+                }
             }
         } else {
             Job::Done(Box::new(parse_import(opts, path, ancestors, l)))

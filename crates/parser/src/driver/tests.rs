@@ -532,6 +532,39 @@ fn imports_are_delivered_in_place_isolated_whatever_the_threads_do() {
 }
 
 #[test]
+fn many_imports_share_a_bounded_set_of_threads() {
+    // 300 imports, each importing one more file: far more than the import
+    // thread limit, so most are parsed in place; the stream is still the
+    // one-thread parse's, and every slot is given back.
+    let d = temp_dir("many-imports");
+    let mut main = String::from("WorldBegin\n");
+    for i in 0..300 {
+        main.push_str(&format!("Import \"sub/i{i}.pbrt\"\n"));
+        std::fs::write(
+            d.join(format!("sub/i{i}.pbrt")),
+            format!("Translate {i} 0 0\nImport \"deeper/j{i}.pbrt\"\n"),
+        )
+        .unwrap();
+        std::fs::write(
+            d.join(format!("sub/deeper/j{i}.pbrt")),
+            "Shape \"sphere\"\n",
+        )
+        .unwrap();
+    }
+    std::fs::write(d.join("main.pbrt"), main).unwrap();
+    let (par, pd) = parse_with(&d, true);
+    let (seq, sd) = parse_with(&d, false);
+    assert!(!pd.has_errors() && !sd.has_errors(), "{pd} {sd}");
+    assert_eq!(
+        par.iter().filter(|c| c.starts_with("Shape sphere")).count(),
+        300
+    );
+    assert_eq!(par, seq);
+    assert!(super::import::import_threads_running() <= super::import::max_import_threads());
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
 fn errors_in_imported_files_keep_their_locations() {
     let d = temp_dir("import-err");
     std::fs::write(
