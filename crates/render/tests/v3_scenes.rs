@@ -5,7 +5,7 @@
 //! pbrt-v4's `--upgrade` does, the pbrt-v3 file must give the same pixels
 //! as the hand-upgraded pbrt-v4 file (same sampler and seed, one thread);
 //! the types pbrt-v4 dropped and rpbrt renders natively (`disney`,
-//! `fourier`, `heightfield`, pbrt-v3's spectrum `uv`/`fbm`/`wrinkled`/
+//! `fourier`, `heightfield`, `nurbs`, pbrt-v3's spectrum `uv`/`fbm`/`wrinkled`/
 //! `windy` textures, `exinfinite`, the light sample counts) are checked
 //! against what pbrt-v3 defines them to be.
 //!
@@ -147,6 +147,8 @@ fn cases() -> Vec<Case> {
         case("shape loopsubdiv", ("", "Shape \"loopsubdiv\" \"integer nlevels\" 2 \"point P\" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0.5 ] \"integer indices\" [ 0 1 2 0 2 3 ]"), ("", "Shape \"loopsubdiv\" \"integer levels\" 2 \"point3 P\" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0.5 ] \"integer indices\" [ 0 1 2 0 2 3 ]")),
         // pbrt-v3's heightfield is the triangle mesh it built.
         case("shape heightfield", ("", "Translate -1 -1 0 Scale 2 2 1 Shape \"heightfield\" \"integer nu\" 3 \"integer nv\" 2 \"float Pz\" [ 0 0.5 0  0.2 0.7 0.1 ]"), ("", "Translate -1 -1 0 Scale 2 2 1 Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  0.5 0 0.5  1 0 0  0 1 0.2  0.5 1 0.7  1 1 0.1 ] \"point2 uv\" [ 0 0  0.5 0  1 0  0 1  0.5 1  1 1 ] \"integer indices\" [ 0 1 4  0 4 3  1 2 5  1 5 4 ]")),
+        // pbrt-v3's nurbs is the 30 × 30 triangle mesh it diced.
+        native("shape nurbs", ("", "Shape \"nurbs\" \"integer nu\" 3 \"integer uorder\" 3 \"float uknots\" [ 0 0 0 1 1 1 ] \"integer nv\" 2 \"integer vorder\" 2 \"float vknots\" [ 0 0 1 1 ] \"float Pw\" [ 1 0 -1 1  0.7071 0.7071 -0.7071 0.7071  0 1 -1 1  1 0 1 1  0.7071 0.7071 0.7071 0.7071  0 1 1 1 ]")),
         // ---- materials
         case("material matte", ("", "Material \"matte\" \"color Kd\" [ 0.2 0.5 0.8 ]\nShape \"sphere\""), ("", "Material \"diffuse\" \"rgb reflectance\" [ 0.2 0.5 0.8 ]\nShape \"sphere\"")),
         case("material plastic", ("", "Material \"plastic\" \"color Kd\" [ 0.2 0.5 0.8 ] \"color Ks\" [ 0.3 0.3 0.3 ] \"float roughness\" 0.1\nShape \"sphere\""), ("", "Material \"coateddiffuse\" \"rgb reflectance\" [ 0.2 0.5 0.8 ] \"float roughness\" 0.1\nShape \"sphere\"")),
@@ -411,4 +413,16 @@ fn native_pbrt_v3_types_behave_as_pbrt_v3_defines_them() {
         (uv - bilerp).abs() < 0.1 * bilerp,
         "uv {uv} vs bilerp {bilerp}"
     );
+    // A bilinear NURBS patch is the quad (diced into 30 × 30 vertices
+    // with the same uvs), up to rounding.
+    let patch = "Shape \"nurbs\" \"integer nu\" 2 \"integer uorder\" 2 \"float uknots\" [ 0 0 1 1 ] \"integer nv\" 2 \"integer vorder\" 2 \"float vknots\" [ 0 0 1 1 ] \"point P\" [ -1 -1 0  1 -1 0  -1 1 0  1 1 0 ]";
+    let nurbs = mean(&native("nurbs", ("", Box::leak(format!("Texture \"t\" \"color\" \"uv\"\nMaterial \"matte\" \"texture Kd\" \"t\"\n{patch}").into_boxed_str()))));
+    assert!((nurbs - uv).abs() < 1e-3 * uv, "nurbs {nurbs} vs quad {uv}");
+    let e = render(
+        "bad",
+        &scene(true, "bad", "", "Shape \"nurbs\" \"integer nu\" 2 \"integer uorder\" 2 \"float uknots\" [ 0 0 1 ] \"integer nv\" 2 \"integer vorder\" 2 \"float vknots\" [ 0 0 1 1 ] \"point P\" [ -1 -1 0  1 -1 0  -1 1 0  1 1 0 ]"),
+    )
+    .err()
+    .expect("short knot vector");
+    assert!(e.contains("bad.pbrt:") && e.contains("\"uknots\""), "{e}");
 }
