@@ -181,6 +181,7 @@ impl SceneBuilder {
         params: ParamList,
         loc: &FileLoc,
     ) -> (String, ParamList) {
+        self.note_pbrt_v3_params(&params);
         let before = fingerprint(&params);
         let u = f(name, params, loc);
         self.keep_upgrade_messages(
@@ -188,6 +189,26 @@ impl SceneBuilder {
             u.diagnostics,
         );
         (u.name, u.params)
+    }
+
+    /// Remembers `loc` if it is the scene's first pbrt-v3-only construct.
+    fn note_pbrt_v3(&mut self, loc: &FileLoc) {
+        if self.scene.pbrt_v3.is_none() {
+            self.scene.pbrt_v3 = Some(loc.clone());
+        }
+    }
+
+    /// Notes a parameter only pbrt-v3 accepts: the type names pbrt-v4
+    /// renamed (it reads them only when upgrading) or a `mapname`.
+    fn note_pbrt_v3_params(&mut self, params: &[ParsedParameter]) {
+        let v3 = params.iter().find(|p| {
+            matches!(p.ty.as_str(), "color" | "point" | "vector")
+                || (p.name == "mapname" && p.ty == "string")
+        });
+        if let Some(p) = v3 {
+            let loc = p.loc.clone();
+            self.note_pbrt_v3(&loc);
+        }
     }
 
     fn keep_upgrade_messages(&mut self, unchanged: bool, diags: Vec<Diagnostic>) {
@@ -230,6 +251,7 @@ impl SceneBuilder {
             Some(f) => self.upgraded(f, name, params, &loc),
             None => {
                 let mut params = params;
+                self.note_pbrt_v3_params(&params);
                 upgrade::upgrade_param_types(&mut params);
                 (name.to_string(), params)
             }
@@ -581,6 +603,12 @@ impl ParserTarget for SceneBuilder {
         Ok(())
     }
 
+    fn world_end(&mut self, loc: FileLoc) -> DirectiveResult {
+        // pbrt-v4 accepts `WorldEnd` only when upgrading.
+        self.note_pbrt_v3(&loc);
+        Ok(())
+    }
+
     fn attribute_begin(&mut self, loc: FileLoc) -> DirectiveResult {
         self.verify_world("AttributeBegin", &loc)?;
         self.pushed
@@ -619,6 +647,7 @@ impl ParserTarget for SceneBuilder {
     }
 
     fn attribute(&mut self, target: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.note_pbrt_v3_params(&params);
         let attrs = match target {
             "shape" => &mut self.state.shape_attributes,
             "light" => &mut self.state.light_attributes,
@@ -649,6 +678,7 @@ impl ParserTarget for SceneBuilder {
         loc: FileLoc,
     ) -> DirectiveResult {
         self.verify_world("Texture", &loc)?;
+        self.note_pbrt_v3_params(&params);
         let before = fingerprint(&params);
         let (new_ty, u) = upgrade::upgrade_texture(ty, texname, params, &loc);
         let unchanged = new_ty == ty && u.name == texname && before == fingerprint(&u.params);

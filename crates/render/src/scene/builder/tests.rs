@@ -396,6 +396,28 @@ fn pbrt_v3_matte_becomes_diffuse() {
 }
 
 #[test]
+fn pbrt_v3_only_constructs_mark_the_scene() {
+    let first = |text: &str| build(text).pbrt_v3.map(|l| (l.line, l.column));
+    // pbrt-v4 text, pbrt-v3 type names included (the mapping runs on
+    // every file), is not marked.
+    let v4 = "Film \"rgb\"\nWorldBegin\nMaterial \"matte\" \"rgb Kd\" [1 1 1]\nLightSource \"goniometric\" \"rgb I\" [1 1 1]\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n";
+    assert_eq!(first(v4), None);
+    assert_eq!(first(&format!("{v4}WorldEnd\n")), Some((6, 1)));
+    assert_eq!(
+        first("WorldBegin\nAttributeBegin\nLightSource \"point\" \"point from\" [0 0 0]\nAttributeEnd\nWorldEnd\n"),
+        Some((3, 21))
+    );
+    assert_eq!(
+        first("Camera \"perspective\"\nWorldBegin\nTexture \"t\" \"spectrum\" \"constant\" \"color value\" [1 1 1]\n"),
+        Some((3, 35))
+    );
+    assert_eq!(
+        first("WorldBegin\nAttribute \"shape\" \"vector v\" [0 0 1]\n"),
+        Some((2, 19))
+    );
+}
+
+#[test]
 fn located_errors() {
     let cases: &[(&str, &str, &str)] = &[
         ("Shape \"sphere\"\nWorldBegin\n", "<string>:1:1:", "Shape not allowed before WorldBegin"),
