@@ -170,6 +170,39 @@ impl SceneBuilder {
             .map_err(|e| Self::transform_error(e, loc.clone(), directive))
     }
 
+    /// In a scene marked pbrt-v3, the rendering options the file left out
+    /// take pbrt-v3's defaults (pbrt-v3 `core/api.cpp`'s `RenderOptions`
+    /// and the creators' parameter defaults): a box filter of radius 0.5,
+    /// the `halton` sampler with 16 samples and the `path` integrator with
+    /// depth 5, where pbrt-v4's are `gaussian`, `zsobol` and `volpath`.
+    /// (Both default to a 1280 × 720 film, a `bvh` and a perspective
+    /// camera with a 90° field of view.)
+    fn use_pbrt_v3_defaults(&mut self) {
+        let unset = |e: &SceneEntity| e.loc == default_loc();
+        let int = |name: &str, v: i32| {
+            let mut p = ParsedParameter::new("integer", name, default_loc());
+            p.ints = vec![v];
+            p
+        };
+        let entity = |name: &str, params: Vec<ParsedParameter>| {
+            SceneEntity::new(
+                name,
+                ParameterDictionary::new(params),
+                default_loc(),
+                "srgb",
+            )
+        };
+        if unset(&self.scene.filter) {
+            self.scene.filter = entity("box", Vec::new());
+        }
+        if unset(&self.scene.sampler) {
+            self.scene.sampler = entity("halton", vec![int("pixelsamples", 16)]);
+        }
+        if unset(&self.scene.integrator) {
+            self.scene.integrator = entity("path", vec![int("maxdepth", 5)]);
+        }
+    }
+
     // ---- entities ---------------------------------------------------------
 
     /// Runs a pbrt-v3 → pbrt-v4 mapping and queues its messages; a mapping
@@ -939,6 +972,9 @@ impl ParserTarget for SceneBuilder {
     }
 
     fn end_of_files(&mut self) -> DirectiveResult {
+        if self.scene.pbrt_v3.is_some() {
+            self.use_pbrt_v3_defaults();
+        }
         if self.block != Block::World {
             self.pending.push(Diagnostic::unlocated_error(
                 "end of files before \"WorldBegin\"",

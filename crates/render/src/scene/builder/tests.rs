@@ -418,6 +418,30 @@ fn pbrt_v3_only_constructs_mark_the_scene() {
 }
 
 #[test]
+fn pbrt_v3_scenes_take_pbrt_v3_option_defaults() {
+    let names = |s: &SceneDescription| {
+        [&s.filter, &s.sampler, &s.integrator, &s.film].map(|e| e.name.clone())
+    };
+    let v4 = build("WorldBegin\nShape \"sphere\"\n");
+    assert_eq!(names(&v4), ["gaussian", "zsobol", "volpath", "rgb"]);
+    let v3 = build("WorldBegin\nShape \"sphere\"\nWorldEnd\n");
+    assert_eq!(names(&v3), ["box", "halton", "path", "rgb"]);
+    let int = |e: &SceneEntity, n: &str| {
+        e.params
+            .params()
+            .iter()
+            .find(|p| p.name == n)
+            .map(|p| p.ints.clone())
+    };
+    assert_eq!(int(&v3.sampler, "pixelsamples"), Some(vec![16]));
+    assert_eq!(int(&v3.integrator, "maxdepth"), Some(vec![5]));
+    // What the file gives is kept.
+    let given =
+        build("Sampler \"sobol\"\nIntegrator \"bdpt\"\nWorldBegin\nShape \"sphere\"\nWorldEnd\n");
+    assert_eq!(names(&given), ["box", "sobol", "bdpt", "rgb"]);
+}
+
+#[test]
 fn located_errors() {
     let cases: &[(&str, &str, &str)] = &[
         ("Shape \"sphere\"\nWorldBegin\n", "<string>:1:1:", "Shape not allowed before WorldBegin"),
