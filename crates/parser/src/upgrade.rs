@@ -794,6 +794,9 @@ pub fn upgrade_shape(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) ->
     if name == "heightfield" {
         upgrade_heightfield(&mut e);
     }
+    if name == "nurbs" {
+        nurbs::upgrade_nurbs(&mut e);
+    }
     e.rename("Kd", "reflectance");
     e.finish()
 }
@@ -870,6 +873,8 @@ fn upgrade_heightfield(e: &mut Edit) {
         uv,
     ));
 }
+
+mod nurbs;
 
 #[cfg(test)]
 mod tests;

@@ -46,13 +46,15 @@ fn sky(path: &Path) {
         .unwrap();
 }
 
-/// A diffuse sphere filling the frame, lit by the infinite light `light`.
+/// A diffuse sphere filling the frame, lit by the infinite light `light`
+/// (every option given: a `mapname` makes the file pbrt-v3, whose
+/// defaults differ).
 fn scene(light: &str, out: &Path, seed: i32) -> String {
     format!(
         "LookAt 0 -3 0.5  0 0 0  0 0 1\nCamera \"perspective\" \"float fov\" 20\n\
          Sampler \"independent\" \"integer pixelsamples\" 64 \"integer seed\" {seed}\n\
          Film \"rgb\" \"integer xresolution\" 24 \"integer yresolution\" 24 \"string filename\" \"{}\"\n\
-         Integrator \"path\" \"integer maxdepth\" 5\nWorldBegin\n\
+         Integrator \"path\" \"integer maxdepth\" 5 PixelFilter \"gaussian\"\nWorldBegin\n\
          AttributeBegin\nRotate 20 1 0 0\n{light}\nAttributeEnd\n\
          Material \"diffuse\" \"rgb reflectance\" [ 0.7 0.7 0.7 ]\nShape \"sphere\" \"float radius\" 1\n",
         out.display()

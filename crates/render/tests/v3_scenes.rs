@@ -5,7 +5,7 @@
 //! pbrt-v4's `--upgrade` does, the pbrt-v3 file must give the same pixels
 //! as the hand-upgraded pbrt-v4 file (same sampler and seed, one thread);
 //! the types pbrt-v4 dropped and rpbrt renders natively (`disney`,
-//! `fourier`, `heightfield`, pbrt-v3's spectrum `uv`/`fbm`/`wrinkled`/
+//! `fourier`, `heightfield`, `nurbs`, pbrt-v3's spectrum `uv`/`fbm`/`wrinkled`/
 //! `windy` textures, `exinfinite`, the light sample counts) are checked
 //! against what pbrt-v3 defines them to be.
 //!
@@ -147,6 +147,8 @@ fn cases() -> Vec<Case> {
         case("shape loopsubdiv", ("", "Shape \"loopsubdiv\" \"integer nlevels\" 2 \"point P\" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0.5 ] \"integer indices\" [ 0 1 2 0 2 3 ]"), ("", "Shape \"loopsubdiv\" \"integer levels\" 2 \"point3 P\" [ -1 -1 0  1 -1 0  1 1 0  -1 1 0.5 ] \"integer indices\" [ 0 1 2 0 2 3 ]")),
         // pbrt-v3's heightfield is the triangle mesh it built.
         case("shape heightfield", ("", "Translate -1 -1 0 Scale 2 2 1 Shape \"heightfield\" \"integer nu\" 3 \"integer nv\" 2 \"float Pz\" [ 0 0.5 0  0.2 0.7 0.1 ]"), ("", "Translate -1 -1 0 Scale 2 2 1 Shape \"trianglemesh\" \"point3 P\" [ 0 0 0  0.5 0 0.5  1 0 0  0 1 0.2  0.5 1 0.7  1 1 0.1 ] \"point2 uv\" [ 0 0  0.5 0  1 0  0 1  0.5 1  1 1 ] \"integer indices\" [ 0 1 4  0 4 3  1 2 5  1 5 4 ]")),
+        // pbrt-v3's nurbs is the 30 × 30 triangle mesh it diced.
+        native("shape nurbs", ("", "Shape \"nurbs\" \"integer nu\" 3 \"integer uorder\" 3 \"float uknots\" [ 0 0 0 1 1 1 ] \"integer nv\" 2 \"integer vorder\" 2 \"float vknots\" [ 0 0 1 1 ] \"float Pw\" [ 1 0 -1 1  0.7071 0.7071 -0.7071 0.7071  0 1 -1 1  1 0 1 1  0.7071 0.7071 0.7071 0.7071  0 1 1 1 ]")),
         // ---- materials
         case("material matte", ("", "Material \"matte\" \"color Kd\" [ 0.2 0.5 0.8 ]\nShape \"sphere\""), ("", "Material \"diffuse\" \"rgb reflectance\" [ 0.2 0.5 0.8 ]\nShape \"sphere\"")),
         case("material plastic", ("", "Material \"plastic\" \"color Kd\" [ 0.2 0.5 0.8 ] \"color Ks\" [ 0.3 0.3 0.3 ] \"float roughness\" 0.1\nShape \"sphere\""), ("", "Material \"coateddiffuse\" \"rgb reflectance\" [ 0.2 0.5 0.8 ] \"float roughness\" 0.1\nShape \"sphere\"")),
@@ -187,6 +189,9 @@ fn cases() -> Vec<Case> {
         case("light distant", ("", "LightSource \"distant\" \"blackbody L\" [ 5500 2 ] \"point from\" [ 0 0 5 ]\nShape \"sphere\""), ("", "LightSource \"distant\" \"float scale\" 2 \"blackbody L\" [ 5500 ] \"point3 from\" [ 0 0 5 ]\nShape \"sphere\"")),
         case("light infinite", ("", "LightSource \"infinite\" \"color L\" [ 0.5 0.6 0.7 ] \"integer nsamples\" 8\nShape \"sphere\""), ("", "LightSource \"infinite\" \"rgb L\" [ 0.5 0.6 0.7 ]\nShape \"sphere\"")),
         case("light exinfinite", ("", "LightSource \"exinfinite\" \"color L\" [ 0.5 0.6 0.7 ] \"integer samples\" 4\nShape \"sphere\""), ("", "LightSource \"infinite\" \"rgb L\" [ 0.5 0.6 0.7 ]\nShape \"sphere\"")),
+        // pbrt-v4 requires an image; pbrt-v3 renders these without one.
+        native("light goniometric no map", ("", "LightSource \"goniometric\" \"color I\" [ 3 3 3 ]\nTranslate 0 0 -2\nShape \"sphere\"")),
+        native("light projection no map", ("", "AttributeBegin\nTranslate 0 0 4\nRotate 180 0 1 0\nLightSource \"projection\" \"color I\" [ 9 9 9 ]\nAttributeEnd\nShape \"sphere\"")),
         case("arealight area", ("", "AttributeBegin\nAreaLightSource \"area\" \"color L\" [ 2 2 2 ] \"integer nsamples\" 4 \"bool twosided\" \"true\"\nShape \"disk\"\nAttributeEnd"), ("", "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [ 2 2 2 ] \"bool twosided\" true\nShape \"disk\"\nAttributeEnd")),
         case("arealight diffuse float nsamples", ("", "AttributeBegin\nAreaLightSource \"diffuse\" \"blackbody L\" [ 4000 3 ] \"float nsamples\" 4\nShape \"disk\"\nAttributeEnd"), ("", "AttributeBegin\nAreaLightSource \"diffuse\" \"float scale\" 3 \"blackbody L\" [ 4000 ]\nShape \"disk\"\nAttributeEnd")),
         // ---- media
@@ -411,4 +416,131 @@ fn native_pbrt_v3_types_behave_as_pbrt_v3_defines_them() {
         (uv - bilerp).abs() < 0.1 * bilerp,
         "uv {uv} vs bilerp {bilerp}"
     );
+    // A bilinear NURBS patch is the quad (diced into 30 × 30 vertices
+    // with the same uvs), up to rounding.
+    let patch = "Shape \"nurbs\" \"integer nu\" 2 \"integer uorder\" 2 \"float uknots\" [ 0 0 1 1 ] \"integer nv\" 2 \"integer vorder\" 2 \"float vknots\" [ 0 0 1 1 ] \"point P\" [ -1 -1 0  1 -1 0  -1 1 0  1 1 0 ]";
+    let nurbs = mean(&native("nurbs", ("", Box::leak(format!("Texture \"t\" \"color\" \"uv\"\nMaterial \"matte\" \"texture Kd\" \"t\"\n{patch}").into_boxed_str()))));
+    assert!((nurbs - uv).abs() < 1e-3 * uv, "nurbs {nurbs} vs quad {uv}");
+    let e = render(
+        "bad",
+        &scene(true, "bad", "", "Shape \"nurbs\" \"integer nu\" 2 \"integer uorder\" 2 \"float uknots\" [ 0 0 1 ] \"integer nv\" 2 \"integer vorder\" 2 \"float vknots\" [ 0 0 1 1 ] \"point P\" [ -1 -1 0  1 -1 0  -1 1 0  1 1 0 ]"),
+    )
+    .err()
+    .expect("short knot vector");
+    assert!(e.contains("bad.pbrt:") && e.contains("\"uknots\""), "{e}");
+}
+
+/// pbrt-v3's `goniometric` and `projection` lights without `mapname`: a
+/// uniform point light, and a constant `I` over the square frustum of
+/// pbrt-v3's default 45° field of view, against the analytic radiance of
+/// a diffuse plane under them; a pbrt-v4 file keeps pbrt-v4's error.
+#[test]
+fn v3_lights_without_maps_match_analytic_radiance() {
+    let plane = "Material \"matte\" \"color Kd\" [ 0.5 0.5 0.5 ]\nShape \"trianglemesh\" \"point P\" [ -10 -10 0  10 -10 0  10 10 0  -10 10 0 ] \"integer indices\" [ 0 1 2 0 2 3 ]";
+    let opts = "Camera \"orthographic\" \"float screenwindow\" [ -1.6 1.6 -1.6 1.6 ]\nSampler \"halton\" \"integer pixelsamples\" 64\nIntegrator \"path\" \"integer maxdepth\" 1";
+    let light_at = |light: &str| {
+        format!("AttributeBegin\nTranslate 0 0 2\nRotate 180 0 1 0\n{light}\nAttributeEnd\n{plane}")
+    };
+    let grey = |r: &Rendered| -> Vec<f64> {
+        r.pixels
+            .chunks(3)
+            .map(|c| c.iter().map(|&v| v as f64).sum::<f64>() / 3.0)
+            .collect()
+    };
+    // The radiance of the plane at (x, y): ρ/π · I cos θ / r², I = 1, d = 2,
+    // averaged over each of the 8 × 8 pixels (0.4 wide) by the midpoint
+    // rule; `half` is the lit half-width (∞: everywhere).
+    let analytic = |half: f64| -> Vec<f64> {
+        let (d, n) = (2.0f64, 40);
+        let mut out = Vec::new();
+        for py in 0..8 {
+            for px in 0..8 {
+                let mut sum = 0.0;
+                for j in 0..n {
+                    for i in 0..n {
+                        let x = -1.6 + 0.4 * (px as f64 + (i as f64 + 0.5) / n as f64);
+                        let y = -1.6 + 0.4 * (py as f64 + (j as f64 + 0.5) / n as f64);
+                        if x.abs() <= half && y.abs() <= half {
+                            let r2 = d * d + x * x + y * y;
+                            sum += 0.5 / std::f64::consts::PI * d / (r2 * r2.sqrt());
+                        }
+                    }
+                }
+                out.push(sum / (n * n) as f64);
+            }
+        }
+        out
+    };
+    let check = |tag: &str, got: &[f64], want: &[f64]| {
+        let (sg, sw) = (got.iter().sum::<f64>(), want.iter().sum::<f64>());
+        assert!((sg / sw - 1.0).abs() < 0.02, "{tag}: total {sg} vs {sw}");
+        for (k, (g, w)) in got.iter().zip(want).enumerate() {
+            if *w == 0.0 {
+                assert_eq!(*g, 0.0, "{tag}: pixel {k} lit outside the frustum");
+            } else {
+                assert!(
+                    (g - w).abs() < 0.05 * w + 2e-3,
+                    "{tag}: pixel {k}: {g} vs {w}"
+                );
+            }
+        }
+    };
+    let gonio = render(
+        "gonio",
+        &scene(
+            true,
+            "gonio",
+            opts,
+            &light_at("LightSource \"goniometric\" \"color I\" [ 1 1 1 ]"),
+        ),
+    )
+    .unwrap();
+    check("goniometric", &grey(&gonio), &analytic(f64::INFINITY));
+    let point = render(
+        "gonio",
+        &scene(
+            true,
+            "gonio",
+            opts,
+            &light_at("LightSource \"point\" \"color I\" [ 1 1 1 ]"),
+        ),
+    )
+    .unwrap();
+    assert_eq!(gonio.pixels, point.pixels);
+    let proj = render(
+        "proj",
+        &scene(
+            true,
+            "proj",
+            opts,
+            &light_at("LightSource \"projection\" \"color I\" [ 1 1 1 ]"),
+        ),
+    )
+    .unwrap();
+    check(
+        "projection",
+        &grey(&proj),
+        &analytic(2.0 * (22.5f64).to_radians().tan()),
+    );
+    let proj90 = render(
+        "proj",
+        &scene(
+            true,
+            "proj",
+            opts,
+            &light_at("LightSource \"projection\" \"color I\" [ 1 1 1 ] \"float fov\" 90"),
+        ),
+    )
+    .unwrap();
+    check("projection fov 90", &grey(&proj90), &analytic(2.0));
+    for ty in ["goniometric", "projection"] {
+        let light = format!("LightSource \"{ty}\" \"rgb I\" [ 1 1 1 ]");
+        let v4 = light_at(&light)
+            .replace("\"point P\"", "\"point3 P\"")
+            .replace("\"matte\" \"color Kd\"", "\"diffuse\" \"rgb reflectance\"");
+        let e = render("v4", &scene(false, "v4", "", &v4))
+            .err()
+            .expect("pbrt-v4 needs the image");
+        assert!(e.contains("must provide \"filename\""), "{e}");
+    }
 }

@@ -118,18 +118,30 @@ fn rgb_image(
     Ok(image.select_channels(&desc))
 }
 
+/// Which of pbrt-v3's meanings a `LightSource` directive takes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LightDialect {
+    /// The directive named its image `mapname`: an `infinite` light's
+    /// image is then pbrt-v3's latitude–longitude map.
+    pub v3_mapname: bool,
+    /// The scene is a pbrt-v3 file: a `goniometric` light without an image
+    /// is pbrt-v3's uniform point light and a `projection` light without
+    /// one projects `I` over its frustum (pbrt-v4 requires the image), and
+    /// a `projection` light's `fov` defaults to pbrt-v3's 45 degrees.
+    pub v3_file: bool,
+}
+
 /// Creates the light of a `LightSource` directive in `medium`, with
 /// unused-parameter warnings. `camera_transform` takes infinite-light
-/// portals, given in world space, into render space. `pbrt_v3` says the
-/// directive was written for pbrt-v3 (an `infinite` light's image is then
-/// a latitude–longitude map).
+/// portals, given in world space, into render space; `dialect` says which
+/// pbrt-v3 meanings apply.
 pub fn create_light(
     name: &str,
     lp: &ParamReader,
     render_from_light: &AnimatedTransform,
     medium: Option<MediumId>,
     camera_transform: &CameraTransform,
-    pbrt_v3: bool,
+    dialect: LightDialect,
 ) -> Result<Light, Diagnostic> {
     let cs = lp.color_space();
     let loc = lp.loc();
@@ -192,6 +204,20 @@ pub fn create_light(
             let i = spectrum_param(lp, "I")?.unwrap_or_else(|| cs.illuminant_spectrum());
             let mut scale = normalize_scale(scale_param(lp)?, &i, "\"I\"", loc)?;
             let filename = lp.string("filename", "")?;
+            let power = lp.float("power", -1.0)?;
+            if filename.is_empty() && dialect.v3_file {
+                // pbrt-v3 (`lights/goniometric.cpp`): without a map the
+                // distribution is 1 everywhere, a point light.
+                if power > 0.0 {
+                    scale *= power / (4.0 * PI);
+                }
+                return Ok(Light::Point(PointLight {
+                    render_from_light,
+                    i: dense(&i),
+                    scale,
+                    medium,
+                }));
+            }
             if filename.is_empty() {
                 return Err(Diagnostic::error(
                     loc.clone(),
@@ -201,7 +227,6 @@ pub fn create_light(
             let floc = lp.param_loc("filename");
             let (im, _) = read_image(lp, &filename)?;
             let image = goniometric_image(&im, &filename, &floc)?;
-            let power = lp.float("power", -1.0)?;
             if power > 0.0 {
                 let res = image.resolution();
                 let wrap = WrapMode2D::new(WrapMode::OctahedralSphere, WrapMode::OctahedralSphere);
@@ -233,7 +258,8 @@ pub fn create_light(
         "projection" => {
             let scale = scale_param(lp)?;
             let power = lp.float("power", -1.0)?;
-            let fov = lp.float("fov", 90.0)?;
+            // pbrt-v3's default field of view is 45 degrees, pbrt-v4's 90.
+            let fov = lp.float("fov", if dialect.v3_file { 45.0 } else { 90.0 })?;
             if !(fov > 0.0 && fov < 180.0) {
                 return Err(Diagnostic::error(
                     lp.param_loc("fov"),
@@ -241,25 +267,42 @@ pub fn create_light(
                 ));
             }
             let filename = lp.string("filename", "")?;
-            if filename.is_empty() {
-                return Err(Diagnostic::error(
-                    loc.clone(),
-                    "must provide \"filename\" to \"projection\" light source",
-                ));
-            }
-            let floc = lp.param_loc("filename");
-            let (im, ics) = read_image(lp, &filename)?;
-            let image = rgb_image(&im, &filename, "projection", &floc)?;
-            let res = image.resolution();
-            if res.x <= 0 || res.y <= 0 {
-                return Err(Diagnostic::error(floc, format!("{filename}: empty image")));
-            }
             let flip = Transform::scale(1.0, -1.0, 1.0);
-            let scale =
-                normalize_scale(scale, &ics.illuminant_spectrum(), "image colour space", loc)?;
-            let mut light =
-                ProjectionLight::new(render_from_light * flip, image, ics, scale, fov, medium);
-            if power > 0.0 {
+            let mut light = if filename.is_empty() && dialect.v3_file {
+                // pbrt-v3 (`lights/projection.cpp`): without a map, `I`
+                // over the square frustum (aspect 1), nothing outside it.
+                let i = spectrum_param(lp, "I")?.unwrap_or_else(|| cs.illuminant_spectrum());
+                let scale = normalize_scale(scale, &i, "\"I\"", loc)?;
+                let white = Image::from_f32(vec![1.0; 3], Point2i::new(1, 1), &["R", "G", "B"])
+                    .map_err(|e| Diagnostic::error(loc.clone(), e.to_string()))?;
+                let mut l =
+                    ProjectionLight::new(render_from_light * flip, white, cs, scale, fov, medium);
+                l.constant_i = Some(dense(&i));
+                l
+            } else {
+                if filename.is_empty() {
+                    return Err(Diagnostic::error(
+                        loc.clone(),
+                        "must provide \"filename\" to \"projection\" light source",
+                    ));
+                }
+                let floc = lp.param_loc("filename");
+                let (im, ics) = read_image(lp, &filename)?;
+                let image = rgb_image(&im, &filename, "projection", &floc)?;
+                let res = image.resolution();
+                if res.x <= 0 || res.y <= 0 {
+                    return Err(Diagnostic::error(floc, format!("{filename}: empty image")));
+                }
+                let scale =
+                    normalize_scale(scale, &ics.illuminant_spectrum(), "image colour space", loc)?;
+                ProjectionLight::new(render_from_light * flip, image, ics, scale, fov, medium)
+            };
+            let res = light.image.resolution();
+            let ics = light.color_space;
+            if power > 0.0 && light.constant_i.is_some() {
+                // The spectrum has unit luminance after normalization.
+                light.scale *= power / light.solid_angle();
+            } else if power > 0.0 {
                 let lum = luminance_vector(ics);
                 let clamp = WrapMode2D::new(WrapMode::Clamp, WrapMode::Clamp);
                 let mut sum = 0.0f64;
@@ -304,7 +347,7 @@ pub fn create_light(
                 scene: SceneSphere::default(),
             })
         }
-        "infinite" => create_infinite(lp, render_from_light, camera_transform, pbrt_v3)?,
+        "infinite" => create_infinite(lp, render_from_light, camera_transform, dialect.v3_mapname)?,
         other => return Err(unknown_type("light", other, LIGHT_NAMES, loc)),
     };
     Ok(light)

@@ -32,7 +32,7 @@ mod portal;
 mod tests;
 
 pub use area::{AreaEmission, DiffuseAreaLight};
-pub use create::{create_area_light, create_light, AREA_LIGHT_NAMES, LIGHT_NAMES};
+pub use create::{create_area_light, create_light, LightDialect, AREA_LIGHT_NAMES, LIGHT_NAMES};
 pub use cull::LightCull;
 pub use distant::DistantLight;
 pub use infinite::{ImageInfiniteLight, UniformInfiniteLight};

@@ -519,6 +519,10 @@ pub struct ProjectionLight {
     pub cos_total_width: Float,
     /// The medium around the light.
     pub medium: Option<MediumId>,
+    /// pbrt-v3's projection light without an image: this intensity over
+    /// the whole frustum (`image` is then a white pixel, giving the
+    /// frustum's shape and sampling).
+    pub constant_i: Option<Spectrum>,
     /// Screen points are sampled by pixel value times cos³θ over the
     /// screen bounds.
     distribution: PiecewiseConstant2D,
@@ -562,6 +566,7 @@ impl ProjectionLight {
             a,
             cos_total_width: 0.0,
             medium,
+            constant_i: None,
             distribution: PiecewiseConstant2D::unit(&[1.0], 1, 1),
         };
         l.cos_total_width = l.dir_from_screen(screen_bounds.p_max).z;
@@ -595,6 +600,14 @@ impl ProjectionLight {
             .apply_point(Point3f::new(0.0, 0.0, 0.0))
     }
 
+    /// The unscaled emission of an image texel's `rgb`.
+    fn emission(&self, rgb: [Float; 3], lambda: &SampledWavelengths) -> SampledSpectrum {
+        match &self.constant_i {
+            Some(i) => i.sample(lambda),
+            None => rgb_illuminant(self.color_space, rgb, lambda),
+        }
+    }
+
     /// Intensity toward light-space direction `wl`.
     pub fn projection(&self, wl: Vector3f, lambda: &SampledWavelengths) -> SampledSpectrum {
         if wl.z < HITHER {
@@ -611,7 +624,7 @@ impl ProjectionLight {
         let st = Point2f::new(st.x, st.y);
         let clamp = WrapMode2D::new(WrapMode::Clamp, WrapMode::Clamp);
         let rgb = [0, 1, 2].map(|c| self.image.lookup_nearest_channel(st, c, clamp));
-        rgb_illuminant(self.color_space, rgb, lambda) * self.scale
+        self.emission(rgb, lambda) * self.scale
     }
 
     /// See [`super::Light::sample_li`].
@@ -655,7 +668,7 @@ impl ProjectionLight {
         let st = Point2f::new(st.x, st.y);
         let clamp = WrapMode2D::new(WrapMode::Clamp, WrapMode::Clamp);
         let rgb = [0, 1, 2].map(|c| self.image.lookup_nearest_channel(st, c, clamp));
-        let l = rgb_illuminant(self.color_space, rgb, lambda) * self.scale;
+        let l = self.emission(rgb, lambda) * self.scale;
         delta_position_le(&self.render_from_light, w, l, pdf_dir, time, self.medium)
     }
     /// `(0, pdf_dir)` of [`sample_le`](Self::sample_le) for the ray's
@@ -678,8 +691,23 @@ impl ProjectionLight {
             self.distribution.pdf(ps) * self.screen_bounds.area() / (self.a * w.z * w.z * w.z);
         (0.0, pdf_dir)
     }
-    /// Sum over pixels of their emission times their solid angle.
+    /// The frustum's solid angle, 4 asin(sin α sin β) for the half-angles
+    /// α, β of its sides.
+    pub fn solid_angle(&self) -> Float {
+        let half = |t: Float| (t * self.tan_half_fov).atan();
+        let (a, b) = (
+            half(self.screen_bounds.p_max.x),
+            half(self.screen_bounds.p_max.y),
+        );
+        4.0 * (a.sin() * b.sin()).asin()
+    }
+
+    /// Sum over pixels of their emission times their solid angle (the
+    /// intensity times the frustum's solid angle for a constant one).
     pub fn phi(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
+        if let Some(i) = &self.constant_i {
+            return i.sample(lambda) * (self.scale * self.solid_angle());
+        }
         let res = self.image.resolution();
         let clamp = WrapMode2D::new(WrapMode::Clamp, WrapMode::Clamp);
         let mut sum = SampledSpectrum::new(0.0);
@@ -687,7 +715,7 @@ impl ProjectionLight {
             for x in 0..res.x {
                 let dwda = self.dwda(self.pixel_screen(x, y));
                 let rgb = [0, 1, 2].map(|c| self.image.get_channel(Point2i::new(x, y), c, clamp));
-                sum += rgb_illuminant(self.color_space, rgb, lambda) * dwda;
+                sum += self.emission(rgb, lambda) * dwda;
             }
         }
         sum * (self.scale * self.a / (res.x as Float * res.y as Float))
@@ -706,7 +734,8 @@ impl ProjectionLight {
                 sum += m as f64;
             }
         }
-        let phi = self.scale * sum as Float / (res.x as Float * res.y as Float);
+        let peak = self.constant_i.as_ref().map_or(1.0, |i| i.max_value());
+        let phi = peak * self.scale * sum as Float / (res.x as Float * res.y as Float);
         let w = self
             .render_from_light
             .apply_vector(Vector3f::new(0.0, 0.0, 1.0));

@@ -63,7 +63,11 @@ pub(crate) fn create_light(
 ) -> Result<(Light, Vec<Diagnostic>), Diagnostic> {
     let at = FileLoc::new(Arc::from("test.pbrt"), 1, 1);
     let r = ParamReader::plain(&e.params, &at);
-    let light = super::create_light(&e.name, &r, &e.render_from_object, medium, ct, e.pbrt_v3)?;
+    let dialect = LightDialect {
+        v3_mapname: e.pbrt_v3,
+        v3_file: e.pbrt_v3,
+    };
+    let light = super::create_light(&e.name, &r, &e.render_from_object, medium, ct, dialect)?;
     Ok((light, r.finish()))
 }
 
@@ -770,4 +774,77 @@ fn image_infinite_from_file_illuminance_and_square_check() {
     assert!(err.message.contains("neither square"), "{}", err.message);
     assert_eq!(line_of(&err), Some(line));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn pbrt_v3_goniometric_and_projection_lights_without_images() {
+    let v3 = |name: &str, params: Vec<ParsedParameter>| {
+        let mut e = entity(name, params);
+        e.pbrt_v3 = true;
+        create_light(&e, None, &CameraTransform::default())
+    };
+    let i = floats("I", &[2.0, 1.0, 0.5]);
+    let point = make("point", vec![i.clone()]);
+    let (gonio, w) = v3("goniometric", vec![i.clone()]).unwrap();
+    assert!(w.is_empty(), "{w:?}");
+    let (proj, w) = v3("projection", vec![i.clone()]).unwrap();
+    assert!(w.is_empty(), "{w:?}");
+    let mut rng = Rng::with_sequence(3);
+    let l = lambda(&mut rng);
+    let li = |light: &Light, p: Point3f| {
+        let ctx = LightSampleContext::from_point(p);
+        light
+            .sample_li(&ctx, Point2f::new(0.5, 0.5), &l, false)
+            .map_or(SampledSpectrum::new(0.0), |s| s.l)
+    };
+    // Directions (x/z, y/z) from the light at the origin, at distance 2.
+    let at = |tx: Float, ty: Float| Vector3f::new(tx, ty, 1.0).normalize() * 2.0;
+    for (tx, ty) in [
+        (0.0, 0.0),
+        (0.3, -0.2),
+        (0.4, 0.4),
+        (-0.41, 0.1),
+        (1.0, 0.0),
+        (0.0, -3.0),
+    ] {
+        let p = Point3f::new(0.0, 0.0, 0.0) + at(tx, ty);
+        // Goniometric without a map: the point light, in every direction.
+        let (g, q) = (li(&gonio, p), li(&point, p));
+        for k in 0..4 {
+            assert!(rel_eq(g[k], q[k], 1e-6), "{tx} {ty}: {} vs {}", g[k], q[k]);
+        }
+        assert!(li(&gonio, Point3f::new(0.0, 0.0, 0.0) - at(tx, ty))[0] > 0.0);
+        // Projection without a map: I / r² inside pbrt-v3's default 45°
+        // square frustum (tan 22.5° = 0.414), nothing outside or behind.
+        let inside = tx.abs() < 0.414 && ty.abs() < 0.414;
+        let e = li(&proj, p);
+        for k in 0..4 {
+            let want = if inside { q[k] } else { 0.0 };
+            assert!(rel_eq(e[k], want, 1e-5), "{tx} {ty}: {} vs {want}", e[k]);
+        }
+        assert_eq!(li(&proj, Point3f::new(0.0, 0.0, 0.0) - at(tx, ty))[0], 0.0);
+    }
+    // Power: the point light's intensity over the frustum's solid angle,
+    // 4 asin(sin² 22.5°).
+    let omega = 4.0 * ((22.5 as Float).to_radians().sin().powi(2)).asin();
+    let (pp, qp) = (proj.phi(&l), point.phi(&l));
+    for k in 0..4 {
+        assert!(rel_eq(pp[k], qp[k] * omega / (4.0 * PI), 1e-4));
+    }
+    // An explicit fov widens it; a pbrt-v4 file keeps pbrt-v4's error.
+    let (wide, _) = v3("projection", vec![i.clone(), floats("fov", &[90.0])]).unwrap();
+    assert!(li(&wide, Point3f::new(0.0, 0.0, 0.0) + at(0.9, 0.0))[0] > 0.0);
+    for name in ["goniometric", "projection"] {
+        let e = create_light(
+            &entity(name, vec![i.clone()]),
+            None,
+            &CameraTransform::default(),
+        )
+        .unwrap_err();
+        assert!(
+            e.message.contains("must provide \"filename\""),
+            "{}",
+            e.message
+        );
+    }
 }

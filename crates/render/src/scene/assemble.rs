@@ -19,7 +19,7 @@ use crate::film::{create_film, FilmOverrides};
 use crate::filter::create_filter;
 use crate::image::MIPMapCache;
 use crate::integrator::{create_integrator, Integrator, IntegratorOptions, RayCounters, Scene};
-use crate::light::{create_light, Light, LightCull, LightType};
+use crate::light::{create_light, Light, LightCull, LightDialect, LightType};
 use crate::lightsampler::create_light_sampler;
 use crate::material::MaterialSet;
 use crate::medium::{create_medium, Medium};
@@ -324,7 +324,10 @@ pub fn create_scene(
             &l.render_from_object,
             medium_of(&l.medium),
             camera_transform,
-            l.pbrt_v3,
+            LightDialect {
+                v3_mapname: l.pbrt_v3,
+                v3_file: desc.pbrt_v3.is_some(),
+            },
         );
         if let Some(light) = p.finish(r, light) {
             lights.push(light);

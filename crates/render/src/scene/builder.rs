@@ -170,6 +170,39 @@ impl SceneBuilder {
             .map_err(|e| Self::transform_error(e, loc.clone(), directive))
     }
 
+    /// In a scene marked pbrt-v3, the rendering options the file left out
+    /// take pbrt-v3's defaults (pbrt-v3 `core/api.cpp`'s `RenderOptions`
+    /// and the creators' parameter defaults): a box filter of radius 0.5,
+    /// the `halton` sampler with 16 samples and the `path` integrator with
+    /// depth 5, where pbrt-v4's are `gaussian`, `zsobol` and `volpath`.
+    /// (Both default to a 1280 × 720 film, a `bvh` and a perspective
+    /// camera with a 90° field of view.)
+    fn use_pbrt_v3_defaults(&mut self) {
+        let unset = |e: &SceneEntity| e.loc == default_loc();
+        let int = |name: &str, v: i32| {
+            let mut p = ParsedParameter::new("integer", name, default_loc());
+            p.ints = vec![v];
+            p
+        };
+        let entity = |name: &str, params: Vec<ParsedParameter>| {
+            SceneEntity::new(
+                name,
+                ParameterDictionary::new(params),
+                default_loc(),
+                "srgb",
+            )
+        };
+        if unset(&self.scene.filter) {
+            self.scene.filter = entity("box", Vec::new());
+        }
+        if unset(&self.scene.sampler) {
+            self.scene.sampler = entity("halton", vec![int("pixelsamples", 16)]);
+        }
+        if unset(&self.scene.integrator) {
+            self.scene.integrator = entity("path", vec![int("maxdepth", 5)]);
+        }
+    }
+
     // ---- entities ---------------------------------------------------------
 
     /// Runs a pbrt-v3 → pbrt-v4 mapping and queues its messages; a mapping
@@ -181,6 +214,7 @@ impl SceneBuilder {
         params: ParamList,
         loc: &FileLoc,
     ) -> (String, ParamList) {
+        self.note_pbrt_v3_params(&params);
         let before = fingerprint(&params);
         let u = f(name, params, loc);
         self.keep_upgrade_messages(
@@ -188,6 +222,26 @@ impl SceneBuilder {
             u.diagnostics,
         );
         (u.name, u.params)
+    }
+
+    /// Remembers `loc` if it is the scene's first pbrt-v3-only construct.
+    fn note_pbrt_v3(&mut self, loc: &FileLoc) {
+        if self.scene.pbrt_v3.is_none() {
+            self.scene.pbrt_v3 = Some(loc.clone());
+        }
+    }
+
+    /// Notes a parameter only pbrt-v3 accepts: the type names pbrt-v4
+    /// renamed (it reads them only when upgrading) or a `mapname`.
+    fn note_pbrt_v3_params(&mut self, params: &[ParsedParameter]) {
+        let v3 = params.iter().find(|p| {
+            matches!(p.ty.as_str(), "color" | "point" | "vector")
+                || (p.name == "mapname" && p.ty == "string")
+        });
+        if let Some(p) = v3 {
+            let loc = p.loc.clone();
+            self.note_pbrt_v3(&loc);
+        }
     }
 
     fn keep_upgrade_messages(&mut self, unchanged: bool, diags: Vec<Diagnostic>) {
@@ -230,6 +284,7 @@ impl SceneBuilder {
             Some(f) => self.upgraded(f, name, params, &loc),
             None => {
                 let mut params = params;
+                self.note_pbrt_v3_params(&params);
                 upgrade::upgrade_param_types(&mut params);
                 (name.to_string(), params)
             }
@@ -581,6 +636,12 @@ impl ParserTarget for SceneBuilder {
         Ok(())
     }
 
+    fn world_end(&mut self, loc: FileLoc) -> DirectiveResult {
+        // pbrt-v4 accepts `WorldEnd` only when upgrading.
+        self.note_pbrt_v3(&loc);
+        Ok(())
+    }
+
     fn attribute_begin(&mut self, loc: FileLoc) -> DirectiveResult {
         self.verify_world("AttributeBegin", &loc)?;
         self.pushed
@@ -619,6 +680,7 @@ impl ParserTarget for SceneBuilder {
     }
 
     fn attribute(&mut self, target: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.note_pbrt_v3_params(&params);
         let attrs = match target {
             "shape" => &mut self.state.shape_attributes,
             "light" => &mut self.state.light_attributes,
@@ -649,6 +711,7 @@ impl ParserTarget for SceneBuilder {
         loc: FileLoc,
     ) -> DirectiveResult {
         self.verify_world("Texture", &loc)?;
+        self.note_pbrt_v3_params(&params);
         let before = fingerprint(&params);
         let (new_ty, u) = upgrade::upgrade_texture(ty, texname, params, &loc);
         let unchanged = new_ty == ty && u.name == texname && before == fingerprint(&u.params);
@@ -909,6 +972,9 @@ impl ParserTarget for SceneBuilder {
     }
 
     fn end_of_files(&mut self) -> DirectiveResult {
+        if self.scene.pbrt_v3.is_some() {
+            self.use_pbrt_v3_defaults();
+        }
         if self.block != Block::World {
             self.pending.push(Diagnostic::unlocated_error(
                 "end of files before \"WorldBegin\"",

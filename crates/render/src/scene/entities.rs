@@ -273,6 +273,13 @@ pub struct SceneDescription {
     pub options: Vec<SceneOption>,
     /// Warnings (and, for a failed build, errors) produced.
     pub diagnostics: Vec<Diagnostic>,
+    /// Where the scene first used a construct only pbrt-v3 accepts (a
+    /// `WorldEnd`, a `color`, `point` or `vector` parameter type, a
+    /// `mapname` parameter; pbrt-v4 rejects them unless upgrading), or
+    /// `None`. Where the same text means different things to pbrt-v3 and
+    /// pbrt-v4 (a `goniometric` or `projection` light without an image),
+    /// such a scene gets pbrt-v3's meaning.
+    pub pbrt_v3: Option<FileLoc>,
 }
 
 impl Default for SceneDescription {
@@ -302,6 +309,7 @@ impl Default for SceneDescription {
             instances: Vec::new(),
             options: Vec::new(),
             diagnostics: Vec::new(),
+            pbrt_v3: None,
         }
     }
 }

@@ -396,6 +396,52 @@ fn pbrt_v3_matte_becomes_diffuse() {
 }
 
 #[test]
+fn pbrt_v3_only_constructs_mark_the_scene() {
+    let first = |text: &str| build(text).pbrt_v3.map(|l| (l.line, l.column));
+    // pbrt-v4 text, pbrt-v3 type names included (the mapping runs on
+    // every file), is not marked.
+    let v4 = "Film \"rgb\"\nWorldBegin\nMaterial \"matte\" \"rgb Kd\" [1 1 1]\nLightSource \"goniometric\" \"rgb I\" [1 1 1]\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n";
+    assert_eq!(first(v4), None);
+    assert_eq!(first(&format!("{v4}WorldEnd\n")), Some((6, 1)));
+    assert_eq!(
+        first("WorldBegin\nAttributeBegin\nLightSource \"point\" \"point from\" [0 0 0]\nAttributeEnd\nWorldEnd\n"),
+        Some((3, 21))
+    );
+    assert_eq!(
+        first("Camera \"perspective\"\nWorldBegin\nTexture \"t\" \"spectrum\" \"constant\" \"color value\" [1 1 1]\n"),
+        Some((3, 35))
+    );
+    assert_eq!(
+        first("WorldBegin\nAttribute \"shape\" \"vector v\" [0 0 1]\n"),
+        Some((2, 19))
+    );
+}
+
+#[test]
+fn pbrt_v3_scenes_take_pbrt_v3_option_defaults() {
+    let names = |s: &SceneDescription| {
+        [&s.filter, &s.sampler, &s.integrator, &s.film].map(|e| e.name.clone())
+    };
+    let v4 = build("WorldBegin\nShape \"sphere\"\n");
+    assert_eq!(names(&v4), ["gaussian", "zsobol", "volpath", "rgb"]);
+    let v3 = build("WorldBegin\nShape \"sphere\"\nWorldEnd\n");
+    assert_eq!(names(&v3), ["box", "halton", "path", "rgb"]);
+    let int = |e: &SceneEntity, n: &str| {
+        e.params
+            .params()
+            .iter()
+            .find(|p| p.name == n)
+            .map(|p| p.ints.clone())
+    };
+    assert_eq!(int(&v3.sampler, "pixelsamples"), Some(vec![16]));
+    assert_eq!(int(&v3.integrator, "maxdepth"), Some(vec![5]));
+    // What the file gives is kept.
+    let given =
+        build("Sampler \"sobol\"\nIntegrator \"bdpt\"\nWorldBegin\nShape \"sphere\"\nWorldEnd\n");
+    assert_eq!(names(&given), ["box", "sobol", "bdpt", "rgb"]);
+}
+
+#[test]
 fn located_errors() {
     let cases: &[(&str, &str, &str)] = &[
         ("Shape \"sphere\"\nWorldBegin\n", "<string>:1:1:", "Shape not allowed before WorldBegin"),
