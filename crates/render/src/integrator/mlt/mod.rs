@@ -198,6 +198,7 @@ pub(crate) fn render(
             cdf.push(acc / sum);
         }
         let splats = OrderedSplats::new();
+        let snapshot_lock = std::sync::Mutex::new(());
         let next_chain = AtomicUsize::new(0);
         let mutations_done = std::sync::atomic::AtomicU64::new(0);
         let films = [&scene_ref.film];
@@ -262,6 +263,10 @@ pub(crate) fn render(
                 mutations_done.fetch_add(taken, Ordering::Relaxed);
                 splats.submit(&films, i, buf);
                 if let Some(o) = opts.observer_wanting(false) {
+                    // One snapshot at a time, its chain count read inside
+                    // the lock: snapshots reach the observer with their
+                    // samples per pixel in order.
+                    let _one = snapshot_lock.lock().unwrap_or_else(|e| e.into_inner());
                     // The chains applied so far (in order) made this many
                     // mutations: the sum of the per-chain counts above.
                     let applied = splats.applied() as u64;
