@@ -1,0 +1,237 @@
+//! The scale benchmark (issue 17, "Scale"): a 10-million-triangle binary PLY
+//! rendered at 64×64 with one sample per pixel, so that reading the mesh and
+//! building the BVH are nearly all the work.
+//!
+//!     cargo bench -p rpbrt --bench scale                  # generate, render, report
+//!     cargo bench -p rpbrt --bench scale -- --write-only  # just write the files
+//!
+//! The mesh is a displaced grid of 2237×2237 vertices (9,999,392 triangles),
+//! binary little-endian, positions and triangle indices only (`float x y z`,
+//! `list uchar int vertex_indices`), written with `scene.pbrt` into a
+//! directory (`--dir`, default `$TMPDIR/rpbrt-scale`); files already there
+//! with the expected size are reused. Each run is
+//! `/usr/bin/time -v rpbrt --nthreads 2 --quiet scene.pbrt`, and the wall
+//! time and peak resident memory ("Maximum resident set size") are printed,
+//! with a `RESULT` line giving the best wall time and the largest peak.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode};
+use std::time::Instant;
+
+/// Vertices along each side of the grid.
+const DEFAULT_N: u32 = 2237;
+
+/// The grid's height above (x, y) in [0, 1]²: a few waves of different
+/// directions and frequencies, so that the BVH sees a surface that is
+/// neither flat nor regular.
+fn height(x: f32, y: f32) -> f32 {
+    use std::f32::consts::TAU;
+    0.06 * (TAU * (3.0 * x + 0.5 * y)).sin()
+        + 0.04 * (TAU * (7.0 * y - 2.0 * x)).cos()
+        + 0.015 * (TAU * 23.0 * x).sin() * (TAU * 19.0 * y).sin()
+}
+
+/// Size in bytes of the PLY body and header [`write_ply`] writes.
+fn ply_size(n: u32) -> u64 {
+    let v = u64::from(n) * u64::from(n);
+    let f = 2 * u64::from(n - 1) * u64::from(n - 1);
+    header(n).len() as u64 + v * 12 + f * 13
+}
+
+fn header(n: u32) -> String {
+    let v = u64::from(n) * u64::from(n);
+    let f = 2 * u64::from(n - 1) * u64::from(n - 1);
+    format!(
+        "ply\nformat binary_little_endian 1.0\ncomment rpbrt scale benchmark grid {n}x{n}\n\
+         element vertex {v}\nproperty float x\nproperty float y\nproperty float z\n\
+         element face {f}\nproperty list uchar int vertex_indices\nend_header\n"
+    )
+}
+
+/// Writes the `n`×`n` grid, streaming (nothing but the output buffer is
+/// held in memory).
+fn write_ply(path: &Path, n: u32) -> std::io::Result<()> {
+    let mut w = BufWriter::with_capacity(1 << 20, File::create(path)?);
+    w.write_all(header(n).as_bytes())?;
+    let step = 1.0 / (n - 1) as f32;
+    for j in 0..n {
+        for i in 0..n {
+            let (x, y) = (i as f32 * step, j as f32 * step);
+            for c in [x, y, height(x, y)] {
+                w.write_all(&c.to_le_bytes())?;
+            }
+        }
+    }
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let a = j * n + i;
+            for tri in [[a, a + 1, a + n + 1], [a, a + n + 1, a + n]] {
+                w.write_all(&[3])?;
+                for v in tri {
+                    w.write_all(&(v as i32).to_le_bytes())?;
+                }
+            }
+        }
+    }
+    w.flush()
+}
+
+/// The scene: the grid seen obliquely from above, a diffuse material,
+/// a distant light and a uniform sky.
+fn scene_text(ply: &str) -> String {
+    format!(
+        "LookAt 0.5 -0.6 0.9  0.5 0.5 0  0 0 1\n\
+         Camera \"perspective\" \"float fov\" 45\n\
+         Film \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" 64\n\
+         \"string filename\" \"scale.exr\"\n\
+         Sampler \"independent\" \"integer pixelsamples\" 1\n\
+         WorldBegin\n\
+         LightSource \"distant\" \"point3 from\" [0.3 -0.2 1] \"point3 to\" [0 0 0]\n\
+         \"blackbody L\" 5500 \"float scale\" 2\n\
+         LightSource \"infinite\" \"rgb L\" [0.1 0.1 0.12]\n\
+         Material \"diffuse\" \"rgb reflectance\" [0.6 0.55 0.5]\n\
+         Shape \"plymesh\" \"string filename\" \"{ply}\"\n"
+    )
+}
+
+/// Writes `grid.ply` and `scene.pbrt` into `dir` (the PLY only when it is
+/// missing or has another size) and returns the scene's path.
+fn write_scene(dir: &Path, n: u32) -> std::io::Result<PathBuf> {
+    std::fs::create_dir_all(dir)?;
+    let ply = dir.join(format!("grid-{n}.ply"));
+    let have = std::fs::metadata(&ply).map(|m| m.len()).ok();
+    if have != Some(ply_size(n)) {
+        let t = Instant::now();
+        write_ply(&ply, n)?;
+        eprintln!(
+            "wrote {} ({:.0} MB) in {:.1} s",
+            ply.display(),
+            ply_size(n) as f64 / 1e6,
+            t.elapsed().as_secs_f64()
+        );
+    }
+    let scene = dir.join("scene.pbrt");
+    std::fs::write(&scene, scene_text(&format!("grid-{n}.ply")))?;
+    Ok(scene)
+}
+
+/// One timed run: (wall seconds, peak RSS in KiB if `/usr/bin/time` gave it).
+fn run_once(scene: &Path, threads: u32) -> Result<(f64, Option<u64>), String> {
+    let rpbrt = env!("CARGO_BIN_EXE_rpbrt");
+    let time = Path::new("/usr/bin/time");
+    let mut cmd = if time.exists() {
+        let mut c = Command::new(time);
+        c.arg("-v").arg(rpbrt);
+        c
+    } else {
+        Command::new(rpbrt)
+    };
+    cmd.arg("--nthreads")
+        .arg(threads.to_string())
+        .arg("--quiet")
+        .arg(scene);
+    if let Some(dir) = scene.parent() {
+        cmd.current_dir(dir);
+    }
+    let t = Instant::now();
+    let out = cmd
+        .output()
+        .map_err(|e| format!("cannot run {rpbrt}: {e}"))?;
+    let wall = t.elapsed().as_secs_f64();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() {
+        return Err(format!("rpbrt failed ({}):\n{stderr}", out.status));
+    }
+    let rss = stderr
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("Maximum resident set size (kbytes):"))
+        .and_then(|v| v.trim().parse().ok());
+    Ok((wall, rss))
+}
+
+struct Args {
+    dir: PathBuf,
+    n: u32,
+    runs: u32,
+    threads: u32,
+    write_only: bool,
+}
+
+fn parse_args() -> Result<Args, String> {
+    let mut a = Args {
+        dir: std::env::temp_dir().join("rpbrt-scale"),
+        n: DEFAULT_N,
+        runs: 3,
+        threads: 2,
+        write_only: false,
+    };
+    let mut it = std::env::args().skip(1);
+    while let Some(arg) = it.next() {
+        let mut value = |name: &str| it.next().ok_or(format!("{name} needs a value"));
+        let number = |name: &str, v: String| {
+            v.parse::<u32>()
+                .map_err(|_| format!("{name}: not a count: {v}"))
+        };
+        match arg.as_str() {
+            "--dir" => a.dir = PathBuf::from(value("--dir")?),
+            "--n" => a.n = number("--n", value("--n")?)?,
+            "--runs" => a.runs = number("--runs", value("--runs")?)?,
+            "--nthreads" => a.threads = number("--nthreads", value("--nthreads")?)?,
+            "--write-only" => a.write_only = true,
+            // `cargo bench` passes this to every bench target.
+            "--bench" => {}
+            other => return Err(format!("unknown argument {other:?}")),
+        }
+    }
+    if a.n < 2 || a.n > 40_000 {
+        return Err(format!("--n {}: must be in [2, 40000]", a.n));
+    }
+    Ok(a)
+}
+
+fn main() -> ExitCode {
+    let args = match parse_args() {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("scale: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let scene = match write_scene(&args.dir, args.n) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("scale: writing the scene in {}: {e}", args.dir.display());
+            return ExitCode::FAILURE;
+        }
+    };
+    println!("scene: {}", scene.display());
+    if args.write_only {
+        return ExitCode::SUCCESS;
+    }
+    let (mut best, mut peak) = (f64::INFINITY, None::<u64>);
+    for run in 0..args.runs {
+        match run_once(&scene, args.threads) {
+            Ok((wall, rss)) => {
+                let rss_text = rss.map_or("n/a (no /usr/bin/time)".into(), |k| {
+                    format!("{:.2} GB", k as f64 * 1024.0 / 1e9)
+                });
+                println!("run {run}: {wall:.2} s, peak RSS {rss_text}");
+                best = best.min(wall);
+                peak = peak.max(rss);
+            }
+            Err(e) => {
+                eprintln!("scale: {e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    }
+    let tris = 2 * u64::from(args.n - 1) * u64::from(args.n - 1);
+    println!(
+        "RESULT scale triangles={tris} threads={} best_wall_s={best:.2} peak_rss_gb={}",
+        args.threads,
+        peak.map_or("n/a".into(), |k| format!("{:.2}", k as f64 * 1024.0 / 1e9))
+    );
+    ExitCode::SUCCESS
+}
