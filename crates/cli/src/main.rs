@@ -340,10 +340,10 @@ fn render_command(opts: &args::Options) -> ExitCode {
             "  Shadow rays                {:>10}",
             c.shadow_rays.load(Ordering::Relaxed)
         );
-        let prims = scene.aggregate.primitives().len().max(1);
+        let prims = scene.aggregate.primitive_count().max(1);
         eprintln!(
             "  Primitives                 {:>10}",
-            scene.aggregate.primitives().len()
+            scene.aggregate.primitive_count()
         );
         eprintln!(
             "  Accelerator memory         {:>10} bytes ({:.1} bytes/primitive)",

@@ -260,6 +260,15 @@ impl Bvh4 {
         Bvh4::from_binary(Bvh::build_with_threads(prim_bounds, params, threads))
     }
 
+    /// [`Bvh4::build_with_threads`] over `n` primitives whose bounds
+    /// `bounds` gives (see [`Bvh::build_from`]).
+    pub fn build_from<F>(n: usize, bounds: F, params: &BvhParams, threads: usize) -> Bvh4
+    where
+        F: Fn(u32) -> Bounds3f + Sync,
+    {
+        Bvh4::from_binary(Bvh::build_from(n, bounds, params, threads))
+    }
+
     /// Collapses a binary BVH into a 4-wide one (same leaves, same
     /// primitive order).
     pub fn from_binary(bin: Bvh) -> Bvh4 {

@@ -92,6 +92,28 @@ impl Accelerator {
         Accelerator::build_with_threads(prim_bounds, params, default_threads())
     }
 
+    /// [`Accelerator::build`] over `n` primitives whose bounds `bounds`
+    /// gives (called once per primitive by the BVH, which never holds the
+    /// bounds apart from its build references).
+    pub fn build_from<F>(n: usize, bounds: F, params: &AccelParams) -> Accelerator
+    where
+        F: Fn(u32) -> Bounds3f + Sync,
+    {
+        let threads = default_threads();
+        match params.kind {
+            AccelKind::Bvh if params.bvh.width == 2 => {
+                Accelerator::Bvh(Bvh::build_from(n, bounds, &params.bvh, threads))
+            }
+            AccelKind::Bvh => {
+                Accelerator::Bvh4(Bvh4::build_from(n, bounds, &params.bvh, threads))
+            }
+            _ => {
+                let b: Vec<Bounds3f> = (0..n as u32).map(bounds).collect();
+                Accelerator::build_with_threads(&b, params, threads)
+            }
+        }
+    }
+
     /// [`Accelerator::build`] with at most about `threads` build threads
     /// (the BVH builds in parallel; its result does not depend on
     /// `threads`).

@@ -5,9 +5,10 @@
 
 use crate::accel::{AccelParams, Accelerator, Aggregate};
 use crate::shape::triangle::{
-    intersect_prepared_triangle, triangle_is_nondegenerate, TriangleFrame, TriangleRay,
+    intersect_prepared_triangle, intersect_triangle, triangle_is_nondegenerate, TriangleFrame,
+    TriangleOf, TriangleRay,
 };
-use crate::shape::{Shape, ShapeMethods};
+use crate::shape::{Shape, ShapeMethods, TriangleMesh};
 use crate::texture::{FloatTextureRef, TextureEvalContext};
 use rpbrt_geometry::animated::AnimatedTransform;
 use rpbrt_geometry::float::Float;
@@ -93,23 +94,23 @@ fn hash_float_ray(r: &Ray) -> Float {
     ((h >> 40) as Float) / (1u64 << 24) as Float
 }
 
-impl GeometricPrimitive {
-    /// Keeps a hit or lets the ray pass according to the alpha mask.
-    #[inline]
-    fn alpha_passes(&self, ray: &Ray, si: &SurfaceInteraction) -> bool {
-        let a = match &self.alpha {
-            Alpha::Opaque => return true,
-            Alpha::Constant(a) => *a,
-            Alpha::Texture(t) => t.evaluate(&TextureEvalContext::from_si(si)),
-        };
-        a >= 1.0 || (a > 0.0 && hash_float_ray(ray) <= a)
-    }
+/// Keeps a hit or lets the ray pass according to the alpha mask.
+#[inline]
+fn alpha_passes(alpha: &Alpha, ray: &Ray, si: &SurfaceInteraction) -> bool {
+    let a = match alpha {
+        Alpha::Opaque => return true,
+        Alpha::Constant(a) => *a,
+        Alpha::Texture(t) => t.evaluate(&TextureEvalContext::from_si(si)),
+    };
+    a >= 1.0 || (a > 0.0 && hash_float_ray(ray) <= a)
+}
 
+impl GeometricPrimitive {
     /// The closest hit in (0, t_max).
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
         let isect = self.shape.intersect(ray, t_max)?;
-        if !self.alpha_passes(ray, &isect.intr) {
+        if !alpha_passes(&self.alpha, ray, &isect.intr) {
             return None;
         }
         Some(PrimitiveIntersection {
@@ -128,6 +129,81 @@ impl GeometricPrimitive {
             Alpha::Opaque => self.shape.intersect_p(ray, t_max),
             _ => self.intersect(ray, t_max).is_some(),
         }
+    }
+}
+
+/// The triangles of one mesh with a common material, media and alpha and
+/// no area light: the primitive of a whole `trianglemesh` or `plymesh`.
+/// An aggregate gives each of its triangles an entry of its own in the
+/// acceleration structure, reached through the mesh and the triangle's
+/// index, so that no per-triangle primitive is stored.
+#[derive(Clone, Debug)]
+pub struct MeshPrimitive {
+    /// The mesh; its degenerate triangles (see
+    /// [`TriangleMesh::is_valid_triangle`]) are left out.
+    pub mesh: Arc<TriangleMesh>,
+    /// Material index (`None`: interface).
+    pub material: Option<u32>,
+    /// Media on either side.
+    pub medium_interface: Option<MediumInterface>,
+    /// Alpha mask.
+    pub alpha: Alpha,
+}
+
+impl MeshPrimitive {
+    /// Triangle `i` of the mesh.
+    #[inline(always)]
+    fn triangle(&self, i: u32) -> TriangleOf<&TriangleMesh> {
+        TriangleOf {
+            mesh: &*self.mesh,
+            tri_index: i,
+        }
+    }
+
+    /// The bounds of triangle `i`; empty for a degenerate triangle, so that
+    /// acceleration structures leave it out.
+    fn triangle_bounds(&self, i: u32) -> Bounds3f {
+        if self.mesh.is_valid_triangle(i as usize) {
+            let [p0, p1, p2] = self.mesh.vertices(i as usize);
+            Bounds3f::new(p0, p1).union_point(p2)
+        } else {
+            Bounds3f::empty()
+        }
+    }
+
+    /// The hit of triangle `i` in (0, t_max), alpha mask applied: what a
+    /// [`GeometricPrimitive`] holding that triangle returns.
+    fn intersect_triangle(&self, i: u32, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
+        let tri = self.triangle(i);
+        let [p0, p1, p2] = tri.vertex_positions();
+        let (b0, b1, b2, t_hit) = intersect_triangle(ray, t_max, p0, p1, p2)?;
+        let si = tri.interaction_at_hit(b0, b1, b2, ray);
+        if !alpha_passes(&self.alpha, ray, &si) {
+            return None;
+        }
+        Some(PrimitiveIntersection {
+            si,
+            t_hit,
+            material: self.material,
+            area_light: None,
+            medium_interface: self.medium_interface,
+        })
+    }
+
+    /// Whether triangle `i` blocks the ray in (0, t_max).
+    fn intersect_p_triangle(&self, i: u32, ray: &Ray, t_max: Float) -> bool {
+        match self.alpha {
+            Alpha::Opaque => {
+                let [p0, p1, p2] = self.mesh.vertices(i as usize);
+                intersect_triangle(ray, t_max, p0, p1, p2).is_some()
+            }
+            _ => self.intersect_triangle(i, ray, t_max).is_some(),
+        }
+    }
+
+    /// The triangles that are not degenerate.
+    fn valid_triangles(&self) -> impl Iterator<Item = u32> + '_ {
+        (0..self.mesh.n_triangles() as u32).filter(|&i| self.mesh.is_valid_triangle(i as usize))
     }
 }
 
@@ -162,6 +238,9 @@ fn transform_hit(
 pub enum Primitive {
     /// A shape with its properties.
     Geometric(GeometricPrimitive),
+    /// The triangles of a mesh with common properties (an aggregate gives
+    /// each triangle an entry).
+    Mesh(MeshPrimitive),
     /// An object instance (boxed: two matrices would make every
     /// primitive large).
     Transformed(Box<TransformedPrimitive>),
@@ -175,6 +254,11 @@ impl Primitive {
     pub fn for_each_material(&self, f: &mut impl FnMut(u32)) {
         match self {
             Primitive::Geometric(p) => {
+                if let Some(m) = p.material {
+                    f(m)
+                }
+            }
+            Primitive::Mesh(p) => {
                 if let Some(m) = p.material {
                     f(m)
                 }
@@ -196,6 +280,9 @@ impl Primitive {
     pub fn bounds(&self) -> Bounds3f {
         match self {
             Primitive::Geometric(p) => p.shape.bounds(),
+            Primitive::Mesh(p) => p
+                .valid_triangles()
+                .fold(Bounds3f::empty(), |b, i| b.union(&p.triangle_bounds(i))),
             Primitive::Transformed(p) => {
                 p.render_from_primitive.apply_bounds(&p.primitive.bounds())
             }
@@ -208,6 +295,19 @@ impl Primitive {
     pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
         match self {
             Primitive::Geometric(p) => p.intersect(ray, t_max),
+            Primitive::Mesh(p) => {
+                // (Aggregates test a mesh's triangles one by one; this is
+                // for a mesh met on its own.)
+                let mut closest = None;
+                let mut t_max = t_max;
+                for i in p.valid_triangles() {
+                    if let Some(pi) = p.intersect_triangle(i, ray, t_max) {
+                        t_max = pi.t_hit;
+                        closest = Some(pi);
+                    }
+                }
+                closest
+            }
             Primitive::Transformed(p) => {
                 let (r, t) = p.render_from_primitive.apply_inverse_ray(ray, t_max);
                 let pi = p.primitive.intersect(&r, t)?;
@@ -227,6 +327,9 @@ impl Primitive {
     pub fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
         match self {
             Primitive::Geometric(p) => p.intersect_p(ray, t_max),
+            Primitive::Mesh(p) => p
+                .valid_triangles()
+                .any(|i| p.intersect_p_triangle(i, ray, t_max)),
             Primitive::Transformed(p) => {
                 let (r, t) = p.render_from_primitive.apply_inverse_ray(ray, t_max);
                 p.primitive.intersect_p(&r, t)
@@ -242,13 +345,18 @@ impl Primitive {
     }
 }
 
-/// Aggregates with at most this many primitives keep the vertices of their
-/// triangles beside the primitives for the traversal.
+/// Aggregates with at most this many entries keep the vertices of their
+/// triangles beside the entries for the traversal.
 const MAX_CACHED_TRIANGLE_PRIMITIVES: usize = 1 << 22;
 
-/// Aggregates with at most this many primitives also keep each triangle's
+/// Aggregates with at most this many entries also keep each triangle's
 /// [`TriangleFrame`] (at most 60 MiB).
 const MAX_TRIANGLE_FRAME_PRIMITIVES: usize = 1 << 20;
+
+/// Up to this many primitives, an entry's primitive is found by a binary
+/// search over their first entries; beyond it, by a table with one `u32`
+/// per entry.
+const MAX_SEARCHED_PRIMITIVES: usize = 16;
 
 /// The closest hit found so far by [`PrimitiveAggregate::intersect`]: an
 /// opaque triangle's barycentrics (its interaction is built once, for the
@@ -271,7 +379,8 @@ enum Closest {
 /// that a batch of rays can be intersected first and shaded later.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HitRecord {
-    /// The primitive hit, an index into [`PrimitiveAggregate::primitives`].
+    /// The entry hit: an index below [`PrimitiveAggregate::entry_count`]
+    /// (a primitive, or one triangle of a [`MeshPrimitive`]).
     pub primitive: u32,
     /// The ray parameter of the hit.
     pub t_hit: Float,
@@ -293,56 +402,166 @@ enum HitKind {
     },
 }
 
+/// Where the entries of an aggregate's primitives lie in the acceleration
+/// structure: one entry per primitive, except a [`MeshPrimitive`], which
+/// has one per triangle (degenerate ones included, with empty bounds).
+/// Entries keep the primitives' order.
+#[derive(Clone, Debug, Default)]
+struct EntryMap {
+    /// The first entry of each primitive, then the number of entries;
+    /// empty when every primitive has one entry (entry `i` is primitive
+    /// `i`).
+    starts: Vec<u32>,
+    /// The primitive of each entry, kept when there are too many
+    /// primitives to search `starts`.
+    owner: Vec<u32>,
+    /// The number of entries.
+    len: usize,
+}
+
+impl EntryMap {
+    fn new(prims: &[Primitive]) -> EntryMap {
+        let entries = |p: &Primitive| match p {
+            Primitive::Mesh(m) => m.mesh.n_triangles(),
+            _ => 1,
+        };
+        let len: usize = prims.iter().map(entries).sum();
+        // The accelerators number entries with `u32`s; a mesh of 2^32
+        // triangles would need hundreds of gigabytes to get here.
+        debug_assert!(len <= u32::MAX as usize);
+        if len == prims.len() && prims.iter().all(|p| entries(p) == 1) {
+            return EntryMap {
+                len,
+                ..EntryMap::default()
+            };
+        }
+        let mut starts = Vec::with_capacity(prims.len() + 1);
+        let mut next = 0u32;
+        for p in prims {
+            starts.push(next);
+            next = next.wrapping_add(entries(p) as u32);
+        }
+        starts.push(next);
+        let mut owner = Vec::new();
+        if prims.len() > MAX_SEARCHED_PRIMITIVES {
+            owner.reserve_exact(len);
+            for (k, p) in prims.iter().enumerate() {
+                owner.extend(std::iter::repeat_n(k as u32, entries(p)));
+            }
+        }
+        EntryMap { starts, owner, len }
+    }
+
+    /// The primitive holding entry `e`, and which of its entries it is
+    /// (the triangle, for a mesh).
+    #[inline(always)]
+    fn locate(&self, e: u32) -> (usize, u32) {
+        if self.starts.is_empty() {
+            return (e as usize, 0);
+        }
+        let p = match self.owner.get(e as usize) {
+            Some(&p) => p as usize,
+            None => self.starts.partition_point(|&s| s <= e).saturating_sub(1),
+        };
+        (p, e - self.starts[p])
+    }
+}
+
 /// Primitives under an acceleration structure (pbrt-v4's aggregates).
 #[derive(Clone, Debug)]
 pub struct PrimitiveAggregate {
     prims: Vec<Primitive>,
+    entries: EntryMap,
     accel: Accelerator,
-    /// Per primitive: the vertices of an opaque, non-degenerate triangle,
+    /// Per entry: the vertices of an opaque, non-degenerate triangle,
     /// so that the traversal tests it without going through the primitive
-    /// and its mesh (`None` for every other primitive).
+    /// and its mesh (`None` for every other entry; empty for large
+    /// aggregates).
     triangle_vertices: Vec<Option<[Point3f; 3]>>,
-    /// Per primitive, for the same triangles: the parts of the surface
+    /// Per entry, for the same triangles: the parts of the surface
     /// interaction that are the same all over the triangle, so that a hit
     /// builds only the rest (empty for large aggregates, default for
-    /// other primitives).
+    /// other entries).
     triangle_frames: Vec<TriangleFrame>,
 }
 
 impl PrimitiveAggregate {
-    /// Builds the structure chosen by `params` over `prims`.
+    /// Builds the structure chosen by `params` over `prims` (over each
+    /// triangle of their meshes).
     pub fn new(prims: Vec<Primitive>, params: &AccelParams) -> Self {
-        let bounds: Vec<Bounds3f> = prims.iter().map(Primitive::bounds).collect();
-        let accel = Accelerator::build(&bounds, params);
-        // 40 bytes per primitive: bounded so that huge scenes do not pay
-        // gigabytes for it (they fall back to going through the mesh).
-        let cache_triangles = prims.len() <= MAX_CACHED_TRIANGLE_PRIMITIVES;
-        let triangle_vertices: Vec<Option<[Point3f; 3]>> = prims
-            .iter()
-            .take(if cache_triangles { prims.len() } else { 0 })
-            .map(|p| match p {
+        Self::with_cache_limits(
+            prims,
+            params,
+            MAX_CACHED_TRIANGLE_PRIMITIVES,
+            MAX_TRIANGLE_FRAME_PRIMITIVES,
+        )
+    }
+
+    /// [`PrimitiveAggregate::new`] keeping triangle vertices for at most
+    /// `max_vertices` entries and frames for at most `max_frames` (tests
+    /// use small limits to reach the paths of large aggregates).
+    fn with_cache_limits(
+        prims: Vec<Primitive>,
+        params: &AccelParams,
+        max_vertices: usize,
+        max_frames: usize,
+    ) -> Self {
+        let entries = EntryMap::new(&prims);
+        let n = entries.len;
+        let accel = Accelerator::build_from(
+            n,
+            |e| {
+                let (p, i) = entries.locate(e);
+                match &prims[p] {
+                    Primitive::Mesh(m) => m.triangle_bounds(i),
+                    prim => prim.bounds(),
+                }
+            },
+            params,
+        );
+        // The vertices of entry `e` when it is an opaque, non-degenerate
+        // triangle.
+        let opaque_triangle = |e: u32| -> Option<[Point3f; 3]> {
+            let (p, i) = entries.locate(e);
+            let [p0, p1, p2] = match &prims[p] {
                 Primitive::Geometric(GeometricPrimitive {
                     shape: Shape::Triangle(tri),
                     alpha: Alpha::Opaque,
                     ..
-                }) => {
-                    let [p0, p1, p2] = tri.vertex_positions();
-                    triangle_is_nondegenerate(p0, p1, p2).then_some([p0, p1, p2])
-                }
-                _ => None,
-            })
-            .collect();
-        // 60 bytes per primitive, read once per closest hit.
-        let triangle_frames = if prims.len() <= MAX_TRIANGLE_FRAME_PRIMITIVES {
-            prims
-                .iter()
+                }) => tri.vertex_positions(),
+                Primitive::Mesh(MeshPrimitive {
+                    mesh,
+                    alpha: Alpha::Opaque,
+                    ..
+                }) if mesh.is_valid_triangle(i as usize) => mesh.vertices(i as usize),
+                _ => return None,
+            };
+            triangle_is_nondegenerate(p0, p1, p2).then_some([p0, p1, p2])
+        };
+        // 40 bytes per entry: bounded so that huge scenes do not pay
+        // gigabytes for it (they fall back to going through the mesh).
+        let triangle_vertices: Vec<Option<[Point3f; 3]>> = if n <= max_vertices {
+            (0..n as u32).map(opaque_triangle).collect()
+        } else {
+            Vec::new()
+        };
+        // 60 bytes per entry, read once per closest hit.
+        let triangle_frames = if n <= max_frames {
+            (0..n as u32)
                 .zip(&triangle_vertices)
-                .map(|(p, cached)| match p {
-                    Primitive::Geometric(GeometricPrimitive {
-                        shape: Shape::Triangle(tri),
-                        ..
-                    }) if cached.is_some() => tri.frame(),
-                    _ => TriangleFrame::default(),
+                .map(|(e, cached)| {
+                    if cached.is_none() {
+                        return TriangleFrame::default();
+                    }
+                    let (p, i) = entries.locate(e);
+                    match &prims[p] {
+                        Primitive::Geometric(GeometricPrimitive {
+                            shape: Shape::Triangle(tri),
+                            ..
+                        }) => tri.frame(),
+                        Primitive::Mesh(m) => m.triangle(i).frame(),
+                        _ => TriangleFrame::default(),
+                    }
                 })
                 .collect()
         } else {
@@ -350,15 +569,29 @@ impl PrimitiveAggregate {
         };
         PrimitiveAggregate {
             prims,
+            entries,
             accel,
             triangle_vertices,
             triangle_frames,
         }
     }
 
-    /// The primitives.
+    /// The primitives (a mesh primitive is one, whatever its triangles).
     pub fn primitives(&self) -> &[Primitive] {
         &self.prims
+    }
+
+    /// The number of entries in the acceleration structure: one per
+    /// primitive, one per triangle of a [`MeshPrimitive`].
+    pub fn entry_count(&self) -> usize {
+        self.entries.len
+    }
+
+    /// The number of entries the acceleration structure holds: those whose
+    /// bounds it can use (degenerate triangles and primitives with
+    /// non-finite bounds are left out).
+    pub fn primitive_count(&self) -> usize {
+        self.accel.primitive_count() - self.accel.skipped_primitives()
     }
 
     /// The acceleration structure.
@@ -398,7 +631,7 @@ impl PrimitiveAggregate {
                     };
                     return Some(t_hit);
                 }
-                self.intersect_other(i, ray, t, &mut closest)
+                self.intersect_other(i, ray, &tr, t, &mut closest)
             },
         );
         match closest {
@@ -429,13 +662,9 @@ impl PrimitiveAggregate {
                     });
                     return Some(t_hit);
                 }
-                let t_hit = self.prims[i as usize].intersect(ray, t)?.t_hit;
-                closest = Some(HitRecord {
-                    primitive: i,
-                    t_hit,
-                    kind: HitKind::Other { t_max: t },
-                });
-                Some(t_hit)
+                let record = self.record_other(i, ray, &tr, t)?;
+                closest = Some(record);
+                Some(record.t_hit)
             },
         );
         closest
@@ -446,19 +675,19 @@ impl PrimitiveAggregate {
     /// [`PrimitiveAggregate::intersect`]): bit for bit the one `intersect`
     /// returns. `None` only for a record of another aggregate.
     pub fn interaction(&self, ray: &Ray, hit: &HitRecord) -> Option<PrimitiveIntersection> {
-        if hit.primitive as usize >= self.prims.len() {
+        if hit.primitive as usize >= self.entries.len {
             return None;
         }
         match hit.kind {
             HitKind::Triangle(b0, b1, b2) => {
                 self.triangle_interaction(hit.primitive, (b0, b1, b2), hit.t_hit, ray)
             }
-            HitKind::Other { t_max } => self.prims[hit.primitive as usize].intersect(ray, t_max),
+            HitKind::Other { t_max } => self.entry_intersect(hit.primitive, ray, t_max),
         }
     }
 
-    /// The interaction of a hit on the opaque triangle `prim` (one in
-    /// `triangle_vertices`) at barycentrics `b`.
+    /// The interaction of a hit on the opaque triangle at entry `prim` at
+    /// barycentrics `b`.
     #[inline(always)]
     fn triangle_interaction(
         &self,
@@ -467,18 +696,16 @@ impl PrimitiveAggregate {
         t_hit: Float,
         ray: &Ray,
     ) -> Option<PrimitiveIntersection> {
-        match &self.prims[prim as usize] {
+        let frame = self.triangle_frames.get(prim as usize);
+        let (p, i) = self.entries.locate(prim);
+        match &self.prims[p] {
             Primitive::Geometric(g) => match &g.shape {
                 Shape::Triangle(tri) => Some(PrimitiveIntersection {
                     // One construction path (not a `match` between two
                     // calls), so that the interaction is built in place
                     // instead of copied.
                     si: tri.interaction_at_hit_with_frame(
-                        &self
-                            .triangle_frames
-                            .get(prim as usize)
-                            .copied()
-                            .unwrap_or_else(|| tri.frame()),
+                        &frame.copied().unwrap_or_else(|| tri.frame()),
                         b.0,
                         b.1,
                         b.2,
@@ -489,27 +716,115 @@ impl PrimitiveAggregate {
                     area_light: g.area_light,
                     medium_interface: g.medium_interface,
                 }),
-                // `triangle_vertices` holds only triangles.
+                // Only triangles are recorded with barycentrics.
                 _ => None,
             },
+            Primitive::Mesh(m) => {
+                let tri = m.triangle(i);
+                Some(PrimitiveIntersection {
+                    si: tri.interaction_at_hit_with_frame(
+                        &frame.copied().unwrap_or_else(|| tri.frame()),
+                        b.0,
+                        b.1,
+                        b.2,
+                        ray,
+                    ),
+                    t_hit,
+                    material: m.material,
+                    area_light: None,
+                    medium_interface: m.medium_interface,
+                })
+            }
             _ => None,
         }
     }
 
-    /// The test of a primitive that is not an opaque triangle, out of line
-    /// so that the triangle test above inlines into the traversal.
+    /// The hit of entry `e` in (0, t_max) with its interaction.
+    fn entry_intersect(&self, e: u32, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
+        let (p, i) = self.entries.locate(e);
+        match &self.prims[p] {
+            Primitive::Mesh(m) => m.intersect_triangle(i, ray, t_max),
+            prim => prim.intersect(ray, t_max),
+        }
+    }
+
+    /// The barycentrics and `t` of a hit on entry `e` when it is an opaque
+    /// triangle of a mesh (an entry the vertex cache does not hold);
+    /// `Err(())` for every other kind of entry.
+    #[inline(always)]
+    fn mesh_triangle_hit(
+        &self,
+        e: u32,
+        tr: &TriangleRay,
+        t_max: Float,
+    ) -> Result<Option<(Float, Float, Float, Float)>, ()> {
+        let (p, i) = self.entries.locate(e);
+        match &self.prims[p] {
+            Primitive::Mesh(MeshPrimitive {
+                mesh,
+                alpha: Alpha::Opaque,
+                ..
+            }) => {
+                let [p0, p1, p2] = mesh.vertices(i as usize);
+                if !triangle_is_nondegenerate(p0, p1, p2) {
+                    return Ok(None);
+                }
+                Ok(intersect_prepared_triangle(tr, t_max, p0, p1, p2))
+            }
+            _ => Err(()),
+        }
+    }
+
+    /// The test of an entry that is not in the vertex cache, out of line
+    /// so that the cached triangle test above inlines into the traversal.
     #[inline(never)]
     fn intersect_other(
         &self,
         i: u32,
         ray: &Ray,
+        tr: &TriangleRay,
         t_max: Float,
         closest: &mut Closest,
     ) -> Option<Float> {
-        let pi = self.prims[i as usize].intersect(ray, t_max)?;
+        if let Ok(hit) = self.mesh_triangle_hit(i, tr, t_max) {
+            let (b0, b1, b2, t_hit) = hit?;
+            *closest = Closest::Triangle {
+                prim: i,
+                b: (b0, b1, b2),
+                t_hit,
+            };
+            return Some(t_hit);
+        }
+        let pi = self.entry_intersect(i, ray, t_max)?;
         let th = pi.t_hit;
         *closest = Closest::Full(pi);
         Some(th)
+    }
+
+    /// [`PrimitiveAggregate::intersect_other`] for
+    /// [`PrimitiveAggregate::intersect_record`].
+    #[inline(never)]
+    fn record_other(
+        &self,
+        i: u32,
+        ray: &Ray,
+        tr: &TriangleRay,
+        t_max: Float,
+    ) -> Option<HitRecord> {
+        if let Ok(hit) = self.mesh_triangle_hit(i, tr, t_max) {
+            let (b0, b1, b2, t_hit) = hit?;
+            return Some(HitRecord {
+                primitive: i,
+                t_hit,
+                kind: HitKind::Triangle(b0, b1, b2),
+            });
+        }
+        let t_hit = self.entry_intersect(i, ray, t_max)?.t_hit;
+        Some(HitRecord {
+            primitive: i,
+            t_hit,
+            kind: HitKind::Other { t_max },
+        })
     }
 
     /// Whether anything is hit in (0, t_max).
@@ -520,9 +835,22 @@ impl PrimitiveAggregate {
                 Some(Some([p0, p1, p2])) => {
                     intersect_prepared_triangle(&tr, t, *p0, *p1, *p2).is_some()
                 }
-                _ => self.prims[i as usize].intersect_p(r, t),
+                _ => self.intersect_p_other(i, r, &tr, t),
             }
         })
+    }
+
+    /// The shadow test of an entry that is not in the vertex cache.
+    #[inline(never)]
+    fn intersect_p_other(&self, i: u32, ray: &Ray, tr: &TriangleRay, t_max: Float) -> bool {
+        if let Ok(hit) = self.mesh_triangle_hit(i, tr, t_max) {
+            return hit.is_some();
+        }
+        let (p, e) = self.entries.locate(i);
+        match &self.prims[p] {
+            Primitive::Mesh(m) => m.intersect_p_triangle(e, ray, t_max),
+            prim => prim.intersect_p(ray, t_max),
+        }
     }
 }
 

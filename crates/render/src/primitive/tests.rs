@@ -261,3 +261,141 @@ fn intersect_is_record_then_interaction() {
     }
     assert!(triangles > 500 && others > 200, "{triangles} {others}");
 }
+
+/// A mesh of `n` random triangles and a few degenerate ones (a repeated
+/// vertex, three collinear points), which no aggregate may return.
+fn random_mesh(rng: &mut Rng, n: usize) -> Arc<TriangleMesh> {
+    let mut p = Vec::new();
+    for _ in 0..n * 3 {
+        p.push(Point3f::new(
+            rng.uniform_float() * 4.0 - 2.0,
+            rng.uniform_float() * 4.0 - 2.0,
+            rng.uniform_float() * 4.0 - 2.0,
+        ));
+    }
+    let mut idx: Vec<u32> = (0..(n * 3) as u32).collect();
+    let k = p.len() as u32;
+    p.extend([
+        Point3f::new(-1.0, -1.0, 0.0),
+        Point3f::new(0.0, 0.0, 0.0),
+        Point3f::new(1.0, 1.0, 0.0),
+    ]);
+    // Degenerate triangles between good ones, so that entries after them
+    // shift.
+    idx.splice(30..30, [k, k + 1, k + 2, 4, 4, 5]);
+    let xf = Transform::identity();
+    let (mesh, warnings) = TriangleMesh::new(&xf, false, idx, p, vec![], vec![], vec![], vec![])
+        .expect("a valid mesh");
+    assert!(warnings.iter().any(|w| w.contains("skipping 2 of")), "{warnings:?}");
+    mesh
+}
+
+/// The same scene as primitives of their own per triangle and as mesh
+/// primitives: every hit is the same, bit for bit, with and without the
+/// vertex and frame caches, with few primitives (entries found by binary
+/// search) and many (by table), opaque and alpha-masked.
+#[test]
+fn mesh_primitives_hit_as_their_triangles_do() {
+    let mut rng = Rng::new(11, 0);
+    let meshes = [random_mesh(&mut rng, 150), random_mesh(&mut rng, 60)];
+    let alphas = [Alpha::Opaque, Alpha::Constant(0.6)];
+    let per_triangle = |spheres: usize| -> Vec<Primitive> {
+        let mut prims = Vec::new();
+        for (mesh, alpha) in meshes.iter().zip(&alphas) {
+            prims.extend(triangle::triangles(mesh).into_iter().map(|t| {
+                Primitive::Geometric(GeometricPrimitive {
+                    shape: Shape::Triangle(t),
+                    material: Some(3),
+                    area_light: None,
+                    medium_interface: None,
+                    alpha: alpha.clone(),
+                })
+            }));
+            for k in 0..spheres {
+                let at = Vector3f::new(k as Float * 0.3 - 2.0, 1.5, 0.5);
+                prims.push(sphere_prim(Transform::translate(at), 0.2));
+            }
+        }
+        prims
+    };
+    let as_meshes = |spheres: usize| -> Vec<Primitive> {
+        let mut prims = Vec::new();
+        for (mesh, alpha) in meshes.iter().zip(&alphas) {
+            prims.push(Primitive::Mesh(MeshPrimitive {
+                mesh: mesh.clone(),
+                material: Some(3),
+                medium_interface: None,
+                alpha: alpha.clone(),
+            }));
+            for k in 0..spheres {
+                let at = Vector3f::new(k as Float * 0.3 - 2.0, 1.5, 0.5);
+                prims.push(sphere_prim(Transform::translate(at), 0.2));
+            }
+        }
+        prims
+    };
+    let params = AccelParams::default();
+    for spheres in [2, 20] {
+        let reference = PrimitiveAggregate::new(per_triangle(spheres), &params);
+        let uncached_reference =
+            PrimitiveAggregate::with_cache_limits(per_triangle(spheres), &params, 0, 0);
+        let cached = PrimitiveAggregate::new(as_meshes(spheres), &params);
+        let vertices_only = PrimitiveAggregate::with_cache_limits(
+            as_meshes(spheres),
+            &params,
+            usize::MAX,
+            0,
+        );
+        let uncached = PrimitiveAggregate::with_cache_limits(as_meshes(spheres), &params, 0, 0);
+        assert_eq!(cached.primitives().len(), 2 + 2 * spheres);
+        assert_eq!(cached.entry_count(), 150 + 60 + 4 + 2 * spheres);
+        assert_eq!(cached.primitive_count(), reference.primitive_count());
+        assert_eq!(cached.bounds(), reference.bounds());
+        let mut rng = Rng::new(12, 0);
+        let mut hits = 0;
+        for _ in 0..4000 {
+            let r = random_ray(&mut rng);
+            let t_max = if rng.uniform_float() < 0.2 {
+                12.0
+            } else {
+                Float::INFINITY
+            };
+            let want = format!("{:?}", reference.intersect(&r, t_max));
+            hits += usize::from(want != "None");
+            let want_p = reference.intersect_p(&r, t_max);
+            for agg in [&uncached_reference, &cached, &vertices_only, &uncached] {
+                assert_eq!(format!("{:?}", agg.intersect(&r, t_max)), want);
+                let record = agg.intersect_record(&r, t_max);
+                let two_steps = record.and_then(|h| agg.interaction(&r, &h));
+                assert_eq!(format!("{two_steps:?}"), want);
+                assert_eq!(agg.intersect_p(&r, t_max), want_p);
+            }
+        }
+        assert!(hits > 1000, "{hits}");
+    }
+}
+
+/// A mesh primitive met outside an aggregate is its closest triangle.
+#[test]
+fn a_lone_mesh_primitive_is_its_closest_triangle() {
+    let mut rng = Rng::new(13, 0);
+    let mesh = random_mesh(&mut rng, 40);
+    let lone = Primitive::Mesh(MeshPrimitive {
+        mesh: mesh.clone(),
+        material: Some(1),
+        medium_interface: None,
+        alpha: Alpha::Opaque,
+    });
+    let agg = PrimitiveAggregate::new(vec![lone.clone()], &AccelParams::default());
+    assert_eq!(lone.bounds(), agg.bounds());
+    let mut hits = 0;
+    for _ in 0..2000 {
+        let r = random_ray(&mut rng);
+        let a = lone.intersect(&r, Float::INFINITY);
+        let b = agg.intersect(&r, Float::INFINITY);
+        assert_eq!(a.map(|h| h.t_hit), b.map(|h| h.t_hit));
+        assert_eq!(lone.intersect_p(&r, Float::INFINITY), b.is_some());
+        hits += usize::from(b.is_some());
+    }
+    assert!(hits > 300, "{hits}");
+}

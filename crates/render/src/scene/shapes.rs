@@ -16,8 +16,8 @@ use super::entities::{
 use crate::light::{create_area_light, Light};
 use crate::material::MaterialSet;
 use crate::params::ParamReader;
-use crate::primitive::{Alpha, GeometricPrimitive, MediumInterface, Primitive};
-use crate::shape::create::{create_shapes, Displacement};
+use crate::primitive::{Alpha, GeometricPrimitive, MediumInterface, MeshPrimitive, Primitive};
+use crate::shape::create::{create_shape_set, create_shapes, Displacement};
 use crate::shape::Shape;
 use crate::texture::{FloatTexture, NamedTextures, TextureEvalContext, TextureParams};
 use rpbrt_geometry::float::Float;
@@ -111,7 +111,7 @@ pub(super) fn create_primitives(
         eval: &eval,
         edge_scale: displacement_edge_scale(cx.desc),
     };
-    let shapes = create_shapes(
+    let shapes = create_shape_set(
         &s.base.name,
         &tp,
         &s.render_from_object,
@@ -173,6 +173,26 @@ pub(super) fn create_primitives(
         Alpha::Constant(a) => Some(Arc::new(FloatTexture::Constant(*a))),
         Alpha::Opaque => None,
     };
+    // A mesh without an area light is one primitive (the aggregate gives
+    // its triangles entries); with one, each triangle is a primitive with
+    // a light of its own.
+    let medium_interface = media.is_transition().then_some(media);
+    let shapes = match (shapes.mesh, &area) {
+        (Some(mesh), None) => {
+            out.push(Primitive::Mesh(MeshPrimitive {
+                mesh,
+                material,
+                medium_interface,
+                alpha: alpha.clone(),
+            }));
+            shapes.shapes
+        }
+        (mesh, _) => crate::shape::create::ShapeSet {
+            mesh,
+            shapes: shapes.shapes,
+        }
+        .into_shapes(),
+    };
     for shape in shapes {
         let area_light = area.as_ref().and_then(|(al, r)| {
             let light = create_area_light(
@@ -201,7 +221,7 @@ pub(super) fn create_primitives(
             area_light,
             // Kept only where it changes the medium (pbrt-v4
             // `SetIntersectionProperties`): elsewhere rays keep theirs.
-            medium_interface: media.is_transition().then_some(media),
+            medium_interface,
             alpha: alpha.clone(),
         }));
     }

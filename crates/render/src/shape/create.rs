@@ -9,6 +9,8 @@ use super::displace::{displace, triangulate, DisplacedMesh};
 use super::loopsubdiv::loop_subdivide;
 use super::triangle::{self, TriangleMesh};
 use super::{Cone, Cylinder, Disk, Hyperboloid, Paraboloid, Shape, ShapeError, Sphere};
+use rpbrt_parser::ply::PlyMesh;
+use std::sync::Arc;
 use crate::params::{unknown_type, ParamReader};
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::transform::Transform;
@@ -66,6 +68,35 @@ pub struct Displacement<'a> {
     pub edge_scale: Float,
 }
 
+/// What one `Shape` directive creates: the triangle mesh it makes, if any,
+/// whose usable triangles come first, then its other shapes (a `plymesh`
+/// with quads gives both, curves and quadrics only shapes).
+#[derive(Debug, Default)]
+pub struct ShapeSet {
+    /// The triangle mesh; [`triangle::triangles`] gives its usable
+    /// triangles (degenerate ones left out, as the mesh's warning said).
+    pub mesh: Option<Arc<TriangleMesh>>,
+    /// The other shapes, in order.
+    pub shapes: Vec<Shape>,
+}
+
+impl ShapeSet {
+    /// Every shape, the mesh's triangles first (one shape per triangle).
+    pub fn into_shapes(self) -> Vec<Shape> {
+        match self.mesh {
+            None => self.shapes,
+            Some(mesh) => {
+                let mut out: Vec<Shape> = triangle::triangles(&mesh)
+                    .into_iter()
+                    .map(Shape::Triangle)
+                    .collect();
+                out.extend(self.shapes);
+                out
+            }
+        }
+    }
+}
+
 /// Creates the shapes of one `Shape "name" ...` directive (a mesh gives
 /// one per triangle or patch); file names resolve against the scene file
 /// they were written in. `displacement` is the `plymesh` shape's
@@ -80,8 +111,21 @@ pub fn create_shapes(
     reverse_orientation: bool,
     displacement: Option<&Displacement>,
 ) -> Result<Vec<Shape>, Diagnostic> {
+    create_shape_set(name, sp, render_from_object, reverse_orientation, displacement)
+        .map(ShapeSet::into_shapes)
+}
+
+/// [`create_shapes`] with a triangle mesh kept whole rather than cut into
+/// one shape per triangle (what aggregates store).
+pub fn create_shape_set(
+    name: &str,
+    sp: &ParamReader,
+    render_from_object: &Transform,
+    reverse_orientation: bool,
+    displacement: Option<&Displacement>,
+) -> Result<ShapeSet, Diagnostic> {
     let loc = sp.loc();
-    let mut out = Vec::new();
+    let mut set = ShapeSet::default();
     let rfo = *render_from_object;
     let ro = reverse_orientation;
     let f = |n: &str, d: Float| sp.float(n, d);
@@ -97,7 +141,7 @@ pub fn create_shapes(
                 f("phimax", 360.0)?,
             )
             .map_err(|e| serr(loc, name, e))?;
-            out.push(Shape::Sphere(Box::new(s)));
+            set.shapes.push(Shape::Sphere(Box::new(s)));
         }
         "cylinder" => {
             let s = Cylinder::new(
@@ -109,7 +153,7 @@ pub fn create_shapes(
                 f("phimax", 360.0)?,
             )
             .map_err(|e| serr(loc, name, e))?;
-            out.push(Shape::Cylinder(Box::new(s)));
+            set.shapes.push(Shape::Cylinder(Box::new(s)));
         }
         "disk" => {
             let s = Disk::new(
@@ -121,7 +165,7 @@ pub fn create_shapes(
                 f("phimax", 360.0)?,
             )
             .map_err(|e| serr(loc, name, e))?;
-            out.push(Shape::Disk(Box::new(s)));
+            set.shapes.push(Shape::Disk(Box::new(s)));
         }
         "cone" => {
             let s = Cone::new(
@@ -132,7 +176,7 @@ pub fn create_shapes(
                 f("phimax", 360.0)?,
             )
             .map_err(|e| serr(loc, name, e))?;
-            out.push(Shape::Cone(Box::new(s)));
+            set.shapes.push(Shape::Cone(Box::new(s)));
         }
         "paraboloid" => {
             let s = Paraboloid::new(
@@ -144,7 +188,7 @@ pub fn create_shapes(
                 f("phimax", 360.0)?,
             )
             .map_err(|e| serr(loc, name, e))?;
-            out.push(Shape::Paraboloid(Box::new(s)));
+            set.shapes.push(Shape::Paraboloid(Box::new(s)));
         }
         "hyperboloid" => {
             let p1 = sp.point3("p1", [0.0, 0.0, 0.0])?;
@@ -157,7 +201,7 @@ pub fn create_shapes(
                 f("phimax", 360.0)?,
             )
             .map_err(|e| serr(loc, name, e))?;
-            out.push(Shape::Hyperboloid(Box::new(s)));
+            set.shapes.push(Shape::Hyperboloid(Box::new(s)));
         }
         "trianglemesh" => {
             let p = p3(sp.point3s("P")?);
@@ -173,7 +217,7 @@ pub fn create_shapes(
             let s: Vec<Vector3f> = sp.vector3s("S")?.into_iter().map(Vector3f::from).collect();
             let uv: Vec<Point2f> = sp.point2s("uv")?.into_iter().map(Point2f::from).collect();
             let fi = sp.ints("faceIndices")?;
-            push_triangles(&mut out, sp, &rfo, ro, idx, p, s, n, uv, fi, name)?;
+            push_triangles(&mut set, sp, &rfo, ro, idx, p, s, n, uv, fi, name)?;
         }
         "plymesh" => {
             let file = sp.string("filename", "")?;
@@ -214,9 +258,9 @@ pub fn create_shapes(
                     triangulate(&mesh.tri_indices, &mesh.quad_indices, &mesh.face_indices);
                 let m = DisplacedMesh {
                     indices,
-                    p: mesh.positions.iter().map(|&a| Point3f::from(a)).collect(),
-                    n: mesh.normals.iter().map(|&a| Normal3f::from(a)).collect(),
-                    uv: mesh.uvs.iter().map(|&a| Point2f::from(a)).collect(),
+                    p: p3(mesh.positions),
+                    n: n3(mesh.normals),
+                    uv: mesh.uvs.into_iter().map(Point2f::from).collect(),
                     face_indices,
                 };
                 let m = displace(m, &rfo, edge_length * d.edge_scale, d.eval).map_err(|e| {
@@ -226,7 +270,7 @@ pub fn create_shapes(
                     )
                 })?;
                 push_triangles(
-                    &mut out,
+                    &mut set,
                     sp,
                     &rfo,
                     ro,
@@ -238,43 +282,48 @@ pub fn create_shapes(
                     m.face_indices,
                     name,
                 )?;
-                return Ok(out);
+                return Ok(set);
             }
-            let p: Vec<Point3f> = mesh.positions.iter().map(|&a| Point3f::from(a)).collect();
-            let n: Vec<Normal3f> = mesh.normals.iter().map(|&a| Normal3f::from(a)).collect();
-            let uv: Vec<Point2f> = mesh.uvs.iter().map(|&a| Point2f::from(a)).collect();
-            let ntri = mesh.tri_indices.len() / 3;
-            let (tri_fi, quad_fi) = if mesh.face_indices.is_empty() {
-                (Vec::new(), Vec::new())
+            // The file's arrays become the mesh's, moved and converted in
+            // place: a large mesh is never held twice.
+            let PlyMesh {
+                positions,
+                normals,
+                uvs,
+                tri_indices,
+                quad_indices,
+                face_indices: mut tri_fi,
+                ..
+            } = mesh;
+            let p = p3(positions);
+            let n = n3(normals);
+            let uv: Vec<Point2f> = uvs.into_iter().map(Point2f::from).collect();
+            let quad_fi = if tri_fi.is_empty() {
+                Vec::new()
             } else {
-                let fi = &mesh.face_indices;
-                (
-                    fi[..ntri.min(fi.len())].to_vec(),
-                    fi[ntri.min(fi.len())..].to_vec(),
-                )
+                tri_fi.split_off((tri_indices.len() / 3).min(tri_fi.len()))
             };
-            if !mesh.tri_indices.is_empty() {
-                push_triangles(
-                    &mut out,
-                    sp,
-                    &rfo,
-                    ro,
-                    mesh.tri_indices.clone(),
-                    p.clone(),
-                    Vec::new(),
-                    n.clone(),
-                    uv.clone(),
-                    tri_fi,
-                    name,
-                )?;
-            }
-            if !mesh.quad_indices.is_empty() {
+            if quad_indices.is_empty() {
+                if !tri_indices.is_empty() {
+                    let s = Vec::new();
+                    push_triangles(
+                        &mut set, sp, &rfo, ro, tri_indices, p, s, n, uv, tri_fi, name,
+                    )?;
+                }
+            } else {
+                if !tri_indices.is_empty() {
+                    // Triangles and quads share the vertices.
+                    let (tp, tn, tuv, s) = (p.clone(), n.clone(), uv.clone(), Vec::new());
+                    push_triangles(
+                        &mut set, sp, &rfo, ro, tri_indices, tp, s, tn, tuv, tri_fi, name,
+                    )?;
+                }
                 push_patches(
-                    &mut out,
+                    &mut set,
                     sp,
                     &rfo,
                     ro,
-                    mesh.quad_indices.clone(),
+                    quad_indices,
                     p,
                     n,
                     uv,
@@ -296,7 +345,7 @@ pub fn create_shapes(
             let n = n3(sp.normals("N")?);
             let uv: Vec<Point2f> = sp.point2s("uv")?.into_iter().map(Point2f::from).collect();
             let fi = sp.ints("faceIndices")?;
-            push_patches(&mut out, sp, &rfo, ro, idx, p, n, uv, fi, name)?;
+            push_patches(&mut set, sp, &rfo, ro, idx, p, n, uv, fi, name)?;
         }
         "loopsubdiv" => {
             let levels = sp.int("levels", 3)?;
@@ -310,7 +359,7 @@ pub fn create_shapes(
             }
             let r = loop_subdivide(levels, &idx, &p).map_err(|e| serr(loc, name, e))?;
             push_triangles(
-                &mut out,
+                &mut set,
                 sp,
                 &rfo,
                 ro,
@@ -349,16 +398,16 @@ pub fn create_shapes(
             for w in warnings {
                 sp.warn(format!("\"curve\" shape: {w}"));
             }
-            out.extend(curves.into_iter().map(Shape::Curve));
+            set.shapes.extend(curves.into_iter().map(Shape::Curve));
         }
         _ => return Err(unknown_type("shape", name, SHAPE_NAMES, loc)),
     }
-    Ok(out)
+    Ok(set)
 }
 
 #[allow(clippy::too_many_arguments)]
 fn push_triangles(
-    out: &mut Vec<Shape>,
+    out: &mut ShapeSet,
     sp: &ParamReader,
     rfo: &Transform,
     ro: bool,
@@ -376,13 +425,14 @@ fn push_triangles(
     for w in warnings {
         sp.warn(format!("\"{name}\" shape: {w}"));
     }
-    out.extend(triangle::triangles(&mesh).into_iter().map(Shape::Triangle));
+    debug_assert!(out.mesh.is_none() && out.shapes.is_empty());
+    out.mesh = Some(mesh);
     Ok(())
 }
 
 #[allow(clippy::too_many_arguments)]
 fn push_patches(
-    out: &mut Vec<Shape>,
+    out: &mut ShapeSet,
     sp: &ParamReader,
     rfo: &Transform,
     ro: bool,
@@ -399,7 +449,7 @@ fn push_patches(
     for w in warnings {
         sp.warn(format!("\"{name}\" shape: {w}"));
     }
-    out.extend(
+    out.shapes.extend(
         bilinear::patches(&mesh)
             .into_iter()
             .map(Shape::BilinearPatch),

@@ -20,6 +20,7 @@ use rpbrt_geometry::spherical::DirectionCone;
 use rpbrt_geometry::transform::Transform;
 use rpbrt_geometry::tuple::*;
 use rpbrt_geometry::Bounds3f;
+use std::ops::Deref;
 use std::sync::Arc;
 
 /// Below this solid angle (steradians) a triangle is sampled by area:
@@ -506,14 +507,19 @@ pub fn intersect_prepared_triangle(
     Some((b0, b1, b2, t))
 }
 
-/// One triangle of a [`TriangleMesh`].
+/// One triangle of a [`TriangleMesh`], reached through `M`: an
+/// `Arc<TriangleMesh>` for the [`Triangle`] shape, or a plain reference for
+/// the triangles an aggregate stores as a mesh and an index.
 #[derive(Clone, Debug)]
-pub struct Triangle {
+pub struct TriangleOf<M> {
     /// The mesh holding the vertices.
-    pub mesh: Arc<TriangleMesh>,
+    pub mesh: M,
     /// Which triangle of the mesh.
     pub tri_index: u32,
 }
+
+/// One triangle of a shared [`TriangleMesh`]: the triangle shape.
+pub type Triangle = TriangleOf<Arc<TriangleMesh>>;
 
 /// The parts of a triangle's surface interaction that do not depend on
 /// where it is hit: the geometric normal (oriented), dp/du and dp/dv, and
@@ -533,12 +539,12 @@ pub struct TriangleFrame {
     pub dndv: Normal3f,
 }
 
-impl Triangle {
+impl<M: Deref<Target = TriangleMesh>> TriangleOf<M> {
     /// Triangle `tri_index` of `mesh` (which must be in range; use
     /// [`triangles`] to get only the valid ones).
-    pub fn new(mesh: Arc<TriangleMesh>, tri_index: u32) -> Self {
+    pub fn new(mesh: M, tri_index: u32) -> Self {
         debug_assert!((tri_index as usize) < mesh.n_triangles());
-        Triangle { mesh, tri_index }
+        TriangleOf { mesh, tri_index }
     }
 
     #[inline]
