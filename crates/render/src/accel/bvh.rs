@@ -58,13 +58,13 @@ impl BvhNode {
 
 /// Largest leaf a node can describe (`count` is a `u16`); degenerate
 /// clusters bigger than this are split by count instead.
-const LEAF_MAX: usize = u16::MAX as usize;
+pub(super) const LEAF_MAX: usize = u16::MAX as usize;
 /// Traversal stack size; the builders keep every leaf at most this deep.
 pub(crate) const STACK_SIZE: usize = 64;
 /// SAH bucket count (pbrt-v4).
 const N_BUCKETS: usize = 12;
 /// Below this many primitives a subtree is not worth a thread.
-const PAR_MIN_PRIMS: usize = 4096;
+pub(super) const PAR_MIN_PRIMS: usize = 4096;
 
 /// A binary BVH over primitive bounds.
 #[derive(Clone, Debug, Default)]
@@ -79,13 +79,13 @@ pub struct Bvh {
 /// bytes (the centroid is computed where it is needed: storing it would
 /// cost 12 bytes per primitive and as much memory traffic per pass).
 #[derive(Clone, Copy, Debug)]
-struct PrimRef {
-    bounds: Bounds3f,
-    index: u32,
+pub(super) struct PrimRef {
+    pub bounds: Bounds3f,
+    pub index: u32,
 }
 
 /// Anything binned by the SAH: primitives, or HLBVH treelets.
-trait Binnable {
+pub(super) trait Binnable {
     fn bounds(&self) -> &Bounds3f;
     fn centroid(&self) -> Point3f;
 }
@@ -146,41 +146,86 @@ fn bucket_of(c: Float, cmin: f64, cext: f64) -> usize {
     b.min(N_BUCKETS - 1)
 }
 
+/// The bounds of a set of primitives and of their centroids.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SetBounds {
+    /// The union of the primitives' bounds.
+    pub bounds: Bounds3f,
+    /// The bounds of their centroids.
+    pub centroids: Bounds3f,
+}
+
+impl SetBounds {
+    /// The bounds of `items`, in one pass.
+    pub(super) fn of<T: Binnable>(items: &[T]) -> SetBounds {
+        let (bounds, centroids) = bounds_and_centroids(items);
+        SetBounds { bounds, centroids }
+    }
+
+    pub(super) fn empty() -> SetBounds {
+        SetBounds {
+            bounds: Bounds3f::empty(),
+            centroids: Bounds3f::empty(),
+        }
+    }
+
+    fn union(&self, o: &SetBounds) -> SetBounds {
+        SetBounds {
+            bounds: self.bounds.union(&o.bounds),
+            centroids: self.centroids.union(&o.centroids),
+        }
+    }
+}
+
+/// A binned SAH split: where it falls and, from the buckets, the bounds of
+/// both sides (min and max are exact, so they are the bounds a pass over
+/// each side would give).
+type SahSplit = (usize, Option<(SetBounds, SetBounds)>);
+
 /// Binned SAH (pbrt-v4 `buildRecursive`). Returns the split position, or
 /// `None` when a leaf is cheaper and allowed (`leaf_max` prims or fewer).
+/// `buckets` is scratch space: each item's bucket is computed once, for
+/// the binning, and read back by the partition.
 fn split_sah<T: Binnable>(
     items: &mut [T],
     bounds: &Bounds3f,
     cb: &Bounds3f,
     dim: usize,
     leaf_max: Option<usize>,
-) -> Option<usize> {
+    buckets: &mut Vec<u8>,
+) -> Option<SahSplit> {
     let n = items.len();
     if n <= 2 {
-        return Some(split_equal(items, dim));
+        return Some((split_equal(items, dim), None));
     }
     let cmin = cb.p_min[dim] as f64;
     let cext = cb.p_max[dim] as f64 - cmin;
     let mut counts = [0usize; N_BUCKETS];
-    let mut bb = [Bounds3f::empty(); N_BUCKETS];
-    for it in items.iter() {
-        let b = bucket_of(it.centroid()[dim], cmin, cext);
+    let mut bb = [SetBounds::empty(); N_BUCKETS];
+    if buckets.len() < n {
+        buckets.resize(n, 0);
+    }
+    for (it, slot) in items.iter().zip(buckets.iter_mut()) {
+        let c = it.centroid();
+        let b = bucket_of(c[dim], cmin, cext);
+        *slot = b as u8;
         counts[b] += 1;
-        bb[b] = bb[b].union(it.bounds());
+        bb[b].bounds = bb[b].bounds.union(it.bounds());
+        bb[b].centroids = bb[b].centroids.union_point(c);
     }
     // Cost of splitting after bucket i, from a forward and a backward sweep.
     let mut costs = [0.0f64; N_BUCKETS - 1];
     let mut below = Bounds3f::empty();
     let mut n_below = 0;
     for i in 0..N_BUCKETS - 1 {
-        below = below.union(&bb[i]);
+        below = below.union(&bb[i].bounds);
         n_below += counts[i];
         costs[i] = n_below as f64 * surface_area_f64(&below);
     }
     let mut above = Bounds3f::empty();
     let mut n_above = 0;
     for i in (1..N_BUCKETS).rev() {
-        above = above.union(&bb[i]);
+        above = above.union(&bb[i].bounds);
         n_above += counts[i];
         costs[i - 1] += n_above as f64 * surface_area_f64(&above);
     }
@@ -205,13 +250,20 @@ fn split_sah<T: Binnable>(
             return None;
         }
     }
-    let mid = partition(items, |it| {
-        bucket_of(it.centroid()[dim], cmin, cext) <= best
+    // `partition` tests the items in their original order (each before
+    // any swap moves it), so the k-th test is of the item binned k-th.
+    let mut k = 0;
+    let mid = partition(items, |_| {
+        let below = buckets[k] as usize <= best;
+        k += 1;
+        below
     });
     if mid == 0 || mid == n {
-        Some(split_equal(items, dim))
+        Some((split_equal(items, dim), None))
     } else {
-        Some(mid)
+        let side =
+            |r: std::ops::Range<usize>| bb[r].iter().fold(SetBounds::empty(), |a, b| a.union(b));
+        Some((mid, Some((side(0..best + 1), side(best + 1..N_BUCKETS)))))
     }
 }
 
@@ -228,53 +280,116 @@ fn append_relocated(out: &mut Vec<BvhNode>, sub: &[BvhNode]) {
     }));
 }
 
-fn ceil_log2(n: usize) -> usize {
+pub(super) fn ceil_log2(n: usize) -> usize {
     (usize::BITS - n.saturating_sub(1).leading_zeros()) as usize
 }
 
-struct Builder {
-    method: SplitMethod,
-    max_prims: usize,
-    par_depth: usize,
+/// What the builder makes of a node.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Decision {
+    /// A leaf of all the node's primitives.
+    Leaf,
+    /// An interior node: the primitives before `mid` (after the
+    /// partition) go to the first child, with the bounds of both sides.
+    Split {
+        mid: usize,
+        dim: usize,
+        sides: (SetBounds, SetBounds),
+    },
+}
+
+/// The top-down builder (SAH, middle and equal-count splits) shared by the
+/// binary BVH and the 4-wide one (`wide.rs`), which make the same
+/// decisions node for node.
+pub(super) struct Builder {
+    pub method: SplitMethod,
+    pub max_prims: usize,
+    pub par_depth: usize,
 }
 
 impl Builder {
-    /// Builds the subtree over `prims` (which sit at `first..` in the final
-    /// primitive order) at `depth`, appending nodes to `out` with child
-    /// offsets relative to `out`'s start.
-    fn build(&self, prims: &mut [PrimRef], first: u32, depth: usize, out: &mut Vec<BvhNode>) {
+    /// The builder for `params` with about `threads` threads (HLBVH, which
+    /// has a builder of its own, falls back to the SAH here).
+    pub(super) fn new(params: &BvhParams, threads: usize) -> Builder {
+        Builder {
+            method: match params.split_method {
+                SplitMethod::Hlbvh => SplitMethod::Sah,
+                m => m,
+            },
+            max_prims: params.max_prims_in_node.clamp(1, 255) as usize,
+            par_depth: if threads > 1 {
+                ceil_log2(threads) + 1
+            } else {
+                0
+            },
+        }
+    }
+
+    /// Decides the node over `prims` (bounds `set`, at binary depth
+    /// `depth`): a leaf, or a split, partitioning `prims`. `buckets` is
+    /// scratch space for the SAH.
+    pub(super) fn decide(
+        &self,
+        prims: &mut [PrimRef],
+        set: &SetBounds,
+        depth: usize,
+        buckets: &mut Vec<u8>,
+    ) -> Decision {
         let n = prims.len();
-        let (bounds, cb) = bounds_and_centroids(prims);
-        let node = out.len();
-        out.push(BvhNode::leaf(&bounds, first, n.min(LEAF_MAX) as u16));
+        let (bounds, cb) = (&set.bounds, &set.centroids);
         let dim = cb.max_dimension();
         // Coincident centroids cannot be separated: leaf them (pbrt-v4).
         let degenerate = cb.p_max[dim] == cb.p_min[dim];
         if n <= LEAF_MAX
             && (n == 1 || degenerate || (self.method != SplitMethod::Sah && n <= self.max_prims))
         {
-            return;
+            return Decision::Leaf;
         }
         // Past this depth a split by count keeps every leaf within the
         // traversal stack, whatever the SAH would do.
         let guard = depth + ceil_log2(n) + 1 >= STACK_SIZE;
         // A node of zero area (all boxes on one line) has no SAH cost to
         // compare; pbrt makes it one leaf, a midpoint split does better.
-        let flat = surface_area_f64(&bounds) == 0.0;
-        let mid = if degenerate || guard {
-            split_equal(prims, dim)
+        let flat = surface_area_f64(bounds) == 0.0;
+        let (mid, sides) = if degenerate || guard {
+            (split_equal(prims, dim), None)
         } else {
             match self.method {
-                SplitMethod::Middle => split_middle(prims, &cb, dim),
-                SplitMethod::Sah | SplitMethod::Hlbvh if flat => split_middle(prims, &cb, dim),
+                SplitMethod::Middle => (split_middle(prims, cb, dim), None),
+                SplitMethod::Sah | SplitMethod::Hlbvh if flat => {
+                    (split_middle(prims, cb, dim), None)
+                }
                 SplitMethod::Sah | SplitMethod::Hlbvh => {
-                    match split_sah(prims, &bounds, &cb, dim, Some(self.max_prims)) {
-                        Some(m) => m,
-                        None => return,
+                    match split_sah(prims, bounds, cb, dim, Some(self.max_prims), buckets) {
+                        Some(s) => s,
+                        None => return Decision::Leaf,
                     }
                 }
-                SplitMethod::EqualCounts => split_equal(prims, dim),
+                SplitMethod::EqualCounts => (split_equal(prims, dim), None),
             }
+        };
+        let sides =
+            sides.unwrap_or_else(|| (SetBounds::of(&prims[..mid]), SetBounds::of(&prims[mid..])));
+        Decision::Split { mid, dim, sides }
+    }
+
+    /// Builds the subtree over `prims` (bounds `set`; they sit at `first..`
+    /// in the final primitive order) at `depth`, appending nodes to `out`
+    /// with child offsets relative to `out`'s start.
+    fn build(
+        &self,
+        prims: &mut [PrimRef],
+        set: &SetBounds,
+        first: u32,
+        depth: usize,
+        out: &mut Vec<BvhNode>,
+        buckets: &mut Vec<u8>,
+    ) {
+        let n = prims.len();
+        let node = out.len();
+        out.push(BvhNode::leaf(&set.bounds, first, n.min(LEAF_MAX) as u16));
+        let Decision::Split { mid, dim, sides } = self.decide(prims, set, depth, buckets) else {
+            return;
         };
         out[node].count = 0;
         out[node].axis = dim as u8;
@@ -285,10 +400,18 @@ impl Builder {
             std::thread::scope(|s| {
                 let handle = s.spawn(|| {
                     let mut v = Vec::with_capacity(2 * right.len() / self.max_prims.max(1));
-                    self.build(right, right_first, depth + 1, &mut v);
+                    let mut buckets = Vec::new();
+                    self.build(
+                        right,
+                        &sides.1,
+                        right_first,
+                        depth + 1,
+                        &mut v,
+                        &mut buckets,
+                    );
                     v
                 });
-                self.build(left, first, depth + 1, out);
+                self.build(left, &sides.0, first, depth + 1, out, buckets);
                 match handle.join() {
                     Ok(v) => right_nodes = v,
                     Err(e) => std::panic::resume_unwind(e),
@@ -297,9 +420,9 @@ impl Builder {
             out[node].offset = out.len() as u32;
             append_relocated(out, &right_nodes);
         } else {
-            self.build(left, first, depth + 1, out);
+            self.build(left, &sides.0, first, depth + 1, out, buckets);
             out[node].offset = out.len() as u32;
-            self.build(right, right_first, depth + 1, out);
+            self.build(right, &sides.1, right_first, depth + 1, out, buckets);
         }
     }
 }
@@ -427,7 +550,8 @@ fn build_upper(treelets: &mut [Treelet], depth: usize, out: &mut Vec<BvhNode>) {
     let mid = if cb.p_max[dim] == cb.p_min[dim] || depth + ceil_log2(treelets.len()) + 1 >= 32 {
         split_equal(treelets, dim)
     } else {
-        split_sah(treelets, &bounds, &cb, dim, None).unwrap_or(treelets.len() / 2)
+        split_sah(treelets, &bounds, &cb, dim, None, &mut Vec::new())
+            .map_or(treelets.len() / 2, |(mid, _)| mid)
     };
     let node = out.len();
     let mut interior = BvhNode::leaf(&bounds, 0, 0);
@@ -512,6 +636,20 @@ fn build_hlbvh(prims: &mut Vec<PrimRef>, max_prims: usize, threads: usize) -> Ve
     out
 }
 
+/// The build references of the `n` primitives whose bounds `bounds` gives,
+/// leaving out those with unusable bounds.
+pub(super) fn prim_refs<F: Fn(u32) -> Bounds3f>(n: usize, bounds: F) -> Vec<PrimRef> {
+    let mut prims = Vec::with_capacity(n);
+    prims.extend((0..n as u32).filter_map(|i| {
+        let b = bounds(i);
+        usable_bounds(&b).then_some(PrimRef {
+            bounds: b,
+            index: i,
+        })
+    }));
+    prims
+}
+
 fn max_depth(nodes: &[BvhNode]) -> usize {
     let mut deepest = 0;
     let mut stack = vec![(0usize, 0usize)];
@@ -534,7 +672,12 @@ impl Bvh {
     /// Builds with at most about `threads` threads; the result is the same
     /// for every thread count.
     pub fn build_with_threads(prim_bounds: &[Bounds3f], params: &BvhParams, threads: usize) -> Bvh {
-        Bvh::build_from(prim_bounds.len(), |i| prim_bounds[i as usize], params, threads)
+        Bvh::build_from(
+            prim_bounds.len(),
+            |i| prim_bounds[i as usize],
+            params,
+            threads,
+        )
     }
 
     /// [`Bvh::build_with_threads`] over `n` primitives whose bounds
@@ -544,48 +687,27 @@ impl Bvh {
     where
         F: Fn(u32) -> Bounds3f + Sync,
     {
-        let mut prims: Vec<PrimRef> = Vec::with_capacity(n);
-        prims.extend((0..n as u32).filter_map(|i| {
-            let b = bounds(i);
-            usable_bounds(&b).then_some(PrimRef {
-                bounds: b,
-                index: i,
-            })
-        }));
-        let prim_bounds_len = n;
+        let mut prims = prim_refs(n, bounds);
         let mut bvh = Bvh {
-            n_input: prim_bounds_len,
-            n_skipped: prim_bounds_len - prims.len(),
+            n_input: n,
+            n_skipped: n - prims.len(),
             ..Default::default()
         };
         if prims.is_empty() {
             return bvh;
         }
-        let max_prims = params.max_prims_in_node.clamp(1, 255) as usize;
-        let par_depth = if threads > 1 {
-            ceil_log2(threads) + 1
-        } else {
-            0
-        };
+        let builder = Builder::new(params, threads);
         let mut nodes = Vec::new();
         if params.split_method == SplitMethod::Hlbvh {
-            nodes = build_hlbvh(&mut prims, max_prims, threads);
+            nodes = build_hlbvh(&mut prims, builder.max_prims, threads);
         }
         if nodes.is_empty() || max_depth(&nodes) > STACK_SIZE {
             // (HLBVH cannot bound its depth while building; an SAH build
             // does, so it is the fallback.)
             nodes.clear();
-            let method = match params.split_method {
-                SplitMethod::Hlbvh => SplitMethod::Sah,
-                m => m,
-            };
-            let builder = Builder {
-                method,
-                max_prims,
-                par_depth,
-            };
-            nodes.reserve(2 * prims.len() / max_prims + 1);
-            builder.build(&mut prims, 0, 0, &mut nodes);
+            nodes.reserve(2 * prims.len() / builder.max_prims + 1);
+            let set = SetBounds::of(&prims);
+            builder.build(&mut prims, &set, 0, 0, &mut nodes, &mut Vec::new());
         }
         nodes.shrink_to_fit();
         bvh.nodes = nodes;

@@ -47,7 +47,8 @@ pub struct Bvh4Node {
 }
 
 impl Bvh4Node {
-    fn empty() -> Bvh4Node {
+    /// A node with every lane unused.
+    pub(super) fn empty() -> Bvh4Node {
         let inf = Float::INFINITY;
         Bvh4Node {
             bounds: [
@@ -257,16 +258,44 @@ impl Bvh4 {
         params: &BvhParams,
         threads: usize,
     ) -> Bvh4 {
-        Bvh4::from_binary(Bvh::build_with_threads(prim_bounds, params, threads))
+        Bvh4::build_from(
+            prim_bounds.len(),
+            |i| prim_bounds[i as usize],
+            params,
+            threads,
+        )
     }
 
     /// [`Bvh4::build_with_threads`] over `n` primitives whose bounds
-    /// `bounds` gives (see [`Bvh::build_from`]).
+    /// `bounds` gives, called once per primitive. The tree is the one
+    /// [`Bvh4::from_binary`] makes of the binary BVH, built without the
+    /// binary tree in between (`wide.rs`), except for HLBVH.
     pub fn build_from<F>(n: usize, bounds: F, params: &BvhParams, threads: usize) -> Bvh4
     where
         F: Fn(u32) -> Bounds3f + Sync,
     {
-        Bvh4::from_binary(Bvh::build_from(n, bounds, params, threads))
+        if params.split_method == super::SplitMethod::Hlbvh {
+            Bvh4::from_binary(Bvh::build_from(n, bounds, params, threads))
+        } else {
+            super::wide::build(n, bounds, params, threads)
+        }
+    }
+
+    /// A tree from its parts (for the direct builder).
+    pub(super) fn from_parts(
+        nodes: Vec<Bvh4Node>,
+        prim_indices: Vec<u32>,
+        bounds: Bounds3f,
+        n_input: usize,
+        n_skipped: usize,
+    ) -> Bvh4 {
+        Bvh4 {
+            nodes,
+            prim_indices,
+            bounds,
+            n_input,
+            n_skipped,
+        }
     }
 
     /// Collapses a binary BVH into a 4-wide one (same leaves, same

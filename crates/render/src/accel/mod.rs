@@ -25,6 +25,7 @@ pub mod kdtree;
 mod params;
 #[cfg(test)]
 mod tests;
+mod wide;
 
 pub use bvh::{Bvh, BvhNode};
 pub use bvh4::{Bvh4, Bvh4Node};
@@ -104,9 +105,7 @@ impl Accelerator {
             AccelKind::Bvh if params.bvh.width == 2 => {
                 Accelerator::Bvh(Bvh::build_from(n, bounds, &params.bvh, threads))
             }
-            AccelKind::Bvh => {
-                Accelerator::Bvh4(Bvh4::build_from(n, bounds, &params.bvh, threads))
-            }
+            AccelKind::Bvh => Accelerator::Bvh4(Bvh4::build_from(n, bounds, &params.bvh, threads)),
             _ => {
                 let b: Vec<Bounds3f> = (0..n as u32).map(bounds).collect();
                 Accelerator::build_with_threads(&b, params, threads)

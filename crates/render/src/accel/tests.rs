@@ -514,6 +514,67 @@ fn builds_are_deterministic() {
     assert_eq!(k1.nodes(), k2.nodes());
 }
 
+/// The 4-wide BVH built directly (`wide.rs`) is the binary BVH collapsed,
+/// node for node and in the same order, for every split method, leaf size
+/// and thread count, on random, clustered, flat and badly spread input.
+#[test]
+fn direct_wide_build_is_the_collapsed_binary_tree() {
+    let tris = random_tris(19, 20000, 0.03);
+    let mut inputs: Vec<(&str, Vec<Bounds3f>)> =
+        vec![("random triangles", tris.iter().map(tri_bounds).collect())];
+    // Clusters of identical boxes (coincident centroids) among others.
+    let mut clustered: Vec<Bounds3f> = tris[..3000].iter().map(tri_bounds).collect();
+    let cluster = Bounds3f::new(Point3f::new(0.4, 0.4, 0.4), Point3f::new(0.5, 0.5, 0.5));
+    clustered.extend(std::iter::repeat_n(cluster, 6000));
+    inputs.push(("clustered", clustered));
+    // Zero-area boxes on a line, and exponentially spaced ones (the depth
+    // guard's equal-count splits).
+    inputs.push((
+        "flat",
+        (0..5000)
+            .map(|i| {
+                let p = Point3f::new(i as Float * 0.01, 0.0, 0.0);
+                Bounds3f::new(p, p)
+            })
+            .collect(),
+    ));
+    inputs.push((
+        "exponential",
+        (0..3000)
+            .map(|i| {
+                let x = (1.02 as Float).powi(i);
+                Bounds3f::new(Point3f::new(x, 0.0, 0.0), Point3f::new(x * 1.001, 1.0, 1.0))
+            })
+            .collect(),
+    ));
+    inputs.push(("one", vec![cluster]));
+    inputs.push(("three", vec![cluster; 3]));
+    for (name, bounds) in &inputs {
+        for method in [
+            SplitMethod::Sah,
+            SplitMethod::Middle,
+            SplitMethod::EqualCounts,
+        ] {
+            for max_prims in [1, 4, 255] {
+                let p = BvhParams {
+                    split_method: method,
+                    max_prims_in_node: max_prims,
+                    ..Default::default()
+                };
+                let want = Bvh4::from_binary(Bvh::build_with_threads(bounds, &p, 1));
+                for threads in [1, 2, 3, 8] {
+                    let got = Bvh4::build_with_threads(bounds, &p, threads);
+                    let what =
+                        format!("{name}, {method:?}, {max_prims} per leaf, {threads} threads");
+                    assert!(got.nodes() == want.nodes(), "{what}: nodes differ");
+                    assert!(got.prim_indices() == want.prim_indices(), "{what}");
+                    assert_eq!(got.bounds(), want.bounds(), "{what}");
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn bvh_leaves_cover_every_primitive_once() {
     let tris = random_tris(18, 5000, 0.05);

@@ -804,13 +804,7 @@ impl PrimitiveAggregate {
     /// [`PrimitiveAggregate::intersect_other`] for
     /// [`PrimitiveAggregate::intersect_record`].
     #[inline(never)]
-    fn record_other(
-        &self,
-        i: u32,
-        ray: &Ray,
-        tr: &TriangleRay,
-        t_max: Float,
-    ) -> Option<HitRecord> {
+    fn record_other(&self, i: u32, ray: &Ray, tr: &TriangleRay, t_max: Float) -> Option<HitRecord> {
         if let Ok(hit) = self.mesh_triangle_hit(i, tr, t_max) {
             let (b0, b1, b2, t_hit) = hit?;
             return Some(HitRecord {

@@ -286,7 +286,10 @@ fn random_mesh(rng: &mut Rng, n: usize) -> Arc<TriangleMesh> {
     let xf = Transform::identity();
     let (mesh, warnings) = TriangleMesh::new(&xf, false, idx, p, vec![], vec![], vec![], vec![])
         .expect("a valid mesh");
-    assert!(warnings.iter().any(|w| w.contains("skipping 2 of")), "{warnings:?}");
+    assert!(
+        warnings.iter().any(|w| w.contains("skipping 2 of")),
+        "{warnings:?}"
+    );
     mesh
 }
 
@@ -340,12 +343,8 @@ fn mesh_primitives_hit_as_their_triangles_do() {
         let uncached_reference =
             PrimitiveAggregate::with_cache_limits(per_triangle(spheres), &params, 0, 0);
         let cached = PrimitiveAggregate::new(as_meshes(spheres), &params);
-        let vertices_only = PrimitiveAggregate::with_cache_limits(
-            as_meshes(spheres),
-            &params,
-            usize::MAX,
-            0,
-        );
+        let vertices_only =
+            PrimitiveAggregate::with_cache_limits(as_meshes(spheres), &params, usize::MAX, 0);
         let uncached = PrimitiveAggregate::with_cache_limits(as_meshes(spheres), &params, 0, 0);
         assert_eq!(cached.primitives().len(), 2 + 2 * spheres);
         assert_eq!(cached.entry_count(), 150 + 60 + 4 + 2 * spheres);

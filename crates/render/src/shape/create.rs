@@ -9,13 +9,13 @@ use super::displace::{displace, triangulate, DisplacedMesh};
 use super::loopsubdiv::loop_subdivide;
 use super::triangle::{self, TriangleMesh};
 use super::{Cone, Cylinder, Disk, Hyperboloid, Paraboloid, Shape, ShapeError, Sphere};
-use rpbrt_parser::ply::PlyMesh;
-use std::sync::Arc;
 use crate::params::{unknown_type, ParamReader};
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::transform::Transform;
 use rpbrt_geometry::tuple::*;
+use rpbrt_parser::ply::PlyMesh;
 use rpbrt_parser::{Diagnostic, FileLoc};
+use std::sync::Arc;
 
 /// The shape type names rpbrt knows.
 pub const SHAPE_NAMES: &[&str] = &[
@@ -111,8 +111,14 @@ pub fn create_shapes(
     reverse_orientation: bool,
     displacement: Option<&Displacement>,
 ) -> Result<Vec<Shape>, Diagnostic> {
-    create_shape_set(name, sp, render_from_object, reverse_orientation, displacement)
-        .map(ShapeSet::into_shapes)
+    create_shape_set(
+        name,
+        sp,
+        render_from_object,
+        reverse_orientation,
+        displacement,
+    )
+    .map(ShapeSet::into_shapes)
 }
 
 /// [`create_shapes`] with a triangle mesh kept whole rather than cut into
@@ -307,7 +313,17 @@ pub fn create_shape_set(
                 if !tri_indices.is_empty() {
                     let s = Vec::new();
                     push_triangles(
-                        &mut set, sp, &rfo, ro, tri_indices, p, s, n, uv, tri_fi, name,
+                        &mut set,
+                        sp,
+                        &rfo,
+                        ro,
+                        tri_indices,
+                        p,
+                        s,
+                        n,
+                        uv,
+                        tri_fi,
+                        name,
                     )?;
                 }
             } else {
@@ -315,7 +331,17 @@ pub fn create_shape_set(
                     // Triangles and quads share the vertices.
                     let (tp, tn, tuv, s) = (p.clone(), n.clone(), uv.clone(), Vec::new());
                     push_triangles(
-                        &mut set, sp, &rfo, ro, tri_indices, tp, s, tn, tuv, tri_fi, name,
+                        &mut set,
+                        sp,
+                        &rfo,
+                        ro,
+                        tri_indices,
+                        tp,
+                        s,
+                        tn,
+                        tuv,
+                        tri_fi,
+                        name,
                     )?;
                 }
                 push_patches(
