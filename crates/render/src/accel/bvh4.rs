@@ -471,7 +471,9 @@ impl Aggregate for Bvh4 {
 
     fn memory_bytes(&self) -> usize {
         std::mem::size_of::<Self>()
-            + self.nodes.capacity() * std::mem::size_of::<Bvh4Node>()
+            // Nodes written (a directly built tree reserves more address
+            // space than it uses; the untouched tail is not memory).
+            + self.nodes.len() * std::mem::size_of::<Bvh4Node>()
             + self.prim_indices.capacity() * 4
     }
 

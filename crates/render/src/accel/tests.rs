@@ -569,6 +569,9 @@ fn direct_wide_build_is_the_collapsed_binary_tree() {
                     assert!(got.nodes() == want.nodes(), "{what}: nodes differ");
                     assert!(got.prim_indices() == want.prim_indices(), "{what}");
                     assert_eq!(got.bounds(), want.bounds(), "{what}");
+                    // The direct build reserves one node per primitive and
+                    // must never outgrow it (growing would copy the tree).
+                    assert!(got.nodes().len() <= bounds.len().max(1), "{what}");
                 }
             }
         }

@@ -88,8 +88,22 @@ where
             nodes = builder.build_root(prims, &mut idx, &kids, par);
         }
     }
-    nodes.shrink_to_fit();
+    // No `shrink_to_fit`: the nodes are 64-byte aligned, so shrinking
+    // would allocate and copy the whole tree (the system allocator only
+    // reallocates in place up to 16-byte alignment), while the reserved
+    // tail was never written and holds no memory.
     Bvh4::from_parts(nodes, idx, set.bounds, n, n_skipped)
+}
+
+/// Nodes to reserve for the wide tree over `prims` primitives: an upper
+/// bound (every wide node is a distinct interior node of the binary tree,
+/// which has fewer than `prims`), capped at 2²⁶ nodes (8 GiB). Reserving it
+/// costs address space, not memory: pages are only made resident as nodes
+/// are written, the vector never reallocates (a doubling would hold the old
+/// and the new copy at once), and the final `shrink_to_fit` returns the
+/// rest.
+fn node_capacity(prims: usize) -> usize {
+    prims.min(1 << 26)
 }
 
 /// Copies the caller indices of `prims` into `idx` (the same length).
@@ -291,7 +305,7 @@ impl Builder {
                 .into_iter()
                 .map(|(lane, k, p, i)| {
                     s.spawn(move || {
-                        let mut sub = Vec::new();
+                        let mut sub = Vec::with_capacity(node_capacity(p.len()));
                         let mut buckets = Vec::new();
                         let f = first + k.start as u32;
                         self.build_wide(p, i, f, k, &mut sub, &mut buckets, wide_depth + 1);
@@ -331,6 +345,7 @@ impl Builder {
         kids: &Kids,
         par: bool,
     ) -> Vec<Bvh4Node> {
+        let idx_len = idx.len();
         let mut root = Bvh4Node::empty();
         for (lane, k) in kids.as_slice().iter().enumerate() {
             set_lane(&mut root, lane, k, 0);
@@ -366,7 +381,7 @@ impl Builder {
             (rest, at) = (tail, k.end);
         }
         let build = |k: Kid, mut refs: Vec<PrimRef>, idx: &mut [u32]| {
-            let mut sub = Vec::new();
+            let mut sub = Vec::with_capacity(node_capacity(refs.len()));
             let mut buckets = Vec::new();
             self.build_wide(
                 &mut refs,
@@ -379,7 +394,8 @@ impl Builder {
             );
             sub
         };
-        let mut nodes = vec![root];
+        let mut nodes = Vec::with_capacity(node_capacity(idx_len));
+        nodes.push(root);
         if !par {
             for (lane, k, refs, idx) in parts {
                 let sub = build(k, refs, idx);
