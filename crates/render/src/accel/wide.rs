@@ -403,18 +403,29 @@ impl Builder {
             }
             return nodes;
         }
+        // As many subtrees in flight as the builder has threads at this
+        // level: a finished subtree's nodes wait (held twice once copied)
+        // only for those before it, and the later subtrees' references
+        // are not yet joined by nodes of their own.
+        let window = (1usize << self.par_depth.saturating_sub(1)).clamp(1, WIDTH);
         std::thread::scope(|s| {
-            let handles: Vec<_> = parts
-                .into_iter()
-                .map(|(lane, k, refs, idx)| (lane, s.spawn(move || build(k, refs, idx))))
-                .collect();
-            // Appended as each finishes in lane order, so that at most
-            // one subtree's nodes are held twice.
-            for (lane, h) in handles {
+            let mut pending = parts.into_iter();
+            let mut running = std::collections::VecDeque::new();
+            let mut start_next = |running: &mut std::collections::VecDeque<_>| {
+                if let Some((lane, k, refs, idx)) = pending.next() {
+                    running.push_back((lane, s.spawn(move || build(k, refs, idx))));
+                }
+            };
+            for _ in 0..window {
+                start_next(&mut running);
+            }
+            // Appended in lane order as each finishes.
+            while let Some((lane, h)) = running.pop_front() {
                 match h.join() {
                     Ok(sub) => nodes[0].child[lane] = append_relocated(&mut nodes, &sub),
                     Err(e) => std::panic::resume_unwind(e),
                 }
+                start_next(&mut running);
             }
         });
         nodes
