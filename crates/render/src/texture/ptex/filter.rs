@@ -25,6 +25,19 @@ use super::reader::{
     PtexBorderMode, PtexFace, PtexFile, PtexMeshType, FLAG_NEIGHBORHOOD_CONSTANT, FLAG_SUBFACE,
 };
 
+/// Writes a filter's result, `acc / weight` per channel, to `out`; where
+/// the weights came to nothing usable, the face's `constant` value.
+pub(super) fn resolve_filtered(acc: &[f64], weight: f64, constant: &[f32], out: &mut [f32]) {
+    let nc = acc.len();
+    if weight.is_nan() || weight <= 0.0 || weight.is_infinite() {
+        out[..nc].copy_from_slice(constant);
+        return;
+    }
+    for (o, a) in out.iter_mut().zip(acc) {
+        *o = (a / weight) as f32;
+    }
+}
+
 /// The most taps along one axis (4 filter widths of 1 to 2 texels, plus
 /// rounding to even pairs).
 const KMAX: usize = 12;
@@ -860,13 +873,7 @@ impl PtexFile {
         };
         q.split_and_apply(k, faceid, 0);
         let weight = q.weight;
-        if weight.is_nan() || weight <= 0.0 || weight.is_infinite() {
-            out[..nc].copy_from_slice(&f.constant);
-            return;
-        }
-        for c in 0..nc {
-            out[c] = (acc[c] / weight) as f32;
-        }
+        resolve_filtered(acc, weight, &f.constant, out);
     }
 }
 

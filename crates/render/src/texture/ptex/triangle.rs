@@ -510,13 +510,7 @@ impl PtexFile {
         };
         a.split_and_apply(k, face, 0);
         let weight = a.weight;
-        if weight.is_nan() || weight <= 0.0 || weight.is_infinite() {
-            out[..nc].copy_from_slice(&f.constant);
-            return;
-        }
-        for c in 0..nc {
-            out[c] = (acc[c] / weight) as f32;
-        }
+        super::filter::resolve_filtered(&acc, weight, &f.constant, out);
     }
 }
 
