@@ -86,40 +86,60 @@ pub(super) fn approx(a: Float, b: Float, rel: Float) -> bool {
     (a - b).abs() <= rel * a.abs().max(b.abs()).max(1e-3)
 }
 
+/// Draws 5000 samples of `b` from random directions; for each sample that
+/// `keep` accepts (it may assert model-specific properties), checks that
+/// the sampled value and density equal `f` and `pdf` to `rel`. Returns how
+/// many samples were checked.
+pub(super) fn check_sample_f_against_f_and_pdf(
+    name: &str,
+    b: &BxDF,
+    rng: &mut Rng,
+    rel: Float,
+    keep: impl Fn(Vector3f, &BSDFSample) -> bool,
+) -> usize {
+    let mut checked = 0;
+    for _ in 0..5000 {
+        let wo = rand_dir(rng);
+        let uc = rng.uniform_float();
+        let Some(bs) = b.sample_f(
+            wo,
+            uc,
+            u2(rng),
+            TransportMode::Radiance,
+            BxDFReflTransFlags::ALL,
+        ) else {
+            continue;
+        };
+        if !keep(wo, &bs) {
+            continue;
+        }
+        let pdf = b.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL);
+        let f = b.f(wo, bs.wi, TransportMode::Radiance);
+        assert!(
+            approx(bs.pdf, pdf, rel),
+            "{name}: pdf {} vs {pdf}, wo {wo:?} wi {:?}",
+            bs.pdf,
+            bs.wi
+        );
+        for i in 0..4 {
+            assert!(approx(bs.f[i], f[i], rel), "{name}: f {:?} vs {f:?}", bs.f);
+        }
+        checked += 1;
+    }
+    checked
+}
+
 #[test]
 fn sample_f_agrees_with_f_and_pdf() {
     let mut rng = Rng::new(100, 0);
     for (name, b) in exact_models() {
-        let mut checked = 0;
-        for _ in 0..5000 {
-            let wo = rand_dir(&mut rng);
-            let uc = rng.uniform_float();
-            let Some(bs) = b.sample_f(
-                wo,
-                uc,
-                u2(&mut rng),
-                TransportMode::Radiance,
-                BxDFReflTransFlags::ALL,
-            ) else {
-                continue;
-            };
+        let checked = check_sample_f_against_f_and_pdf(&name, &b, &mut rng, 2e-3, |_, bs| {
             if bs.is_specular() || bs.pdf == 0.0 || bs.wi.z == 0.0 {
-                continue;
+                return false;
             }
             assert!(!bs.pdf_is_proportional);
-            let pdf = b.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL);
-            let f = b.f(wo, bs.wi, TransportMode::Radiance);
-            assert!(
-                approx(bs.pdf, pdf, 2e-3),
-                "{name}: pdf {} vs {pdf}, wo {wo:?} wi {:?}",
-                bs.pdf,
-                bs.wi
-            );
-            for i in 0..4 {
-                assert!(approx(bs.f[i], f[i], 2e-3), "{name}: f {:?} vs {f:?}", bs.f);
-            }
-            checked += 1;
-        }
+            true
+        });
         assert!(checked > 1000, "{name}: only {checked} usable samples");
     }
 }

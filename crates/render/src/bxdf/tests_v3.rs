@@ -7,7 +7,7 @@ use rpbrt_geometry::float::*;
 use rpbrt_geometry::same_hemisphere;
 use rpbrt_geometry::tuple::*;
 
-use super::tests::{albedo, approx, chi2_test, rand_dir, u2};
+use super::tests::{albedo, approx, check_sample_f_against_f_and_pdf, chi2_test, rand_dir};
 use super::*;
 use crate::rng::Rng;
 use crate::spectrum::SampledSpectrum;
@@ -79,32 +79,14 @@ fn disney_models() -> Vec<(&'static str, BxDF)> {
 fn disney_sample_f_agrees_with_f_and_pdf() {
     let mut rng = Rng::new(300, 0);
     for (name, b) in disney_models() {
-        let mut checked = 0;
-        for _ in 0..5000 {
-            let wo = rand_dir(&mut rng);
-            let uc = rng.uniform_float();
-            let Some(bs) = b.sample_f(
-                wo,
-                uc,
-                u2(&mut rng),
-                TransportMode::Radiance,
-                BxDFReflTransFlags::ALL,
-            ) else {
-                continue;
-            };
+        let checked = check_sample_f_against_f_and_pdf(name, &b, &mut rng, 2e-3, |wo, bs| {
             assert!(
                 !bs.is_specular(),
                 "{name}: the Disney BSDF has no delta lobe"
             );
-            let pdf = b.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL);
-            let f = b.f(wo, bs.wi, TransportMode::Radiance);
-            assert!(approx(bs.pdf, pdf, 2e-3), "{name}: pdf {} vs {pdf}", bs.pdf);
-            for i in 0..4 {
-                assert!(approx(bs.f[i], f[i], 2e-3), "{name}: f {:?} vs {f:?}", bs.f);
-            }
             assert_eq!(bs.is_transmission(), !same_hemisphere(wo, bs.wi));
-            checked += 1;
-        }
+            true
+        });
         assert!(checked > 3000, "{name}: only {checked} usable samples");
     }
 }
@@ -391,29 +373,11 @@ fn fourier_sample_f_agrees_with_f_and_pdf() {
         ("grey", fourier_bxdf(smooth_table(1, 1.5, 0.8))),
         ("colour", fourier_bxdf(smooth_table(3, 1.33, 0.6))),
     ] {
-        let mut checked = 0;
-        for _ in 0..5000 {
-            let wo = rand_dir(&mut rng);
-            let uc = rng.uniform_float();
-            let Some(bs) = b.sample_f(
-                wo,
-                uc,
-                u2(&mut rng),
-                TransportMode::Radiance,
-                BxDFReflTransFlags::ALL,
-            ) else {
-                continue;
-            };
-            let pdf = b.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL);
-            let f = b.f(wo, bs.wi, TransportMode::Radiance);
-            assert!(approx(bs.pdf, pdf, 1e-4), "{name}: pdf {} vs {pdf}", bs.pdf);
-            for i in 0..4 {
-                assert!(approx(bs.f[i], f[i], 1e-4), "{name}: {:?} vs {f:?}", bs.f);
-            }
+        let checked = check_sample_f_against_f_and_pdf(name, &b, &mut rng, 1e-4, |wo, bs| {
             assert!((bs.wi.length() - 1.0).abs() < 1e-4);
             assert_eq!(bs.is_transmission(), !same_hemisphere(wo, bs.wi));
-            checked += 1;
-        }
+            true
+        });
         assert!(checked > 4000, "{name}: {checked}");
     }
 }
