@@ -500,6 +500,12 @@ fn cubic_bezier(cp: &[[Float; 3]], u: Float) -> [Float; 3] {
     out
 }
 
+/// An sRGB reflectance at the sampled wavelengths: the textures whose
+/// colour is an sRGB albedo whatever the consumer (marble, pbrt-v3's uv).
+fn srgb_albedo(rgb: RGB, lambda: &SampledWavelengths) -> SampledSpectrum {
+    Spectrum::RgbAlbedo(RgbAlbedoSpectrum::new(RgbColorSpace::srgb(), rgb)).sample(lambda)
+}
+
 /// Marble: a sine of the height perturbed by FBm, through a colour spline
 /// (pbrt-v4 `MarbleTexture`). Always an sRGB albedo, whatever the consumer.
 #[derive(Clone, Debug)]
@@ -546,8 +552,7 @@ impl MarbleTexture {
         ctx: &TextureEvalContext,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        Spectrum::RgbAlbedo(RgbAlbedoSpectrum::new(RgbColorSpace::srgb(), self.rgb(ctx)))
-            .sample(lambda)
+        srgb_albedo(self.rgb(ctx), lambda)
     }
 }
 
@@ -573,7 +578,6 @@ impl UvTexture {
         ctx: &TextureEvalContext,
         lambda: &SampledWavelengths,
     ) -> SampledSpectrum {
-        Spectrum::RgbAlbedo(RgbAlbedoSpectrum::new(RgbColorSpace::srgb(), self.rgb(ctx)))
-            .sample(lambda)
+        srgb_albedo(self.rgb(ctx), lambda)
     }
 }
