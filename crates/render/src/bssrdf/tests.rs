@@ -186,6 +186,35 @@ fn profile_integral_matches_rho_eff() {
     }
 }
 
+/// Checks a histogram of `b.sample_sr` radii (up to `sample_sr(0.999)`)
+/// against 2π r `pdf_sr(r)` integrated over each bin; returns that radius.
+fn check_sample_sr_histogram(b: &impl SeparableBssrdf, seed: u64) -> Float {
+    // Histogram of sampled radii against 2π r pdf_sr(r) integrated per bin.
+    let r_max = b.sample_sr(0.999).unwrap();
+    const BINS: usize = 16;
+    let mut hist = [0usize; BINS];
+    let mut rng = Rng::new(seed, 0);
+    let n = 200_000;
+    for _ in 0..n {
+        let r = b.sample_sr(rng.uniform_float()).unwrap();
+        assert!(r >= 0.0 && r.is_finite());
+        if r < r_max {
+            hist[((r / r_max * BINS as Float) as usize).min(BINS - 1)] += 1;
+        }
+    }
+    for (k, &h) in hist.iter().enumerate() {
+        let mut want = 0.0;
+        let m = 400;
+        for j in 0..m {
+            let r = r_max * (k as Float + (j as Float + 0.5) / m as Float) / BINS as Float;
+            want += 2.0 * PI * r * b.pdf_sr(r)[0] * r_max / (BINS * m) as Float;
+        }
+        let got = h as Float / n as Float;
+        assert!((got - want).abs() < 0.006, "bin {k}: {got} vs {want}");
+    }
+    r_max
+}
+
 #[test]
 fn sample_sr_matches_pdf_sr_and_profile() {
     let t = table();
@@ -212,29 +241,7 @@ fn sample_sr_matches_pdf_sr_and_profile() {
             assert!(pdf[i].is_finite() && pdf[i] >= 0.0);
         }
     }
-    // Histogram of sampled radii against 2π r pdf_sr(r) integrated per bin.
-    let r_max = b.sample_sr(0.999).unwrap();
-    const BINS: usize = 16;
-    let mut hist = [0usize; BINS];
-    let mut rng = Rng::new(5, 0);
-    let n = 200_000;
-    for _ in 0..n {
-        let r = b.sample_sr(rng.uniform_float()).unwrap();
-        assert!(r >= 0.0 && r.is_finite());
-        if r < r_max {
-            hist[((r / r_max * BINS as Float) as usize).min(BINS - 1)] += 1;
-        }
-    }
-    for (k, &h) in hist.iter().enumerate() {
-        let mut want = 0.0;
-        let m = 400;
-        for j in 0..m {
-            let r = r_max * (k as Float + (j as Float + 0.5) / m as Float) / BINS as Float;
-            want += 2.0 * PI * r * b.pdf_sr(r)[0] * r_max / (BINS * m) as Float;
-        }
-        let got = h as Float / n as Float;
-        assert!((got - want).abs() < 0.006, "bin {k}: {got} vs {want}");
-    }
+    let r_max = check_sample_sr_histogram(&b, 5);
     // Radii scale with the mean free path.
     assert!(r_max > 0.0 && r_max * st < *t.radius_samples.last().unwrap());
 }
@@ -253,6 +260,15 @@ fn probe_segments_and_pdf_sp() {
         SampledSpectrum::new(1.0),
         t,
     );
+    check_probes(&b);
+}
+
+/// Checks `b`'s probe segments (on the sphere of radius r_max, crossing
+/// the tangent plane at the sampled radius), that `pdf_sp` integrates to
+/// ½ over the tangent plane, and the sample at a hit. `b`'s shading normal
+/// must be +z.
+fn check_probes(b: &impl SeparableBssrdf) {
+    let (po, ns) = (b.po(), b.ns());
     let r_max = b.sample_sr(0.999).unwrap();
     let mut rng = Rng::new(9, 0);
     let mut hits = 0;
@@ -348,4 +364,92 @@ fn beam_diffusion_terms_are_physical() {
     assert!(
         beam_diffusion_ms(0.9, 0.1, 0.0, 1.33, 0.5) > beam_diffusion_ms(0.2, 0.8, 0.0, 1.33, 0.5)
     );
+}
+
+fn disney_bssrdf(r: SampledSpectrum, d: SampledSpectrum) -> DisneyBssrdf {
+    DisneyBssrdf::new(
+        Point3f::new(1.0, 2.0, 3.0),
+        Normal3f::new(0.0, 0.0, 1.0),
+        1.4,
+        r,
+        d,
+    )
+}
+
+#[test]
+fn disney_profile_integrates_to_the_albedo() {
+    let r = SampledSpectrum::from_array([0.9, 0.5, 0.2, 1.0]);
+    let d = SampledSpectrum::from_array([0.05, 0.5, 2.0, 1e-3]);
+    let b = disney_bssrdf(r, d);
+    for i in 0..N_SPECTRUM_SAMPLES {
+        // ∫ 2π r Sr(r) dr over [0, 60 d] by the midpoint rule.
+        let n = 50_000;
+        let h = 60.0 * d[i] / n as Float;
+        let mut sum = 0.0f64;
+        let mut pdf_sum = 0.0f64;
+        for k in 0..n {
+            let x = (k as Float + 0.5) * h;
+            sum += (2.0 * PI * x * b.sr(x)[i] * h) as f64;
+            pdf_sum += (2.0 * PI * x * b.pdf_sr(x)[i] * h) as f64;
+        }
+        assert!(
+            (sum as Float - r[i]).abs() < 1e-3 * r[i],
+            "{i}: {sum} vs {}",
+            r[i]
+        );
+        assert!(
+            (pdf_sum - 1.0).abs() < 1e-3,
+            "{i}: pdf integrates to {pdf_sum}"
+        );
+        // The density is the profile over the albedo, so Sr / pdf = R.
+        for x in [1e-7, 0.01, 0.3, 4.0] {
+            let (sr, pdf) = (b.sr(x)[i], b.pdf_sr(x)[i]);
+            assert!(
+                (sr - r[i] * pdf).abs() <= 1e-5 * sr + 1e-30,
+                "{i} {x}: {sr} vs {pdf}"
+            );
+        }
+    }
+    // A wavelength without a scatter distance scatters nothing.
+    let z = disney_bssrdf(r, SampledSpectrum::from_array([0.1, 0.0, 0.1, 0.1]));
+    assert_eq!(z.sr(0.05)[1], 0.0);
+    assert_eq!(z.pdf_sr(0.05)[1], 0.0);
+    let none = disney_bssrdf(r, SampledSpectrum::from_array([0.0, 0.1, 0.1, 0.1]));
+    assert!(none.sample_sr(0.5).is_none());
+    assert!(none.sample_sp(0.7, Point2f::new(0.5, 0.5)).is_none());
+}
+
+#[test]
+fn disney_sampling_follows_the_closed_form_cdf() {
+    let d: Float = 0.2;
+    let b = disney_bssrdf(SampledSpectrum::new(0.8), SampledSpectrum::new(d));
+    // P(r < x) = 1 − e^(−x/d)/4 − ¾ e^(−x/3d), with stratified uniforms.
+    let n = 100_000;
+    let radii: Vec<Float> = (0..n)
+        .map(|k| b.sample_sr((k as Float + 0.5) / n as Float).unwrap())
+        .collect();
+    for x in [0.01, 0.1, 0.3, 1.0, 3.0] {
+        let got = radii.iter().filter(|&&r| r < x).count() as Float / n as Float;
+        let want = 1.0 - (-x / d).exp() / 4.0 - 0.75 * (-x / (3.0 * d)).exp();
+        assert!((got - want).abs() < 2e-3, "{x}: {got} vs {want}");
+    }
+    assert!(radii.iter().all(|r| r.is_finite() && *r >= 0.0));
+    // u = 0.999 lands in the wide exponential: r_max = −3d ln(1 − 0.998667).
+    let r_max = b.sample_sr(0.999).unwrap();
+    assert!((r_max - 3.0 * d * (1.0 as Float / (1.0 - (0.999 - 0.25) / 0.75)).ln()).abs() < 1e-3);
+    check_sample_sr_histogram(&b, 11);
+}
+
+#[test]
+fn disney_probe_segments_and_pdf_sp() {
+    let b = disney_bssrdf(
+        SampledSpectrum::new(0.7),
+        SampledSpectrum::from_array([0.3, 0.1, 0.6, 0.3]),
+    );
+    check_probes(&b);
+    // Through the enum the same.
+    let e = Bssrdf::Disney(b);
+    let p = Point3f::new(1.2, 2.1, 3.0);
+    assert_eq!(e.sp(p), b.sp(p));
+    assert_eq!(e.pdf_sp(p, b.ns()), b.pdf_sp(p, b.ns()));
 }

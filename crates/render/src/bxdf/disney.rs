@@ -31,16 +31,19 @@ use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::SampledSpectrum;
 
 /// The lobes, as bits of [`DisneyBxDF::lobes`], in pbrt-v3's order.
-const DIFFUSE: u8 = 1;
-const FAKE_SS: u8 = 2;
-const RETRO: u8 = 4;
-const SHEEN: u8 = 8;
-const SPECULAR: u8 = 16;
-const CLEARCOAT: u8 = 32;
-const SPEC_TRANS: u8 = 64;
-const DIFF_TRANS: u8 = 128;
-const ALL_LOBES: [u8; 8] = [
-    DIFFUSE, FAKE_SS, RETRO, SHEEN, SPECULAR, CLEARCOAT, SPEC_TRANS, DIFF_TRANS,
+const DIFFUSE: u16 = 1;
+const FAKE_SS: u16 = 2;
+/// Solid surfaces with a BSSRDF: perfect specular transmission into it,
+/// in place of the diffuse lobe.
+const ENTRY: u16 = 4;
+const RETRO: u16 = 8;
+const SHEEN: u16 = 16;
+const SPECULAR: u16 = 32;
+const CLEARCOAT: u16 = 64;
+const SPEC_TRANS: u16 = 128;
+const DIFF_TRANS: u16 = 256;
+const ALL_LOBES: [u16; 9] = [
+    DIFFUSE, FAKE_SS, ENTRY, RETRO, SHEEN, SPECULAR, CLEARCOAT, SPEC_TRANS, DIFF_TRANS,
 ];
 
 /// The material's parameters evaluated at a point (pbrt-v3
@@ -77,6 +80,9 @@ pub struct DisneyParams {
     pub flatness: Float,
     /// Thin surfaces: diffuse transmission (0 to 2; half transmits).
     pub diff_trans: Float,
+    /// Solid surfaces: light the diffuse lobe would scatter enters a
+    /// BSSRDF instead (a non-black `scatterdistance`).
+    pub subsurface: bool,
 }
 
 /// pbrt-v3's Disney BSDF at one point.
@@ -103,7 +109,7 @@ pub struct DisneyBxDF {
     /// The transmission distribution of thin surfaces (roughness scaled
     /// by the index of refraction), with height-correlated masking.
     thin_trans: TrowbridgeReitzDistribution,
-    lobes: u8,
+    lobes: u16,
 }
 
 #[inline]
@@ -166,13 +172,13 @@ fn refraction_pair(wo: Vector3f, wi: Vector3f, wh: Vector3f) -> bool {
 
 /// The side of the surface a lobe scatters to.
 #[inline]
-fn is_transmission_lobe(lobe: u8) -> bool {
-    lobe == SPEC_TRANS || lobe == DIFF_TRANS
+fn is_transmission_lobe(lobe: u16) -> bool {
+    lobe == SPEC_TRANS || lobe == DIFF_TRANS || lobe == ENTRY
 }
 
 impl DisneyBxDF {
     /// The BSDF pbrt-v3's `DisneyMaterial::ComputeScatteringFunctions`
-    /// builds from `p` (without a subsurface `scatterdistance`).
+    /// builds from `p`.
     pub fn new(p: &DisneyParams) -> Self {
         let c = p.color.clamp_zero();
         let diffuse_weight = (1.0 - p.metallic) * (1.0 - p.spec_trans);
@@ -190,7 +196,12 @@ impl DisneyBxDF {
         };
         let mut lobes = SPECULAR;
         if diffuse_weight > 0.0 {
-            lobes |= DIFFUSE | RETRO;
+            lobes |= RETRO;
+            lobes |= if p.subsurface && !p.thin {
+                ENTRY
+            } else {
+                DIFFUSE
+            };
             if p.thin {
                 lobes |= FAKE_SS;
             }
@@ -245,7 +256,7 @@ impl DisneyBxDF {
 
     /// The lobes `sample_flags` allows.
     #[inline]
-    fn matching(&self, sample_flags: BxDFReflTransFlags) -> impl Iterator<Item = u8> + '_ {
+    fn matching(&self, sample_flags: BxDFReflTransFlags) -> impl Iterator<Item = u16> + '_ {
         let refl = sample_flags.contains(BxDFReflTransFlags::REFLECTION);
         let trans = sample_flags.contains(BxDFReflTransFlags::TRANSMISSION);
         ALL_LOBES.into_iter().filter(move |&l| {
@@ -263,7 +274,13 @@ impl DisneyBxDF {
     }
 
     /// One lobe's value (no side test).
-    fn lobe_f(&self, lobe: u8, wo: Vector3f, wi: Vector3f, mode: TransportMode) -> SampledSpectrum {
+    fn lobe_f(
+        &self,
+        lobe: u16,
+        wo: Vector3f,
+        wi: Vector3f,
+        mode: TransportMode,
+    ) -> SampledSpectrum {
         let zero = SampledSpectrum::new(0.0);
         let (fo, fi) = (
             schlick_weight(abs_cos_theta(wo)),
@@ -399,7 +416,7 @@ impl DisneyBxDF {
     }
 
     /// One lobe's sampling density (each lobe checks its own side).
-    fn lobe_pdf(&self, lobe: u8, wo: Vector3f, wi: Vector3f) -> Float {
+    fn lobe_pdf(&self, lobe: u16, wo: Vector3f, wi: Vector3f) -> Float {
         match lobe {
             DIFFUSE | FAKE_SS | RETRO | SHEEN if same_hemisphere(wo, wi) => {
                 cosine_hemisphere_pdf(abs_cos_theta(wi))
@@ -462,7 +479,7 @@ impl DisneyBxDF {
     }
 
     /// Samples one lobe: the incident direction, or `None`.
-    fn lobe_sample(&self, lobe: u8, wo: Vector3f, u: Point2f) -> Option<Vector3f> {
+    fn lobe_sample(&self, lobe: u16, wo: Vector3f, u: Point2f) -> Option<Vector3f> {
         match lobe {
             DIFFUSE | FAKE_SS | RETRO | SHEEN | DIFF_TRANS => {
                 let mut wi = sample_cosine_hemisphere(u);
@@ -517,12 +534,34 @@ impl DisneyBxDF {
         }
     }
 
+    /// Samples the specular transmission into the BSSRDF, chosen among
+    /// `n` lobes (pbrt-v3's `SpecularTransmission` with T = 1: no other
+    /// lobe adds to its value or density).
+    fn sample_entry(&self, wo: Vector3f, n: usize, mode: TransportMode) -> Option<BSDFSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let (wi, etap) = refract(wo, Normal3f::new(0.0, 0.0, 1.0), self.eta)?;
+        let mut ft = 1.0 - fr_dielectric(cos_theta(wo), self.eta);
+        if mode == TransportMode::Radiance {
+            ft /= sqr(etap);
+        }
+        Some(BSDFSample::with_eta(
+            SampledSpectrum::new(ft / abs_cos_theta(wi)),
+            wi,
+            1.0 / n as Float,
+            BxDFFlags::SPECULAR_TRANSMISSION,
+            etap,
+        ))
+    }
+
     /// The flags of one lobe.
     #[inline]
-    fn lobe_flags(lobe: u8) -> BxDFFlags {
+    fn lobe_flags(lobe: u16) -> BxDFFlags {
         match lobe {
             SPECULAR | CLEARCOAT => BxDFFlags::GLOSSY_REFLECTION,
             SPEC_TRANS => BxDFFlags::GLOSSY_TRANSMISSION,
+            ENTRY => BxDFFlags::SPECULAR_TRANSMISSION,
             DIFF_TRANS => BxDFFlags::DIFFUSE_TRANSMISSION,
             _ => BxDFFlags::DIFFUSE_REFLECTION,
         }
@@ -555,6 +594,9 @@ impl BxDFMethods for DisneyBxDF {
         }
         let k = ((uc * n as Float) as usize).min(n - 1);
         let lobe = self.matching(sample_flags).nth(k)?;
+        if lobe == ENTRY {
+            return self.sample_entry(wo, n, mode);
+        }
         let wi = self.lobe_sample(lobe, wo, u)?;
         if wi.z == 0.0 || self.lobe_pdf(lobe, wo, wi) == 0.0 {
             return None;

@@ -4,8 +4,8 @@
 //! sampled directions.
 
 use rpbrt_geometry::float::*;
-use rpbrt_geometry::same_hemisphere;
 use rpbrt_geometry::tuple::*;
+use rpbrt_geometry::{abs_cos_theta, cos_theta, same_hemisphere, sin_theta};
 
 use super::tests::{albedo, approx, check_sample_f_against_f_and_pdf, chi2_test, rand_dir};
 use super::*;
@@ -29,6 +29,7 @@ fn disney(edit: impl Fn(&mut DisneyParams)) -> BxDF {
         thin: false,
         flatness: 0.0,
         diff_trans: 1.0,
+        subsurface: false,
     };
     edit(&mut p);
     BxDF::Disney(DisneyBxDF::new(&p))
@@ -82,7 +83,7 @@ fn disney_sample_f_agrees_with_f_and_pdf() {
         let checked = check_sample_f_against_f_and_pdf(name, &b, &mut rng, 2e-3, |wo, bs| {
             assert!(
                 !bs.is_specular(),
-                "{name}: the Disney BSDF has no delta lobe"
+                "{name}: the Disney BSDF has no delta lobe without a BSSRDF"
             );
             assert_eq!(bs.is_transmission(), !same_hemisphere(wo, bs.wi));
             true
@@ -218,6 +219,84 @@ fn disney_lobes_follow_the_parameters() {
     // Fully metallic: no diffuse lobes, the flags say glossy only.
     let m = disney(|p| p.metallic = 1.0);
     assert_eq!(m.flags(), BxDFFlags::GLOSSY_REFLECTION);
+}
+
+#[test]
+fn disney_subsurface_enters_through_specular_transmission() {
+    // Zero roughness: no retro-reflection and a near-mirror specular lobe,
+    // so away from the mirror direction nothing but the diffuse lobe
+    // reflects, and a BSSRDF surface has none.
+    let up = Vector3f::new(0.0, 0.0, 1.0);
+    let wi = Vector3f::new(0.6, 0.0, 0.8);
+    let b = disney(|p| {
+        p.roughness = 0.0;
+        p.subsurface = true;
+    });
+    assert!(b.f(up, wi, TransportMode::Radiance)[0] < 1e-6);
+    assert!(b.f(up, -wi, TransportMode::Radiance).is_black());
+    assert!(b.flags().is_specular() && b.flags().is_transmissive());
+    let plain = disney(|p| p.roughness = 0.0);
+    assert!(plain.f(up, wi, TransportMode::Radiance)[0] > 0.1);
+    // Thin surfaces keep their diffuse lobes.
+    let thin = disney(|p| {
+        p.thin = true;
+        p.subsurface = true;
+    });
+    assert!(!thin.flags().is_specular());
+
+    // Lobes: entry, retro, specular. The entry is chosen a third of the
+    // time, refracts by Snell's law and carries (1 − Fr)/η² in radiance.
+    let b = disney(|p| p.subsurface = true);
+    let mut rng = Rng::new(320, 0);
+    let (mut entries, n) = (0, 30_000);
+    for _ in 0..n {
+        let wo = rand_dir(&mut rng);
+        let Some(bs) = b.sample_f(
+            wo,
+            rng.uniform_float(),
+            Point2f::new(rng.uniform_float(), rng.uniform_float()),
+            TransportMode::Radiance,
+            BxDFReflTransFlags::ALL,
+        ) else {
+            continue;
+        };
+        if !bs.is_specular() {
+            continue;
+        }
+        entries += 1;
+        assert!(bs.is_transmission() && !same_hemisphere(wo, bs.wi));
+        assert!((bs.pdf - 1.0 / 3.0).abs() < 1e-6);
+        let (sin_o, sin_i) = (sin_theta(wo), sin_theta(bs.wi));
+        let eta = if wo.z > 0.0 { 1.5 } else { 1.0 / 1.5 };
+        assert!(
+            (sin_o - eta * sin_i).abs() < 1e-4,
+            "{sin_o} vs {eta}·{sin_i}"
+        );
+        assert!((bs.eta - eta).abs() < 1e-6);
+        let ft = (1.0 - fr_dielectric(cos_theta(wo), 1.5)) / (eta * eta);
+        let got = bs.f[0] * abs_cos_theta(bs.wi);
+        assert!((got - ft).abs() < 1e-4 * ft.max(1e-3), "{got} vs {ft}");
+        assert!(b.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL) == 0.0);
+    }
+    // A third of the draws, less those from below beyond the critical
+    // angle (total internal reflection): cos θ > √(1 − 1/η²) passes.
+    let share = entries as Float / n as Float;
+    let below = (1.0 - 1.0 / (1.5 as Float * 1.5)).sqrt();
+    let want = (0.5 + 0.5 * (1.0 - below)) / 3.0;
+    assert!((share - want).abs() < 0.01, "{share} vs {want}");
+    // Sampling reflection only leaves the entry out.
+    for _ in 0..2000 {
+        let wo = rand_dir(&mut rng);
+        if let Some(bs) = b.sample_f(
+            wo,
+            rng.uniform_float(),
+            Point2f::new(rng.uniform_float(), rng.uniform_float()),
+            TransportMode::Radiance,
+            BxDFReflTransFlags::REFLECTION,
+        ) {
+            assert!(!bs.is_specular() && same_hemisphere(wo, bs.wi));
+        }
+    }
 }
 
 #[test]

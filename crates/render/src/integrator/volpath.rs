@@ -9,7 +9,7 @@ use super::volume::{
     hit_medium_toward, medium_toward, segment_rng, shadow_transmittance, ShadowTransmittance,
 };
 use super::{skip_intersection, RayIntegrator, Scene, VertexOrigins};
-use crate::bssrdf::TabulatedBssrdf;
+use crate::bssrdf::{Bssrdf, SeparableBssrdf};
 use crate::bxdf::{BxDFReflTransFlags, TransportMode, BSDF};
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
@@ -459,7 +459,7 @@ impl VolPathIntegrator {
     fn subsurface(
         &self,
         scene: &Scene,
-        bssrdf: &TabulatedBssrdf,
+        bssrdf: &Bssrdf,
         material: Option<u32>,
         time: Float,
         lambda: &SampledWavelengths,

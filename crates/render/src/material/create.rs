@@ -309,19 +309,15 @@ fn create_disney(tp: &TextureParams, cache: &mut NormalMapCache) -> Result<Mater
         |v| v > 0.0,
         "index of refraction must be positive",
     )?;
-    // pbrt-v3 replaces the diffuse lobe of a non-thin surface with its
-    // Disney BSSRDF when "scatterdistance" is not black; rpbrt has no
-    // Disney BSSRDF and keeps the diffuse lobe.
+    // pbrt-v3 replaces the diffuse lobe of a solid surface with its Disney
+    // BSSRDF where "scatterdistance" is not black; a constant black one is
+    // the same as none.
     let thin = tp.bool("thin", false)?;
-    if let Some(sd) = tp.spectrum_texture_opt("scatterdistance", SpectrumType::Unbounded)? {
-        let black = matches!(&*sd, SpectrumTexture::Constant(s) if s.max_value() == 0.0);
-        if !black && !thin {
-            tp.warn_at(
-                "scatterdistance",
-                "pbrt-v3's Disney subsurface scattering is not implemented; the diffuse lobe is used instead",
-            );
-        }
-    }
+    let scatter_distance = tp
+        .spectrum_texture_opt("scatterdistance", SpectrumType::Unbounded)?
+        .filter(|sd| {
+            !thin && !matches!(&**sd, SpectrumTexture::Constant(s) if s.max_value() <= 0.0)
+        });
     Ok(Material::Disney(Box::new(DisneyMaterial {
         color: tp.spectrum_texture("color", Spectrum::constant(0.5), SpectrumType::Albedo)?,
         metallic: f("metallic", 0.0)?,
@@ -337,6 +333,7 @@ fn create_disney(tp: &TextureParams, cache: &mut NormalMapCache) -> Result<Mater
         thin,
         flatness: f("flatness", 0.0)?,
         diff_trans: f("difftrans", 1.0)?,
+        scatter_distance,
         perturbation: perturbation(tp, cache)?,
     })))
 }

@@ -1,9 +1,11 @@
 //! pbrt-v3's `disney` material (pbrt-v3 `materials/disney.cpp`), which
 //! pbrt-v4 dropped: every parameter is a texture, evaluated at the point
-//! and handed to [`DisneyBxDF`].
+//! and handed to [`DisneyBxDF`]; a solid surface with a non-black
+//! `scatterdistance` there also has a [`DisneyBssrdf`].
 
+use crate::bssrdf::DisneyBssrdf;
 use crate::bxdf::{BxDF, DisneyBxDF, DisneyParams};
-use crate::spectrum::SampledWavelengths;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use crate::texture::{FloatTextureRef, SpectrumTextureRef};
 
 use super::{MaterialEvalContext, ShadingPerturbation};
@@ -40,6 +42,8 @@ pub struct DisneyMaterial {
     pub flatness: FloatTextureRef,
     /// `difftrans` (1).
     pub diff_trans: FloatTextureRef,
+    /// `scatterdistance` (black: none), kept only for solid surfaces.
+    pub scatter_distance: Option<SpectrumTextureRef>,
     /// `bumpmap` (pbrt-v3's name for `displacement`).
     pub perturbation: ShadingPerturbation,
 }
@@ -65,7 +69,52 @@ impl DisneyMaterial {
             thin: self.thin,
             flatness: self.flatness.evaluate(t),
             diff_trans: self.diff_trans.evaluate(t),
+            subsurface: self.scatter_distance(ctx, lambda).is_some(),
         };
         BxDF::Disney(DisneyBxDF::new(&p))
+    }
+
+    /// The scatter distance at a point of a solid surface, unless black
+    /// there (pbrt-v3 then keeps the diffuse lobe).
+    fn scatter_distance(
+        &self,
+        ctx: &MaterialEvalContext,
+        lambda: &SampledWavelengths,
+    ) -> Option<SampledSpectrum> {
+        if self.thin {
+            return None;
+        }
+        let d = self.scatter_distance.as_ref()?.evaluate(&ctx.tex, lambda);
+        (!d.clamp_zero().is_black()).then_some(d)
+    }
+
+    /// True when the material can have a BSSRDF somewhere.
+    pub fn has_subsurface_scattering(&self) -> bool {
+        !self.thin && self.scatter_distance.is_some()
+    }
+
+    /// The BSSRDF at a point (pbrt-v3 creates it with the diffuse weight
+    /// (1 − metallic)(1 − spectrans) times the colour as its albedo), or
+    /// `None` where the surface has no diffuse part or no scatter distance.
+    pub fn get_bssrdf(
+        &self,
+        ctx: &MaterialEvalContext,
+        lambda: &SampledWavelengths,
+    ) -> Option<DisneyBssrdf> {
+        let d = self.scatter_distance(ctx, lambda)?;
+        let t = &ctx.tex;
+        let diffuse_weight =
+            (1.0 - self.metallic.evaluate(t)) * (1.0 - self.spec_trans.evaluate(t));
+        if !(diffuse_weight > 0.0) {
+            return None;
+        }
+        let color = self.color.evaluate(t, lambda).clamp_zero();
+        Some(DisneyBssrdf::new(
+            t.p,
+            ctx.ns,
+            self.eta.evaluate(t),
+            color * diffuse_weight,
+            d,
+        ))
     }
 }

@@ -18,6 +18,7 @@ use rpbrt_geometry::interaction::SurfaceInteraction;
 use rpbrt_geometry::tuple::*;
 use rpbrt_parser::FileLoc;
 
+use crate::bssrdf::Bssrdf;
 use crate::bxdf::{BxDF, DiffuseBxDF, TrowbridgeReitzDistribution, BSDF};
 use crate::image::Image;
 use crate::spectrum::{SampledWavelengths, Spectrum};
@@ -249,10 +250,15 @@ impl Material {
         }
     }
 
-    /// True for materials with a BSSRDF (only `subsurface`).
+    /// True for materials that can have a BSSRDF (`subsurface`, and a solid
+    /// `disney` with a `scatterdistance`).
     #[inline]
     pub fn has_subsurface_scattering(&self) -> bool {
-        matches!(self, Material::Subsurface(_))
+        match self {
+            Material::Subsurface(_) => true,
+            Material::Disney(m) => m.has_subsurface_scattering(),
+            _ => false,
+        }
     }
 
     /// True for `interface` materials, which have no BSDF.
@@ -495,11 +501,11 @@ impl MaterialSet {
         material: u32,
         si: &SurfaceInteraction,
         lambda: &SampledWavelengths,
-    ) -> Option<crate::bssrdf::TabulatedBssrdf<'static>> {
+    ) -> Option<Bssrdf<'static>> {
+        let ctx = MaterialEvalContext::from_si(si);
         match self.resolve(material, si)? {
-            (_, Material::Subsurface(m)) => {
-                Some(m.get_bssrdf(&MaterialEvalContext::from_si(si), lambda))
-            }
+            (_, Material::Subsurface(m)) => Some(Bssrdf::Tabulated(m.get_bssrdf(&ctx, lambda))),
+            (_, Material::Disney(m)) => m.get_bssrdf(&ctx, lambda).map(Bssrdf::Disney),
             _ => None,
         }
     }

@@ -95,7 +95,7 @@ mod tests {
     use rpbrt_geometry::tuple::*;
 
     use super::*;
-    use crate::bssrdf::catmull_rom;
+    use crate::bssrdf::{catmull_rom, SeparableBssrdf};
     use crate::spectrum::Spectrum;
     use crate::texture::{FloatTexture, SpectrumTexture};
 

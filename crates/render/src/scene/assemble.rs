@@ -18,7 +18,9 @@ use crate::camera::create_camera;
 use crate::film::{create_film, FilmOverrides};
 use crate::filter::create_filter;
 use crate::image::MIPMapCache;
-use crate::integrator::{create_integrator, Integrator, IntegratorOptions, RayCounters, Scene};
+use crate::integrator::{
+    create_integrator, Integrator, IntegratorOptions, RayCounters, Scene, VolPathIntegrator,
+};
 use crate::light::{create_light, Light, LightCull, LightDialect, LightType};
 use crate::lightsampler::create_light_sampler;
 use crate::material::MaterialSet;
@@ -149,6 +151,27 @@ fn create_media(desc: &SceneDescription, p: &mut Problems) -> (Vec<Medium>, Hash
         }
     }
     (media, ids)
+}
+
+/// pbrt-v3's `path` integrator traced BSSRDFs, which pbrt-v4's leaves to
+/// `volpath`: in a pbrt-v3 scene with subsurface scattering, `path` is
+/// rendered by `volpath` with the same parameters (the same image in
+/// expectation, the BSSRDF included).
+fn v3_path_with_subsurface(
+    desc: &SceneDescription,
+    materials: &MaterialSet,
+    integrator: Integrator,
+) -> Integrator {
+    match integrator {
+        Integrator::Path(p) if desc.pbrt_v3.is_some() && materials.any_subsurface() => {
+            Integrator::VolPath(VolPathIntegrator {
+                max_depth: p.max_depth,
+                light_sampler_name: p.light_sampler_name,
+                regularize: p.regularize,
+            })
+        }
+        i => i,
+    }
 }
 
 /// What [`check_integrator_support`] looks at.
@@ -429,7 +452,8 @@ pub fn create_scene(
             seed: opts.seed,
             outfile: opts.film.outfile.clone(),
         };
-        let i = create_integrator(&desc.integrator.name, &r, &iopts);
+        let i = create_integrator(&desc.integrator.name, &r, &iopts)
+            .map(|i| v3_path_with_subsurface(desc, &materials, i));
         p.finish(r, i)
     });
     if let Some(i) = &integrator {
