@@ -12,9 +12,11 @@
 //! rate with that many build threads.
 //!
 //! Every structure, obvhs' CWBVH included, calls the same hit closure:
-//! `intersect_prepared_triangle` on the caller's triangle array (with the
-//! per-ray `TriangleRay`, as the renderer does), so only traversal
-//! differs. Output: one `RESULT` line per mesh, structure and thread count.
+//! `intersect_prepared_triangle` on a triangle array (with the per-ray
+//! `TriangleRay`, as the renderer does), so only traversal and the
+//! triangles' memory order differ: rpbrt's structures read the triangles
+//! in their slot order (the 4-wide BVH's leaf order), as the renderer's
+//! `PrimitiveAggregate` does, obvhs the caller's order. Output: one `RESULT` line per mesh, structure and thread count.
 //!
 //! Every mesh is then benchmarked again as `<mesh>-closed`: inside a closed,
 //! tessellated cube around it with the camera inside, so that (nearly) all
@@ -482,15 +484,24 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
             let t0 = Instant::now();
             let a = Accelerator::build_with_threads(&bounds, &params, threads);
             let build = n / t0.elapsed().as_secs_f64() / 1e6;
+            // The triangles in the structure's slot order (leaf order for
+            // the 4-wide BVH), as `PrimitiveAggregate` keeps them.
+            let slot_tris: Vec<Tri> = match a.slot_entries() {
+                Some(order) => order.iter().map(|&e| tris[e as usize]).collect(),
+                None => tris.clone(),
+            };
+            let slot_tris = &slot_tris;
             let closest = |r: &Ray| {
                 let tr = TriangleRay::new(r);
-                a.intersect(r, Float::INFINITY, |p, _, t| hit_tri(tris, &tr, p, t))
-                    .is_some()
+                a.intersect_slots(r, Float::INFINITY, |s, _, _, t| {
+                    hit_tri(slot_tris, &tr, s, t)
+                })
+                .is_some()
             };
             let any = |r: &Ray| {
                 let tr = TriangleRay::new(r);
-                a.intersect_p(r, Float::INFINITY, |p, _, t| {
-                    hit_tri(tris, &tr, p, t).is_some()
+                a.intersect_p_slots(r, Float::INFINITY, |s, _, _, t| {
+                    hit_tri(slot_tris, &tr, s, t).is_some()
                 })
             };
             let (c, _) = run(&cam_set, threads, closest);
@@ -503,9 +514,9 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
                     let sample = subset(rays, 20_000);
                     for r in &sample {
                         let tr = TriangleRay::new(r);
-                        a.intersect(r, Float::INFINITY, |p, _, t| {
+                        a.intersect_slots(r, Float::INFINITY, |s, _, _, t| {
                             k += 1;
-                            hit_tri(tris, &tr, p, t)
+                            hit_tri(slot_tris, &tr, s, t)
                         });
                     }
                     k as f64 / sample.len() as f64

@@ -350,6 +350,27 @@ impl Aggregate for Bvh4 {
     where
         F: FnMut(u32, &Ray, Float) -> Option<Float>,
     {
+        self.intersect_slots(ray, t_max, |_, p, r, t| hit(p, r, t))
+    }
+
+    #[inline]
+    fn intersect_p<F>(&self, ray: &Ray, t_max: Float, mut hit: F) -> bool
+    where
+        F: FnMut(u32, &Ray, Float) -> bool,
+    {
+        self.intersect_p_slots(ray, t_max, |_, p, r, t| hit(p, r, t))
+    }
+
+    /// Slots are positions in [`Bvh4::prim_indices`] (leaf order).
+    fn slot_entries(&self) -> Option<&[u32]> {
+        Some(&self.prim_indices)
+    }
+
+    #[inline]
+    fn intersect_slots<F>(&self, ray: &Ray, t_max: Float, mut hit: F) -> Option<(u32, Float)>
+    where
+        F: FnMut(u32, u32, &Ray, Float) -> Option<Float>,
+    {
         if self.nodes.is_empty() {
             return None;
         }
@@ -373,6 +394,7 @@ impl Aggregate for Bvh4 {
                 let c = node.count[i] as usize;
                 closest_in_leaf(
                     &self.prim_indices[start..start + c],
+                    start as u32,
                     ray,
                     &mut t_max,
                     &mut best,
@@ -430,9 +452,9 @@ impl Aggregate for Bvh4 {
     }
 
     #[inline]
-    fn intersect_p<F>(&self, ray: &Ray, t_max: Float, mut hit: F) -> bool
+    fn intersect_p_slots<F>(&self, ray: &Ray, t_max: Float, mut hit: F) -> bool
     where
-        F: FnMut(u32, &Ray, Float) -> bool,
+        F: FnMut(u32, u32, &Ray, Float) -> bool,
     {
         if self.nodes.is_empty() {
             return false;
@@ -450,8 +472,11 @@ impl Aggregate for Bvh4 {
                 let c = node.count[i];
                 if c > 0 {
                     let start = node.child[i] as usize;
-                    for &p in &self.prim_indices[start..start + c as usize] {
-                        if hit(p, ray, t_max) {
+                    for (k, &p) in self.prim_indices[start..start + c as usize]
+                        .iter()
+                        .enumerate()
+                    {
+                        if hit((start + k) as u32, p, ray, t_max) {
                             return true;
                         }
                     }
@@ -486,19 +511,21 @@ impl Aggregate for Bvh4 {
     }
 }
 
-/// Tests the primitives of one leaf, shrinking `t_max` on each closer hit.
+/// Tests the primitives of one leaf (the first in slot `first`),
+/// shrinking `t_max` on each closer hit.
 #[inline(always)]
 fn closest_in_leaf<F>(
     prims: &[u32],
+    first: u32,
     ray: &Ray,
     t_max: &mut Float,
     best: &mut Option<(u32, Float)>,
     hit: &mut F,
 ) where
-    F: FnMut(u32, &Ray, Float) -> Option<Float>,
+    F: FnMut(u32, u32, &Ray, Float) -> Option<Float>,
 {
-    for &p in prims {
-        if let Some(t) = hit(p, ray, *t_max) {
+    for (k, &p) in prims.iter().enumerate() {
+        if let Some(t) = hit(first + k as u32, p, ray, *t_max) {
             debug_assert!(t <= *t_max);
             *t_max = t;
             *best = Some((p, t));

@@ -59,6 +59,33 @@ pub trait Aggregate {
     where
         F: FnMut(u32, &Ray, Float) -> bool;
 
+    /// [`Aggregate::intersect`], also handing `hit` the entry's slot: where
+    /// the structure keeps its entries (see [`Aggregate::slot_entries`]), so
+    /// that a caller can store per-entry data in traversal order.
+    #[inline(always)]
+    fn intersect_slots<F>(&self, ray: &Ray, t_max: Float, mut hit: F) -> Option<(u32, Float)>
+    where
+        F: FnMut(u32, u32, &Ray, Float) -> Option<Float>,
+    {
+        self.intersect(ray, t_max, |p, r, t| hit(p, p, r, t))
+    }
+
+    /// [`Aggregate::intersect_p`] with slots, as
+    /// [`Aggregate::intersect_slots`].
+    #[inline(always)]
+    fn intersect_p_slots<F>(&self, ray: &Ray, t_max: Float, mut hit: F) -> bool
+    where
+        F: FnMut(u32, u32, &Ray, Float) -> bool,
+    {
+        self.intersect_p(ray, t_max, |p, r, t| hit(p, p, r, t))
+    }
+
+    /// The entry held in each slot, when slots are not the entry indices
+    /// themselves (`None`: slot = entry index).
+    fn slot_entries(&self) -> Option<&[u32]> {
+        None
+    }
+
     /// Heap and inline bytes used by the structure (for `--stats`).
     fn memory_bytes(&self) -> usize;
 
@@ -166,6 +193,38 @@ impl Aggregate for Accelerator {
             Accelerator::Bvh4(a) => a.intersect_p(ray, t_max, hit),
             Accelerator::KdTree(a) => a.intersect_p(ray, t_max, hit),
             Accelerator::Grid(a) => a.intersect_p(ray, t_max, hit),
+        }
+    }
+    #[inline]
+    fn intersect_slots<F>(&self, ray: &Ray, t_max: Float, hit: F) -> Option<(u32, Float)>
+    where
+        F: FnMut(u32, u32, &Ray, Float) -> Option<Float>,
+    {
+        match self {
+            Accelerator::Bvh(a) => a.intersect_slots(ray, t_max, hit),
+            Accelerator::Bvh4(a) => a.intersect_slots(ray, t_max, hit),
+            Accelerator::KdTree(a) => a.intersect_slots(ray, t_max, hit),
+            Accelerator::Grid(a) => a.intersect_slots(ray, t_max, hit),
+        }
+    }
+    #[inline]
+    fn intersect_p_slots<F>(&self, ray: &Ray, t_max: Float, hit: F) -> bool
+    where
+        F: FnMut(u32, u32, &Ray, Float) -> bool,
+    {
+        match self {
+            Accelerator::Bvh(a) => a.intersect_p_slots(ray, t_max, hit),
+            Accelerator::Bvh4(a) => a.intersect_p_slots(ray, t_max, hit),
+            Accelerator::KdTree(a) => a.intersect_p_slots(ray, t_max, hit),
+            Accelerator::Grid(a) => a.intersect_p_slots(ray, t_max, hit),
+        }
+    }
+    fn slot_entries(&self) -> Option<&[u32]> {
+        match self {
+            Accelerator::Bvh(a) => a.slot_entries(),
+            Accelerator::Bvh4(a) => a.slot_entries(),
+            Accelerator::KdTree(a) => a.slot_entries(),
+            Accelerator::Grid(a) => a.slot_entries(),
         }
     }
     fn memory_bytes(&self) -> usize {

@@ -175,6 +175,21 @@ where
         }
         let any = accel.intersect_p(ray, *t_max, |p, r, t| hit(p, r, t).is_some());
         assert_eq!(any, brute.is_some(), "{name}: ray {k} {ray:?}: intersect_p");
+        // The slot variants find the same, and each slot names its entry.
+        let entry_of = |slot: u32| match accel.slot_entries() {
+            Some(order) => order[slot as usize],
+            None => slot,
+        };
+        let by_slot = accel.intersect_slots(ray, *t_max, |s, p, r, t| {
+            assert_eq!(entry_of(s), p, "{name}: slot {s}");
+            hit(p, r, t)
+        });
+        assert_eq!(by_slot, got, "{name}: ray {k}: intersect_slots");
+        let any_slot = accel.intersect_p_slots(ray, *t_max, |s, p, r, t| {
+            assert_eq!(entry_of(s), p, "{name}: slot {s}");
+            hit(p, r, t).is_some()
+        });
+        assert_eq!(any_slot, any, "{name}: ray {k}: intersect_p_slots");
     }
     n_hits
 }

@@ -473,10 +473,11 @@ pub struct PrimitiveAggregate {
     prims: Vec<Primitive>,
     entries: EntryMap,
     accel: Accelerator,
-    /// Per entry: the vertices of an opaque, non-degenerate triangle,
-    /// so that the traversal tests it without going through the primitive
-    /// and its mesh (`None` for every other entry; empty for large
-    /// aggregates).
+    /// Per slot of the acceleration structure (its leaf order for the
+    /// 4-wide BVH, so that a leaf's triangles are read from consecutive
+    /// memory): the vertices of an opaque, non-degenerate triangle, so that
+    /// the traversal tests it without going through the primitive and its
+    /// mesh (`None` for every other entry; empty for large aggregates).
     triangle_vertices: Vec<Option<[Point3f; 3]>>,
     /// Per entry, for the same triangles: the parts of the surface
     /// interaction that are the same all over the triangle, so that a hit
@@ -540,17 +541,18 @@ impl PrimitiveAggregate {
         };
         // 40 bytes per entry: bounded so that huge scenes do not pay
         // gigabytes for it (they fall back to going through the mesh).
-        let triangle_vertices: Vec<Option<[Point3f; 3]>> = if n <= max_vertices {
-            (0..n as u32).map(opaque_triangle).collect()
-        } else {
-            Vec::new()
+        let cached = n <= max_vertices;
+        let triangle_vertices: Vec<Option<[Point3f; 3]>> = match accel.slot_entries() {
+            _ if !cached => Vec::new(),
+            Some(order) => order.iter().map(|&e| opaque_triangle(e)).collect(),
+            None => (0..n as u32).map(opaque_triangle).collect(),
         };
-        // 60 bytes per entry, read once per closest hit.
-        let triangle_frames = if n <= max_frames {
+        // 60 bytes per entry, read once per closest hit; only for the
+        // triangles whose vertices are cached.
+        let triangle_frames = if cached && n <= max_frames {
             (0..n as u32)
-                .zip(&triangle_vertices)
-                .map(|(e, cached)| {
-                    if cached.is_none() {
+                .map(|e| {
+                    if opaque_triangle(e).is_none() {
                         return TriangleFrame::default();
                     }
                     let (p, i) = entries.locate(e);
@@ -616,12 +618,12 @@ impl PrimitiveAggregate {
     pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
         let mut closest = Closest::None;
         let tr = TriangleRay::new(ray);
-        self.accel.intersect(
+        self.accel.intersect_slots(
             ray,
             t_max,
             #[inline(always)]
-            |i, _, t| {
-                if let Some(Some([p0, p1, p2])) = self.triangle_vertices.get(i as usize) {
+            |slot, i, _, t| {
+                if let Some(Some([p0, p1, p2])) = self.triangle_vertices.get(slot as usize) {
                     let (p0, p1, p2) = (*p0, *p1, *p2);
                     let (b0, b1, b2, t_hit) = intersect_prepared_triangle(&tr, t, p0, p1, p2)?;
                     closest = Closest::Triangle {
@@ -647,12 +649,12 @@ impl PrimitiveAggregate {
     pub fn intersect_record(&self, ray: &Ray, t_max: Float) -> Option<HitRecord> {
         let mut closest = None;
         let tr = TriangleRay::new(ray);
-        self.accel.intersect(
+        self.accel.intersect_slots(
             ray,
             t_max,
             #[inline(always)]
-            |i, _, t| {
-                if let Some(Some([p0, p1, p2])) = self.triangle_vertices.get(i as usize) {
+            |slot, i, _, t| {
+                if let Some(Some([p0, p1, p2])) = self.triangle_vertices.get(slot as usize) {
                     let (p0, p1, p2) = (*p0, *p1, *p2);
                     let (b0, b1, b2, t_hit) = intersect_prepared_triangle(&tr, t, p0, p1, p2)?;
                     closest = Some(HitRecord {
@@ -824,8 +826,8 @@ impl PrimitiveAggregate {
     /// Whether anything is hit in (0, t_max).
     pub fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
         let tr = TriangleRay::new(ray);
-        self.accel.intersect_p(ray, t_max, |i, r, t| {
-            match self.triangle_vertices.get(i as usize) {
+        self.accel.intersect_p_slots(ray, t_max, |slot, i, r, t| {
+            match self.triangle_vertices.get(slot as usize) {
                 Some(Some([p0, p1, p2])) => {
                     intersect_prepared_triangle(&tr, t, *p0, *p1, *p2).is_some()
                 }
