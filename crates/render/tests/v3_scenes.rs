@@ -664,3 +664,53 @@ fn v3_disney_bssrdf_spreads_light_by_burleys_profile() {
         );
     }
 }
+
+/// Odd scatter distances (zero in some channels, huge, tiny) and a
+/// textured one render finite pixels without panicking; a negative one is
+/// pbrt-v4's located RGB error; a constant black one is the diffuse lobe,
+/// the same image as leaving it out.
+#[test]
+fn v3_disney_bssrdf_takes_odd_scatter_distances() {
+    let sphere = "Shape \"sphere\" \"float radius\" 1";
+    for sd in [
+        "\"color scatterdistance\" [ 0 0.1 0 ]",
+        "\"color scatterdistance\" [ 1e30 1e-30 0.5 ]",
+        "\"color scatterdistance\" [ 0 0 1e-9 ]",
+        "\"texture scatterdistance\" \"c\"",
+    ] {
+        let world = format!(
+            "Texture \"c\" \"color\" \"checkerboard\" \"color tex1\" [ 0 0 0 ] \"color tex2\" [ 0.2 0.1 0.05 ]\nMaterial \"disney\" {sd}\n{sphere}"
+        );
+        let r =
+            render("odd", &scene(true, "odd", "", &world)).unwrap_or_else(|e| panic!("{sd}: {e}"));
+        assert!(r.pixels.iter().all(|v| v.is_finite()), "{sd}");
+    }
+    let e = render(
+        "neg",
+        &scene(
+            true,
+            "neg",
+            "",
+            &format!("Material \"disney\" \"color scatterdistance\" [ -1 0.1 0 ]\n{sphere}"),
+        ),
+    )
+    .err()
+    .expect("negative RGB");
+    assert!(e.contains("scatterdistance") && e.contains("negative"), "{e}");
+    let black = render(
+        "black",
+        &scene(
+            true,
+            "black",
+            "",
+            &format!("Material \"disney\" \"color scatterdistance\" [ 0 0 0 ]\n{sphere}"),
+        ),
+    )
+    .unwrap();
+    let none = render(
+        "black",
+        &scene(true, "black", "", &format!("Material \"disney\"\n{sphere}")),
+    )
+    .unwrap();
+    assert_eq!(black.pixels, none.pixels);
+}
