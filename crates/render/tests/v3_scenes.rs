@@ -696,7 +696,10 @@ fn v3_disney_bssrdf_takes_odd_scatter_distances() {
     )
     .err()
     .expect("negative RGB");
-    assert!(e.contains("scatterdistance") && e.contains("negative"), "{e}");
+    assert!(
+        e.contains("scatterdistance") && e.contains("negative"),
+        "{e}"
+    );
     let black = render(
         "black",
         &scene(

@@ -20,7 +20,7 @@ use rpbrt_geometry::tuple::*;
 
 use crate::spectrum::{SampledSpectrum, N_SPECTRUM_SAMPLES};
 
-use super::separable::SeparableBssrdf;
+use super::separable::{BssrdfOrigin, SeparableBssrdf};
 
 /// pbrt-v3 keeps radii this far from the profile's 1/r singularity.
 const MIN_RADIUS: Float = 1e-6;
@@ -28,9 +28,7 @@ const MIN_RADIUS: Float = 1e-6;
 /// Burley's normalized-diffusion BSSRDF leaving one point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DisneyBssrdf {
-    po: Point3f,
-    ns: Normal3f,
-    eta: Float,
+    origin: BssrdfOrigin,
     /// Albedo: the profile's integral over the plane.
     r: SampledSpectrum,
     /// Scatter distance, per wavelength.
@@ -50,9 +48,7 @@ impl DisneyBssrdf {
         d: SampledSpectrum,
     ) -> Self {
         DisneyBssrdf {
-            po,
-            ns,
-            eta,
+            origin: BssrdfOrigin { po, ns, eta },
             r: r.clamp_zero(),
             d: d.clamp_zero(),
         }
@@ -72,16 +68,8 @@ impl DisneyBssrdf {
 }
 
 impl SeparableBssrdf for DisneyBssrdf {
-    fn po(&self) -> Point3f {
-        self.po
-    }
-
-    fn ns(&self) -> Normal3f {
-        self.ns
-    }
-
-    fn eta(&self) -> Float {
-        self.eta
+    fn origin(&self) -> &BssrdfOrigin {
+        &self.origin
     }
 
     fn sr(&self, r: Float) -> SampledSpectrum {

@@ -13,7 +13,9 @@ pub mod table;
 pub mod tabulated;
 
 pub use disney::DisneyBssrdf;
-pub use separable::{BssrdfProbeSegment, BssrdfSample, SeparableBssrdf, SubsurfaceInteraction};
+pub use separable::{
+    BssrdfOrigin, BssrdfProbeSegment, BssrdfSample, SeparableBssrdf, SubsurfaceInteraction,
+};
 pub use spline::{
     catmull_rom, catmull_rom_weights, integrate_catmull_rom, invert_catmull_rom, newton_bisection,
     sample_catmull_rom_2d, SplineSample,
@@ -25,7 +27,6 @@ pub use table::{
 pub use tabulated::{subsurface_from_diffuse, TabulatedBssrdf};
 
 use rpbrt_geometry::float::Float;
-use rpbrt_geometry::tuple::{Normal3f, Point3f};
 
 use crate::spectrum::SampledSpectrum;
 
@@ -48,16 +49,8 @@ macro_rules! dispatch {
 }
 
 impl SeparableBssrdf for Bssrdf<'_> {
-    fn po(&self) -> Point3f {
-        dispatch!(self, b => b.po())
-    }
-
-    fn ns(&self) -> Normal3f {
-        dispatch!(self, b => b.ns())
-    }
-
-    fn eta(&self) -> Float {
-        dispatch!(self, b => b.eta())
+    fn origin(&self) -> &BssrdfOrigin {
+        dispatch!(self, b => b.origin())
     }
 
     fn sr(&self, r: Float) -> SampledSpectrum {

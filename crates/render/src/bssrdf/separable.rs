@@ -82,18 +82,25 @@ pub struct BssrdfSample {
 /// Probabilities of projecting along the local x, y and z axes.
 const AXIS_PROB: [Float; 3] = [0.25, 0.25, 0.5];
 
+/// Where light leaves a BSSRDF: the point, its shading normal and the
+/// boundary's relative index of refraction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BssrdfOrigin {
+    /// The point light leaves from.
+    pub po: Point3f,
+    /// The shading normal there.
+    pub ns: Normal3f,
+    /// Relative index of refraction of the boundary.
+    pub eta: Float,
+}
+
 /// A BSSRDF whose spatial term depends on distance alone. Implementors give
-/// the point light leaves from, its shading normal, the boundary's relative
-/// index of refraction and the radial profile (in world units, as an area
+/// where light leaves and the radial profile (in world units, as an area
 /// density); sampling the probe segment, its density and the sample at a
 /// probe hit follow from those.
 pub trait SeparableBssrdf {
-    /// The point light leaves from.
-    fn po(&self) -> Point3f;
-    /// The shading normal at [`Self::po`].
-    fn ns(&self) -> Normal3f;
-    /// Relative index of refraction of the boundary.
-    fn eta(&self) -> Float;
+    /// Where light leaves.
+    fn origin(&self) -> &BssrdfOrigin;
     /// The radial profile Sr(r) at world-space distance `r`.
     fn sr(&self, r: Float) -> SampledSpectrum;
     /// Samples a radius with the first wavelength's profile; `None` when
@@ -103,10 +110,10 @@ pub trait SeparableBssrdf {
     /// each wavelength's own profile, picks the point at radius `r`.
     fn pdf_sr(&self, r: Float) -> SampledSpectrum;
 
-    /// The spatial term Sp between [`Self::po`] and `pi`.
+    /// The spatial term Sp between the origin and `pi`.
     #[inline]
     fn sp(&self, pi: Point3f) -> SampledSpectrum {
-        self.sr(distance(self.po(), pi))
+        self.sr(distance(self.origin().po, pi))
     }
 
     /// Samples a probe segment: a projection axis of the shading frame
@@ -114,7 +121,8 @@ pub trait SeparableBssrdf {
     /// [`Self::sample_sr`] (`u2[0]`) and an angle (`u2[1]`); the segment runs
     /// along the axis through the sphere of radius r_max = `sample_sr(0.999)`.
     fn sample_sp(&self, u1: Float, u2: Point2f) -> Option<BssrdfProbeSegment> {
-        let n = Vector3f::from(self.ns());
+        let o = self.origin();
+        let n = Vector3f::from(o.ns);
         let f = if u1 < 0.25 {
             Frame::from_x(n)
         } else if u1 < 0.5 {
@@ -132,7 +140,7 @@ pub trait SeparableBssrdf {
             return None;
         }
         let l = 2.0 * (r_max * r_max - r * r).sqrt();
-        let p_start = self.po() + r * (f.x * phi.cos() + f.y * phi.sin()) - f.z * (l / 2.0);
+        let p_start = o.po + r * (f.x * phi.cos() + f.y * phi.sin()) - f.z * (l / 2.0);
         Some(BssrdfProbeSegment {
             p0: p_start,
             p1: p_start + f.z * l,
@@ -142,8 +150,9 @@ pub trait SeparableBssrdf {
     /// The density (per unit area) of [`Self::sample_sp`] finding `pi` with
     /// surface normal `ni`, combined over the three projection axes.
     fn pdf_sp(&self, pi: Point3f, ni: Normal3f) -> SampledSpectrum {
-        let f = Frame::from_z(Vector3f::from(self.ns()));
-        let d = f.to_local(pi - self.po());
+        let o = self.origin();
+        let f = Frame::from_z(Vector3f::from(o.ns));
+        let d = f.to_local(pi - o.po);
         let n = f.to_local_normal(ni);
         let r_proj = [
             (d.y * d.y + d.z * d.z).sqrt(),
@@ -161,7 +170,7 @@ pub trait SeparableBssrdf {
     /// Turns a probe-ray hit into a BSSRDF sample: Sp, the sampling density
     /// and the normalized-Fresnel BSDF light enters through.
     fn probe_intersection_to_sample(&self, si: &SubsurfaceInteraction) -> BssrdfSample {
-        let bxdf = BxDF::NormalizedFresnel(NormalizedFresnelBxDF::new(self.eta()));
+        let bxdf = BxDF::NormalizedFresnel(NormalizedFresnelBxDF::new(self.origin().eta));
         let wo = Vector3f::from(si.ns);
         let p = si.p();
         BssrdfSample {

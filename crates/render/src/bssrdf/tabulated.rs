@@ -7,7 +7,7 @@ use rpbrt_geometry::tuple::*;
 
 use crate::spectrum::{SampledSpectrum, N_SPECTRUM_SAMPLES};
 
-use super::separable::SeparableBssrdf;
+use super::separable::{BssrdfOrigin, SeparableBssrdf};
 use super::spline::{catmull_rom_weights, invert_catmull_rom, sample_catmull_rom_2d};
 use super::table::BssrdfTable;
 
@@ -15,10 +15,8 @@ use super::table::BssrdfTable;
 /// S(po, pi) ≈ Sp(|po − pi|) · Sw(wi), with per-wavelength σt and albedo.
 #[derive(Clone, Copy, Debug)]
 pub struct TabulatedBssrdf<'a> {
-    po: Point3f,
+    origin: BssrdfOrigin,
     wo: Vector3f,
-    ns: Normal3f,
-    eta: Float,
     sigma_t: SampledSpectrum,
     rho: SampledSpectrum,
     table: &'a BssrdfTable,
@@ -39,10 +37,8 @@ impl<'a> TabulatedBssrdf<'a> {
     ) -> Self {
         let sigma_t = sigma_a + sigma_s;
         TabulatedBssrdf {
-            po,
+            origin: BssrdfOrigin { po, ns, eta },
             wo,
-            ns,
-            eta,
             sigma_t,
             rho: SampledSpectrum::safe_div(sigma_s, sigma_t),
             table,
@@ -94,16 +90,8 @@ impl<'a> TabulatedBssrdf<'a> {
 }
 
 impl SeparableBssrdf for TabulatedBssrdf<'_> {
-    fn po(&self) -> Point3f {
-        self.po
-    }
-
-    fn ns(&self) -> Normal3f {
-        self.ns
-    }
-
-    fn eta(&self) -> Float {
-        self.eta
+    fn origin(&self) -> &BssrdfOrigin {
+        &self.origin
     }
 
     fn sr(&self, r: Float) -> SampledSpectrum {
