@@ -45,7 +45,7 @@ AttributeEnd
 "#;
 
 /// Media of every type, interfaces, a medium around the camera and
-/// subsurface scattering, rendered by volpath.
+/// subsurface scattering (tabulated and Disney), rendered by volpath.
 const BUILTIN_MEDIA: &str = r#"LookAt 0 0 -5  0 0 0  0 1 0
 MediumInterface "" "fog"
 Camera "perspective" "float fov" 45
@@ -89,6 +89,11 @@ AttributeBegin
   Translate 0 -2 0
   Material "subsurface" "string name" "Ketchup" "float scale" 10
   Shape "sphere" "float radius" 0.8
+AttributeEnd
+AttributeBegin
+  Translate 0 -2 2
+  Material "disney" "rgb color" [ 0.8 0.5 0.3 ] "rgb scatterdistance" [ 0.1 0.05 0.02 ] "float spectrans" 0.2
+  Shape "sphere" "float radius" 0.5
 AttributeEnd
 AttributeBegin
   Translate 0 0 2
