@@ -35,6 +35,8 @@ pub struct Options {
     pub stats: bool,
     /// `--write-partial-images`.
     pub write_partial_images: bool,
+    /// `--wavefront`: the wavefront path tracer.
+    pub wavefront: bool,
     /// `--disable-pixel-jitter`.
     pub disable_pixel_jitter: bool,
     /// `--disable-wavelength-jitter`.
@@ -111,6 +113,8 @@ Rendering options:
   --stats                      Print statistics after rendering.
   --tile <k/n>                 Render tile k (0-based) of n tiles of the image;
                                `imgtool assemble` joins them.
+  --wavefront                  Render path and volpath scenes with the wavefront path
+                               tracer (many paths per thread at once; same image).
   --write-partial-images       Write the image periodically while rendering.
 
 Scene file tools:
@@ -324,6 +328,7 @@ pub fn parse_args(args: &[String]) -> Result<Options, ArgError> {
             "quiet" => o.quiet = true,
             "stats" => o.stats = true,
             "writepartialimages" => o.write_partial_images = true,
+            "wavefront" => o.wavefront = true,
             "disablepixeljitter" => o.disable_pixel_jitter = true,
             "disablewavelengthjitter" => o.disable_wavelength_jitter = true,
             "disabletexturefiltering" => o.disable_texture_filtering = true,

@@ -207,6 +207,15 @@ fn render_command(opts: &args::Options) -> ExitCode {
         }
     }
 
+    let wavefront = opts.wavefront || desc_flag(&desc, "wavefront");
+    if wavefront && !integrator.has_wavefront() && !opts.quiet {
+        eprintln!(
+            "rpbrt: warning: --wavefront: the \"{}\" integrator{} has no wavefront form yet; rendering it with the scalar loop",
+            integrator.name(),
+            if integrator.name() == "volpath" { " with participating media" } else { "" }
+        );
+    }
+
     let interrupt = Arc::new(AtomicBool::new(false));
     // A second Ctrl-C ends the process at once; the first one stops the
     // render after the current wave and writes the image so far.
@@ -244,6 +253,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
         observer: watch
             .as_ref()
             .map(|w| Arc::clone(w) as Arc<dyn rpbrt_render::integrator::RenderObserver>),
+        wavefront,
     };
     let tev = match (&watch, &opts.display_server) {
         (Some(w), Some(address)) => {

@@ -43,6 +43,20 @@ impl Rng {
         self.state = self.state.wrapping_add(offset);
         self.uniform_u32();
     }
+    /// The generator's whole state (state, increment), to be handed back
+    /// to [`Rng::from_raw`].
+    #[inline]
+    pub(crate) fn raw(&self) -> (u64, u64) {
+        (self.state, self.inc)
+    }
+    /// The generator whose [`Rng::raw`] state was `raw`.
+    #[inline]
+    pub(crate) fn from_raw(raw: (u64, u64)) -> Self {
+        Rng {
+            state: raw.0,
+            inc: raw.1,
+        }
+    }
     /// A uniformly distributed 32-bit value.
     #[inline]
     pub fn uniform_u32(&mut self) -> u32 {

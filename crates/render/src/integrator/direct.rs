@@ -60,6 +60,18 @@ impl<'a> VertexOrigins<'a> {
     }
 }
 
+/// A light sample's contribution waiting for its shadow ray: `ld` counts
+/// when nothing blocks `ray` in (0, `t_max`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ShadowQuery {
+    /// The shadow ray, from the vertex toward the point on the light.
+    pub ray: Ray,
+    /// Its extent.
+    pub t_max: Float,
+    /// The unoccluded contribution.
+    pub ld: SampledSpectrum,
+}
+
 /// Samples direct lighting at a surface hit with multiple importance
 /// sampling (pbrt-v4 `PathIntegrator::SampleLd`), given its two sampler
 /// draws: `u` chooses the light and `u_light` the point on it. `origins`
@@ -75,40 +87,57 @@ pub(crate) fn sample_ld(
     u: Float,
     u_light: Point2f,
 ) -> SampledSpectrum {
+    match sample_ld_deferred(scene, light_sampler, origins, bsdf, lambda, u, u_light) {
+        Some(q) if !scene.intersect_p(&q.ray, q.t_max) => q.ld,
+        _ => SampledSpectrum::new(0.0),
+    }
+}
+
+/// [`sample_ld`] with its shadow ray left to the caller (the wavefront
+/// integrator traces a batch of them together): `None` when the sample
+/// contributes nothing whatever the visibility.
+#[inline]
+pub(crate) fn sample_ld_deferred(
+    scene: &Scene,
+    light_sampler: &LightSampler,
+    origins: &mut VertexOrigins,
+    bsdf: &BSDF,
+    lambda: &SampledWavelengths,
+    u: Float,
+    u_light: Point2f,
+) -> Option<ShadowQuery> {
     let si = origins.si;
     let ctx = surface_light_context(origins, bsdf);
-    let sampled = light_sampler.sample(&ctx, u);
-    let Some(sampled) = sampled else {
-        return SampledSpectrum::new(0.0);
-    };
+    let sampled = light_sampler.sample(&ctx, u)?;
     if light_sample_culled(scene, sampled.light, ctx.p(), bsdf, si) {
-        return SampledSpectrum::new(0.0);
+        return None;
     }
     let light = &scene.lights[sampled.light as usize];
-    let Some(ls) = light.sample_li(&ctx, u_light, lambda, true) else {
-        return SampledSpectrum::new(0.0);
-    };
+    let ls = light.sample_li(&ctx, u_light, lambda, true)?;
     if ls.l.is_black() || ls.pdf == 0.0 {
-        return SampledSpectrum::new(0.0);
+        return None;
     }
     let wo = si.wo;
     let wi = ls.wi;
     let f = bsdf.f(wo, wi, crate::bxdf::TransportMode::Radiance) * abs_dot(wi, si.shading.n);
-    if f.is_black() || !scene.unoccluded_from(origins, ls.p_light, ls.n_light) {
-        return SampledSpectrum::new(0.0);
+    if f.is_black() {
+        return None;
     }
+    let (ray, t_max) = scene.shadow_ray_from(origins, ls.p_light, ls.n_light);
     let p_l = sampled.p * ls.pdf;
-    if light.light_type().is_delta() {
-        return ls.l * f / p_l;
-    }
-    let p_b = bsdf.pdf(
-        wo,
-        wi,
-        crate::bxdf::TransportMode::Radiance,
-        crate::bxdf::BxDFReflTransFlags::ALL,
-    );
-    let w_l = crate::sampling::power_heuristic(1.0, p_l, 1.0, p_b);
-    ls.l * f * (w_l / p_l)
+    let ld = if light.light_type().is_delta() {
+        ls.l * f / p_l
+    } else {
+        let p_b = bsdf.pdf(
+            wo,
+            wi,
+            crate::bxdf::TransportMode::Radiance,
+            crate::bxdf::BxDFReflTransFlags::ALL,
+        );
+        let w_l = crate::sampling::power_heuristic(1.0, p_l, 1.0, p_b);
+        ls.l * f * (w_l / p_l)
+    };
+    Some(ShadowQuery { ray, t_max, ld })
 }
 
 /// The light-sampling context of a surface vertex, its point nudged off

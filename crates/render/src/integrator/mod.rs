@@ -44,6 +44,7 @@ mod sppm;
 pub mod tile;
 mod volpath;
 mod volume;
+mod wavefront;
 mod whitted;
 
 pub use bdpt::BdptIntegrator;
@@ -120,6 +121,9 @@ impl Integrator {
         // One match per render: each arm runs a loop built for its
         // integrator (no dispatch per ray).
         let mut result = match self {
+            Integrator::Path(i) if opts.wavefront => {
+                tile::render_tiles(&wavefront::WavefrontPath(i), scene, opts, metadata, progress)
+            }
             Integrator::Path(i) => {
                 tile::render_tiles(&tile::RayTiles(i), scene, opts, metadata, progress)
             }
@@ -153,6 +157,13 @@ impl Integrator {
                 .extend(crate::texture::ptex::take_lookup_warnings());
         }
         result
+    }
+
+    /// True when `--wavefront` ([`RenderOptions::wavefront`]) renders this
+    /// integrator with the wavefront path tracer; the others (and
+    /// `volpath` with media, for now) keep their scalar loops.
+    pub fn has_wavefront(&self) -> bool {
+        matches!(self, Integrator::Path(_))
     }
 
     /// The integrator's name in scene files.

@@ -2,7 +2,9 @@
 //! estimation with multiple importance sampling, Russian roulette and
 //! optional BSDF regularization.
 
-use super::{sample_ld, skip_intersection, RayIntegrator, Scene, VertexOrigins};
+use super::direct::{sample_ld_deferred, ShadowQuery};
+use super::{skip_intersection, RayIntegrator, Scene, VertexOrigins};
+use crate::primitive::PrimitiveIntersection;
 use crate::bxdf::{BxDFReflTransFlags, TransportMode};
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
@@ -81,116 +83,172 @@ impl RayIntegrator for PathIntegrator {
         sampler: &mut Sampler,
         mut visible: Option<&mut VisibleSurface>,
     ) -> SampledSpectrum {
-        let light_sampler: &LightSampler = &scene.light_sampler;
         let mut s = PathState::new(ray);
         loop {
             // Matched by reference: moving the (large) intersection out of
             // the `Option` would copy it.
             let mut closest = scene.intersect(&s.ray.ray, Float::INFINITY);
-            let Some(hit) = closest.as_mut() else {
-                // Escaped: infinite lights, weighted by MIS unless the last
-                // bounce could not have been light-sampled.
-                for &li in &scene.infinite_lights {
-                    let light = &scene.lights[li as usize];
-                    let le = light.le(&s.ray.ray, lambda);
-                    if le.is_black() {
-                        continue;
-                    }
-                    if s.depth == 0 || s.specular_bounce {
-                        s.l += s.beta * le;
-                    } else {
-                        let p_l = light_sampler.pmf(&s.prev_ctx, li)
-                            * light.pdf_li(&s.prev_ctx, s.ray.ray.d, true);
-                        let w_b = power_heuristic(1.0, s.p_b, 1.0, p_l);
-                        s.l += s.beta * le * w_b;
-                    }
-                }
-                break;
-            };
-            // Emission from an area light that was hit.
-            let le = scene.le(hit, -s.ray.ray.d, lambda);
-            if !le.is_black() {
-                if s.depth == 0 || s.specular_bounce {
-                    s.l += s.beta * le;
-                } else if let Some(al) = hit.area_light {
-                    let light = &scene.lights[al as usize];
-                    let p_l = light_sampler.pmf(&s.prev_ctx, al)
-                        * light.pdf_li(&s.prev_ctx, s.ray.ray.d, true);
-                    let w_l = power_heuristic(1.0, s.p_b, 1.0, p_l);
-                    s.l += s.beta * le * w_l;
+            let step = self.vertex(
+                scene,
+                &mut s,
+                closest.as_mut(),
+                lambda,
+                sampler,
+                visible.as_deref_mut(),
+            );
+            if let Some(q) = step.shadow {
+                if !scene.intersect_p(&q.ray, q.t_max) {
+                    s.l += q.ld;
                 }
             }
-            // Borrowed in place: moving the (large) BSDF out would copy it.
-            let mut bsdf_slot = scene.get_bsdf(hit, &s.ray, lambda, sampler);
-            let Some(bsdf) = bsdf_slot.as_mut() else {
-                s.specular_bounce = true;
-                s.ray = skip_intersection(&s.ray, hit);
-                continue;
-            };
-            if s.depth == 0 {
-                if let Some(v) = visible.take() {
-                    *v = scene.visible_surface(hit, bsdf);
-                }
-            }
-            if self.regularize && s.any_non_specular {
-                bsdf.regularize();
-            }
-            if s.depth == self.max_depth {
-                break;
-            }
-            s.depth += 1;
-            let si = &hit.si;
-            let mut origins = VertexOrigins::new(si);
-            // Sampler draws in pbrt-v4's order: the light's two, then the
-            // BSDF's two (taken together when there is a light sample).
-            let (u, u2) = if bsdf.flags().is_non_specular() {
-                let (u_light, u_light_2d, u, u2) = sampler.get_vertex_samples();
-                let ld = sample_ld(
-                    scene,
-                    light_sampler,
-                    &mut origins,
-                    bsdf,
-                    lambda,
-                    u_light,
-                    u_light_2d,
-                );
-                s.l += s.beta * ld;
-                (u, u2)
-            } else {
-                (sampler.get_1d(), sampler.get_2d())
-            };
-            s.prev_ctx = LightSampleContext::from_si(si);
-            let wo = -s.ray.ray.d;
-            let Some(bs) =
-                bsdf.sample_f(wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL)
-            else {
-                break;
-            };
-            s.beta *= bs.f * (abs_dot(bs.wi, si.shading.n) / bs.pdf);
-            s.p_b = if bs.pdf_is_proportional {
-                bsdf.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL)
-            } else {
-                bs.pdf
-            };
-            s.specular_bounce = bs.is_specular();
-            s.any_non_specular |= !bs.is_specular();
-            if bs.is_transmission() {
-                s.eta_scale *= bs.eta * bs.eta;
-            }
-            s.ray = RayDifferential::new(origins.spawn_ray(bs.wi));
-            let rr_beta = s.beta * s.eta_scale;
-            let m = rr_beta.max_component_value();
-            if m < 1.0 && s.depth > 1 {
-                let q = (1.0 - m).max(0.0);
-                if sampler.get_1d() < q {
-                    break;
-                }
-                s.beta /= 1.0 - q;
-            }
-            if s.beta.is_black() {
+            if step.done {
                 break;
             }
         }
         s.l
+    }
+}
+
+/// What a path vertex leaves to the caller: a shadow ray whose
+/// contribution counts if nothing blocks it, and whether the path ends
+/// (after that contribution).
+pub(crate) struct VertexStep {
+    /// The light sample's shadow query, its contribution already
+    /// multiplied by the path throughput.
+    pub shadow: Option<ShadowQuery>,
+    /// The path ends here.
+    pub done: bool,
+}
+
+impl PathIntegrator {
+    /// One vertex of pbrt-v4's `PathIntegrator::Li`: the ray `s.ray`
+    /// ended at `hit` (`None`: it escaped). Adds emission to `s.l`, samples
+    /// the lights and the BSDF, and leaves `s.ray` on the next bounce. The
+    /// scalar path tracer and the wavefront one both run every vertex
+    /// through here, so they give the same pixels; they differ only in
+    /// when they trace the rays.
+    #[inline(always)]
+    pub(crate) fn vertex(
+        &self,
+        scene: &Scene,
+        s: &mut PathState,
+        hit: Option<&mut PrimitiveIntersection>,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+        visible: Option<&mut VisibleSurface>,
+    ) -> VertexStep {
+        const DONE: VertexStep = VertexStep {
+            shadow: None,
+            done: true,
+        };
+        let light_sampler: &LightSampler = &scene.light_sampler;
+        let Some(hit) = hit else {
+            // Escaped: infinite lights, weighted by MIS unless the last
+            // bounce could not have been light-sampled.
+            for &li in &scene.infinite_lights {
+                let light = &scene.lights[li as usize];
+                let le = light.le(&s.ray.ray, lambda);
+                if le.is_black() {
+                    continue;
+                }
+                if s.depth == 0 || s.specular_bounce {
+                    s.l += s.beta * le;
+                } else {
+                    let p_l = light_sampler.pmf(&s.prev_ctx, li)
+                        * light.pdf_li(&s.prev_ctx, s.ray.ray.d, true);
+                    let w_b = power_heuristic(1.0, s.p_b, 1.0, p_l);
+                    s.l += s.beta * le * w_b;
+                }
+            }
+            return DONE;
+        };
+        // Emission from an area light that was hit.
+        let le = scene.le(hit, -s.ray.ray.d, lambda);
+        if !le.is_black() {
+            if s.depth == 0 || s.specular_bounce {
+                s.l += s.beta * le;
+            } else if let Some(al) = hit.area_light {
+                let light = &scene.lights[al as usize];
+                let p_l = light_sampler.pmf(&s.prev_ctx, al)
+                    * light.pdf_li(&s.prev_ctx, s.ray.ray.d, true);
+                let w_l = power_heuristic(1.0, s.p_b, 1.0, p_l);
+                s.l += s.beta * le * w_l;
+            }
+        }
+        // Borrowed in place: moving the (large) BSDF out would copy it.
+        let mut bsdf_slot = scene.get_bsdf(hit, &s.ray, lambda, sampler);
+        let Some(bsdf) = bsdf_slot.as_mut() else {
+            s.specular_bounce = true;
+            s.ray = skip_intersection(&s.ray, hit);
+            return VertexStep {
+                shadow: None,
+                done: false,
+            };
+        };
+        if s.depth == 0 {
+            if let Some(v) = visible {
+                *v = scene.visible_surface(hit, bsdf);
+            }
+        }
+        if self.regularize && s.any_non_specular {
+            bsdf.regularize();
+        }
+        if s.depth == self.max_depth {
+            return DONE;
+        }
+        s.depth += 1;
+        let si = &hit.si;
+        let mut origins = VertexOrigins::new(si);
+        // Sampler draws in pbrt-v4's order: the light's two, then the
+        // BSDF's two (taken together when there is a light sample).
+        let mut shadow = None;
+        let (u, u2) = if bsdf.flags().is_non_specular() {
+            let (u_light, u_light_2d, u, u2) = sampler.get_vertex_samples();
+            shadow = sample_ld_deferred(
+                scene,
+                light_sampler,
+                &mut origins,
+                bsdf,
+                lambda,
+                u_light,
+                u_light_2d,
+            )
+            .map(|q| ShadowQuery {
+                ld: s.beta * q.ld,
+                ..q
+            });
+            (u, u2)
+        } else {
+            (sampler.get_1d(), sampler.get_2d())
+        };
+        s.prev_ctx = LightSampleContext::from_si(si);
+        let wo = -s.ray.ray.d;
+        let Some(bs) = bsdf.sample_f(wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL)
+        else {
+            return VertexStep { shadow, done: true };
+        };
+        s.beta *= bs.f * (abs_dot(bs.wi, si.shading.n) / bs.pdf);
+        s.p_b = if bs.pdf_is_proportional {
+            bsdf.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL)
+        } else {
+            bs.pdf
+        };
+        s.specular_bounce = bs.is_specular();
+        s.any_non_specular |= !bs.is_specular();
+        if bs.is_transmission() {
+            s.eta_scale *= bs.eta * bs.eta;
+        }
+        s.ray = RayDifferential::new(origins.spawn_ray(bs.wi));
+        let rr_beta = s.beta * s.eta_scale;
+        let m = rr_beta.max_component_value();
+        if m < 1.0 && s.depth > 1 {
+            let q = (1.0 - m).max(0.0);
+            if sampler.get_1d() < q {
+                return VertexStep { shadow, done: true };
+            }
+            s.beta /= 1.0 - q;
+        }
+        let done = s.beta.is_black();
+        VertexStep { shadow, done }
     }
 }

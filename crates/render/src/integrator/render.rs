@@ -37,6 +37,10 @@ pub struct RenderOptions {
     /// [`RenderObserver::wants_image`] after each unit of work and hand
     /// over a [`Snapshot`] when it says yes, and always at the end.
     pub observer: Option<Arc<dyn RenderObserver>>,
+    /// `--wavefront`: render with the wavefront path tracer (many paths
+    /// per thread at once; the same image) where the integrator has one
+    /// ([`crate::integrator::Integrator::has_wavefront`]).
+    pub wavefront: bool,
 }
 
 /// The image of a render in progress, as the film would write its R, G

@@ -128,6 +128,32 @@ impl Scene {
         self.aggregate.intersect_record(ray, t_max)
     }
 
+    /// [`Scene::intersect_record`] of each ray in `rays` (with no bound on
+    /// the ray parameter), into `out` (cleared first): a batch of rays
+    /// traced together.
+    pub fn intersect_records(&self, rays: &[Ray], out: &mut Vec<Option<HitRecord>>) {
+        LOCAL_RAY_COUNTS.with(|c| {
+            let (closest, shadow) = c.get();
+            c.set((closest + rays.len() as u64, shadow));
+        });
+        out.clear();
+        out.extend(
+            rays.iter()
+                .map(|r| self.aggregate.intersect_record(r, Float::INFINITY)),
+        );
+    }
+
+    /// Whether anything blocks each ray of `rays` in (0, its t_max), into
+    /// `out` (cleared first): [`Scene::intersect_p`] of a batch of rays.
+    pub fn intersect_ps(&self, rays: &[(Ray, Float)], out: &mut Vec<bool>) {
+        LOCAL_RAY_COUNTS.with(|c| {
+            let (closest, shadow) = c.get();
+            c.set((closest, shadow + rays.len() as u64));
+        });
+        out.clear();
+        out.extend(rays.iter().map(|(r, t)| self.aggregate.intersect_p(r, *t)));
+    }
+
     /// Whether anything blocks `ray` in (0, t_max).
     #[inline]
     pub fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
@@ -138,20 +164,21 @@ impl Scene {
         self.aggregate.intersect_p(ray, t_max)
     }
 
-    /// [`Scene::unoccluded`] with the surface point's offset origin taken
-    /// from `origins` (the same ray).
+    /// The shadow ray [`Scene::unoccluded`] traces, with the surface
+    /// point's offset origin taken from `origins` (the same ray), and its
+    /// extent.
     #[inline]
-    pub(crate) fn unoccluded_from(
+    pub(crate) fn shadow_ray_from(
         &self,
         origins: &mut VertexOrigins,
         to_p: Point3fi,
         to_n: Normal3f,
-    ) -> bool {
+    ) -> (Ray, Float) {
         let si = origins.si;
         let p_to = to_p.midpoint();
         let pf = origins.toward(p_to - si.p());
         let r = spawn_ray_from_origin_to_surface(pf, si.time, p_to, to_p.error(), to_n);
-        !self.intersect_p(&r, 1.0 - SHADOW_EPSILON)
+        (r, 1.0 - SHADOW_EPSILON)
     }
 
     /// True when nothing blocks the segment between a surface point and a

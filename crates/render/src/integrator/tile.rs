@@ -26,6 +26,7 @@ use rpbrt_geometry::bounds::Bounds2i;
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::ray::RayDifferential;
 use rpbrt_geometry::tuple::*;
+use std::ops::Range;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
@@ -96,6 +97,41 @@ pub trait TileIntegrator: Sync {
     /// of [`SplatBuffer::add_to`] is `extra_films()[k - 1]`).
     fn extra_films(&self) -> &[crate::film::Film] {
         &[]
+    }
+
+    /// Takes samples `samples` of every pixel of `bounds`, pixel by pixel
+    /// in `bounds.iter()` order and each pixel's samples in order, adding
+    /// them to `tile` (splats to `splats`); returns the camera samples
+    /// taken. Stops early, between samples, once `opts` is interrupted:
+    /// every sample taken is whole. The default takes one sample at a time
+    /// ([`TileIntegrator::evaluate_pixel_sample`]); the wavefront path
+    /// tracer takes many at once, adding them to the tile in the same
+    /// order.
+    #[allow(clippy::too_many_arguments)]
+    fn render_tile(
+        &self,
+        scene: &Scene,
+        opts: &RenderOptions,
+        bounds: Bounds2i,
+        samples: Range<i32>,
+        sampler: &mut Sampler,
+        tile: &mut FilmTile,
+        splats: &mut SplatBuffer,
+        differentials: bool,
+    ) -> u64 {
+        let mut taken = 0;
+        for p in bounds.iter() {
+            for s in samples.clone() {
+                // Checked per sample: one pixel's samples can take minutes.
+                if opts.interrupted() {
+                    return taken;
+                }
+                sampler.start_pixel_sample(p, s, 0);
+                self.evaluate_pixel_sample(scene, opts, p, sampler, tile, splats, differentials);
+                taken += 1;
+            }
+        }
+        taken
     }
 }
 
@@ -240,19 +276,41 @@ impl CameraRaySample {
         };
         if let Some((ray, weight)) = self.ray {
             l = li(ray, &mut self.lambda, visible.as_mut()) * weight;
-            if l.has_nan() || !l.y(&self.lambda).is_finite() {
-                // pbrt-v4 drops such samples (and logs them).
-                l = SampledSpectrum::new(0.0);
-            }
         }
-        tile.add_sample(
+        add_estimate(
+            tile,
             self.p_pixel,
             l,
             &self.lambda,
-            visible.as_ref().filter(|v| v.set),
+            visible.as_ref(),
             self.cs.filter_weight,
         );
     }
+}
+
+/// Adds a camera sample's radiance estimate `l` (already multiplied by
+/// the camera ray's weight) to `tile`: NaN and infinite estimates are
+/// dropped, as pbrt-v4 does (and logs them), and `visible` counts only
+/// when something set it.
+#[inline]
+pub(crate) fn add_estimate(
+    tile: &mut FilmTile,
+    p_pixel: Point2i,
+    mut l: SampledSpectrum,
+    lambda: &SampledWavelengths,
+    visible: Option<&VisibleSurface>,
+    filter_weight: Float,
+) {
+    if l.has_nan() || !l.y(lambda).is_finite() {
+        l = SampledSpectrum::new(0.0);
+    }
+    tile.add_sample(
+        p_pixel,
+        l,
+        lambda,
+        visible.filter(|v| v.set),
+        filter_weight,
+    );
 }
 
 /// The samples of the wave after `[start, end)`: pbrt-v4's schedule,
@@ -332,27 +390,16 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
                         let mut tile = scene_ref.film.make_tile(b);
                         let mut tile_splats = splats.buffer();
                         super::RayCounters::reset_local();
-                        let mut camera_rays = 0u64;
-                        for p in b.iter() {
-                            // Checked per pixel: a wave can be the whole
-                            // render.
-                            if opts.interrupted() {
-                                break;
-                            }
-                            for s in wave_start..wave_end {
-                                sampler.start_pixel_sample(p, s, 0);
-                                integrator.evaluate_pixel_sample(
-                                    scene_ref,
-                                    opts,
-                                    p,
-                                    &mut sampler,
-                                    &mut tile,
-                                    &mut tile_splats,
-                                    differentials,
-                                );
-                            }
-                            camera_rays += (wave_end - wave_start) as u64;
-                        }
+                        let camera_rays = integrator.render_tile(
+                            scene_ref,
+                            opts,
+                            b,
+                            wave_start..wave_end,
+                            &mut sampler,
+                            &mut tile,
+                            &mut tile_splats,
+                            differentials,
+                        );
                         scene_ref.counters.flush_local();
                         scene_ref
                             .counters

@@ -91,6 +91,23 @@ impl HaltonSampler {
         self.randomize
     }
 
+    /// Where this sampler stands in its pixel sample.
+    #[inline]
+    pub fn cursor(&self) -> super::SamplerCursor {
+        super::SamplerCursor {
+            a: self.halton_index,
+            dimension: self.dimension,
+            ..Default::default()
+        }
+    }
+
+    /// Goes back to where [`HaltonSampler::cursor`] stood.
+    #[inline]
+    pub fn set_cursor(&mut self, c: &super::SamplerCursor) {
+        self.halton_index = c.a;
+        self.dimension = c.dimension;
+    }
+
     /// Finds the Halton index of sample `sample_index` in pixel `p`: the
     /// index whose scaled first two dimensions fall in `p` (mod 128),
     /// found by the Chinese remainder theorem.

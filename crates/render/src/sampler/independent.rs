@@ -38,6 +38,23 @@ impl IndependentSampler {
         start_stream(&mut self.rng, p, self.seed, sample_index, dimension);
     }
 
+    /// Where this sampler stands in its pixel sample.
+    #[inline]
+    pub fn cursor(&self) -> super::SamplerCursor {
+        let (a, b) = self.rng.raw();
+        super::SamplerCursor {
+            a,
+            b,
+            ..Default::default()
+        }
+    }
+
+    /// Goes back to where [`IndependentSampler::cursor`] stood.
+    #[inline]
+    pub fn set_cursor(&mut self, c: &super::SamplerCursor) {
+        self.rng = Rng::from_raw((c.a, c.b));
+    }
+
     /// The next 1-D value.
     #[inline]
     pub fn get_1d(&mut self) -> Float {

@@ -51,6 +51,26 @@ impl SampleSource for Sampler {
     }
 }
 
+/// Where a sampler stands within one pixel sample: everything
+/// [`Sampler::start_pixel_sample`] and the draws since have set, without
+/// the sampler's tables and caches. Many paths in flight at once (the
+/// wavefront integrator's lanes) share one sampler and keep a cursor each:
+/// [`Sampler::set_cursor`] then continues a path's sample exactly where
+/// [`Sampler::cursor`] left it. Each sampler uses the fields it needs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SamplerCursor {
+    /// A sampler's 64-bit position (a sequence index, a generator state).
+    pub(crate) a: u64,
+    /// A second 64-bit word (a generator's increment).
+    pub(crate) b: u64,
+    /// The pixel.
+    pub(crate) pixel: Point2i,
+    /// The sample index within the pixel.
+    pub(crate) index: i32,
+    /// The next sample dimension.
+    pub(crate) dimension: i32,
+}
+
 /// A sampler: a closed set of variants with one-line delegation (the
 /// Rust form of pbrt-v4's tagged `Sampler`).
 #[derive(Clone, Debug)]
@@ -97,6 +117,20 @@ impl Sampler {
     #[inline]
     pub fn start_pixel_sample(&mut self, p: Point2i, sample_index: i32, dimension: i32) {
         dispatch!(self, s => s.start_pixel_sample(p, sample_index, dimension))
+    }
+
+    /// Where the sampler stands in its current pixel sample.
+    #[inline]
+    pub fn cursor(&self) -> SamplerCursor {
+        dispatch!(self, s => s.cursor())
+    }
+
+    /// Continues the pixel sample that [`Sampler::cursor`] described (of
+    /// this sampler or a clone of it), as if no other sample had been
+    /// started since.
+    #[inline]
+    pub fn set_cursor(&mut self, c: &SamplerCursor) {
+        dispatch!(self, s => s.set_cursor(c))
     }
 
     /// The next sample dimension, in [0,1).

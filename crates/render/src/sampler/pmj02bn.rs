@@ -323,6 +323,25 @@ impl Pmj02bnSampler {
         self.samples_per_pixel
     }
 
+    /// Where this sampler stands in its pixel sample.
+    #[inline]
+    pub fn cursor(&self) -> super::SamplerCursor {
+        super::SamplerCursor {
+            pixel: self.pixel,
+            index: self.sample_index,
+            dimension: self.dimension,
+            ..Default::default()
+        }
+    }
+
+    /// Goes back to where [`Pmj02bnSampler::cursor`] stood.
+    #[inline]
+    pub fn set_cursor(&mut self, c: &super::SamplerCursor) {
+        self.pixel = c.pixel;
+        self.sample_index = c.index;
+        self.dimension = c.dimension;
+    }
+
     /// Starts sample `index` of pixel `p` at `dimension` (at least 2).
     #[inline]
     pub fn start_pixel_sample(&mut self, p: Point2i, index: i32, dimension: i32) {

@@ -71,6 +71,25 @@ impl SobolSampler {
         self.samples_per_pixel
     }
 
+    /// Where this sampler stands in its pixel sample.
+    #[inline]
+    pub fn cursor(&self) -> super::SamplerCursor {
+        super::SamplerCursor {
+            a: self.sobol_index,
+            pixel: self.pixel,
+            dimension: self.dimension,
+            ..Default::default()
+        }
+    }
+
+    /// Goes back to where [`SobolSampler::cursor`] stood.
+    #[inline]
+    pub fn set_cursor(&mut self, c: &super::SamplerCursor) {
+        self.sobol_index = c.a;
+        self.pixel = c.pixel;
+        self.dimension = c.dimension;
+    }
+
     /// Finds the sequence index of sample `sample_index` in pixel `p`.
     #[inline]
     pub fn start_pixel_sample(&mut self, p: Point2i, sample_index: i32, dim: i32) {
@@ -242,6 +261,25 @@ impl PaddedSobolSampler {
     #[inline]
     pub fn samples_per_pixel(&self) -> i32 {
         self.samples_per_pixel
+    }
+
+    /// Where this sampler stands in its pixel sample.
+    #[inline]
+    pub fn cursor(&self) -> super::SamplerCursor {
+        super::SamplerCursor {
+            pixel: self.pixel,
+            index: self.sample_index,
+            dimension: self.dimension,
+            ..Default::default()
+        }
+    }
+
+    /// Goes back to where [`PaddedSobolSampler::cursor`] stood.
+    #[inline]
+    pub fn set_cursor(&mut self, c: &super::SamplerCursor) {
+        self.pixel = c.pixel;
+        self.sample_index = c.index;
+        self.dimension = c.dimension;
     }
 
     /// Starts sample `index` of pixel `p` at `dimension`.
@@ -481,6 +519,23 @@ impl ZSobolSampler {
     #[inline]
     pub fn samples_per_pixel(&self) -> i32 {
         1 << self.log2_samples_per_pixel
+    }
+
+    /// Where this sampler stands in its pixel sample.
+    #[inline]
+    pub fn cursor(&self) -> super::SamplerCursor {
+        super::SamplerCursor {
+            a: self.morton_index,
+            dimension: self.dimension,
+            ..Default::default()
+        }
+    }
+
+    /// Goes back to where [`ZSobolSampler::cursor`] stood.
+    #[inline]
+    pub fn set_cursor(&mut self, c: &super::SamplerCursor) {
+        self.morton_index = c.a;
+        self.dimension = c.dimension;
     }
 
     /// Starts sample `index` of pixel `p` at `dimension`.

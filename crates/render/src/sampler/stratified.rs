@@ -46,6 +46,28 @@ impl StratifiedSampler {
         self.x_pixel_samples * self.y_pixel_samples
     }
 
+    /// Where this sampler stands in its pixel sample.
+    #[inline]
+    pub fn cursor(&self) -> super::SamplerCursor {
+        let (a, b) = self.rng.raw();
+        super::SamplerCursor {
+            a,
+            b,
+            pixel: self.pixel,
+            index: self.sample_index,
+            dimension: self.dimension,
+        }
+    }
+
+    /// Goes back to where [`StratifiedSampler::cursor`] stood.
+    #[inline]
+    pub fn set_cursor(&mut self, c: &super::SamplerCursor) {
+        self.rng = Rng::from_raw((c.a, c.b));
+        self.pixel = c.pixel;
+        self.sample_index = c.index;
+        self.dimension = c.dimension;
+    }
+
     /// Starts sample `index` of pixel `p` at `dimension`.
     #[inline]
     pub fn start_pixel_sample(&mut self, p: Point2i, index: i32, dimension: i32) {

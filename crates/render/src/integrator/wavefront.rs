@@ -1,0 +1,268 @@
+//! The wavefront path tracer (`--wavefront`; pbrt-v4's flag, not its
+//! design): many paths of a tile in flight at once on each thread, taken
+//! through the stages of a path vertex together, so that each stage's
+//! work can run lane-parallel (book chapter 15 describes pbrt-v4's GPU
+//! form of the same idea).
+//!
+//! The design follows what is fast on a CPU rather than pbrt-v4's
+//! `--wavefront` (million-item global queues, one indirect call per item,
+//! measured 5–10× slower than its own scalar path): each worker thread
+//! keeps a small pool of [`LANES`] paths that stays in cache (MoonRay's
+//! per-core queues), refilled from its tile's pixel samples as paths end.
+//! A pass over the pool runs three stages:
+//!
+//! 1. **trace**: the closest hit of every path's ray, as one batch
+//!    ([`PrimitiveAggregate::intersect_records`]);
+//! 2. **shade**: each path's vertex ([`PathIntegrator::vertex`], the code
+//!    the scalar path tracer runs): emission, the BSDF, a light sample and
+//!    the next ray;
+//! 3. **shadow**: the light samples' shadow rays, as one batch, adding the
+//!    contributions of the unblocked ones.
+//!
+//! Every path's arithmetic is the scalar path tracer's, its sampler
+//! dimensions drawn in the same order (each lane keeps a
+//! [`SamplerCursor`] into the thread's one sampler), and finished samples
+//! are added to the tile in the scalar loop's order through a bounded
+//! reorder buffer: the image is the scalar path tracer's, bit for bit, for
+//! any thread count.
+//!
+//! [`PrimitiveAggregate::intersect_records`]: crate::primitive::PrimitiveAggregate::intersect_records
+
+use super::path::{PathIntegrator, PathState};
+use super::render::RenderOptions;
+use super::tile::{add_estimate, CameraRaySample, RayTiles, TileIntegrator};
+use super::Scene;
+use crate::film::{FilmTile, SplatBuffer, VisibleSurface};
+use crate::primitive::HitRecord;
+use crate::sampler::{Sampler, SamplerCursor};
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use rpbrt_geometry::bounds::Bounds2i;
+use rpbrt_geometry::float::Float;
+use rpbrt_geometry::ray::Ray;
+use rpbrt_geometry::tuple::*;
+use std::ops::Range;
+
+/// Paths in flight per thread.
+const LANES: usize = 256;
+
+/// Finished samples the reorder buffer holds ahead of the oldest path
+/// still in flight (a power of two). A path can start only when its
+/// sample's slot is free, so one long path holds back at most this many.
+const REORDER: usize = 4 * LANES;
+
+/// The path tracer under the wavefront loop.
+pub(crate) struct WavefrontPath<'a>(pub &'a PathIntegrator);
+
+/// A path in flight.
+struct Lane {
+    /// The sample's position in the tile's order.
+    seq: usize,
+    /// Its pixel.
+    p_pixel: Point2i,
+    /// Where its sampler draws continue.
+    cursor: SamplerCursor,
+    /// Its wavelengths.
+    lambda: SampledWavelengths,
+    /// Its path.
+    path: PathState,
+    /// The camera ray's weight.
+    camera_weight: Float,
+    /// The filter's weight.
+    filter_weight: Float,
+    /// The first visible surface (G-buffer films only).
+    visible: Option<VisibleSurface>,
+    /// The path has ended (once its shadow ray is traced).
+    done: bool,
+}
+
+/// A finished sample waiting for its turn to be added to the tile.
+struct Finished {
+    p_pixel: Point2i,
+    l: SampledSpectrum,
+    lambda: SampledWavelengths,
+    visible: Option<VisibleSurface>,
+    filter_weight: Float,
+}
+
+/// Finished samples, added to the tile in sequence order.
+struct ReorderBuffer {
+    slots: Vec<Option<Finished>>,
+    /// The next sample to add.
+    next: usize,
+}
+
+impl ReorderBuffer {
+    fn new() -> Self {
+        ReorderBuffer {
+            slots: (0..REORDER).map(|_| None).collect(),
+            next: 0,
+        }
+    }
+
+    /// Whether sample `seq` may start: its slot is free.
+    #[inline]
+    fn has_room(&self, seq: usize) -> bool {
+        seq < self.next + REORDER
+    }
+
+    /// Files sample `seq` and adds every sample now in order to `tile`.
+    fn finish(&mut self, seq: usize, f: Finished, tile: &mut FilmTile) {
+        debug_assert!(self.has_room(seq) && seq >= self.next);
+        self.slots[seq % REORDER] = Some(f);
+        while let Some(f) = self.slots[self.next % REORDER].take() {
+            add_estimate(
+                tile,
+                f.p_pixel,
+                f.l,
+                &f.lambda,
+                f.visible.as_ref(),
+                f.filter_weight,
+            );
+            self.next += 1;
+        }
+    }
+}
+
+impl TileIntegrator for WavefrontPath<'_> {
+    fn evaluate_pixel_sample(
+        &self,
+        scene: &Scene,
+        opts: &RenderOptions,
+        p_pixel: Point2i,
+        sampler: &mut Sampler,
+        tile: &mut FilmTile,
+        splats: &mut SplatBuffer,
+        differentials: bool,
+    ) {
+        RayTiles(self.0).evaluate_pixel_sample(
+            scene,
+            opts,
+            p_pixel,
+            sampler,
+            tile,
+            splats,
+            differentials,
+        );
+    }
+
+    fn render_tile(
+        &self,
+        scene: &Scene,
+        opts: &RenderOptions,
+        bounds: Bounds2i,
+        samples: Range<i32>,
+        sampler: &mut Sampler,
+        tile: &mut FilmTile,
+        _splats: &mut SplatBuffer,
+        differentials: bool,
+    ) -> u64 {
+        let pixels: Vec<Point2i> = bounds.iter().collect();
+        let per_pixel = (samples.end - samples.start).max(0) as usize;
+        let total = pixels.len() * per_pixel;
+        let gbuffer = scene.film.uses_visible_surface();
+        let mut reorder = ReorderBuffer::new();
+        let mut lanes: Vec<Lane> = Vec::with_capacity(LANES);
+        let mut rays: Vec<Ray> = Vec::with_capacity(LANES);
+        let mut hits: Vec<Option<HitRecord>> = Vec::with_capacity(LANES);
+        let mut shadow_rays: Vec<(Ray, Float)> = Vec::with_capacity(LANES);
+        let mut shadow_lanes: Vec<(usize, SampledSpectrum)> = Vec::with_capacity(LANES);
+        let mut blocked: Vec<bool> = Vec::with_capacity(LANES);
+        let mut started = 0;
+        loop {
+            // Refill the pool in the tile's sample order. Once
+            // interrupted, no sample starts; those in flight finish.
+            while lanes.len() < LANES
+                && started < total
+                && reorder.has_room(started)
+                && !opts.interrupted()
+            {
+                let seq = started;
+                started += 1;
+                let p_pixel = pixels[seq / per_pixel];
+                let index = samples.start + (seq % per_pixel) as i32;
+                sampler.start_pixel_sample(p_pixel, index, 0);
+                let cs = CameraRaySample::take(scene, opts, p_pixel, sampler, differentials);
+                let Some((ray, camera_weight)) = cs.ray else {
+                    let f = Finished {
+                        p_pixel,
+                        l: SampledSpectrum::new(0.0),
+                        lambda: cs.lambda,
+                        visible: None,
+                        filter_weight: cs.cs.filter_weight,
+                    };
+                    reorder.finish(seq, f, tile);
+                    continue;
+                };
+                lanes.push(Lane {
+                    seq,
+                    p_pixel,
+                    cursor: sampler.cursor(),
+                    lambda: cs.lambda,
+                    path: PathState::new(ray),
+                    camera_weight,
+                    filter_weight: cs.cs.filter_weight,
+                    visible: gbuffer.then(VisibleSurface::default),
+                    done: false,
+                });
+            }
+            if lanes.is_empty() {
+                break;
+            }
+
+            // Trace: every path's closest hit.
+            rays.clear();
+            rays.extend(lanes.iter().map(|l| l.path.ray.ray));
+            scene.intersect_records(&rays, &mut hits);
+
+            // Shade: one vertex of every path.
+            shadow_rays.clear();
+            shadow_lanes.clear();
+            for (i, (lane, hit)) in lanes.iter_mut().zip(&hits).enumerate() {
+                sampler.set_cursor(&lane.cursor);
+                let mut isect = hit.and_then(|h| scene.aggregate.interaction(&rays[i], &h));
+                let step = self.0.vertex(
+                    scene,
+                    &mut lane.path,
+                    isect.as_mut(),
+                    &mut lane.lambda,
+                    sampler,
+                    lane.visible.as_mut(),
+                );
+                lane.cursor = sampler.cursor();
+                lane.done = step.done;
+                if let Some(q) = step.shadow {
+                    shadow_rays.push((q.ray, q.t_max));
+                    shadow_lanes.push((i, q.ld));
+                }
+            }
+
+            // Shadow: the light samples' visibility.
+            scene.intersect_ps(&shadow_rays, &mut blocked);
+            for (&(i, ld), &b) in shadow_lanes.iter().zip(&blocked) {
+                if !b {
+                    lanes[i].path.l += ld;
+                }
+            }
+
+            // Retire the paths that ended.
+            let mut i = 0;
+            while i < lanes.len() {
+                if lanes[i].done {
+                    let lane = lanes.swap_remove(i);
+                    let f = Finished {
+                        p_pixel: lane.p_pixel,
+                        l: lane.path.l * lane.camera_weight,
+                        lambda: lane.lambda,
+                        visible: lane.visible,
+                        filter_weight: lane.filter_weight,
+                    };
+                    reorder.finish(lane.seq, f, tile);
+                } else {
+                    i += 1;
+                }
+            }
+        }
+        debug_assert_eq!(reorder.next, started);
+        started as u64
+    }
+}
