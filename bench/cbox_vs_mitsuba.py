@@ -7,7 +7,9 @@ independent sampler, max_depth 8 = pbrt maxdepth 7), in the same run.
     apt-get install libllvm19      # for the LLVM variants
     python3 bench/cbox_vs_mitsuba.py [--variants scalar_spectral,llvm_ad_spectral] [--threads 2]
 
-Prints one RESULT line with every variant's time and its ratio to rpbrt's.
+Prints one RESULT line with every variant's time and its ratio to rpbrt's,
+for each rpbrt design (--designs scalar,wavefront: the default loop and
+--wavefront).
 Each Mitsuba variant is timed on its render call after a warm-up render (the
 LLVM variants JIT-compile there); rpbrt is timed as a whole process, the
 median of --repeat runs interleaved with Mitsuba's (the machine drifts).
@@ -34,17 +36,20 @@ ap.add_argument("--threads", type=int, default=2)
 ap.add_argument("--spp", type=int, default=64)
 ap.add_argument("--repeat", type=int, default=3)
 ap.add_argument("--rpbrt", default=os.path.join(root, "target", "release", "rpbrt"))
+ap.add_argument("--designs", default="scalar,wavefront",
+                help="rpbrt designs to time: scalar (the default loop), wavefront (--wavefront)")
 args = ap.parse_args()
 
 if not os.path.exists(args.rpbrt):
     subprocess.run(["cargo", "build", "--release", "-q"], cwd=root, check=True)
 
 
-def time_rpbrt():
+def time_rpbrt(design):
     out = os.path.join("/tmp", "rpbrt-cbox-bench.exr")
+    extra = ["--wavefront"] if design == "wavefront" else []
     t0 = time.perf_counter()
     subprocess.run([args.rpbrt, "--quiet", "--nthreads", str(args.threads), "--spp",
-                    str(args.spp), "--outfile", out, scene], check=True)
+                    str(args.spp), "--outfile", out] + extra + [scene], check=True)
     return time.perf_counter() - t0
 
 
@@ -76,16 +81,21 @@ def mitsuba_renderer(variant):
 
 variants = [v for v in args.variants.split(",") if v]
 renderers = {v: mitsuba_renderer(v) for v in variants}
-times = {"rpbrt": []}
+designs = [d for d in args.designs.split(",") if d]
+times = {f"rpbrt_{d}": [] for d in designs}
 times.update({v: [] for v in variants})
 for i in range(args.repeat):
-    times["rpbrt"].append(time_rpbrt())
+    for d in designs:
+        times[f"rpbrt_{d}"].append(time_rpbrt(d))
     for v in variants:
         times[v].append(renderers[v](i + 1))
 
 med = {k: statistics.median(v) for k, v in times.items()}
-fields = [f"scene=mitsuba-cbox spp={args.spp} threads={args.threads} repeat={args.repeat}",
-          f"rpbrt_s={med['rpbrt']:.2f}"]
+fields = [f"scene=mitsuba-cbox spp={args.spp} threads={args.threads} repeat={args.repeat}"]
+for d in designs:
+    fields.append(f"rpbrt_{d}_s={med['rpbrt_' + d]:.2f}")
 for v in variants:
-    fields.append(f"mitsuba_{v}_s={med[v]:.2f} ratio_{v}_over_rpbrt={med[v] / med['rpbrt']:.2f}")
+    for d in designs:
+        fields.append(f"ratio_{v}_over_rpbrt_{d}={med[v] / med['rpbrt_' + d]:.2f}")
+    fields.insert(len(designs) + 1, f"mitsuba_{v}_s={med[v]:.2f}")
 print("RESULT " + " ".join(fields))

@@ -400,7 +400,6 @@ fn print_result(mesh: &str, accel: &str, threads: usize, v: [f64; 4], extra: &st
 
 /// The camera rays regrouped into `tw`×`th` pixel tiles (tile after tile,
 /// row-major inside each), the order packet tracers take them in.
-#[cfg_attr(not(feature = "embree"), allow(dead_code))]
 fn tiled(cam: &[Ray], tw: usize, th: usize) -> Vec<Ray> {
     let res = (cam.len() as f64).sqrt().round() as usize;
     let mut out = Vec::with_capacity(cam.len());
@@ -418,7 +417,6 @@ fn tiled(cam: &[Ray], tw: usize, th: usize) -> Vec<Ray> {
 
 /// Runs `f` over consecutive groups of `n` rays split across `threads`;
 /// returns Mrays/s and the hits `f` reports.
-#[cfg_attr(not(feature = "embree"), allow(dead_code))]
 fn run_groups<F>(rays: &[Ray], n: usize, threads: usize, f: F) -> (f64, usize)
 where
     F: Fn(&[Ray]) -> usize + Sync,
@@ -536,7 +534,37 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
             } else {
                 ""
             };
-            print_result(&mesh.name, name, threads, [build, c, i, s], default);
+            // The 4-wide BVH's packet traversal at the processor's SIMD
+            // width: camera rays in 4×2 (8 lanes) or 2×2 (4 lanes) pixel
+            // tiles, and the incoherent rays in groups of the same size.
+            let mut extra = String::new();
+            if let Accelerator::Bvh4(bvh) = &a {
+                let level = rpbrt_render::simd::level();
+                let w = level.lanes();
+                if w > 1 {
+                    let packet = |g: &[Ray]| {
+                        let trs: Vec<TriangleRay> = g.iter().map(TriangleRay::new).collect();
+                        let mut t_max = [Float::INFINITY; 16];
+                        let mut best = [None; 16];
+                        bvh.intersect_packet(
+                            level,
+                            g,
+                            &mut t_max[..g.len()],
+                            &mut best[..g.len()],
+                            |lane, s, _, _, t| hit_tri(slot_tris, &trs[lane], s, t),
+                        );
+                        best[..g.len()].iter().filter(|b| b.is_some()).count()
+                    };
+                    let (tw, th) = if w == 8 { (4, 2) } else { (2, 2) };
+                    let (pc, _) = run_groups(&tiled(&cam_set, tw, th), w, threads, packet);
+                    let (pi, _) = run_groups(&bounce_set, w, threads, packet);
+                    extra = format!(
+                        " simd={} packet{w}_coherent_mrays_s={pc:.2} packet{w}_incoherent_mrays_s={pi:.2}",
+                        level.name()
+                    );
+                }
+            }
+            print_result(&mesh.name, name, threads, [build, c, i, s], &(default.to_string() + &extra));
         }
     }
 

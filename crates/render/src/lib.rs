@@ -21,6 +21,7 @@ pub mod sampling;
 pub mod scene;
 pub mod select;
 pub mod shape;
+pub mod simd;
 pub mod spectrum;
 pub mod texture;
 

@@ -514,7 +514,7 @@ impl Aggregate for Bvh4 {
 /// Tests the primitives of one leaf (the first in slot `first`),
 /// shrinking `t_max` on each closer hit.
 #[inline(always)]
-fn closest_in_leaf<F>(
+pub(super) fn closest_in_leaf<F>(
     prims: &[u32],
     first: u32,
     ray: &Ray,

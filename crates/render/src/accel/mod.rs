@@ -22,6 +22,7 @@ pub mod bvh;
 pub mod bvh4;
 pub mod grid;
 pub mod kdtree;
+pub(crate) mod packet;
 mod params;
 #[cfg(test)]
 mod tests;

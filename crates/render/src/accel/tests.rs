@@ -149,6 +149,7 @@ where
     H: Fn(u32, &Ray, Float) -> Option<Float>,
 {
     let mut n_hits = 0;
+    let mut singles = Vec::with_capacity(rays.len());
     for (k, (ray, t_max)) in rays.iter().enumerate() {
         let mut brute: Option<(u32, Float)> = None;
         for p in 0..n as u32 {
@@ -190,8 +191,39 @@ where
             hit(p, r, t).is_some()
         });
         assert_eq!(any_slot, any, "{name}: ray {k}: intersect_p_slots");
+        singles.push(got);
+    }
+    // The 4-wide BVH's packet traversal, at every width this processor
+    // runs: 16 rays a call (two packets of 8, four of 4, or sixteen
+    // single lanes), each ray's hit at the single ray's distance.
+    if let Accelerator::Bvh4(bvh) = accel {
+        for level in crate::simd::SimdLevel::available() {
+            for (g, group) in rays.chunks(16).enumerate() {
+                let rs: Vec<Ray> = group.iter().map(|(r, _)| *r).collect();
+                let mut t_max: Vec<Float> = group.iter().map(|(_, t)| *t).collect();
+                let mut best = vec![None; rs.len()];
+                bvh.intersect_packet(level, &rs, &mut t_max, &mut best, |lane, s, p, r, t| {
+                    assert_eq!(entry_of_bvh4(bvh, s), p, "{name}: packet slot {s}");
+                    assert_eq!(*r, rs[lane]);
+                    hit(p, r, t)
+                });
+                for (lane, b) in best.iter().enumerate() {
+                    let k = 16 * g + lane;
+                    assert_eq!(
+                        b.map(|b| b.1),
+                        singles[k].map(|s| s.1),
+                        "{name}: {level:?} packet: ray {k} {:?}",
+                        rays[k]
+                    );
+                }
+            }
+        }
     }
     n_hits
+}
+
+fn entry_of_bvh4(bvh: &Bvh4, slot: u32) -> u32 {
+    bvh.prim_indices()[slot as usize]
 }
 
 fn check_all<H>(bounds: &[Bounds3f], rays: &[(Ray, Float)], hit: H, min_hits: usize)

@@ -130,17 +130,39 @@ impl Scene {
 
     /// [`Scene::intersect_record`] of each ray in `rays` (with no bound on
     /// the ray parameter), into `out` (cleared first): a batch of rays
-    /// traced together.
-    pub fn intersect_records(&self, rays: &[Ray], out: &mut Vec<Option<HitRecord>>) {
+    /// traced together. The first `coherent` rays are traced as packets of
+    /// `level`'s width (camera rays through the same few pixels); the
+    /// rest one by one.
+    pub fn intersect_records(
+        &self,
+        rays: &[Ray],
+        coherent: usize,
+        level: crate::simd::SimdLevel,
+        out: &mut Vec<Option<HitRecord>>,
+    ) {
         LOCAL_RAY_COUNTS.with(|c| {
             let (closest, shadow) = c.get();
             c.set((closest + rays.len() as u64, shadow));
         });
         out.clear();
-        out.extend(
-            rays.iter()
-                .map(|r| self.aggregate.intersect_record(r, Float::INFINITY)),
-        );
+        out.resize(rays.len(), None);
+        let coherent = coherent.min(rays.len());
+        let width = level.lanes();
+        if width > 1 {
+            for (r, o) in rays[..coherent]
+                .chunks(width)
+                .zip(out[..coherent].chunks_mut(width))
+            {
+                self.aggregate.intersect_records_packet(r, level, o);
+            }
+        } else {
+            for (r, o) in rays[..coherent].iter().zip(&mut out[..coherent]) {
+                *o = self.aggregate.intersect_record(r, Float::INFINITY);
+            }
+        }
+        for (r, o) in rays[coherent..].iter().zip(&mut out[coherent..]) {
+            *o = self.aggregate.intersect_record(r, Float::INFINITY);
+        }
     }
 
     /// Whether anything blocks each ray of `rays` in (0, its t_max), into

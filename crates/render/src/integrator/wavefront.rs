@@ -73,6 +73,8 @@ struct Lane {
     visible: Option<VisibleSurface>,
     /// The path has ended (once its shadow ray is traced).
     done: bool,
+    /// The ray is the camera ray.
+    camera: bool,
 }
 
 /// A finished sample waiting for its turn to be added to the tile.
@@ -168,6 +170,7 @@ impl TileIntegrator for WavefrontPath<'_> {
         let mut shadow_lanes: Vec<(usize, SampledSpectrum)> = Vec::with_capacity(LANES);
         let mut blocked: Vec<bool> = Vec::with_capacity(LANES);
         let mut started = 0;
+        let level = crate::simd::level();
         loop {
             // Refill the pool in the tile's sample order. Once
             // interrupted, no sample starts; those in flight finish.
@@ -203,16 +206,25 @@ impl TileIntegrator for WavefrontPath<'_> {
                     filter_weight: cs.cs.filter_weight,
                     visible: gbuffer.then(VisibleSurface::default),
                     done: false,
+                    camera: true,
                 });
             }
             if lanes.is_empty() {
                 break;
             }
 
-            // Trace: every path's closest hit.
+            // Trace: every path's closest hit, camera rays first (as
+            // packets: they are consecutive samples of a few pixels).
+            let mut coherent = 0;
+            for i in 0..lanes.len() {
+                if lanes[i].camera {
+                    lanes.swap(coherent, i);
+                    coherent += 1;
+                }
+            }
             rays.clear();
             rays.extend(lanes.iter().map(|l| l.path.ray.ray));
-            scene.intersect_records(&rays, &mut hits);
+            scene.intersect_records(&rays, coherent, level, &mut hits);
 
             // Shade: one vertex of every path.
             shadow_rays.clear();
@@ -230,6 +242,7 @@ impl TileIntegrator for WavefrontPath<'_> {
                 );
                 lane.cursor = sampler.cursor();
                 lane.done = step.done;
+                lane.camera = false;
                 if let Some(q) = step.shadow {
                     shadow_rays.push((q.ray, q.t_max));
                     shadow_lanes.push((i, q.ld));

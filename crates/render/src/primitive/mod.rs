@@ -3,7 +3,9 @@
 //! placed by a fixed or animated transformation; and aggregates that put an
 //! acceleration structure over a set of primitives.
 
+use crate::accel::packet::MAX_PACKET;
 use crate::accel::{AccelParams, Accelerator, Aggregate};
+use crate::simd::SimdLevel;
 use crate::shape::triangle::{
     intersect_prepared_triangle, intersect_triangle, triangle_is_nondegenerate, TriangleFrame,
     TriangleOf, TriangleRay,
@@ -670,6 +672,63 @@ impl PrimitiveAggregate {
             },
         );
         closest
+    }
+
+    /// [`PrimitiveAggregate::intersect_record`] of each of up to
+    /// [`MAX_PACKET`] rays (no bound on the ray parameter), into the first
+    /// `rays.len()` values of `out`. Under the 4-wide BVH the rays walk the
+    /// tree as one packet at `level`'s width ([`crate::accel::packet`]);
+    /// otherwise, or at [`SimdLevel::Scalar`], one by one. The records are
+    /// those of single rays, but where two primitives tie exactly in
+    /// distance.
+    pub fn intersect_records_packet(
+        &self,
+        rays: &[Ray],
+        level: SimdLevel,
+        out: &mut [Option<HitRecord>],
+    ) {
+        let n = rays.len();
+        let Accelerator::Bvh4(bvh) = &self.accel else {
+            for (o, r) in out.iter_mut().zip(rays) {
+                *o = self.intersect_record(r, Float::INFINITY);
+            }
+            return;
+        };
+        if level == SimdLevel::Scalar || n > MAX_PACKET {
+            for (o, r) in out.iter_mut().zip(rays) {
+                *o = self.intersect_record(r, Float::INFINITY);
+            }
+            return;
+        }
+        let mut trs = [TriangleRay::new(&rays[0]); MAX_PACKET];
+        for (t, r) in trs.iter_mut().zip(rays) {
+            *t = TriangleRay::new(r);
+        }
+        let mut t_max = [Float::INFINITY; MAX_PACKET];
+        let mut best = [None; MAX_PACKET];
+        let mut records = [None::<HitRecord>; MAX_PACKET];
+        bvh.intersect_packet(
+            level,
+            rays,
+            &mut t_max[..n],
+            &mut best[..n],
+            |lane: usize, slot: u32, i: u32, ray: &Ray, t: Float| {
+                    let tr = &trs[lane];
+                    if let Some(Some([p0, p1, p2])) = self.triangle_vertices.get(slot as usize) {
+                        let (b0, b1, b2, t_hit) = intersect_prepared_triangle(tr, t, *p0, *p1, *p2)?;
+                        records[lane] = Some(HitRecord {
+                            primitive: i,
+                            t_hit,
+                            kind: HitKind::Triangle(b0, b1, b2),
+                        });
+                        return Some(t_hit);
+                    }
+                    let record = self.record_other(i, ray, tr, t)?;
+                    records[lane] = Some(record);
+                    Some(record.t_hit)
+                },
+        );
+        out[..n].copy_from_slice(&records[..n]);
     }
 
     /// The interaction of a hit that [`PrimitiveAggregate::intersect_record`]

@@ -1,0 +1,280 @@
+//! The lane types: `N` `f32` lanes with the operations kernels use, each
+//! lane computing exactly what the scalar expression computes.
+
+/// `N` lanes of `f32` and a mask of `N` lanes.
+///
+/// Implementations are `#[inline(always)]` throughout: kernels instantiated
+/// by [`super::dispatch`] compile them inside functions built for the
+/// level's instruction set. `min` and `max` keep the scalar code's order
+/// (`a < b ? a : b`, `a > b ? a : b`), which is also what x86's
+/// `minps`/`maxps` do with NaN.
+pub trait F32Lanes: Copy {
+    /// The lane count.
+    const N: usize;
+    /// A lane mask (one boolean per lane).
+    type Mask: Copy;
+    /// Every lane `x`.
+    fn splat(x: f32) -> Self;
+    /// Lanes from the first `N` values of `s`.
+    fn load(s: &[f32]) -> Self;
+    /// Writes the lanes to the first `N` values of `s`.
+    fn store(self, s: &mut [f32]);
+    /// Lane-wise `self + o`.
+    fn add(self, o: Self) -> Self;
+    /// Lane-wise `self - o`.
+    fn sub(self, o: Self) -> Self;
+    /// Lane-wise `self * o`.
+    fn mul(self, o: Self) -> Self;
+    /// Lane-wise `if self < o { self } else { o }`.
+    fn min(self, o: Self) -> Self;
+    /// Lane-wise `if self > o { self } else { o }`.
+    fn max(self, o: Self) -> Self;
+    /// Lane-wise `self < o`.
+    fn lt(self, o: Self) -> Self::Mask;
+    /// Lane-wise `self <= o`.
+    fn le(self, o: Self) -> Self::Mask;
+    /// Lane-wise `if m { a } else { b }`.
+    fn select(m: Self::Mask, a: Self, b: Self) -> Self;
+    /// Lane-wise `a && b`.
+    fn and(a: Self::Mask, b: Self::Mask) -> Self::Mask;
+    /// The mask as bits, lane `i` at bit `i`.
+    fn bits(m: Self::Mask) -> u32;
+    /// The mask whose lane `i` is bit `i` of `bits`.
+    fn from_bits(bits: u32) -> Self::Mask;
+}
+
+/// One lane: the scalar code itself, for processors without vector units
+/// (and as the reference the vector widths are tested against).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scalar1(pub f32);
+
+impl F32Lanes for Scalar1 {
+    const N: usize = 1;
+    type Mask = bool;
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        Scalar1(x)
+    }
+    #[inline(always)]
+    fn load(s: &[f32]) -> Self {
+        Scalar1(s[0])
+    }
+    #[inline(always)]
+    fn store(self, s: &mut [f32]) {
+        s[0] = self.0;
+    }
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        Scalar1(self.0 + o.0)
+    }
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        Scalar1(self.0 - o.0)
+    }
+    #[inline(always)]
+    fn mul(self, o: Self) -> Self {
+        Scalar1(self.0 * o.0)
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        if self.0 < o.0 {
+            self
+        } else {
+            o
+        }
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        if self.0 > o.0 {
+            self
+        } else {
+            o
+        }
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> bool {
+        self.0 < o.0
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> bool {
+        self.0 <= o.0
+    }
+    #[inline(always)]
+    fn select(m: bool, a: Self, b: Self) -> Self {
+        if m {
+            a
+        } else {
+            b
+        }
+    }
+    #[inline(always)]
+    fn and(a: bool, b: bool) -> bool {
+        a && b
+    }
+    #[inline(always)]
+    fn bits(m: bool) -> u32 {
+        m as u32
+    }
+    #[inline(always)]
+    fn from_bits(bits: u32) -> bool {
+        bits & 1 != 0
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub use x86::{F32x4, F32x8};
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use super::F32Lanes;
+    use std::arch::x86_64::*;
+
+    /// Eight lanes in an AVX register. Only [`crate::simd::dispatch`]'s
+    /// AVX2 path runs code that uses it (the processor has AVX2 there).
+    #[derive(Clone, Copy, Debug)]
+    pub struct F32x8(__m256);
+
+    /// Four lanes in an SSE register. Only [`crate::simd::dispatch`]'s
+    /// SSE4.1 and AVX2 paths run code that uses it.
+    #[derive(Clone, Copy, Debug)]
+    pub struct F32x4(__m128);
+
+    // SAFETY (every `unsafe` block below): these types are only used by
+    // kernels that `dispatch` runs after checking that the processor has
+    // the instructions (AVX for F32x8, SSE4.1 for F32x4); slices are
+    // length-checked before unaligned loads and stores.
+    impl F32Lanes for F32x8 {
+        const N: usize = 8;
+        type Mask = __m256;
+        #[inline(always)]
+        fn splat(x: f32) -> Self {
+            unsafe { F32x8(_mm256_set1_ps(x)) }
+        }
+        #[inline(always)]
+        fn load(s: &[f32]) -> Self {
+            let s = &s[..8];
+            unsafe { F32x8(_mm256_loadu_ps(s.as_ptr())) }
+        }
+        #[inline(always)]
+        fn store(self, s: &mut [f32]) {
+            let s = &mut s[..8];
+            unsafe { _mm256_storeu_ps(s.as_mut_ptr(), self.0) }
+        }
+        #[inline(always)]
+        fn add(self, o: Self) -> Self {
+            unsafe { F32x8(_mm256_add_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn sub(self, o: Self) -> Self {
+            unsafe { F32x8(_mm256_sub_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn mul(self, o: Self) -> Self {
+            unsafe { F32x8(_mm256_mul_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn min(self, o: Self) -> Self {
+            // minps(a, b) = a < b ? a : b.
+            unsafe { F32x8(_mm256_min_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn max(self, o: Self) -> Self {
+            unsafe { F32x8(_mm256_max_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn lt(self, o: Self) -> __m256 {
+            unsafe { _mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0) }
+        }
+        #[inline(always)]
+        fn le(self, o: Self) -> __m256 {
+            unsafe { _mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0) }
+        }
+        #[inline(always)]
+        fn select(m: __m256, a: Self, b: Self) -> Self {
+            unsafe { F32x8(_mm256_blendv_ps(b.0, a.0, m)) }
+        }
+        #[inline(always)]
+        fn and(a: __m256, b: __m256) -> __m256 {
+            unsafe { _mm256_and_ps(a, b) }
+        }
+        #[inline(always)]
+        fn bits(m: __m256) -> u32 {
+            unsafe { _mm256_movemask_ps(m) as u32 }
+        }
+        #[inline(always)]
+        fn from_bits(bits: u32) -> __m256 {
+            unsafe {
+                let lane = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+                let b = _mm256_set1_epi32(bits as i32);
+                _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(b, lane), lane))
+            }
+        }
+    }
+
+    impl F32Lanes for F32x4 {
+        const N: usize = 4;
+        type Mask = __m128;
+        #[inline(always)]
+        fn splat(x: f32) -> Self {
+            unsafe { F32x4(_mm_set1_ps(x)) }
+        }
+        #[inline(always)]
+        fn load(s: &[f32]) -> Self {
+            let s = &s[..4];
+            unsafe { F32x4(_mm_loadu_ps(s.as_ptr())) }
+        }
+        #[inline(always)]
+        fn store(self, s: &mut [f32]) {
+            let s = &mut s[..4];
+            unsafe { _mm_storeu_ps(s.as_mut_ptr(), self.0) }
+        }
+        #[inline(always)]
+        fn add(self, o: Self) -> Self {
+            unsafe { F32x4(_mm_add_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn sub(self, o: Self) -> Self {
+            unsafe { F32x4(_mm_sub_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn mul(self, o: Self) -> Self {
+            unsafe { F32x4(_mm_mul_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn min(self, o: Self) -> Self {
+            unsafe { F32x4(_mm_min_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn max(self, o: Self) -> Self {
+            unsafe { F32x4(_mm_max_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn lt(self, o: Self) -> __m128 {
+            unsafe { _mm_cmplt_ps(self.0, o.0) }
+        }
+        #[inline(always)]
+        fn le(self, o: Self) -> __m128 {
+            unsafe { _mm_cmple_ps(self.0, o.0) }
+        }
+        #[inline(always)]
+        fn select(m: __m128, a: Self, b: Self) -> Self {
+            unsafe { F32x4(_mm_blendv_ps(b.0, a.0, m)) }
+        }
+        #[inline(always)]
+        fn and(a: __m128, b: __m128) -> __m128 {
+            unsafe { _mm_and_ps(a, b) }
+        }
+        #[inline(always)]
+        fn bits(m: __m128) -> u32 {
+            unsafe { _mm_movemask_ps(m) as u32 }
+        }
+        #[inline(always)]
+        fn from_bits(bits: u32) -> __m128 {
+            unsafe {
+                let lane = _mm_setr_epi32(1, 2, 4, 8);
+                let b = _mm_set1_epi32(bits as i32);
+                _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(b, lane), lane))
+            }
+        }
+    }
+}

@@ -1,0 +1,164 @@
+//! SIMD lanes and the run-time choice of instruction set: the one module
+//! that holds `std::arch` intrinsics (STYLE.md's boundary, as glam keeps
+//! its backends apart).
+//!
+//! A kernel is written once, generic over [`F32Lanes`] (a few `f32` lanes
+//! and their operations), and [`dispatch`] runs it at the widest width the
+//! processor offers: AVX2 with FMA (8 lanes), SSE4.1 (4 lanes) or plain
+//! scalar code (1 lane), chosen once per process from
+//! `is_x86_feature_detected!`, or forced with `RPBRT_SIMD=scalar|sse4|avx2`
+//! (for tests and benchmarks; a level the processor lacks falls back to
+//! the best it has). Every lane operation is the IEEE operation the scalar
+//! code performs (`min`/`max` with the scalar code's NaN order), so a
+//! kernel gives the same values at every width. AVX-512 is not built yet:
+//! processors that have it run the AVX2 kernels.
+
+mod lanes;
+
+pub use lanes::{F32Lanes, Scalar1};
+#[cfg(target_arch = "x86_64")]
+pub use lanes::{F32x4, F32x8};
+
+use std::sync::OnceLock;
+
+/// An instruction-set level kernels can run at.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum SimdLevel {
+    /// One lane, no vector instructions.
+    Scalar,
+    /// SSE4.1: 4 lanes.
+    Sse4,
+    /// AVX2 with FMA: 8 lanes.
+    Avx2,
+}
+
+impl SimdLevel {
+    /// Lanes of `f32` per vector at this level.
+    pub fn lanes(self) -> usize {
+        match self {
+            SimdLevel::Scalar => 1,
+            SimdLevel::Sse4 => 4,
+            SimdLevel::Avx2 => 8,
+        }
+    }
+
+    /// The name `RPBRT_SIMD` takes and statistics print.
+    pub fn name(self) -> &'static str {
+        match self {
+            SimdLevel::Scalar => "scalar",
+            SimdLevel::Sse4 => "sse4",
+            SimdLevel::Avx2 => "avx2",
+        }
+    }
+
+    /// The level named `s` (as `RPBRT_SIMD` spells it).
+    pub fn parse(s: &str) -> Option<SimdLevel> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "scalar" => Some(SimdLevel::Scalar),
+            "sse4" | "sse4.1" | "sse41" => Some(SimdLevel::Sse4),
+            "avx2" => Some(SimdLevel::Avx2),
+            _ => None,
+        }
+    }
+
+    /// Every level this processor runs, lowest first.
+    pub fn available() -> Vec<SimdLevel> {
+        [SimdLevel::Scalar, SimdLevel::Sse4, SimdLevel::Avx2]
+            .into_iter()
+            .filter(|&l| l <= SimdLevel::detected())
+            .collect()
+    }
+
+    /// The best level this processor runs.
+    pub fn detected() -> SimdLevel {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") {
+                return SimdLevel::Avx2;
+            }
+            if is_x86_feature_detected!("sse4.1") {
+                return SimdLevel::Sse4;
+            }
+        }
+        SimdLevel::Scalar
+    }
+}
+
+/// The level kernels run at: [`SimdLevel::detected`], or `RPBRT_SIMD` when
+/// it names a level the processor has (a lower one; a higher one is
+/// capped at what the processor runs). Read once per process.
+pub fn level() -> SimdLevel {
+    static LEVEL: OnceLock<SimdLevel> = OnceLock::new();
+    *LEVEL.get_or_init(|| {
+        let best = SimdLevel::detected();
+        match std::env::var("RPBRT_SIMD").ok().as_deref().and_then(SimdLevel::parse) {
+            Some(forced) => forced.min(best),
+            None => best,
+        }
+    })
+}
+
+/// The warning for an `RPBRT_SIMD` value that names no level, or a level
+/// this processor lacks (for the command line to print); `None` when the
+/// variable is unset or usable.
+pub fn env_warning() -> Option<String> {
+    let v = std::env::var("RPBRT_SIMD").ok()?;
+    match SimdLevel::parse(&v) {
+        None => Some(format!(
+            "RPBRT_SIMD=\"{v}\" is not one of scalar, sse4, avx2; using {}",
+            level().name()
+        )),
+        Some(l) if l > SimdLevel::detected() => Some(format!(
+            "RPBRT_SIMD={v}: this processor lacks it; using {}",
+            level().name()
+        )),
+        Some(_) => None,
+    }
+}
+
+/// A computation written once over [`F32Lanes`], run by [`dispatch`] at
+/// one width.
+pub trait Kernel {
+    /// What the kernel returns.
+    type Output;
+    /// Runs the kernel with lanes `L`. Must be `#[inline(always)]`-friendly
+    /// (generic code, no function pointers) so that it compiles inside
+    /// [`dispatch`]'s target-feature functions.
+    fn run<L: F32Lanes>(self) -> Self::Output;
+}
+
+/// Runs `k` at `level` (normally [`level()`]; a level above what the
+/// processor runs is lowered to it, so any value is safe).
+#[inline]
+pub fn dispatch<K: Kernel>(level: SimdLevel, k: K) -> K::Output {
+    let level = level.min(SimdLevel::detected());
+    match level {
+        #[cfg(target_arch = "x86_64")]
+        SimdLevel::Avx2 => {
+            // SAFETY: the processor has AVX2 and FMA (`level` is at most
+            // `detected()`).
+            unsafe { run_avx2(k) }
+        }
+        #[cfg(target_arch = "x86_64")]
+        SimdLevel::Sse4 => {
+            // SAFETY: the processor has SSE4.1 (as above).
+            unsafe { run_sse4(k) }
+        }
+        _ => k.run::<Scalar1>(),
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn run_avx2<K: Kernel>(k: K) -> K::Output {
+    k.run::<F32x8>()
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "sse4.1")]
+unsafe fn run_sse4<K: Kernel>(k: K) -> K::Output {
+    k.run::<F32x4>()
+}
+
+#[cfg(test)]
+mod tests;

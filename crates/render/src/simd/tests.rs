@@ -1,0 +1,124 @@
+use super::*;
+use crate::rng::Rng;
+
+/// Applies every lane operation to `a` and `b` at width `L` and returns
+/// the results lane by lane, to compare with the scalar code's.
+struct AllOps<'a> {
+    a: &'a [f32],
+    b: &'a [f32],
+}
+
+impl Kernel for AllOps<'_> {
+    type Output = Vec<[u32; 9]>;
+    #[inline(always)]
+    fn run<L: F32Lanes>(self) -> Vec<[u32; 9]> {
+        let mut out = Vec::new();
+        for (ca, cb) in self.a.chunks_exact(L::N).zip(self.b.chunks_exact(L::N)) {
+            let (a, b) = (L::load(ca), L::load(cb));
+            let mut vals = [[0.0f32; 16]; 6];
+            a.add(b).store(&mut vals[0]);
+            a.sub(b).store(&mut vals[1]);
+            a.mul(b).store(&mut vals[2]);
+            a.min(b).store(&mut vals[3]);
+            a.max(b).store(&mut vals[4]);
+            L::select(a.lt(b), a, b).store(&mut vals[5]);
+            let lt = L::bits(a.lt(b));
+            let le = L::bits(a.le(b));
+            let both = L::bits(L::and(a.lt(b), L::from_bits(0b1010_1010_1010_1010)));
+            for i in 0..L::N {
+                out.push([
+                    vals[0][i].to_bits(),
+                    vals[1][i].to_bits(),
+                    vals[2][i].to_bits(),
+                    vals[3][i].to_bits(),
+                    vals[4][i].to_bits(),
+                    vals[5][i].to_bits(),
+                    (lt >> i) & 1,
+                    (le >> i) & 1,
+                    (both >> i) & 1,
+                ]);
+            }
+        }
+        out
+    }
+}
+
+/// Every width gives the scalar results bit for bit, on random values and
+/// on the awkward ones (zeros of both signs, infinities, NaN, subnormals).
+#[test]
+fn every_width_computes_what_scalar_code_computes() {
+    let special = [
+        0.0f32,
+        -0.0,
+        1.0,
+        -1.0,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+        1e-40,
+        -1e-40,
+        f32::MAX,
+        3.5,
+        -2.25,
+    ];
+    let mut rng = Rng::with_sequence(5);
+    let mut a = Vec::new();
+    let mut b = Vec::new();
+    for &x in &special {
+        for &y in &special {
+            a.push(x);
+            b.push(y);
+        }
+    }
+    for _ in 0..4000 {
+        a.push((rng.uniform_float() - 0.5) * 1e3);
+        b.push((rng.uniform_float() - 0.5) * 1e3);
+    }
+    // A multiple of 16 values, for every width.
+    while a.len() % 16 != 0 {
+        a.push(1.0);
+        b.push(2.0);
+    }
+    let reference = dispatch(SimdLevel::Scalar, AllOps { a: &a, b: &b });
+    // The scalar lanes are the scalar expressions themselves.
+    for (i, r) in reference.iter().enumerate() {
+        let (x, y) = (a[i], b[i]);
+        assert_eq!(r[0], (x + y).to_bits());
+        assert_eq!(r[3], (if x < y { x } else { y }).to_bits());
+        assert_eq!(r[4], (if x > y { x } else { y }).to_bits());
+        assert_eq!(r[6], (x < y) as u32);
+        assert_eq!(r[7], (x <= y) as u32);
+    }
+    let levels = SimdLevel::available();
+    assert!(levels.contains(&SimdLevel::Scalar));
+    for level in levels {
+        let got = dispatch(level, AllOps { a: &a, b: &b });
+        assert_eq!(got.len(), reference.len());
+        for (i, (g, r)) in got.iter().zip(&reference).enumerate() {
+            // The mask test ANDs with every other lane of a 16-lane
+            // pattern: lane i of an N-wide chunk is bit i % N.
+            let mut r = *r;
+            let lanes = level.lanes();
+            let bit = if lanes == 1 {
+                0
+            } else {
+                (0b1010_1010_1010_1010u32 >> (i % lanes)) & 1
+            };
+            r[8] = r[6] & bit;
+            assert_eq!(*g, r, "{level:?}: values {} and {}", a[i], b[i]);
+        }
+    }
+}
+
+#[test]
+fn levels_parse_and_order() {
+    assert_eq!(SimdLevel::parse("AVX2"), Some(SimdLevel::Avx2));
+    assert_eq!(SimdLevel::parse("sse4.1"), Some(SimdLevel::Sse4));
+    assert_eq!(SimdLevel::parse("scalar"), Some(SimdLevel::Scalar));
+    assert_eq!(SimdLevel::parse("avx9"), None);
+    assert!(SimdLevel::Scalar < SimdLevel::Sse4 && SimdLevel::Sse4 < SimdLevel::Avx2);
+    // Asking for more than the processor has runs what it has.
+    assert!(level() <= SimdLevel::detected());
+    let sum = dispatch(SimdLevel::Avx2, AllOps { a: &[1.0; 16], b: &[2.0; 16] });
+    assert!(sum.iter().all(|r| r[0] == 3.0f32.to_bits()));
+}
