@@ -99,7 +99,7 @@ fn render_part(
 /// Serves part requests from stdin until it ends.
 pub fn run(integrator: &Integrator, scene: &mut Scene, base: RenderOptions) -> ExitCode {
     if !integrator.renders_pixel_samples() {
-        eprintln!(
+        diagln!(
             "rpbrt: error: --serve-parts: the \"{}\" integrator does not render pixel by pixel, so it cannot render parts",
             integrator.name()
         );

@@ -674,3 +674,52 @@ fn imgtool_makesky_writes_an_equal_area_sky() {
     assert!(String::from_utf8_lossy(&run.stderr).contains("--outfile"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A tiny emitter scene, 4×4 pixels at 1 sample, for tests about the
+/// command rather than the image.
+const TINY_SCENE: &str = "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" 45\nSampler \"independent\" \"integer pixelsamples\" 1\nFilm \"rgb\" \"integer xresolution\" 4 \"integer yresolution\" 4\nWorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [ 0.5 0.5 0.5 ]\nShape \"sphere\" \"float bogus\" 1\n";
+
+fn dev_full() -> std::fs::File {
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap()
+}
+
+#[test]
+fn failed_stderr_write_does_not_abort_the_render() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-cli-devfull-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("tiny.pbrt");
+    std::fs::write(&p, TINY_SCENE).unwrap();
+    let exr = dir.join("tiny.exr");
+    let _ = std::fs::remove_file(&exr);
+    // The unused "bogus" parameter warns and --stats prints: both go to a
+    // stderr that cannot be written.
+    let status = rpbrt()
+        .arg("--stats")
+        .arg("--outfile")
+        .arg(&exr)
+        .arg(&p)
+        .stderr(dev_full())
+        .status()
+        .unwrap();
+    assert_eq!(status.code(), Some(0));
+    assert!(std::fs::metadata(&exr).unwrap().len() > 0);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn failed_stdout_write_is_an_error_exit_not_a_panic() {
+    for args in [&["--help"][..], &["--version"][..], &["imgtool", "help"][..]] {
+        let out = rpbrt()
+            .args(args)
+            .stdout(dev_full())
+            .stderr(std::process::Stdio::piped())
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert!(e.contains("standard output") && !e.contains("panicked"), "{e}");
+    }
+}
