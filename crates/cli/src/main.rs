@@ -227,6 +227,18 @@ fn render_command(opts: &args::Options) -> ExitCode {
         }
     }
 
+    // The outputs' directories are checked now, not after the render.
+    if !opts.serve_parts {
+        let outputs = std::iter::once(("output image", scene.film.filename()))
+            .chain(opts.mse_reference_out.as_deref().map(|p| ("--mse-reference-out", p)));
+        for (what, path) in outputs {
+            if let Err(e) = check_output(what, path) {
+                diagln!("rpbrt: error: {e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    }
+
     let interrupt = Arc::new(AtomicBool::new(false));
     // A second Ctrl-C ends the process at once; the first one stops the
     // render after the current wave and writes the image so far.
@@ -382,6 +394,22 @@ fn render_command(opts: &args::Options) -> ExitCode {
         return ExitCode::from(130);
     }
     ExitCode::SUCCESS
+}
+
+/// Fails fast when `path` could not be written once the render is done:
+/// a missing or read-only directory is found before hours of rendering.
+pub(crate) fn check_output(what: &str, path: &str) -> Result<(), String> {
+    let p = std::path::Path::new(path);
+    rpbrt_render::image::io::check_writable(p).map_err(|e| {
+        let dir = p
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(std::path::Path::new("."));
+        format!(
+            "{what} \"{path}\" cannot be written in directory \"{}\": {e}",
+            dir.display()
+        )
+    })
 }
 
 /// The progress bar line for a progress report.

@@ -84,6 +84,7 @@ fn render_part(
     if !scene.film.set_active_bounds(bounds) {
         return Err("the tile lies outside the film".into());
     }
+    crate::check_output("--outfile", &req.outfile)?;
     scene.film.set_filename(req.outfile.clone());
     let opts = RenderOptions {
         sample_range: req.range.map(|(start, end)| SampleRange { start, end }),

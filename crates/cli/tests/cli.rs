@@ -723,3 +723,40 @@ fn failed_stdout_write_is_an_error_exit_not_a_panic() {
         assert!(e.contains("standard output") && !e.contains("panicked"), "{e}");
     }
 }
+
+#[test]
+fn missing_output_directory_fails_before_rendering() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-cli-outdir-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // 64×64 pixels at a million samples each would render for hours.
+    let heavy = TINY_SCENE
+        .replace("pixelsamples\" 1", "pixelsamples\" 1000000")
+        .replace("resolution\" 4", "resolution\" 64");
+    assert!(heavy.contains("yresolution\" 64"));
+    let p = dir.join("heavy.pbrt");
+    std::fs::write(&p, &heavy).unwrap();
+    let missing = dir.join("missing-dir");
+    let t = std::time::Instant::now();
+    let out = rpbrt()
+        .arg("--outfile")
+        .arg(missing.join("x.exr"))
+        .arg(&p)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains(&*missing.to_string_lossy()), "{e}");
+    // The scene's own file name is checked the same way.
+    let in_scene = heavy.replace(
+        "Film \"rgb\"",
+        "Film \"rgb\" \"string filename\" \"no-such-dir/y.exr\"",
+    );
+    let p = dir.join("heavy-named.pbrt");
+    std::fs::write(&p, in_scene).unwrap();
+    let out = rpbrt().arg(&p).current_dir(&dir).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("no-such-dir"), "{e}");
+    assert!(t.elapsed() < std::time::Duration::from_secs(10));
+    let _ = std::fs::remove_dir_all(&dir);
+}

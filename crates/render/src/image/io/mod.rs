@@ -131,6 +131,24 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     result
 }
 
+/// Checks, before any work is spent on it, that a file could be written at
+/// `path` the way [`write_atomically`] writes it: creates and removes an
+/// exclusive temporary file in the directory the write would reach
+/// (through symlinks), and refuses a `path` that is a directory. A render
+/// can thus fail in a moment rather than after hours.
+pub fn check_writable(path: &Path) -> std::io::Result<()> {
+    let target = resolve_symlinks(path)?;
+    if std::fs::metadata(&target).is_ok_and(|m| m.is_dir()) {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "is a directory",
+        ));
+    }
+    let (tmp, f) = create_temp_beside(&target, None)?;
+    drop(f);
+    std::fs::remove_file(&tmp)
+}
+
 /// Follows `path` through any chain of symlinks (relative links resolve
 /// against the link's own directory) to the file a write through it would
 /// reach, which need not exist yet. Gives up after as many hops as Linux
@@ -487,6 +505,17 @@ mod tests {
         std::fs::create_dir_all(d.join("out.exr/inside")).unwrap();
         assert!(write_atomically(&d.join("out.exr"), b"x").is_err());
         assert_eq!(entries(&d), ["out.exr"]);
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn output_check_writable_probes_the_directory() {
+        let d = temp_dir("probe");
+        assert!(super::check_writable(&d.join("out.exr")).is_ok());
+        assert!(super::check_writable(&d.join("missing/out.exr")).is_err());
+        assert!(super::check_writable(&d).is_err());
+        // The probe leaves nothing behind.
+        assert!(entries(&d).is_empty());
         let _ = std::fs::remove_dir_all(&d);
     }
 
