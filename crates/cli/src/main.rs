@@ -5,19 +5,25 @@
 /// `eprint!` that ignores write errors. Diagnostics and progress are
 /// best effort: std's `eprint!` panics when the write fails (stderr on a
 /// full disk or `/dev/full`), which would abort a render and lose its image.
+/// Messages often quote scene text or file names, so control characters
+/// other than newline and tab are escaped rather than sent to the terminal.
 macro_rules! diag {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        let _ = write!(std::io::stderr(), $($arg)*);
+        let text = format!($($arg)*);
+        let text = rpbrt_parser::diag::escape_controls(&text, "\n\t");
+        let _ = std::io::stderr().write_all(text.as_bytes());
     }};
 }
 
 /// `eprintln!` that ignores write errors (see [`diag!`]).
 macro_rules! diagln {
-    ($($arg:tt)*) => {{
-        use std::io::Write as _;
-        let _ = writeln!(std::io::stderr(), $($arg)*);
-    }};
+    () => {
+        diag!("\n")
+    };
+    ($($arg:tt)*) => {
+        diag!("{}\n", format_args!($($arg)*))
+    };
 }
 
 mod args;
@@ -300,8 +306,10 @@ fn render_command(opts: &args::Options) -> ExitCode {
             w.progress(p);
         }
         if show_progress {
-            diag!("{}", progress_line(p));
-            let _ = std::io::stderr().flush();
+            // Written as is: the bar's `\r` is ours, not scene text.
+            let mut err = std::io::stderr().lock();
+            let _ = err.write_all(progress_line(p).as_bytes());
+            let _ = err.flush();
         }
     };
     let result = integrator.render(&mut scene, &render_opts, &mut metadata, &draw_progress);

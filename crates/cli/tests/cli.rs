@@ -760,3 +760,80 @@ fn missing_output_directory_fails_before_rendering() {
     assert!(t.elapsed() < std::time::Duration::from_secs(10));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn scene_control_characters_are_escaped_in_messages() {
+    let p = temp_scene(
+        "osc.pbrt",
+        "WorldBegin\nShape \"\x1b]0;pwned\x07\"\n",
+    );
+    let out = rpbrt().arg(&p).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(!e.contains('\x1b') && !e.contains('\x07'), "{e:?}");
+    assert!(e.contains("\\u{1b}]0;pwned\\u{7}"), "{e}");
+}
+
+#[test]
+fn missing_scene_file_reports_only_that() {
+    let out = rpbrt()
+        .arg("/nonexistent-dir/missing-scene.pbrt")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("missing-scene.pbrt"), "{e}");
+    assert!(!e.contains("WorldBegin"), "{e}");
+    assert_eq!(e.lines().filter(|l| l.contains("error")).count(), 1, "{e}");
+}
+
+#[test]
+fn degenerate_look_at_names_the_directive_once() {
+    let p = temp_scene("lookat.pbrt", "LookAt 0 0 0  0 0 0  0 1 0\nWorldBegin\n");
+    let out = rpbrt().arg(&p).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("lookat.pbrt:1:1: error: LookAt: \"up\""), "{e}");
+    assert!(!e.contains("LookAt: LookAt"), "{e}");
+}
+
+#[test]
+fn named_medium_type_is_not_an_unused_parameter() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-cli-medium-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = TINY_SCENE
+        .replace(" \"float bogus\" 1", "")
+        .replace(
+            "WorldBegin\n",
+            "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"float scale\" 0.1\nMediumInterface \"\" \"fog\"\nWorldBegin\n",
+        );
+    let p = dir.join("fog.pbrt");
+    std::fs::write(&p, scene).unwrap();
+    let out = rpbrt()
+        .arg("--outfile")
+        .arg(dir.join("fog.exr"))
+        .arg(&p)
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{e}");
+    assert!(!e.contains("unused"), "{e}");
+    // A parameter the medium does not take is still reported.
+    let p2 = dir.join("fog2.pbrt");
+    std::fs::write(
+        &p2,
+        std::fs::read_to_string(&p)
+            .unwrap()
+            .replace("\"float scale\" 0.1", "\"float scael\" 0.1"),
+    )
+    .unwrap();
+    let out = rpbrt()
+        .arg("--outfile")
+        .arg(dir.join("fog2.exr"))
+        .arg(&p2)
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("scael") && !e.contains("\"type\""), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -110,7 +110,10 @@ impl Parser {
                     run.push(src);
                     run.run();
                 }
-                Err(msg) => run.report(Diagnostic::unlocated_error(msg)),
+                Err(msg) => {
+                    run.input_missing = true;
+                    run.report(Diagnostic::unlocated_error(msg));
+                }
             }
         }
         run.finish()
@@ -289,6 +292,10 @@ struct Run<'a> {
     warnings: usize,
     dropped_warnings: usize,
     stopped: bool,
+    /// A scene file named on the command line could not be opened: the
+    /// scene is incomplete, so its end is not checked (an "end of files
+    /// before WorldBegin" would only repeat that the file is missing).
+    input_missing: bool,
     warned_transform_begin: bool,
     kept: HashSet<Arc<str>>,
     /// Whether the target wants comments.
@@ -323,6 +330,7 @@ impl<'a> Run<'a> {
             warnings: 0,
             dropped_warnings: 0,
             stopped: false,
+            input_missing: false,
             warned_transform_begin: false,
             kept: HashSet::new(),
             comments,
@@ -389,7 +397,7 @@ impl<'a> Run<'a> {
         if !self.stopped {
             self.replay_deferred();
         }
-        if !self.stopped {
+        if !self.stopped && !self.input_missing {
             self.flush_comments();
             let r = self.target.end_of_files();
             self.drain(r);
