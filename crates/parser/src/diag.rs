@@ -272,7 +272,7 @@ impl Diagnostics {
                     None => reread
                         .entry(loc.file.clone())
                         .or_insert_with(|| {
-                            input::read_file_limited(&*loc.file, input::DEFAULT_MAX_FILE_BYTES).ok()
+                            input::read_file_limited(&*loc.file, input::DEFAULT_MAX_SCENE_FILE_BYTES).ok()
                         })
                         .as_deref(),
                 },

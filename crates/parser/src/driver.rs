@@ -45,7 +45,7 @@ impl Default for ParseOptions {
             max_warnings: 1000,
             max_include_depth: 64,
             max_values: 1 << 30,
-            max_file_bytes: input::DEFAULT_MAX_FILE_BYTES,
+            max_file_bytes: input::DEFAULT_MAX_SCENE_FILE_BYTES,
             parallel_import: true,
         }
     }
@@ -53,9 +53,9 @@ impl Default for ParseOptions {
 
 /// Reads a scene file, decompressing it when it starts with the gzip magic
 /// bytes (whatever its extension), with the default size limit
-/// ([`input::DEFAULT_MAX_FILE_BYTES`]).
+/// ([`input::DEFAULT_MAX_SCENE_FILE_BYTES`]).
 pub fn read_scene_file(path: impl AsRef<Path>) -> std::io::Result<Vec<u8>> {
-    input::read_file_limited(path, input::DEFAULT_MAX_FILE_BYTES)
+    input::read_file_limited(path, input::DEFAULT_MAX_SCENE_FILE_BYTES)
 }
 
 /// Parses the given files in order, then calls `end_of_files`.
@@ -105,7 +105,7 @@ impl Parser {
                 break;
             }
             let path = path.as_ref();
-            match run.open(path) {
+            match run.open(path, false) {
                 Ok(src) => {
                     run.push(src);
                     run.run();
@@ -461,7 +461,21 @@ impl<'a> Run<'a> {
         }
     }
 
-    fn open(&self, path: &Path) -> Result<Source, String> {
+    /// Reads the scene file `path` whole. An included (or imported) file
+    /// must be a regular file: a device or FIFO named by a scene (say
+    /// `/dev/zero`) would otherwise be read up to the size limit. Files
+    /// named on the command line may be pipes (`rpbrt /dev/stdin`), bounded
+    /// by the limit alone.
+    fn open(&self, path: &Path, included: bool) -> Result<Source, String> {
+        if included {
+            match std::fs::metadata(path) {
+                Ok(m) if !m.is_file() => {
+                    return Err(format!("{}: not a regular file", path.display()));
+                }
+                // A missing file is reported by the read below.
+                _ => {}
+            }
+        }
         let data = input::read_file_limited(path, self.opts.max_file_bytes)
             .map_err(|e| format!("{}: {e}", path.display()))?;
         let dir = match path.parent() {
@@ -940,7 +954,7 @@ impl<'a> Run<'a> {
             self.start_import(path, canon, loc);
             return;
         }
-        match self.open(&path) {
+        match self.open(&path, true) {
             Ok(src) => self.push(src),
             Err(msg) => self.report(Diagnostic::error(loc.clone(), format!("cannot read {msg}"))),
         }
