@@ -131,9 +131,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
     let t0 = Instant::now();
     let watching = opts.preview.is_some() || opts.display_server.is_some();
     if watching && opts.serve_parts {
-        diagln!(
-            "rpbrt: error: --preview and --display-server watch one render, not --serve-parts"
-        );
+        diagln!("rpbrt: error: --preview and --display-server watch one render, not --serve-parts");
         return ExitCode::FAILURE;
     }
     // Watching: the server binds before the scene loads, so that a port
@@ -235,8 +233,11 @@ fn render_command(opts: &args::Options) -> ExitCode {
 
     // The outputs' directories are checked now, not after the render.
     if !opts.serve_parts {
-        let outputs = std::iter::once(("output image", scene.film.filename()))
-            .chain(opts.mse_reference_out.as_deref().map(|p| ("--mse-reference-out", p)));
+        let outputs = std::iter::once(("output image", scene.film.filename())).chain(
+            opts.mse_reference_out
+                .as_deref()
+                .map(|p| ("--mse-reference-out", p)),
+        );
         for (what, path) in outputs {
             if let Err(e) = check_output(what, path) {
                 diagln!("rpbrt: error: {e}");

@@ -711,7 +711,11 @@ fn failed_stderr_write_does_not_abort_the_render() {
 
 #[test]
 fn failed_stdout_write_is_an_error_exit_not_a_panic() {
-    for args in [&["--help"][..], &["--version"][..], &["imgtool", "help"][..]] {
+    for args in [
+        &["--help"][..],
+        &["--version"][..],
+        &["imgtool", "help"][..],
+    ] {
         let out = rpbrt()
             .args(args)
             .stdout(dev_full())
@@ -720,7 +724,10 @@ fn failed_stdout_write_is_an_error_exit_not_a_panic() {
             .unwrap();
         assert_eq!(out.status.code(), Some(1), "{args:?}");
         let e = String::from_utf8_lossy(&out.stderr);
-        assert!(e.contains("standard output") && !e.contains("panicked"), "{e}");
+        assert!(
+            e.contains("standard output") && !e.contains("panicked"),
+            "{e}"
+        );
     }
 }
 
@@ -763,10 +770,7 @@ fn missing_output_directory_fails_before_rendering() {
 
 #[test]
 fn scene_control_characters_are_escaped_in_messages() {
-    let p = temp_scene(
-        "osc.pbrt",
-        "WorldBegin\nShape \"\x1b]0;pwned\x07\"\n",
-    );
+    let p = temp_scene("osc.pbrt", "WorldBegin\nShape \"\x1b]0;pwned\x07\"\n");
     let out = rpbrt().arg(&p).output().unwrap();
     assert_eq!(out.status.code(), Some(1));
     let e = String::from_utf8_lossy(&out.stderr);

@@ -272,7 +272,11 @@ impl Diagnostics {
                     None => reread
                         .entry(loc.file.clone())
                         .or_insert_with(|| {
-                            input::read_file_limited(&*loc.file, input::DEFAULT_MAX_SCENE_FILE_BYTES).ok()
+                            input::read_file_limited(
+                                &*loc.file,
+                                input::DEFAULT_MAX_SCENE_FILE_BYTES,
+                            )
+                            .ok()
                         })
                         .as_deref(),
                 },
@@ -333,7 +337,10 @@ mod tests {
         let r = d.render(Some(src.as_bytes()));
         assert!(!r.contains('\x1b') && !r.contains('\x07'), "{r:?}");
         let lines: Vec<&str> = r.lines().collect();
-        assert_eq!(lines[0], "a.pbrt:1:20: error: unknown shape \"\\u{1b}]0;title\\u{7}\"");
+        assert_eq!(
+            lines[0],
+            "a.pbrt:1:20: error: unknown shape \"\\u{1b}]0;title\\u{7}\""
+        );
         assert_eq!(lines[2], "1 | Shape \"\\u{1b}]0;title\\u{7}\" 1");
         // The caret stays under the `1` after the escapes.
         let col = lines[2].find(" 1").unwrap() + 1;

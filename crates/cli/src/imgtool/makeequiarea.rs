@@ -71,7 +71,8 @@ pub fn run(args: &[String]) -> Result<(), String> {
         diagln!(
             "rpbrt imgtool: warning: {infile}: resolution ({}, {}) doesn't have a 2:1 aspect \
              ratio; it is doubtful that this is a latitude-longitude environment map",
-            res.x, res.y
+            res.x,
+            res.y
         );
     }
     let n = resolution.unwrap_or(res.x);

@@ -793,7 +793,8 @@ fn included_device_is_a_located_error_not_an_endless_read() {
     let e: Vec<String> = res.unwrap_err().iter().map(|d| d.to_string()).collect();
     assert!(
         e.iter()
-            .any(|m| m.contains("main.pbrt:2:1: error:") && m.contains("/dev/zero: not a regular file")),
+            .any(|m| m.contains("main.pbrt:2:1: error:")
+                && m.contains("/dev/zero: not a regular file")),
         "{e:?}"
     );
     assert!(
@@ -818,7 +819,11 @@ fn gzip_bomb_scene_stops_at_the_size_limit() {
     let gz = enc.finish().unwrap();
     assert!(gz.len() < 64 << 10);
     std::fs::write(d.join("bomb.pbrt.gz"), gz).unwrap();
-    std::fs::write(d.join("main.pbrt"), "WorldBegin\nInclude \"bomb.pbrt.gz\"\n").unwrap();
+    std::fs::write(
+        d.join("main.pbrt"),
+        "WorldBegin\nInclude \"bomb.pbrt.gz\"\n",
+    )
+    .unwrap();
     // The limit lowered to 1 MiB keeps the test small; the default (1 GiB)
     // works the same way.
     let opts = ParseOptions {

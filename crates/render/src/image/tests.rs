@@ -1007,7 +1007,10 @@ fn exr_header_size_claims_are_checked_against_the_file() {
         bytes[at + 12..at + 16].copy_from_slice(&y_max.to_le_bytes());
         let e = Image::read_from_bytes(&bytes, "damaged.exr", None)
             .expect_err("a damaged header was decoded");
-        assert!(e.to_string().contains("damaged header"), "{x_max}x{y_max}: {e}");
+        assert!(
+            e.to_string().contains("damaged header"),
+            "{x_max}x{y_max}: {e}"
+        );
     }
     // A file cut short after its header is refused by the same check.
     let header_end = good.len() - 40;

@@ -457,7 +457,11 @@ mod tests {
             .is_symlink());
         assert_eq!(
             entries(&d),
-            [planted.file_name().unwrap().to_str().unwrap(), "victim.txt", "x.exr"]
+            [
+                planted.file_name().unwrap().to_str().unwrap(),
+                "victim.txt",
+                "x.exr"
+            ]
         );
         let _ = std::fs::remove_dir_all(&d);
     }
