@@ -18,8 +18,9 @@ use std::path::Path;
 /// The two bytes every gzip member starts with (RFC 1952, section 2.3.1).
 pub const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
 
-/// The default largest file (after decompression) that is read into memory:
-/// 64 GiB (also the parser's default `ParseOptions::max_file_bytes`).
+/// The default largest image file (after decompression) that is read into
+/// memory: 64 GiB. Scene text has its own, lower limit
+/// ([`DEFAULT_MAX_SCENE_FILE_BYTES`]).
 pub const DEFAULT_MAX_FILE_BYTES: u64 = 1 << 36;
 
 /// The default largest scene file (after decompression) the parser reads
