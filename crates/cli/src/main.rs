@@ -2,6 +2,30 @@
 //! calls into the parser and renderer crates, printing located diagnostics
 //! (`file:line:col: error: ...`) and exiting non-zero on errors.
 
+/// `eprint!` that ignores write errors. Diagnostics and progress are
+/// best effort: std's `eprint!` panics when the write fails (stderr on a
+/// full disk or `/dev/full`), which would abort a render and lose its image.
+/// Messages often quote scene text or file names, so control characters
+/// other than newline and tab are escaped rather than sent to the terminal.
+macro_rules! diag {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let text = format!($($arg)*);
+        let text = rpbrt_parser::diag::escape_controls(&text, "\n\t");
+        let _ = std::io::stderr().write_all(text.as_bytes());
+    }};
+}
+
+/// `eprintln!` that ignores write errors (see [`diag!`]).
+macro_rules! diagln {
+    () => {
+        diag!("\n")
+    };
+    ($($arg:tt)*) => {
+        diag!("{}\n", format_args!($($arg)*))
+    };
+}
+
 mod args;
 mod imgtool;
 mod preview;
@@ -32,27 +56,25 @@ fn main() -> ExitCode {
     let opts = match args::parse_args(&argv) {
         Ok(o) => o,
         Err(e) => {
-            eprintln!("rpbrt: error: {e}");
+            diagln!("rpbrt: error: {e}");
             return ExitCode::FAILURE;
         }
     };
     if opts.help {
-        print!("{}", args::USAGE);
-        return ExitCode::SUCCESS;
+        return print_product(args::USAGE);
     }
     if opts.version {
-        println!("rpbrt {}", env!("CARGO_PKG_VERSION"));
-        return ExitCode::SUCCESS;
+        return print_product(&format!("rpbrt {}\n", env!("CARGO_PKG_VERSION")));
     }
     if opts.files.is_empty() {
-        eprintln!("rpbrt: error: no scene file given\n\n{}", args::USAGE);
+        diagln!("rpbrt: error: no scene file given\n\n{}", args::USAGE);
         return ExitCode::FAILURE;
     }
     if opts.format || opts.upgrade {
         return format_scene(&opts);
     }
     if opts.toply {
-        eprintln!("rpbrt: error: --toply is used together with --format or --upgrade");
+        diagln!("rpbrt: error: --toply is used together with --format or --upgrade");
         return ExitCode::FAILURE;
     }
     render_command(&opts)
@@ -73,21 +95,25 @@ fn format_scene(opts: &args::Options) -> ExitCode {
         Err(d) => (d, false),
     };
     if !diags.is_empty() {
-        eprint!("{}", diags.render());
+        diag!("{}", diags.render());
     }
     if !ok {
         return ExitCode::FAILURE;
     }
-    let out = target.into_output();
-    let mut stdout = std::io::stdout().lock();
-    if stdout
-        .write_all(out.as_bytes())
-        .and_then(|_| stdout.flush())
-        .is_err()
-    {
-        return ExitCode::FAILURE;
+    print_product(&target.into_output())
+}
+
+/// Writes output that is the command's product (usage, version, formatted
+/// scene) to stdout: a failed write is an error exit with a message, not
+/// a panic; a closed pipe (`| head`) is not an error.
+fn print_product(s: &str) -> ExitCode {
+    match imgtool::emit(s) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            diagln!("rpbrt: error: {e}");
+            ExitCode::FAILURE
+        }
     }
-    ExitCode::SUCCESS
 }
 
 /// Peak resident memory in bytes (Linux), for `--stats`.
@@ -105,9 +131,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
     let t0 = Instant::now();
     let watching = opts.preview.is_some() || opts.display_server.is_some();
     if watching && opts.serve_parts {
-        eprintln!(
-            "rpbrt: error: --preview and --display-server watch one render, not --serve-parts"
-        );
+        diagln!("rpbrt: error: --preview and --display-server watch one render, not --serve-parts");
         return ExitCode::FAILURE;
     }
     // Watching: the server binds before the scene loads, so that a port
@@ -121,11 +145,11 @@ fn render_command(opts: &args::Options) -> ExitCode {
                 } else {
                     ""
                 };
-                eprintln!("rpbrt: preview at {}{everywhere}", p.url());
+                diagln!("rpbrt: preview at {}{everywhere}", p.url());
                 Some(p)
             }
             Err(e) => {
-                eprintln!("rpbrt: error: {e}");
+                diagln!("rpbrt: error: {e}");
                 return ExitCode::FAILURE;
             }
         },
@@ -143,7 +167,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
     let (desc, diags) = match build_scene(&paths, &build) {
         Ok(r) => r,
         Err(d) => {
-            eprint!("{}", d.render());
+            diag!("{}", d.render());
             return ExitCode::FAILURE;
         }
     };
@@ -172,34 +196,34 @@ fn render_command(opts: &args::Options) -> ExitCode {
         Ok(c) => c,
         Err(errors) => {
             all.items.extend(errors);
-            eprint!("{}", all.render());
+            diag!("{}", all.render());
             return ExitCode::FAILURE;
         }
     };
     all.items.extend(created.warnings);
     if !opts.quiet && !all.is_empty() {
-        eprint!("{}", all.render());
+        diag!("{}", all.render());
     }
     let mut scene = created.scene;
     let integrator = created.integrator;
     let t_create = t0.elapsed() - t_parse;
     if let Some((start, end)) = opts.spp_range {
         if !integrator.renders_pixel_samples() {
-            eprintln!(
+            diagln!(
                 "rpbrt: error: --spp-range: the \"{}\" integrator does not take samples pixel by pixel, so its samples cannot be split into ranges",
                 integrator.name()
             );
             return ExitCode::FAILURE;
         }
         if let Err(e) = (SampleRange { start, end }).check(scene.sampler.samples_per_pixel()) {
-            eprintln!("rpbrt: error: {e}");
+            diagln!("rpbrt: error: {e}");
             return ExitCode::FAILURE;
         }
     }
     if opts.tile.is_some() && !opts.quiet {
         let name = integrator.name();
         if matches!(name, "bdpt" | "lightpath" | "mlt" | "sppm") {
-            eprintln!(
+            diagln!(
                 "rpbrt: warning: --tile: the tiles of a \"{name}\" render do not join into its full image (light paths splat across tile edges{}){}",
                 if name == "sppm" { " and the photon count follows the pixel count" } else { "" },
                 if integrator.renders_pixel_samples() { "; split it with --spp-range instead" } else { "" }
@@ -207,9 +231,29 @@ fn render_command(opts: &args::Options) -> ExitCode {
         }
     }
 
+    // The outputs' directories are checked now, not after the render.
+    if !opts.serve_parts {
+        let outputs = std::iter::once(("output image", scene.film.filename())).chain(
+            opts.mse_reference_out
+                .as_deref()
+                .map(|p| ("--mse-reference-out", p)),
+        );
+        for (what, path) in outputs {
+            if let Err(e) = check_output(what, path) {
+                diagln!("rpbrt: error: {e}");
+                return ExitCode::FAILURE;
+            }
+        }
+    }
+
+    if let Some(w) = rpbrt_render::simd::env_warning() {
+        if !opts.quiet {
+            diagln!("rpbrt: warning: {w}");
+        }
+    }
     let wavefront = opts.wavefront || desc_flag(&desc, "wavefront");
     if wavefront && !integrator.has_wavefront() && !opts.quiet {
-        eprintln!(
+        diagln!(
             "rpbrt: warning: --wavefront: the \"{}\" integrator{} has no wavefront form yet; rendering it with the scalar loop",
             integrator.name(),
             if integrator.name() == "volpath" { " with participating media" } else { "" }
@@ -229,14 +273,14 @@ fn render_command(opts: &args::Options) -> ExitCode {
         Some(path) => match rpbrt_render::image::Image::read(std::path::Path::new(path), None) {
             Ok(im) => Some(im.image),
             Err(e) => {
-                eprintln!("rpbrt: error: --mse-reference-image: {e}");
+                diagln!("rpbrt: error: --mse-reference-image: {e}");
                 return ExitCode::FAILURE;
             }
         },
         None => None,
     };
     if opts.mse_reference_out.is_some() && mse_reference.is_none() {
-        eprintln!("rpbrt: error: --mse-reference-out needs --mse-reference-image");
+        diagln!("rpbrt: error: --mse-reference-out needs --mse-reference-image");
         return ExitCode::FAILURE;
     }
     let render_opts = RenderOptions {
@@ -278,14 +322,16 @@ fn render_command(opts: &args::Options) -> ExitCode {
             w.progress(p);
         }
         if show_progress {
-            eprint!("{}", progress_line(p));
-            let _ = std::io::stderr().flush();
+            // Written as is: the bar's `\r` is ours, not scene text.
+            let mut err = std::io::stderr().lock();
+            let _ = err.write_all(progress_line(p).as_bytes());
+            let _ = err.flush();
         }
     };
     let result = integrator.render(&mut scene, &render_opts, &mut metadata, &draw_progress);
     if show_progress {
         // Below the bar's last state.
-        eprintln!();
+        diagln!();
     }
     if let Some(w) = &watch {
         w.finish();
@@ -300,13 +346,13 @@ fn render_command(opts: &args::Options) -> ExitCode {
     let stats = match result {
         Ok(s) => s,
         Err(e) => {
-            eprintln!("rpbrt: error: {e}");
+            diagln!("rpbrt: error: {e}");
             return ExitCode::FAILURE;
         }
     };
     if !opts.quiet {
         for w in &stats.warnings {
-            eprintln!("rpbrt: warning: {w}");
+            diagln!("rpbrt: warning: {w}");
         }
     }
     if let Some(path) = &opts.mse_reference_out {
@@ -316,62 +362,83 @@ fn render_command(opts: &args::Options) -> ExitCode {
             .map(|(spp, mse)| format!("{spp} {mse:e}\n"))
             .collect();
         if let Err(e) = std::fs::write(path, text) {
-            eprintln!("rpbrt: error: --mse-reference-out {path}: {e}");
+            diagln!("rpbrt: error: --mse-reference-out {path}: {e}");
             return ExitCode::FAILURE;
         }
     }
     if opts.stats {
         let c = &scene.counters;
         let secs = stats.render_time.as_secs_f64().max(1e-9);
-        eprintln!("Statistics:");
-        eprintln!(
+        diagln!("Statistics:");
+        diagln!(
             "  Parse and build scene      {:>10.3} s",
             t_parse.as_secs_f64()
         );
-        eprintln!(
+        diagln!(
             "  Create render objects      {:>10.3} s",
             t_create.as_secs_f64()
         );
-        eprintln!("  Render                     {:>10.3} s", secs);
-        eprintln!(
+        diagln!("  Render                     {:>10.3} s", secs);
+        diagln!(
+            "  Design                     {:>10}  (SIMD {})",
+            if render_opts.wavefront && integrator.has_wavefront() { "wavefront" } else { "scalar" },
+            rpbrt_render::simd::level().name()
+        );
+        diagln!(
             "  Samples                    {:>10}  ({:.3} M/s)",
             stats.samples,
             stats.samples as f64 / secs / 1e6
         );
-        eprintln!(
+        diagln!(
             "  Camera rays                {:>10}",
             c.camera_rays.load(Ordering::Relaxed)
         );
-        eprintln!(
+        diagln!(
             "  Intersection rays          {:>10}",
             c.intersection_rays.load(Ordering::Relaxed)
         );
-        eprintln!(
+        diagln!(
             "  Shadow rays                {:>10}",
             c.shadow_rays.load(Ordering::Relaxed)
         );
         let prims = scene.aggregate.primitive_count().max(1);
-        eprintln!(
+        diagln!(
             "  Primitives                 {:>10}",
             scene.aggregate.primitive_count()
         );
-        eprintln!(
+        diagln!(
             "  Accelerator memory         {:>10} bytes ({:.1} bytes/primitive)",
             scene.aggregate.accelerator().memory_bytes(),
             scene.aggregate.accelerator().memory_bytes() as f64 / prims as f64
         );
         if let Some(m) = peak_memory_bytes() {
-            eprintln!(
+            diagln!(
                 "  Peak memory                {:>10.1} MiB",
                 m as f64 / (1024.0 * 1024.0)
             );
         }
     }
     if stats.interrupted {
-        eprintln!("rpbrt: interrupted; wrote the image rendered so far");
+        diagln!("rpbrt: interrupted; wrote the image rendered so far");
         return ExitCode::from(130);
     }
     ExitCode::SUCCESS
+}
+
+/// Fails fast when `path` could not be written once the render is done:
+/// a missing or read-only directory is found before hours of rendering.
+pub(crate) fn check_output(what: &str, path: &str) -> Result<(), String> {
+    let p = std::path::Path::new(path);
+    rpbrt_render::image::io::check_writable(p).map_err(|e| {
+        let dir = p
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(std::path::Path::new("."));
+        format!(
+            "{what} \"{path}\" cannot be written in directory \"{}\": {e}",
+            dir.display()
+        )
+    })
 }
 
 /// The progress bar line for a progress report.

@@ -84,6 +84,7 @@ fn render_part(
     if !scene.film.set_active_bounds(bounds) {
         return Err("the tile lies outside the film".into());
     }
+    crate::check_output("--outfile", &req.outfile)?;
     scene.film.set_filename(req.outfile.clone());
     let opts = RenderOptions {
         sample_range: req.range.map(|(start, end)| SampleRange { start, end }),
@@ -99,7 +100,7 @@ fn render_part(
 /// Serves part requests from stdin until it ends.
 pub fn run(integrator: &Integrator, scene: &mut Scene, base: RenderOptions) -> ExitCode {
     if !integrator.renders_pixel_samples() {
-        eprintln!(
+        diagln!(
             "rpbrt: error: --serve-parts: the \"{}\" integrator does not render pixel by pixel, so it cannot render parts",
             integrator.name()
         );

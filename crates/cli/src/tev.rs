@@ -146,7 +146,7 @@ impl TevClient {
             self.shown = None;
             if !self.warned {
                 self.warned = true;
-                eprintln!(
+                diagln!(
                     "rpbrt: warning: --display-server {}: {e}; will keep trying",
                     self.address
                 );

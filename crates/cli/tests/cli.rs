@@ -674,3 +674,170 @@ fn imgtool_makesky_writes_an_equal_area_sky() {
     assert!(String::from_utf8_lossy(&run.stderr).contains("--outfile"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A tiny emitter scene, 4×4 pixels at 1 sample, for tests about the
+/// command rather than the image.
+const TINY_SCENE: &str = "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" 45\nSampler \"independent\" \"integer pixelsamples\" 1\nFilm \"rgb\" \"integer xresolution\" 4 \"integer yresolution\" 4\nWorldBegin\nAreaLightSource \"diffuse\" \"rgb L\" [ 0.5 0.5 0.5 ]\nShape \"sphere\" \"float bogus\" 1\n";
+
+fn dev_full() -> std::fs::File {
+    std::fs::OpenOptions::new()
+        .write(true)
+        .open("/dev/full")
+        .unwrap()
+}
+
+#[test]
+fn failed_stderr_write_does_not_abort_the_render() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-cli-devfull-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("tiny.pbrt");
+    std::fs::write(&p, TINY_SCENE).unwrap();
+    let exr = dir.join("tiny.exr");
+    let _ = std::fs::remove_file(&exr);
+    // The unused "bogus" parameter warns and --stats prints: both go to a
+    // stderr that cannot be written.
+    let status = rpbrt()
+        .arg("--stats")
+        .arg("--outfile")
+        .arg(&exr)
+        .arg(&p)
+        .stderr(dev_full())
+        .status()
+        .unwrap();
+    assert_eq!(status.code(), Some(0));
+    assert!(std::fs::metadata(&exr).unwrap().len() > 0);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn failed_stdout_write_is_an_error_exit_not_a_panic() {
+    for args in [
+        &["--help"][..],
+        &["--version"][..],
+        &["imgtool", "help"][..],
+    ] {
+        let out = rpbrt()
+            .args(args)
+            .stdout(dev_full())
+            .stderr(std::process::Stdio::piped())
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{args:?}");
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            e.contains("standard output") && !e.contains("panicked"),
+            "{e}"
+        );
+    }
+}
+
+#[test]
+fn missing_output_directory_fails_before_rendering() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-cli-outdir-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // 64×64 pixels at a million samples each would render for hours.
+    let heavy = TINY_SCENE
+        .replace("pixelsamples\" 1", "pixelsamples\" 1000000")
+        .replace("resolution\" 4", "resolution\" 64");
+    assert!(heavy.contains("yresolution\" 64"));
+    let p = dir.join("heavy.pbrt");
+    std::fs::write(&p, &heavy).unwrap();
+    let missing = dir.join("missing-dir");
+    let t = std::time::Instant::now();
+    let out = rpbrt()
+        .arg("--outfile")
+        .arg(missing.join("x.exr"))
+        .arg(&p)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains(&*missing.to_string_lossy()), "{e}");
+    // The scene's own file name is checked the same way.
+    let in_scene = heavy.replace(
+        "Film \"rgb\"",
+        "Film \"rgb\" \"string filename\" \"no-such-dir/y.exr\"",
+    );
+    let p = dir.join("heavy-named.pbrt");
+    std::fs::write(&p, in_scene).unwrap();
+    let out = rpbrt().arg(&p).current_dir(&dir).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("no-such-dir"), "{e}");
+    assert!(t.elapsed() < std::time::Duration::from_secs(10));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn scene_control_characters_are_escaped_in_messages() {
+    let p = temp_scene("osc.pbrt", "WorldBegin\nShape \"\x1b]0;pwned\x07\"\n");
+    let out = rpbrt().arg(&p).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(!e.contains('\x1b') && !e.contains('\x07'), "{e:?}");
+    assert!(e.contains("\\u{1b}]0;pwned\\u{7}"), "{e}");
+}
+
+#[test]
+fn missing_scene_file_reports_only_that() {
+    let out = rpbrt()
+        .arg("/nonexistent-dir/missing-scene.pbrt")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("missing-scene.pbrt"), "{e}");
+    assert!(!e.contains("WorldBegin"), "{e}");
+    assert_eq!(e.lines().filter(|l| l.contains("error")).count(), 1, "{e}");
+}
+
+#[test]
+fn degenerate_look_at_names_the_directive_once() {
+    let p = temp_scene("lookat.pbrt", "LookAt 0 0 0  0 0 0  0 1 0\nWorldBegin\n");
+    let out = rpbrt().arg(&p).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("lookat.pbrt:1:1: error: LookAt: \"up\""), "{e}");
+    assert!(!e.contains("LookAt: LookAt"), "{e}");
+}
+
+#[test]
+fn named_medium_type_is_not_an_unused_parameter() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-cli-medium-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = TINY_SCENE
+        .replace(" \"float bogus\" 1", "")
+        .replace(
+            "WorldBegin\n",
+            "MakeNamedMedium \"fog\" \"string type\" \"homogeneous\" \"float scale\" 0.1\nMediumInterface \"\" \"fog\"\nWorldBegin\n",
+        );
+    let p = dir.join("fog.pbrt");
+    std::fs::write(&p, scene).unwrap();
+    let out = rpbrt()
+        .arg("--outfile")
+        .arg(dir.join("fog.exr"))
+        .arg(&p)
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{e}");
+    assert!(!e.contains("unused"), "{e}");
+    // A parameter the medium does not take is still reported.
+    let p2 = dir.join("fog2.pbrt");
+    std::fs::write(
+        &p2,
+        std::fs::read_to_string(&p)
+            .unwrap()
+            .replace("\"float scale\" 0.1", "\"float scael\" 0.1"),
+    )
+    .unwrap();
+    let out = rpbrt()
+        .arg("--outfile")
+        .arg(dir.join("fog2.exr"))
+        .arg(&p2)
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(e.contains("scael") && !e.contains("\"type\""), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -175,7 +175,7 @@ impl fmt::Display for TransformError {
                 write!(f, "transformation matrix is singular (not invertible)")
             }
             TransformError::DegenerateLookAt => {
-                write!(f, "LookAt: \"up\" vector and viewing direction are parallel, or eye and look-at points coincide")
+                write!(f, "\"up\" vector and viewing direction are parallel, or eye and look-at points coincide")
             }
             TransformError::ZeroAxis => write!(f, "rotation axis has zero length"),
             TransformError::BadProjection => write!(f, "invalid projection parameters"),

@@ -78,16 +78,25 @@ impl Diagnostic {
         let mut out = self.to_string();
         if let (Some(loc), Some(src)) = (&self.loc, source) {
             if let Some(line) = source_line(src, loc.line) {
-                let text = String::from_utf8_lossy(line);
-                let text = text.trim_end_matches(['\r', '\n']);
-                // Tabs keep their width so the caret lines up in a terminal.
+                let raw = String::from_utf8_lossy(line);
+                let raw = raw.trim_end_matches(['\r', '\n']);
+                // Tabs keep their width so the caret lines up in a terminal;
+                // other control characters are shown escaped (a scene must
+                // not drive the terminal), and the caret skips their escape.
                 let mut caret = String::new();
-                for (i, ch) in text.chars().enumerate() {
+                for (i, ch) in raw.chars().enumerate() {
                     if i + 1 >= loc.column as usize {
                         break;
                     }
-                    caret.push(if ch == '\t' { '\t' } else { ' ' });
+                    match ch {
+                        '\t' => caret.push('\t'),
+                        c if is_unsafe_control(c) => {
+                            caret.push_str(&" ".repeat(c.escape_unicode().count()))
+                        }
+                        _ => caret.push(' '),
+                    }
                 }
+                let text = escape_controls(raw, "\t");
                 // Columns count bytes; clamp for lines with multibyte characters.
                 let gutter = loc.line.to_string();
                 let pad = " ".repeat(gutter.len());
@@ -97,6 +106,31 @@ impl Diagnostic {
         }
         out
     }
+}
+
+/// True for characters a terminal may act on rather than show: the C0
+/// and C1 controls and DEL.
+fn is_unsafe_control(c: char) -> bool {
+    c.is_control()
+}
+
+/// `s` with its control characters other than those in `keep` written as
+/// `\u{1b}`-style escapes, so that text from a scene or an image file (an
+/// OSC sequence setting the window title, a bell, a cursor move) is shown
+/// rather than obeyed when printed to a terminal.
+pub fn escape_controls<'a>(s: &'a str, keep: &str) -> std::borrow::Cow<'a, str> {
+    if !s.chars().any(|c| is_unsafe_control(c) && !keep.contains(c)) {
+        return std::borrow::Cow::Borrowed(s);
+    }
+    let mut out = String::with_capacity(s.len() + 16);
+    for c in s.chars() {
+        if is_unsafe_control(c) && !keep.contains(c) {
+            out.extend(c.escape_unicode());
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
 }
 
 /// Returns line `line` (1-based) of `src`, without its terminator.
@@ -126,11 +160,14 @@ fn source_line(src: &[u8], line: u32) -> Option<&[u8]> {
 }
 
 impl fmt::Display for Diagnostic {
+    /// Control characters in the file name or message (often quoting the
+    /// scene) are escaped; newlines and tabs are kept.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match &self.loc {
-            Some(loc) => write!(f, "{}: {}: {}", loc, self.severity, self.message),
-            None => write!(f, "{}: {}", self.severity, self.message),
-        }
+        let text = match &self.loc {
+            Some(loc) => format!("{}: {}: {}", loc, self.severity, self.message),
+            None => format!("{}: {}", self.severity, self.message),
+        };
+        f.write_str(&escape_controls(&text, "\n\t"))
     }
 }
 
@@ -235,7 +272,11 @@ impl Diagnostics {
                     None => reread
                         .entry(loc.file.clone())
                         .or_insert_with(|| {
-                            input::read_file_limited(&*loc.file, input::DEFAULT_MAX_FILE_BYTES).ok()
+                            input::read_file_limited(
+                                &*loc.file,
+                                input::DEFAULT_MAX_SCENE_FILE_BYTES,
+                            )
+                            .ok()
                         })
                         .as_deref(),
                 },
@@ -285,6 +326,28 @@ mod tests {
         let w = Diagnostic::warning(loc(1, 1), "hmm");
         assert_eq!(w.to_string(), "a.pbrt:1:1: warning: hmm");
         assert_eq!(Diagnostic::unlocated_error("x").to_string(), "error: x");
+    }
+
+    #[test]
+    fn diagnostic_escapes_terminal_control_characters() {
+        // An OSC sequence setting the terminal's title, quoted by a message
+        // and present in the source line.
+        let src = "Shape \"\x1b]0;title\x07\" 1\n";
+        let d = Diagnostic::error(loc(1, 20), "unknown shape \"\x1b]0;title\x07\"");
+        let r = d.render(Some(src.as_bytes()));
+        assert!(!r.contains('\x1b') && !r.contains('\x07'), "{r:?}");
+        let lines: Vec<&str> = r.lines().collect();
+        assert_eq!(
+            lines[0],
+            "a.pbrt:1:20: error: unknown shape \"\\u{1b}]0;title\\u{7}\""
+        );
+        assert_eq!(lines[2], "1 | Shape \"\\u{1b}]0;title\\u{7}\" 1");
+        // The caret stays under the `1` after the escapes.
+        let col = lines[2].find(" 1").unwrap() + 1;
+        assert_eq!(lines[3].find('^'), Some(col), "{r}");
+        // Newlines in messages and tabs in source stay as they are.
+        let m = Diagnostic::unlocated_error("a\n\tb").to_string();
+        assert_eq!(m, "error: a\n\tb");
     }
 
     #[test]

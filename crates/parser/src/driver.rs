@@ -45,7 +45,7 @@ impl Default for ParseOptions {
             max_warnings: 1000,
             max_include_depth: 64,
             max_values: 1 << 30,
-            max_file_bytes: input::DEFAULT_MAX_FILE_BYTES,
+            max_file_bytes: input::DEFAULT_MAX_SCENE_FILE_BYTES,
             parallel_import: true,
         }
     }
@@ -53,9 +53,9 @@ impl Default for ParseOptions {
 
 /// Reads a scene file, decompressing it when it starts with the gzip magic
 /// bytes (whatever its extension), with the default size limit
-/// ([`input::DEFAULT_MAX_FILE_BYTES`]).
+/// ([`input::DEFAULT_MAX_SCENE_FILE_BYTES`]).
 pub fn read_scene_file(path: impl AsRef<Path>) -> std::io::Result<Vec<u8>> {
-    input::read_file_limited(path, input::DEFAULT_MAX_FILE_BYTES)
+    input::read_file_limited(path, input::DEFAULT_MAX_SCENE_FILE_BYTES)
 }
 
 /// Parses the given files in order, then calls `end_of_files`.
@@ -105,12 +105,15 @@ impl Parser {
                 break;
             }
             let path = path.as_ref();
-            match run.open(path) {
+            match run.open(path, false) {
                 Ok(src) => {
                     run.push(src);
                     run.run();
                 }
-                Err(msg) => run.report(Diagnostic::unlocated_error(msg)),
+                Err(msg) => {
+                    run.input_missing = true;
+                    run.report(Diagnostic::unlocated_error(msg));
+                }
             }
         }
         run.finish()
@@ -289,6 +292,10 @@ struct Run<'a> {
     warnings: usize,
     dropped_warnings: usize,
     stopped: bool,
+    /// A scene file named on the command line could not be opened: the
+    /// scene is incomplete, so its end is not checked (an "end of files
+    /// before WorldBegin" would only repeat that the file is missing).
+    input_missing: bool,
     warned_transform_begin: bool,
     kept: HashSet<Arc<str>>,
     /// Whether the target wants comments.
@@ -323,6 +330,7 @@ impl<'a> Run<'a> {
             warnings: 0,
             dropped_warnings: 0,
             stopped: false,
+            input_missing: false,
             warned_transform_begin: false,
             kept: HashSet::new(),
             comments,
@@ -389,7 +397,7 @@ impl<'a> Run<'a> {
         if !self.stopped {
             self.replay_deferred();
         }
-        if !self.stopped {
+        if !self.stopped && !self.input_missing {
             self.flush_comments();
             let r = self.target.end_of_files();
             self.drain(r);
@@ -453,7 +461,21 @@ impl<'a> Run<'a> {
         }
     }
 
-    fn open(&self, path: &Path) -> Result<Source, String> {
+    /// Reads the scene file `path` whole. An included (or imported) file
+    /// must be a regular file: a device or FIFO named by a scene (say
+    /// `/dev/zero`) would otherwise be read up to the size limit. Files
+    /// named on the command line may be pipes (`rpbrt /dev/stdin`), bounded
+    /// by the limit alone.
+    fn open(&self, path: &Path, included: bool) -> Result<Source, String> {
+        if included {
+            match std::fs::metadata(path) {
+                Ok(m) if !m.is_file() => {
+                    return Err(format!("{}: not a regular file", path.display()));
+                }
+                // A missing file is reported by the read below.
+                _ => {}
+            }
+        }
         let data = input::read_file_limited(path, self.opts.max_file_bytes)
             .map_err(|e| format!("{}: {e}", path.display()))?;
         let dir = match path.parent() {
@@ -932,7 +954,7 @@ impl<'a> Run<'a> {
             self.start_import(path, canon, loc);
             return;
         }
-        match self.open(&path) {
+        match self.open(&path, true) {
             Ok(src) => self.push(src),
             Err(msg) => self.report(Diagnostic::error(loc.clone(), format!("cannot read {msg}"))),
         }

@@ -18,9 +18,18 @@ use std::path::Path;
 /// The two bytes every gzip member starts with (RFC 1952, section 2.3.1).
 pub const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
 
-/// The default largest file (after decompression) that is read into memory:
-/// 64 GiB (also the parser's default `ParseOptions::max_file_bytes`).
+/// The default largest image file (after decompression) that is read into
+/// memory: 64 GiB. Scene text has its own, lower limit
+/// ([`DEFAULT_MAX_SCENE_FILE_BYTES`]).
 pub const DEFAULT_MAX_FILE_BYTES: u64 = 1 << 36;
+
+/// The default largest scene file (after decompression) the parser reads
+/// into memory: 1 GiB of text per file. Scene text is held whole while it
+/// is parsed, so this is a bound on memory, not only on disk reads: an
+/// `Include "/dev/urandom"` or a small `.pbrt.gz` inflating without end
+/// stops here with an error. Real scenes keep bulk geometry in PLY files
+/// and stay far below it. `ParseOptions::max_file_bytes` changes it.
+pub const DEFAULT_MAX_SCENE_FILE_BYTES: u64 = 1 << 30;
 
 /// Size of the buffer between the file and its consumer.
 const BUFFER_SIZE: usize = 64 * 1024;

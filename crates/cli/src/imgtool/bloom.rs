@@ -43,7 +43,7 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     let b = bloom(&im.image, level, width, iterations, scale)
         .map_err(|e| a.err(format!("{infile}: {e}")))?;
     if b.width != width {
-        eprintln!(
+        diagln!(
             "rpbrt imgtool bloom: warning: bloom width must be odd; using {}",
             b.width
         );

@@ -90,10 +90,10 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     let c =
         convert(&im.image, &im.metadata, &o, to_exr).map_err(|e| a.err(format!("{input}: {e}")))?;
     for w in &c.warnings {
-        eprintln!("rpbrt imgtool convert: warning: {input}: {w}");
+        diagln!("rpbrt imgtool convert: warning: {input}: {w}");
     }
     if o.despike < f32::INFINITY {
-        eprintln!("{input}: despiked {} pixels", c.despiked);
+        diagln!("{input}: despiked {} pixels", c.despiked);
     }
     save(&c.image, &output, &c.metadata)
 }

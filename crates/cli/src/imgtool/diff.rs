@@ -129,11 +129,11 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     let tol = difftol.unwrap_or(0.0);
     let n = zero_infinities(&mut image);
     if n > 0 {
-        eprintln!("rpbrt imgtool diff: warning: {image_file}: clamped {n} infinite pixel values.");
+        diagln!("rpbrt imgtool diff: warning: {image_file}: clamped {n} infinite pixel values.");
     }
     let n = zero_infinities(&mut refim);
     if n > 0 {
-        eprintln!("rpbrt imgtool diff: warning: {ref_file}: clamped {n} infinite pixel values.");
+        diagln!("rpbrt imgtool diff: warning: {ref_file}: clamped {n} infinite pixel values.");
     }
     let avg = |im: &Image| {
         let v = im.to_f32_vec();

@@ -68,10 +68,11 @@ pub fn run(args: &[String]) -> Result<(), String> {
     let read = Image::read(Path::new(&infile), None).map_err(|e| e.to_string())?;
     let res = read.image.resolution();
     if res.x != 2 * res.y {
-        eprintln!(
+        diagln!(
             "rpbrt imgtool: warning: {infile}: resolution ({}, {}) doesn't have a 2:1 aspect \
              ratio; it is doubtful that this is a latitude-longitude environment map",
-            res.x, res.y
+            res.x,
+            res.y
         );
     }
     let n = resolution.unwrap_or(res.x);

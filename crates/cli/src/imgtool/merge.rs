@@ -33,7 +33,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
         .and_then(|v| v.get(2))
         .and_then(|s| s.parse::<i32>().ok());
     if let Some(total) = total.filter(|t| *t != covered) {
-        eprintln!(
+        diagln!(
             "rpbrt imgtool: warning: merge: the ranges hold {covered} of the render's {total} samples per pixel"
         );
     }

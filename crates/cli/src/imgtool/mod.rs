@@ -178,7 +178,7 @@ fn find(name: &str) -> Option<&'static Command> {
 /// Runs `rpbrt imgtool <args>`.
 pub fn run(args: &[String]) -> ExitCode {
     let Some(cmd) = args.first() else {
-        eprint!("{}", overview());
+        diag!("{}", overview());
         return ExitCode::FAILURE;
     };
     let rest = &args[1..];
@@ -207,7 +207,7 @@ pub fn run(args: &[String]) -> ExitCode {
         // A command that printed its own verdict (pbrt-v4's diff).
         Err(e) if e.is_empty() => ExitCode::FAILURE,
         Err(e) => {
-            eprintln!("rpbrt imgtool: error: {e}");
+            diagln!("rpbrt imgtool: error: {e}");
             ExitCode::FAILURE
         }
     }

@@ -91,7 +91,7 @@ fn parse_import(
         let mut run = Run::new(&opts, &mut rec);
         run.ancestors = ancestors;
         run.is_import = true;
-        match run.open(&path) {
+        match run.open(&path, true) {
             Ok(src) => {
                 run.push(src);
                 run.run();

@@ -778,3 +778,76 @@ fn suggestions() {
     assert_eq!(suggest("xyz"), None);
     assert_eq!(edit_distance("kitten", "sitting"), 3);
 }
+
+#[cfg(unix)]
+#[test]
+fn included_device_is_a_located_error_not_an_endless_read() {
+    let d = temp_dir("devzero");
+    std::fs::write(
+        d.join("main.pbrt"),
+        "Shape \"sphere\"\nInclude \"/dev/zero\"\nImport \"/dev/urandom\"\n",
+    )
+    .unwrap();
+    let t = std::time::Instant::now();
+    let res = parse_files(&[d.join("main.pbrt")], &mut Rec::default());
+    let e: Vec<String> = res.unwrap_err().iter().map(|d| d.to_string()).collect();
+    assert!(
+        e.iter()
+            .any(|m| m.contains("main.pbrt:2:1: error:")
+                && m.contains("/dev/zero: not a regular file")),
+        "{e:?}"
+    );
+    assert!(
+        e.iter()
+            .any(|m| m.contains("main.pbrt:3:1: error:") && m.contains("not a regular file")),
+        "{e:?}"
+    );
+    assert!(t.elapsed() < std::time::Duration::from_secs(5));
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn gzip_bomb_scene_stops_at_the_size_limit() {
+    use std::io::Write;
+    let d = temp_dir("bomb");
+    // 4 MiB of blank lines compress to a few KiB.
+    let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
+    let blank = vec![b'\n'; 1 << 20];
+    for _ in 0..4 {
+        enc.write_all(&blank).unwrap();
+    }
+    let gz = enc.finish().unwrap();
+    assert!(gz.len() < 64 << 10);
+    std::fs::write(d.join("bomb.pbrt.gz"), gz).unwrap();
+    std::fs::write(
+        d.join("main.pbrt"),
+        "WorldBegin\nInclude \"bomb.pbrt.gz\"\n",
+    )
+    .unwrap();
+    // The limit lowered to 1 MiB keeps the test small; the default (1 GiB)
+    // works the same way.
+    let opts = ParseOptions {
+        max_file_bytes: 1 << 20,
+        ..ParseOptions::default()
+    };
+    let res = Parser::new(opts.clone()).parse_files(&[d.join("main.pbrt")], &mut Rec::default());
+    let e: Vec<String> = res.unwrap_err().iter().map(|d| d.to_string()).collect();
+    assert!(
+        e.iter().any(|m| m.contains("main.pbrt:2:1: error:")
+            && m.contains("decompressed size exceeds the limit of 1048576 bytes")),
+        "{e:?}"
+    );
+    // Within the limit, the same file reads.
+    let roomy = ParseOptions {
+        max_file_bytes: 8 << 20,
+        ..opts
+    };
+    Parser::new(roomy)
+        .parse_files(&[d.join("main.pbrt")], &mut Rec::default())
+        .unwrap();
+    assert_eq!(
+        ParseOptions::default().max_file_bytes,
+        crate::input::DEFAULT_MAX_SCENE_FILE_BYTES
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}

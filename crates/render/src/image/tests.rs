@@ -976,6 +976,48 @@ fn exr_with_a_vast_data_window_is_an_error() {
     );
 }
 
+/// A data window that passes the fixed pixel limit but is far more than
+/// the file holds (30000² RGB float, 10.8 GB, from a file of a few hundred
+/// bytes) made `imgtool info` allocate gigabytes: it is held against the
+/// file's size now.
+#[test]
+fn exr_header_size_claims_are_checked_against_the_file() {
+    let im = Image::new(
+        PixelFormat::Float,
+        Point2i::new(4, 2),
+        &["R", "G", "B"],
+        ColorEncoding::Linear,
+    );
+    let good = im.encode("a.exr", &ImageMetadata::default()).unwrap();
+    // The undamaged file still reads.
+    let r = Image::read_from_bytes(&good, "a.exr", None).unwrap();
+    assert_eq!(r.image.resolution, Point2i::new(4, 2));
+    let key = b"dataWindow\0box2i\0";
+    let at = good
+        .windows(key.len())
+        .position(|w| w == key)
+        .expect("a data window")
+        + key.len()
+        + 4;
+    let t = std::time::Instant::now();
+    // Tall (many chunks) and wide (one chunk of vast lines).
+    for (x_max, y_max) in [(29_999i32, 29_999i32), ((1 << 29) - 1, 0), (3, 1 << 20)] {
+        let mut bytes = good.clone();
+        bytes[at + 8..at + 12].copy_from_slice(&x_max.to_le_bytes());
+        bytes[at + 12..at + 16].copy_from_slice(&y_max.to_le_bytes());
+        let e = Image::read_from_bytes(&bytes, "damaged.exr", None)
+            .expect_err("a damaged header was decoded");
+        assert!(
+            e.to_string().contains("damaged header"),
+            "{x_max}x{y_max}: {e}"
+        );
+    }
+    // A file cut short after its header is refused by the same check.
+    let header_end = good.len() - 40;
+    assert!(Image::read_from_bytes(&good[..header_end], "cut.exr", None).is_err());
+    assert!(t.elapsed() < std::time::Duration::from_secs(5));
+}
+
 #[test]
 fn channel_lists_keep_commas_of_spectral_names() {
     use crate::image::ops::split_channel_list;

@@ -183,6 +183,20 @@ pub fn create_sampler(
                 xs = n / div;
                 ys = n / xs;
             }
+            // Samples per pixel are counted in an i32: a larger product
+            // would wrap (65536² to 0 samples, an endless pixel loop;
+            // 46341² to 1).
+            let spp = i64::from(xs) * i64::from(ys);
+            if spp > i64::from(i32::MAX) {
+                return Err(sp.error_at(
+                    "xsamples",
+                    format!(
+                        "stratified: \"xsamples\" × \"ysamples\" ({xs} × {ys} = {spp}) \
+                         exceeds the {} samples per pixel a pixel can take",
+                        i32::MAX
+                    ),
+                ));
+            }
             let seed = sp.int("seed", options_seed)?;
             Sampler::Stratified(StratifiedSampler::new(xs, ys, jitter, seed))
         }

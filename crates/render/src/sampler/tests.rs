@@ -646,4 +646,28 @@ fn cursors_resume_interleaved_pixel_samples_exactly() {
             assert_eq!(alone, mixed, "{} at {spp} spp", s.name());
         }
     }
+
+#[test]
+fn stratified_sample_count_overflow_is_an_error() {
+    let loc = FileLoc::new("test.pbrt".into(), 1, 1);
+    let mut w = Vec::new();
+    // 65536² wrapped to 0 samples per pixel, 46341² to 1.
+    for side in [65536, 46341] {
+        let params = ParameterDictionary::new(vec![
+            int_param("xsamples", side),
+            int_param("ysamples", side),
+        ]);
+        let e = create_sampler("stratified", &params, RES, None, None, &loc, &mut w)
+            .err()
+            .unwrap_or_else(|| panic!("{side}² samples accepted"));
+        assert!(e.message.contains("exceeds"), "{}", e.message);
+        assert_eq!(e.loc.as_ref().map(|l| l.line), Some(1));
+    }
+    // The largest square that fits is fine.
+    let params = ParameterDictionary::new(vec![
+        int_param("xsamples", 46340),
+        int_param("ysamples", 46340),
+    ]);
+    let s = create_sampler("stratified", &params, RES, None, None, &loc, &mut w).unwrap();
+    assert_eq!(s.samples_per_pixel(), 46340 * 46340);
 }

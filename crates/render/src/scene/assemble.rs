@@ -144,7 +144,12 @@ fn create_media(desc: &SceneDescription, p: &mut Problems) -> (Vec<Medium>, Hash
                 "animated transformation provided for medium; only the start transform will be used",
             );
         }
-        let medium = create_medium(&m.base.name, &r, &m.render_from_object.start_transform);
+        // The builder keeps the type among the parameters as its
+        // `"string type"`; reading it here marks it used (it is the
+        // entity's name), so it is not reported as an unused parameter.
+        let medium = r
+            .string("type", &m.base.name)
+            .and_then(|ty| create_medium(&ty, &r, &m.render_from_object.start_transform));
         if let Some(medium) = p.finish(r, medium) {
             ids.insert(m.name.clone(), media.len() as u32);
             media.push(medium);

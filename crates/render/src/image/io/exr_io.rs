@@ -83,16 +83,41 @@ fn from_matrix(m: &[[f32; 4]; 4]) -> [f32; 16] {
     r
 }
 
+/// The most bytes of raw samples one byte of a chunk's stored data can
+/// stand for under `compression`: a bound on what a file of a given size
+/// can honestly hold. Deflate (ZIP, and PXR24 after its 32-to-24-bit
+/// rounding) stops near 1032:1; PIZ's run-length Huffman code needs at
+/// least 9 bits for a run of 255 half values; RLE stores a run of at most
+/// 128 bytes in 2; B44A packs a flat 4×4 block of halves (32 bytes) in 3.
+fn max_expansion(compression: exr::compression::Compression) -> u64 {
+    use exr::compression::Compression as C;
+    match compression {
+        C::Uncompressed => 1,
+        C::RLE => 64,
+        C::B44 | C::B44A => 11,
+        C::ZIP1 | C::ZIP16 | C::PIZ => 1100,
+        // PXR24 and anything the decoder may add later.
+        _ => 1400,
+    }
+}
+
 /// Checks the headers' claims before the decoder allocates for them: a
 /// corrupted size or channel count must be an error, not an allocation
-/// that aborts the process.
+/// that aborts the process. Beyond fixed limits, the claims are held
+/// against the bytes actually in the file: each chunk needs an 8-byte
+/// offset-table entry, and the samples must fit the stored data at the
+/// compression's best ratio ([`max_expansion`]).
 fn check_headers(data: &[u8]) -> FmtResult<()> {
-    let meta = std::panic::catch_unwind(|| {
-        exr::meta::MetaData::read_from_buffered(Cursor::new(data), false)
-    })
+    let mut cursor = Cursor::new(data);
+    let meta = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        exr::meta::MetaData::read_from_buffered(&mut cursor, false)
+    }))
     .map_err(|_| "EXR header decoder failed on malformed data".to_string())?
     .map_err(|e| e.to_string())?;
+    let after_headers = data.len() as u64 - cursor.position().min(data.len() as u64);
     let mut total: u64 = 0;
+    let mut chunks: u64 = 0;
+    let mut expandable: u64 = 0;
     for h in &meta.headers {
         let (w, hgt) = (h.layer_size.0 as u64, h.layer_size.1 as u64);
         super::check_resolution(
@@ -101,12 +126,36 @@ fn check_headers(data: &[u8]) -> FmtResult<()> {
         )?;
         let channels = h.channels.list.len() as u64;
         total = total.saturating_add((w * hgt).saturating_mul(channels.max(1)));
+        chunks = chunks.saturating_add(h.chunk_count as u64);
+        let bytes_per_pixel: u64 = h
+            .channels
+            .list
+            .iter()
+            .map(|c| c.sample_type.bytes_per_sample() as u64)
+            .sum();
+        let raw = (w * hgt).saturating_mul(bytes_per_pixel);
+        // Samples per byte of stored data, scaled so headers of different
+        // compressions add up: raw / ratio, rounded up.
+        expandable = expandable.saturating_add(raw.div_ceil(max_expansion(h.compression)));
     }
     // Every sample is decoded to at most four bytes.
     if total > super::MAX_PIXELS * 4 {
         return Err(format!(
             "EXR file claims {total} samples, more than the supported {}",
             super::MAX_PIXELS * 4
+        ));
+    }
+    if chunks.saturating_mul(8) > after_headers {
+        return Err(format!(
+            "EXR header claims {chunks} chunks, but the file has only {after_headers} bytes \
+             after its header (truncated file or damaged header)"
+        ));
+    }
+    let stored = after_headers - chunks * 8;
+    if !meta.headers.iter().any(|h| h.deep) && expandable > stored {
+        return Err(format!(
+            "EXR header claims more pixel data than {stored} stored bytes can hold \
+             (truncated file or damaged header)"
         ));
     }
     Ok(())

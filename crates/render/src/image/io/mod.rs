@@ -102,25 +102,136 @@ pub struct ImageAndMetadata {
 
 /// Writes `bytes` to `path` through a temporary file in the same directory
 /// (same file system) that is renamed over `path` once complete.
+///
+/// The temporary file is created exclusively (`O_CREAT|O_EXCL`, which also
+/// refuses to follow a symlink planted at its name) under an unpredictable
+/// name, so another user of a shared directory can neither guess it in
+/// advance nor redirect the write elsewhere. When `path` itself is a symlink
+/// the write goes through it: the file it names is replaced and the link
+/// stays a link, as a plain `open(O_TRUNC)` would have done. A replaced file
+/// keeps its permission bits; a new one gets the default (umask) mode.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     use std::io::Write;
-    let file_name = path
-        .file_name()
-        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file name"))?;
-    let mut tmp_name = std::ffi::OsString::from(".");
-    tmp_name.push(file_name);
-    tmp_name.push(format!(".{}.tmp", std::process::id()));
-    let tmp = path.with_file_name(tmp_name);
+    let target = resolve_symlinks(path)?;
+    let existing_mode = existing_permissions(&target);
+    let (tmp, mut f) = create_temp_beside(&target, existing_mode.as_ref())?;
     let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
+        if let Some(perm) = existing_mode {
+            // The creation mode went through the umask; set the exact bits.
+            f.set_permissions(perm)?;
+        }
         f.write_all(bytes)?;
         f.sync_all()?;
-        std::fs::rename(&tmp, path)
+        drop(f);
+        std::fs::rename(&tmp, &target)
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
     result
+}
+
+/// Checks, before any work is spent on it, that a file could be written at
+/// `path` the way [`write_atomically`] writes it: creates and removes an
+/// exclusive temporary file in the directory the write would reach
+/// (through symlinks), and refuses a `path` that is a directory. A render
+/// can thus fail in a moment rather than after hours.
+pub fn check_writable(path: &Path) -> std::io::Result<()> {
+    let target = resolve_symlinks(path)?;
+    if std::fs::metadata(&target).is_ok_and(|m| m.is_dir()) {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "is a directory",
+        ));
+    }
+    let (tmp, f) = create_temp_beside(&target, None)?;
+    drop(f);
+    std::fs::remove_file(&tmp)
+}
+
+/// Follows `path` through any chain of symlinks (relative links resolve
+/// against the link's own directory) to the file a write through it would
+/// reach, which need not exist yet. Gives up after as many hops as Linux
+/// allows (40) so that a link loop is an error rather than a hang.
+fn resolve_symlinks(path: &Path) -> std::io::Result<std::path::PathBuf> {
+    let mut current = path.to_path_buf();
+    for _ in 0..40 {
+        match std::fs::symlink_metadata(&current) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let link = std::fs::read_link(&current)?;
+                current = match current.parent() {
+                    Some(dir) if link.is_relative() => dir.join(link),
+                    _ => link,
+                };
+            }
+            _ => return Ok(current),
+        }
+    }
+    Err(std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        "too many levels of symbolic links",
+    ))
+}
+
+/// Permission bits of an existing regular file at `path`, which the new file
+/// should keep (a private 0600 image must not become world-readable).
+fn existing_permissions(path: &Path) -> Option<std::fs::Permissions> {
+    std::fs::metadata(path)
+        .ok()
+        .filter(|m| m.is_file())
+        .map(|m| m.permissions())
+}
+
+/// Creates a fresh file named `.<name>.<unique>.tmp` in `target`'s directory,
+/// retrying a bounded number of times when the name is taken.
+fn create_temp_beside(
+    target: &Path,
+    mode: Option<&std::fs::Permissions>,
+) -> std::io::Result<(std::path::PathBuf, std::fs::File)> {
+    use std::hash::{BuildHasher, Hasher};
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    let file_name = target
+        .file_name()
+        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "not a file name"))?;
+    let mut last_err = None;
+    for _ in 0..64 {
+        let count = COUNTER.fetch_add(1, Ordering::Relaxed);
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos() as u64)
+            .unwrap_or(0);
+        // `RandomState` is seeded from the OS's random source: the hash is
+        // what makes the name unguessable, the rest what makes it unique.
+        let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+        h.write_u64(count);
+        h.write_u64(nanos);
+        let mut tmp_name = std::ffi::OsString::from(".");
+        tmp_name.push(file_name);
+        tmp_name.push(format!(
+            ".{}-{count}-{:016x}.tmp",
+            std::process::id(),
+            h.finish()
+        ));
+        let tmp = target.with_file_name(tmp_name);
+        let mut options = std::fs::OpenOptions::new();
+        options.write(true).create_new(true);
+        #[cfg(unix)]
+        if let Some(perm) = mode {
+            use std::os::unix::fs::{OpenOptionsExt, PermissionsExt};
+            options.mode(perm.mode() & 0o7777);
+        }
+        #[cfg(not(unix))]
+        let _ = mode;
+        match options.open(&tmp) {
+            Ok(f) => return Ok((tmp, f)),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => last_err = Some(e),
+            Err(e) => return Err(e),
+        }
+    }
+    Err(last_err.unwrap_or_else(|| {
+        std::io::Error::new(std::io::ErrorKind::AlreadyExists, "no free temporary name")
+    }))
 }
 
 /// Result type of the format modules: a message without the file name.
@@ -303,4 +414,123 @@ pub(crate) fn check_resolution(w: i64, h: i64) -> FmtResult<Point2i> {
         x: w as i32,
         y: h as i32,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::write_atomically;
+    use std::path::{Path, PathBuf};
+
+    fn temp_dir(tag: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("rpbrt-io-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    /// Every directory entry's name, sorted.
+    fn entries(d: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn output_temp_file_does_not_follow_planted_symlink() {
+        // The old scheme's temp name was `.<name>.<pid>.tmp`; a link planted
+        // there must not redirect the write onto the victim.
+        let d = temp_dir("planted");
+        let victim = d.join("victim.txt");
+        std::fs::write(&victim, b"precious").unwrap();
+        let planted = d.join(format!(".x.exr.{}.tmp", std::process::id()));
+        std::os::unix::fs::symlink(&victim, &planted).unwrap();
+        write_atomically(&d.join("x.exr"), b"image").unwrap();
+        assert_eq!(std::fs::read(&victim).unwrap(), b"precious");
+        assert_eq!(std::fs::read(d.join("x.exr")).unwrap(), b"image");
+        assert!(std::fs::symlink_metadata(&planted)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(
+            entries(&d),
+            [
+                planted.file_name().unwrap().to_str().unwrap(),
+                "victim.txt",
+                "x.exr"
+            ]
+        );
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn output_through_symlink_keeps_the_link_and_updates_its_target() {
+        let d = temp_dir("link");
+        std::fs::create_dir(d.join("real")).unwrap();
+        std::fs::write(d.join("real/out.exr"), b"old").unwrap();
+        // A relative link, resolved against the link's own directory.
+        std::os::unix::fs::symlink("real/out.exr", d.join("out.exr")).unwrap();
+        write_atomically(&d.join("out.exr"), b"new").unwrap();
+        assert!(std::fs::symlink_metadata(d.join("out.exr"))
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read(d.join("real/out.exr")).unwrap(), b"new");
+        assert_eq!(entries(&d), ["out.exr", "real"]);
+        assert_eq!(entries(&d.join("real")), ["out.exr"]);
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn output_replacing_a_private_file_keeps_its_mode() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = temp_dir("mode");
+        let p = d.join("private.exr");
+        std::fs::write(&p, b"old").unwrap();
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o600)).unwrap();
+        write_atomically(&p, b"new").unwrap();
+        let mode = std::fs::metadata(&p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o600);
+        assert_eq!(std::fs::read(&p).unwrap(), b"new");
+        assert_eq!(entries(&d), ["private.exr"]);
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn output_write_failure_leaves_no_temp_file() {
+        let d = temp_dir("fail");
+        // Renaming a file over a non-empty directory fails after the temp
+        // file was written; it must be cleaned up.
+        std::fs::create_dir_all(d.join("out.exr/inside")).unwrap();
+        assert!(write_atomically(&d.join("out.exr"), b"x").is_err());
+        assert_eq!(entries(&d), ["out.exr"]);
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn output_check_writable_probes_the_directory() {
+        let d = temp_dir("probe");
+        assert!(super::check_writable(&d.join("out.exr")).is_ok());
+        assert!(super::check_writable(&d.join("missing/out.exr")).is_err());
+        assert!(super::check_writable(&d).is_err());
+        // The probe leaves nothing behind.
+        assert!(entries(&d).is_empty());
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn output_symlink_loop_is_an_error() {
+        let d = temp_dir("loop");
+        std::os::unix::fs::symlink("b", d.join("a")).unwrap();
+        std::os::unix::fs::symlink("a", d.join("b")).unwrap();
+        assert!(write_atomically(&d.join("a"), b"x").is_err());
+        assert_eq!(entries(&d), ["a", "b"]);
+        let _ = std::fs::remove_dir_all(&d);
+    }
 }
