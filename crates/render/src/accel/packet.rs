@@ -78,6 +78,16 @@ struct PacketRays<L: F32Lanes> {
     neg: [L::Mask; 3],
 }
 
+/// The slab planes of a packet whose rays all share their direction
+/// signs: per axis, the row of the near and far plane and the origins
+/// they are tested against.
+struct Octant<L: F32Lanes> {
+    near: [usize; 3],
+    far: [usize; 3],
+    o_near: [L; 3],
+    o_far: [L; 3],
+}
+
 #[inline(always)]
 fn packet_rays<L: F32Lanes>(rays: &[Ray]) -> PacketRays<L> {
     let mut o_lo = [[0.0 as Float; MAX_PACKET]; 3];
@@ -134,6 +144,23 @@ fn packet_closest<L: F32Lanes, F>(
     let inf = L::splat(Float::INFINITY);
     let all = (1u32 << rays.len()) - 1;
     let mut active = L::from_bits(all);
+    // Packets whose rays share their direction signs (camera rays through
+    // nearby pixels) take the near and far planes without a per-lane
+    // select.
+    let octant = {
+        let signs = [0, 1, 2].map(|a| L::bits(pr.neg[a]) & all);
+        if signs.iter().all(|&s| s == 0 || s == all) {
+            let neg = signs.map(|s| s != 0);
+            Some(Octant::<L> {
+                near: [0, 1, 2].map(|a| if neg[a] { 3 + a } else { a }),
+                far: [0, 1, 2].map(|a| if neg[a] { a } else { 3 + a }),
+                o_near: [0, 1, 2].map(|a| if neg[a] { pr.o_hi[a] } else { pr.o_lo[a] }),
+                o_far: [0, 1, 2].map(|a| if neg[a] { pr.o_lo[a] } else { pr.o_hi[a] }),
+            })
+        } else {
+            None
+        }
+    };
     let mut stack: [MaybeUninit<(u32, L)>; PACKET_STACK] =
         [const { MaybeUninit::uninit() }; PACKET_STACK];
     let mut sp = 0usize;
@@ -146,13 +173,24 @@ fn packet_closest<L: F32Lanes, F>(
         for c in 0..WIDTH {
             let mut t0 = zero;
             let mut t1 = t_max_v;
-            for a in 0..3 {
-                let t_lo = L::splat(b[a][c]).sub(pr.o_lo[a]).mul(pr.inv[a]);
-                let t_hi = L::splat(b[3 + a][c]).sub(pr.o_hi[a]).mul(pr.inv[a]);
-                let near = L::select(pr.neg[a], t_hi, t_lo);
-                let far = L::select(pr.neg[a], t_lo, t_hi).mul(pad);
-                t0 = t0.max(near);
-                t1 = t1.min(far);
+            if let Some(oct) = &octant {
+                // Every ray enters each slab by the same plane: the
+                // single-ray test's planes, chosen once per packet.
+                for a in 0..3 {
+                    let near = L::splat(b[oct.near[a]][c]).sub(oct.o_near[a]).mul(pr.inv[a]);
+                    let far = L::splat(b[oct.far[a]][c]).sub(oct.o_far[a]).mul(pr.inv[a]);
+                    t0 = t0.max(near);
+                    t1 = t1.min(far.mul(pad));
+                }
+            } else {
+                for a in 0..3 {
+                    let t_lo = L::splat(b[a][c]).sub(pr.o_lo[a]).mul(pr.inv[a]);
+                    let t_hi = L::splat(b[3 + a][c]).sub(pr.o_hi[a]).mul(pr.inv[a]);
+                    let near = L::select(pr.neg[a], t_hi, t_lo);
+                    let far = L::select(pr.neg[a], t_lo, t_hi).mul(pad);
+                    t0 = t0.max(near);
+                    t1 = t1.min(far);
+                }
             }
             let m = L::and(t0.le(t1), active);
             hit_bits[c] = L::bits(m);

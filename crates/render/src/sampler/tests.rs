@@ -646,6 +646,7 @@ fn cursors_resume_interleaved_pixel_samples_exactly() {
             assert_eq!(alone, mixed, "{} at {spp} spp", s.name());
         }
     }
+}
 
 #[test]
 fn stratified_sample_count_overflow_is_an_error() {
