@@ -841,3 +841,53 @@ fn named_medium_type_is_not_an_unused_parameter() {
     assert!(e.contains("scael") && !e.contains("\"type\""), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Ctrl-C is honoured within a second even when each pixel has billions
+/// of samples (it was checked once per pixel, and the second wave takes
+/// all of a pixel's remaining samples: SIGINT went unanswered for
+/// minutes), in both designs, and the image so far is written.
+#[test]
+fn ctrl_c_is_honoured_between_samples_of_one_pixel() {
+    for design in [None, Some("--wavefront")] {
+        let out = std::env::temp_dir().join(format!(
+            "rpbrt-cli-{}-ctrlc-{}.exr",
+            std::process::id(),
+            design.is_some()
+        ));
+        let scene = temp_scene(
+            "ctrlc.pbrt",
+            "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\"\nSampler \"independent\" \"integer pixelsamples\" 2147483647\nFilm \"rgb\" \"integer xresolution\" 2 \"integer yresolution\" 2\nWorldBegin\nLightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\nMaterial \"diffuse\"\nShape \"sphere\" \"float radius\" 1\n",
+        );
+        let mut cmd = rpbrt();
+        cmd.args(["--quiet", "--nthreads", "2", "--outfile"]).arg(&out);
+        if let Some(d) = design {
+            cmd.arg(d);
+        }
+        let mut child = cmd.arg(&scene).spawn().unwrap();
+        // Into the second wave: each pixel's remaining 2^31 - 2 samples.
+        std::thread::sleep(std::time::Duration::from_millis(1500));
+        let sent = Command::new("kill")
+            .args(["-INT", &child.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(sent.success());
+        let t0 = std::time::Instant::now();
+        let status = loop {
+            if let Some(s) = child.try_wait().unwrap() {
+                break s;
+            }
+            if t0.elapsed() > std::time::Duration::from_secs(10) {
+                let _ = child.kill();
+                panic!("{design:?}: still rendering 10 s after SIGINT");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+        };
+        assert!(
+            t0.elapsed() < std::time::Duration::from_secs(2),
+            "{design:?}: took {:?} to stop",
+            t0.elapsed()
+        );
+        assert_eq!(status.code(), Some(130), "{design:?}");
+        assert!(out.exists(), "{design:?}: no image written");
+    }
+}

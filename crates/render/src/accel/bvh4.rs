@@ -246,6 +246,21 @@ impl<T: Copy> Stack<T> {
 }
 
 impl Bvh4 {
+    /// Starts loading the nodes of the interior children in `mask`: their
+    /// loads overlap the leaf tests and box tests before they are visited
+    /// (large trees do not fit in cache).
+    #[inline(always)]
+    pub(super) fn prefetch_children(&self, node: &Bvh4Node, mask: u32) {
+        let mut inner = mask & !node.leaf_lanes;
+        while inner != 0 {
+            let i = inner.trailing_zeros() as usize;
+            inner &= inner - 1;
+            if let Some(n) = self.nodes.get(node.child[i] as usize) {
+                crate::simd::prefetch(n);
+            }
+        }
+    }
+
     /// Builds over `prim_bounds` with all available cores.
     pub fn build(prim_bounds: &[Bounds3f], params: &BvhParams) -> Bvh4 {
         Bvh4::build_with_threads(prim_bounds, params, super::default_threads())
@@ -382,6 +397,7 @@ impl Aggregate for Bvh4 {
         loop {
             let node = &self.nodes[cur as usize];
             let (t0, mask) = w.test(node, t_max);
+            self.prefetch_children(node, mask);
             // Leaf children first, in lane order: each tests its primitives
             // against the shrinking `t_max`, so their order does not change
             // which are tested, and not sorting them saves branches on
@@ -465,6 +481,7 @@ impl Aggregate for Bvh4 {
         loop {
             let node = &self.nodes[cur as usize];
             let (_, mut mask) = w.test(node, t_max);
+            self.prefetch_children(node, mask);
             let mut next: Option<u32> = None;
             while mask != 0 {
                 let i = mask.trailing_zeros() as usize;
