@@ -196,6 +196,8 @@ fn packet_closest<L: F32Lanes, F>(
             hit_bits[c] = L::bits(m);
             t_near[c] = L::select(m, t0, inf);
         }
+        let entered = (0..WIDTH).fold(0, |m, c| m | (((hit_bits[c] != 0) as u32) << c));
+        bvh.prefetch_children(node, entered);
         // Leaf children, in lane order, each against the rays that enter it.
         let mut leaves = node.leaf_lanes;
         let mut leaf_hit = false;
