@@ -3,11 +3,13 @@
 //! closed form), `volpath` against `simplevolpath`, determinism across
 //! thread counts, and located errors for bad media.
 
-use rpbrt_render::image::{Image, ImageMetadata};
-use rpbrt_render::integrator::RenderOptions;
+use rpbrt_render::image::Image;
 use rpbrt_render::scene::assemble::{create_scene, CreateOptions};
 use rpbrt_render::scene::{build_scene_from_str, BuildOptions};
 use std::path::PathBuf;
+
+mod common;
+use common::render_scene;
 
 fn out_path(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("rpbrt-media-{}", std::process::id()));
@@ -15,60 +17,6 @@ fn out_path(tag: &str) -> PathBuf {
     dir.join(format!("{tag}.exr"))
 }
 
-/// Renders scene text and returns the image. Integrators with a wavefront
-/// form render twice, scalar and `--wavefront`, which must give the same
-/// pixels bit for bit: every test here runs under both designs.
-fn render_scene(text: &str, threads: usize) -> Image {
-    let (scalar, has_wavefront) = render_with(text, threads, false);
-    if has_wavefront {
-        let (wavefront, _) = render_with(text, threads, true);
-        assert_same_pixels(&scalar, &wavefront, text);
-    }
-    scalar
-}
-
-/// Renders scene text with or without `--wavefront`; also says whether
-/// the integrator has a wavefront form.
-fn render_with(text: &str, threads: usize, wavefront: bool) -> (Image, bool) {
-    let (desc, _) = build_scene_from_str(text, &BuildOptions::default())
-        .unwrap_or_else(|d| panic!("{}", d.render()));
-    let created = match create_scene(&desc, &CreateOptions::default()) {
-        Ok(c) => c,
-        Err(e) => panic!(
-            "{:?}",
-            e.iter().map(|d| d.message.clone()).collect::<Vec<_>>()
-        ),
-    };
-    let mut scene = created.scene;
-    let opts = RenderOptions {
-        nthreads: threads,
-        wavefront,
-        ..Default::default()
-    };
-    let mut md = ImageMetadata::default();
-    created
-        .integrator
-        .render(&mut scene, &opts, &mut md, &|_| {})
-        .unwrap();
-    let path = scene.film.filename().to_string();
-    let image = Image::read(std::path::Path::new(&path), None)
-        .unwrap()
-        .image;
-    (image, created.integrator.has_wavefront())
-}
-
-/// The two images have the same channels and bit-identical values.
-fn assert_same_pixels(a: &Image, b: &Image, what: &str) {
-    assert_eq!(a.channel_names(), b.channel_names());
-    let (va, vb) = (a.to_f32_vec(), b.to_f32_vec());
-    assert_eq!(va.len(), vb.len());
-    let differing = va
-        .iter()
-        .zip(&vb)
-        .filter(|(x, y)| x.to_bits() != y.to_bits())
-        .count();
-    assert_eq!(differing, 0, "wavefront and scalar differ in {differing} values:\n{what}");
-}
 
 fn mean_rgb(im: &Image) -> f64 {
     let v = im.to_f32_vec();
