@@ -16,7 +16,9 @@
 //! page out (see [`Limits`]): the whole request head must arrive within
 //! a deadline of the accept however its bytes are paced, one client
 //! holds only a share of the slots, and some slots are kept for clients
-//! holding none.
+//! holding none. Each snapshot is encoded once for all the requests
+//! sending it, and slow readers hold at most [`MAX_IMAGE_BUFFERS`]
+//! encodings alive.
 //!
 //! The server is stateless towards the browser, so a page closed and
 //! reopened mid-render picks up where the render is. It binds to loopback
@@ -47,6 +49,12 @@ pub const FINAL_GRACE: Duration = Duration::from_secs(5);
 const MAX_HEAD: usize = 16 * 1024;
 /// How long one write of the answer may wait for the client to read.
 const CLIENT_TIMEOUT: Duration = Duration::from_secs(10);
+/// Most encoded `/image` answers alive at once. Requests for one
+/// snapshot share its encoding; when slow readers still hold this many
+/// (older snapshots), a request gets the newest of them rather than
+/// another copy, so memory stays at the frame plus this many encodings
+/// however many clients read slowly.
+const MAX_IMAGE_BUFFERS: usize = 2;
 /// What a request head that missed [`Limits::head_deadline`] is told.
 const HEAD_TOO_SLOW: &str = "request head not received in time";
 
@@ -110,6 +118,25 @@ struct Shared {
     /// Connections being served: in all, and per client (see
     /// [`client_key`]).
     clients: Mutex<Clients>,
+    /// The encoded snapshots being sent (see [`MAX_IMAGE_BUFFERS`]).
+    images: Mutex<Images>,
+}
+
+/// A snapshot encoded for `/image`, shared by every request sending it.
+#[derive(Clone, Debug)]
+struct Encoded {
+    version: u64,
+    done: bool,
+    bytes: Arc<Vec<u8>>,
+}
+
+/// The encoded snapshots alive: the latest, and those still being sent.
+#[derive(Debug, Default)]
+struct Images {
+    live: Vec<Encoded>,
+    /// Snapshots encoded so far (one per version, unless readers made
+    /// some skip).
+    encodes: u64,
 }
 
 /// The connections being served.
@@ -158,6 +185,30 @@ fn client_key(ip: IpAddr) -> IpAddr {
 impl Shared {
     fn clients(&self) -> std::sync::MutexGuard<'_, Clients> {
         self.clients.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The latest snapshot encoded for `/image` (see
+    /// [`MAX_IMAGE_BUFFERS`]), or `None` before the first one.
+    fn image(&self) -> Option<Encoded> {
+        let frame = self.watch.state().frame.clone()?;
+        let mut im = self.images.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(e) = im.live.iter().find(|e| e.version == frame.version) {
+            return Some(e.clone());
+        }
+        // Encodings only this cache holds are sent by nobody: let them go.
+        // (Counts only fall outside the lock, so this never drops one in use.)
+        im.live.retain(|e| Arc::strong_count(&e.bytes) > 1);
+        if im.live.len() >= MAX_IMAGE_BUFFERS {
+            return im.live.iter().max_by_key(|e| e.version).cloned();
+        }
+        let e = Encoded {
+            version: frame.version,
+            done: frame.snapshot.done,
+            bytes: Arc::new(encode_image(&frame)),
+        };
+        im.encodes += 1;
+        im.live.push(e.clone());
+        Some(e)
     }
 
     /// A slot for a connection from `peer`, or `None` when the limits
@@ -214,6 +265,7 @@ impl Preview {
             final_status_served: AtomicBool::new(false),
             limits,
             clients: Mutex::new(Clients::default()),
+            images: Mutex::new(Images::default()),
         });
         let s = Arc::clone(&shared);
         std::thread::spawn(move || accept_loop(listener, s));
@@ -447,17 +499,17 @@ fn serve(stream: TcpStream, deadline: Instant, shared: &Shared) -> std::io::Resu
         }
         "/image" => {
             shared.watch.viewer_seen();
-            let frame = shared.watch.state().frame.clone();
-            match frame {
-                Some(f) => {
+            match shared.image() {
+                Some(e) => {
+                    let body = e.bytes.as_slice();
                     respond(
                         &mut out,
                         "200 OK",
                         "application/octet-stream",
-                        &encode_image(&f),
+                        body,
                         head_only,
                     )?;
-                    if f.snapshot.done && !head_only {
+                    if e.done && !head_only {
                         shared.final_image_served.store(true, Ordering::Relaxed);
                     }
                     Ok(())

@@ -387,3 +387,74 @@ fn preview_connection_limits_keep_slots_for_new_clients() {
     assert_eq!(sh.clients().total, 0);
     assert!(sh.clients().per_client.is_empty());
 }
+
+/// Memory amplification: slow `/image` readers (each reads 64 bytes and
+/// stalls) share one encoding per snapshot, and once they hold
+/// [`MAX_IMAGE_BUFFERS`] of them a newer request gets the newest of those
+/// rather than a new copy; the page loads meanwhile.
+#[test]
+fn preview_slow_image_readers_share_one_encoding() {
+    let watch = Arc::new(Watch::new());
+    let p = Preview::start("127.0.0.1:0".parse().unwrap(), Arc::clone(&watch)).unwrap();
+    let addr = p.addr();
+    let host = format!("127.0.0.1:{}", addr.port());
+    // 25 MB: more than loopback's socket buffers take in, so the server
+    // threads stay in their writes holding the encoding.
+    let (w, h) = (2048, 1024);
+    let snap = |spp| Snapshot {
+        width: w,
+        height: h,
+        rgb: vec![0.25; 3 * w * h],
+        spp,
+        done: false,
+    };
+    let stalled_reader = || {
+        let mut s = TcpStream::connect(addr).unwrap();
+        s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+        write!(s, "GET /image HTTP/1.1\r\nHost: {host}\r\n\r\n").unwrap();
+        let mut first = [0u8; 64];
+        s.read_exact(&mut first).unwrap();
+        s
+    };
+    let images = || {
+        let im = p.shared.images.lock().unwrap();
+        (
+            im.encodes,
+            im.live.len(),
+            im.live.iter().map(|e| e.version).max(),
+        )
+    };
+    watch.image(snap(1));
+    let mut readers: Vec<TcpStream> = (0..4).map(|_| stalled_reader()).collect();
+    assert_eq!(images(), (1, 1, Some(1)), "four readers, one encoding");
+    watch.image(snap(2));
+    readers.push(stalled_reader());
+    assert_eq!(images(), (2, 2, Some(2)));
+    // Both encodings are being read: version 3 is answered with 2.
+    watch.image(snap(3));
+    let (head, body) = {
+        let mut s = stalled_reader();
+        let mut rest = vec![0u8; 512];
+        s.read_exact(&mut rest).unwrap();
+        (s, rest)
+    };
+    drop(head);
+    let at = body.windows(4).position(|w| w == b"RPV1").unwrap();
+    let version = u64::from_le_bytes(body[at + 24..at + 32].try_into().unwrap());
+    assert_eq!(version, 2);
+    assert_eq!(images(), (2, 2, Some(2)));
+    let t0 = Instant::now();
+    let (head, page) = get(addr, "/", &host);
+    assert!(head.starts_with("HTTP/1.1 200") && page == PAGE.as_bytes());
+    assert!(t0.elapsed() < Duration::from_secs(2));
+    // Once the readers go, the next request encodes the latest snapshot.
+    drop(readers);
+    let t0 = Instant::now();
+    let mut latest = 0;
+    while latest != 3 && t0.elapsed() < Duration::from_secs(3) {
+        let (_, b) = get(addr, "/image", &host);
+        latest = u64::from_le_bytes(b[24..32].try_into().unwrap());
+    }
+    assert_eq!(latest, 3);
+    assert_eq!(images().0, 3);
+}
