@@ -257,6 +257,8 @@ impl Preview {
         let addr = listener
             .local_addr()
             .map_err(|e| StartError(format!("--preview: {e}")))?;
+        // A page opened mid-render is served the latest wave's end at once.
+        watch.keep_wave_ends();
         let shared = Arc::new(Shared {
             watch,
             port: addr.port(),

@@ -458,3 +458,27 @@ fn preview_slow_image_readers_share_one_encoding() {
     assert_eq!(latest, 3);
     assert_eq!(images().0, 3);
 }
+
+/// A page opened after the first wave: the server keeps the ends of waves
+/// while nobody watches, so the page's first `/image` has the latest one
+/// rather than "no image yet" until a tile of the current (long) wave
+/// ends; snapshots inside a wave still wait for a viewer.
+#[test]
+fn preview_late_page_gets_the_last_wave_end_at_once() {
+    let watch = Arc::new(Watch::new());
+    let p = Preview::start("127.0.0.1:0".parse().unwrap(), Arc::clone(&watch)).unwrap();
+    assert!(!watch.viewer_recent());
+    assert!(
+        !watch.wants_image(false),
+        "inside a wave: only for a viewer"
+    );
+    assert!(
+        watch.wants_image(true),
+        "a wave's end: kept for a later page"
+    );
+    watch.image(frame(1, false).snapshot);
+    let host = format!("127.0.0.1:{}", p.addr().port());
+    let (head, body) = get(p.addr(), "/image", &host);
+    assert!(head.starts_with("HTTP/1.1 200"), "{head}");
+    assert_eq!(u64::from_le_bytes(body[24..32].try_into().unwrap()), 1);
+}
