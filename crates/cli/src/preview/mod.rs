@@ -20,6 +20,11 @@
 //! sending it, and slow readers hold at most [`MAX_IMAGE_BUFFERS`]
 //! encodings alive.
 //!
+//! It stays std-only on purpose: three GET routes, plus the limits above.
+//! tiny_http offers neither a head deadline nor per-client shares, and
+//! hyper (which has a head timeout) would bring an async runtime along;
+//! either would still need the per-client accounting written here.
+//!
 //! The server is stateless towards the browser, so a page closed and
 //! reopened mid-render picks up where the render is. It binds to loopback
 //! unless given another address, and then refuses requests whose `Host`
