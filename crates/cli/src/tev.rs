@@ -107,6 +107,24 @@ pub struct TevClient {
     /// The frame tev was last sent in full (its tiles are what it shows).
     shown: Option<Arc<Frame>>,
     warned: bool,
+    /// How long a connect or a send may take ([`NET_TIMEOUT`]).
+    timeout: Duration,
+}
+
+/// `e` from a write to tev, said plainly when the write timed out: std
+/// reports a send timeout on Unix as `WouldBlock`, whose text ("Resource
+/// temporarily unavailable (os error 11)") says nothing of what happened.
+fn writing(e: std::io::Error, timeout: Duration) -> std::io::Error {
+    match e.kind() {
+        std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut => std::io::Error::new(
+            std::io::ErrorKind::TimedOut,
+            format!(
+                "timed out writing to tev (it took no data for {} s)",
+                timeout.as_secs_f32()
+            ),
+        ),
+        _ => e,
+    }
 }
 
 impl TevClient {
@@ -119,15 +137,16 @@ impl TevClient {
             stream: None,
             shown: None,
             warned: false,
+            timeout: NET_TIMEOUT,
         }
     }
 
     fn connect(&self) -> std::io::Result<TcpStream> {
         let mut last = None;
         for a in self.address.to_socket_addrs()? {
-            match TcpStream::connect_timeout(&a, NET_TIMEOUT) {
+            match TcpStream::connect_timeout(&a, self.timeout) {
                 Ok(s) => {
-                    s.set_write_timeout(Some(NET_TIMEOUT))?;
+                    s.set_write_timeout(Some(self.timeout))?;
                     s.set_nodelay(true)?;
                     return Ok(s);
                 }
@@ -161,7 +180,8 @@ impl TevClient {
         }
         if self.stream.is_none() {
             let mut s = self.connect()?;
-            s.write_all(&create_image(&self.title, w as i32, h as i32, &CHANNELS))?;
+            s.write_all(&create_image(&self.title, w as i32, h as i32, &CHANNELS))
+                .map_err(|e| writing(e, self.timeout))?;
             self.stream = Some(s);
             self.shown = None;
         }
@@ -181,16 +201,18 @@ impl TevClient {
                 };
                 if !unchanged {
                     let rect = t.map(|v| v as i32);
-                    stream.write_all(&update_image(
-                        &self.title,
-                        name,
-                        rect,
-                        tile_values(frame, t, c),
-                    ))?;
+                    stream
+                        .write_all(&update_image(
+                            &self.title,
+                            name,
+                            rect,
+                            tile_values(frame, t, c),
+                        ))
+                        .map_err(|e| writing(e, self.timeout))?;
                 }
             }
         }
-        stream.flush()?;
+        stream.flush().map_err(|e| writing(e, self.timeout))?;
         self.shown = Some(Arc::clone(frame));
         Ok(())
     }
@@ -459,6 +481,38 @@ mod tests {
             let want: Vec<f32> = (0..16).map(|k| last.snapshot.rgb[3 * k + c]).collect();
             assert_eq!(values, &want);
         }
+    }
+
+    /// A tev that stops reading: the send timeout is reported as a
+    /// timeout, not as "Resource temporarily unavailable (os error 11)".
+    #[test]
+    fn tev_write_timeout_is_reported_as_a_timeout() {
+        let listener = TcpListener::bind("127.0.0.1:0").unwrap();
+        let addr = listener.local_addr().unwrap().to_string();
+        // Accepts and holds the connection without reading it.
+        let holder = std::thread::spawn(move || listener.accept().map(|(s, _)| s));
+        let mut client = TevClient::new(&addr, "t");
+        client.timeout = Duration::from_millis(200);
+        // 25 MB of non-zero tiles: more than loopback's socket buffers.
+        let (width, height) = (2048, 1024);
+        let frame = Arc::new(Frame {
+            version: 1,
+            snapshot: Snapshot {
+                width,
+                height,
+                rgb: vec![1.0; 3 * width * height],
+                spp: 1,
+                done: false,
+            },
+        });
+        let e = client.try_display(&frame).unwrap_err();
+        let text = e.to_string();
+        assert_eq!(e.kind(), std::io::ErrorKind::TimedOut, "{text}");
+        assert!(
+            text.contains("timed out writing to tev") && !text.contains("os error"),
+            "{text}"
+        );
+        drop(holder.join().unwrap());
     }
 
     #[test]

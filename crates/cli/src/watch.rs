@@ -4,7 +4,11 @@
 //! report, for the HTTP server and the tev client to read from their own
 //! threads. Snapshots are taken only while someone is watching and at
 //! most every [`SNAPSHOT_INTERVAL`] (oftener at the end of a wave), so
-//! the render pays a film read now and then, never more.
+//! the render pays a film read now and then, never more. With
+//! [`Watch::keep_wave_ends`] the ends of waves are kept even while nobody
+//! watches, so that a page opened mid-render has an image at once rather
+//! than when the next tile of a long wave finishes (minutes at high
+//! sample counts).
 
 use rpbrt_render::integrator::{Progress, RenderObserver, Snapshot};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -54,6 +58,8 @@ pub struct Watch {
     last_viewer_ms: AtomicU64,
     /// A consumer that always wants images (the tev client).
     always: AtomicBool,
+    /// Snapshots at the ends of waves are wanted even with nobody watching.
+    wave_ends: AtomicBool,
 }
 
 impl Default for Watch {
@@ -72,6 +78,7 @@ impl Watch {
             last_snapshot_ms: AtomicU64::new(u64::MAX),
             last_viewer_ms: AtomicU64::new(u64::MAX),
             always: AtomicBool::new(false),
+            wave_ends: AtomicBool::new(false),
         }
     }
 
@@ -99,6 +106,13 @@ impl Watch {
     /// Snapshots are wanted whether or not a browser watches (tev).
     pub fn always_want(&self) {
         self.always.store(true, Ordering::Relaxed);
+    }
+
+    /// Snapshots at the ends of waves are wanted whether or not a browser
+    /// watches (`--preview`): a page that connects later is served the
+    /// latest at once. A wave's end is rare and its snapshot a film read.
+    pub fn keep_wave_ends(&self) {
+        self.wave_ends.store(true, Ordering::Relaxed);
     }
 
     /// Names the image (the file it is written to).
@@ -133,7 +147,8 @@ impl Watch {
 
 impl RenderObserver for Watch {
     fn wants_image(&self, wave_end: bool) -> bool {
-        if !self.always.load(Ordering::Relaxed) && !self.viewer_recent() {
+        let kept = wave_end && self.wave_ends.load(Ordering::Relaxed);
+        if !kept && !self.always.load(Ordering::Relaxed) && !self.viewer_recent() {
             return false;
         }
         let interval = if wave_end {

@@ -2,8 +2,17 @@
 //! (pbrt-v4's `info`).
 
 use super::{emit, load_md};
+use rpbrt_parser::diag::escape_controls;
 use rpbrt_render::image::ops::info;
 use rpbrt_render::image::ImageMetadata;
+
+/// `s` with every control character escaped, newlines and tabs included:
+/// file names, attribute keys and values and channel names come from the
+/// image file, and a terminal would obey an escape sequence in them (or a
+/// newline would forge a line of the report).
+fn shown(s: &str) -> String {
+    escape_controls(s, "").into_owned()
+}
 
 /// Usage of `imgtool info`.
 pub const USAGE: &str = "\
@@ -31,7 +40,7 @@ fn metadata_lines(md: &ImageMetadata) -> Vec<String> {
         Some("dci-p3") => "DCI-P3".into(),
         Some("rec2020") => "rec2020".into(),
         Some("aces2065-1") => "ACES".into(),
-        Some(o) => o.to_string(),
+        Some(o) => shown(o),
     };
     l.push(format!("color space: {cs}"));
     if let Some(f) = md.full_resolution {
@@ -68,8 +77,8 @@ fn metadata_lines(md: &ImageMetadata) -> Vec<String> {
         l.push(format!("MSE vs. reference image: {m}"));
     }
     for (k, v) in &md.strings {
-        let vals: Vec<String> = v.iter().map(|s| format!("\"{s}\"")).collect();
-        l.push(format!("\"{k}\": [ {} ]", vals.join(" ")));
+        let vals: Vec<String> = v.iter().map(|s| format!("\"{}\"", shown(s))).collect();
+        l.push(format!("\"{}\": [ {} ]", shown(k), vals.join(" ")));
     }
     l
 }
@@ -84,11 +93,15 @@ pub fn run(args: &[String]) -> Result<(), String> {
     }
     for f in args {
         let im = load_md(f)?;
-        let mut s = format!("{f}:\n");
+        let mut s = format!("{}:\n", shown(f));
         for l in metadata_lines(&im.metadata) {
             s += &format!("  {l}\n");
         }
-        s += &info(&im.image).to_string();
+        let mut stats = info(&im.image);
+        for c in &mut stats.channels {
+            c.name = shown(&c.name);
+        }
+        s += &stats.to_string();
         emit(&s)?;
     }
     Ok(())

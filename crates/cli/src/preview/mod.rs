@@ -12,6 +12,19 @@
 //! - `/image`: the latest snapshot, [`IMAGE_HEADER`] bytes of header then
 //!   RGB `f32` values (see [`encode_image`]).
 //!
+//! Connections are limited so that slow or many clients cannot lock the
+//! page out (see [`Limits`]): the whole request head must arrive within
+//! a deadline of the accept however its bytes are paced, one client
+//! holds only a share of the slots, and some slots are kept for clients
+//! holding none. Each snapshot is encoded once for all the requests
+//! sending it, and slow readers hold at most [`MAX_IMAGE_BUFFERS`]
+//! encodings alive.
+//!
+//! It stays std-only on purpose: three GET routes, plus the limits above.
+//! tiny_http offers neither a head deadline nor per-client shares, and
+//! hyper (which has a head timeout) would bring an async runtime along;
+//! either would still need the per-client accounting written here.
+//!
 //! The server is stateless towards the browser, so a page closed and
 //! reopened mid-render picks up where the render is. It binds to loopback
 //! unless given another address, and then refuses requests whose `Host`
@@ -21,10 +34,11 @@
 //! still save it.
 
 use crate::watch::{Frame, Watch};
-use std::io::{BufRead, BufReader, Write};
-use std::net::{SocketAddr, TcpListener, TcpStream};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::Arc;
+use std::collections::HashMap;
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::{IpAddr, Ipv6Addr, SocketAddr, TcpListener, TcpStream};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// The page.
@@ -36,12 +50,48 @@ pub const IMAGE_HEADER: usize = 32;
 /// How long the process waits after the render for a watching page to
 /// fetch the final image.
 pub const FINAL_GRACE: Duration = Duration::from_secs(5);
-/// Most connections served at once; more are closed unanswered.
-const MAX_CONNECTIONS: usize = 32;
 /// Longest request head read.
 const MAX_HEAD: usize = 16 * 1024;
-/// How long a client may take to send its request or read the answer.
+/// How long one write of the answer may wait for the client to read.
 const CLIENT_TIMEOUT: Duration = Duration::from_secs(10);
+/// Most encoded `/image` answers alive at once. Requests for one
+/// snapshot share its encoding; when slow readers still hold this many
+/// (older snapshots), a request gets the newest of them rather than
+/// another copy, so memory stays at the frame plus this many encodings
+/// however many clients read slowly.
+const MAX_IMAGE_BUFFERS: usize = 2;
+/// What a request head that missed [`Limits::head_deadline`] is told.
+const HEAD_TOO_SLOW: &str = "request head not received in time";
+
+/// How many connections are served, to whom, and for how long a request
+/// head may trickle in. A connection over a limit is closed unanswered.
+#[derive(Clone, Copy, Debug)]
+struct Limits {
+    /// Most connections served at once.
+    connections: usize,
+    /// Most connections one client (an IPv4 address, an IPv6 /64: what one
+    /// host commonly has) holds at once. A browser opens a few per page.
+    per_client: usize,
+    /// Of `connections`, those only a client holding none may take: clients
+    /// that filled their shares still leave room for a newcomer.
+    reserved: usize,
+    /// How long after the accept the whole request head must have arrived.
+    /// A per-read timeout alone lets a client that sends a byte now and
+    /// then hold its slot for ever (slowloris).
+    head_deadline: Duration,
+}
+
+impl Limits {
+    /// A browser sends its head at once; a few seconds allow for a slow
+    /// link. 8 connections per client is more than a page uses (it polls
+    /// one request at a time) and leaves 24 unreserved slots for others.
+    const DEFAULT: Limits = Limits {
+        connections: 32,
+        per_client: 8,
+        reserved: 8,
+        head_deadline: Duration::from_secs(5),
+    };
+}
 
 /// Why the server could not start.
 #[derive(Debug)]
@@ -69,12 +119,134 @@ struct Shared {
     /// said the render had finished.
     final_image_served: AtomicBool,
     final_status_served: AtomicBool,
-    connections: AtomicUsize,
+    limits: Limits,
+    /// Connections being served: in all, and per client (see
+    /// [`client_key`]).
+    clients: Mutex<Clients>,
+    /// The encoded snapshots being sent (see [`MAX_IMAGE_BUFFERS`]).
+    images: Mutex<Images>,
+}
+
+/// A snapshot encoded for `/image`, shared by every request sending it.
+#[derive(Clone, Debug)]
+struct Encoded {
+    version: u64,
+    done: bool,
+    bytes: Arc<Vec<u8>>,
+}
+
+/// The encoded snapshots alive: the latest, and those still being sent.
+#[derive(Debug, Default)]
+struct Images {
+    live: Vec<Encoded>,
+    /// Snapshots encoded so far (one per version, unless readers made
+    /// some skip).
+    encodes: u64,
+}
+
+/// The connections being served.
+#[derive(Debug, Default)]
+struct Clients {
+    total: usize,
+    per_client: HashMap<IpAddr, usize>,
+}
+
+/// A claimed connection slot, given back when dropped (also when the
+/// connection's thread panics).
+struct Slot {
+    shared: Arc<Shared>,
+    client: IpAddr,
+}
+
+impl Drop for Slot {
+    fn drop(&mut self) {
+        let mut c = self.shared.clients();
+        c.total -= 1;
+        if let Some(n) = c.per_client.get_mut(&self.client) {
+            *n -= 1;
+            if *n == 0 {
+                c.per_client.remove(&self.client);
+            }
+        }
+    }
+}
+
+/// The key connections are counted under: the IPv4 address (IPv4-mapped
+/// IPv6 ones included), or the /64 of an IPv6 one, since a host is
+/// commonly given a whole /64 and could otherwise pose as many clients.
+fn client_key(ip: IpAddr) -> IpAddr {
+    match ip {
+        IpAddr::V4(_) => ip,
+        IpAddr::V6(v6) => match v6.to_ipv4_mapped() {
+            Some(v4) => IpAddr::V4(v4),
+            None => {
+                let s = v6.segments();
+                IpAddr::V6(Ipv6Addr::new(s[0], s[1], s[2], s[3], 0, 0, 0, 0))
+            }
+        },
+    }
+}
+
+impl Shared {
+    fn clients(&self) -> std::sync::MutexGuard<'_, Clients> {
+        self.clients.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The latest snapshot encoded for `/image` (see
+    /// [`MAX_IMAGE_BUFFERS`]), or `None` before the first one.
+    fn image(&self) -> Option<Encoded> {
+        let frame = self.watch.state().frame.clone()?;
+        let mut im = self.images.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(e) = im.live.iter().find(|e| e.version == frame.version) {
+            return Some(e.clone());
+        }
+        // Encodings only this cache holds are sent by nobody: let them go.
+        // (Counts only fall outside the lock, so this never drops one in use.)
+        im.live.retain(|e| Arc::strong_count(&e.bytes) > 1);
+        if im.live.len() >= MAX_IMAGE_BUFFERS {
+            return im.live.iter().max_by_key(|e| e.version).cloned();
+        }
+        let e = Encoded {
+            version: frame.version,
+            done: frame.snapshot.done,
+            bytes: Arc::new(encode_image(&frame)),
+        };
+        im.encodes += 1;
+        im.live.push(e.clone());
+        Some(e)
+    }
+
+    /// A slot for a connection from `peer`, or `None` when the limits
+    /// say to close it.
+    fn claim(self: &Arc<Self>, peer: IpAddr) -> Option<Slot> {
+        let client = client_key(peer);
+        let l = self.limits;
+        let mut c = self.clients();
+        let held = c.per_client.get(&client).copied().unwrap_or(0);
+        let room = if held == 0 {
+            l.connections
+        } else {
+            l.connections.saturating_sub(l.reserved)
+        };
+        if held >= l.per_client || c.total >= room {
+            return None;
+        }
+        c.total += 1;
+        *c.per_client.entry(client).or_insert(0) += 1;
+        Some(Slot {
+            shared: Arc::clone(self),
+            client,
+        })
+    }
 }
 
 impl Preview {
     /// Binds `addr` and serves `watch` from a thread of its own.
     pub fn start(addr: SocketAddr, watch: Arc<Watch>) -> Result<Self, StartError> {
+        Self::start_with(addr, watch, Limits::DEFAULT)
+    }
+
+    fn start_with(addr: SocketAddr, watch: Arc<Watch>, limits: Limits) -> Result<Self, StartError> {
         let listener = TcpListener::bind(addr).map_err(|e| {
             StartError(match e.kind() {
                 std::io::ErrorKind::AddrInUse => format!(
@@ -90,13 +262,17 @@ impl Preview {
         let addr = listener
             .local_addr()
             .map_err(|e| StartError(format!("--preview: {e}")))?;
+        // A page opened mid-render is served the latest wave's end at once.
+        watch.keep_wave_ends();
         let shared = Arc::new(Shared {
             watch,
             port: addr.port(),
             loopback: addr.ip().is_loopback(),
             final_image_served: AtomicBool::new(false),
             final_status_served: AtomicBool::new(false),
-            connections: AtomicUsize::new(0),
+            limits,
+            clients: Mutex::new(Clients::default()),
+            images: Mutex::new(Images::default()),
         });
         let s = Arc::clone(&shared);
         std::thread::spawn(move || accept_loop(listener, s));
@@ -131,26 +307,45 @@ impl Preview {
 
 fn accept_loop(listener: TcpListener, shared: Arc<Shared>) {
     for stream in listener.incoming() {
+        let accepted = Instant::now();
         let Ok(stream) = stream else {
             // Out of descriptors and the like: let it pass.
             std::thread::sleep(Duration::from_millis(10));
             continue;
         };
-        if shared.connections.fetch_add(1, Ordering::Relaxed) >= MAX_CONNECTIONS {
-            shared.connections.fetch_sub(1, Ordering::Relaxed);
+        let Ok(peer) = stream.peer_addr() else {
             continue;
-        }
-        let s = Arc::clone(&shared);
-        let spawned = std::thread::Builder::new()
+        };
+        let Some(slot) = shared.claim(peer.ip()) else {
+            continue;
+        };
+        let deadline = accepted + shared.limits.head_deadline;
+        // A failed spawn drops the closure, and the slot with it.
+        let _ = std::thread::Builder::new()
             .name("preview-http".into())
             .spawn(move || {
                 // Errors are the client's going away: nothing to report.
-                let _ = serve(stream, &s);
-                s.connections.fetch_sub(1, Ordering::Relaxed);
+                let _ = serve(stream, deadline, &slot.shared);
+                drop(slot);
             });
-        if spawned.is_err() {
-            shared.connections.fetch_sub(1, Ordering::Relaxed);
+    }
+}
+
+/// Reads a connection until a deadline, however the bytes are paced:
+/// each read waits only for what is left of the time.
+struct DeadlineReader<'a> {
+    stream: &'a TcpStream,
+    deadline: Instant,
+}
+
+impl Read for DeadlineReader<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let left = self.deadline.saturating_duration_since(Instant::now());
+        if left.is_zero() {
+            return Err(std::io::ErrorKind::TimedOut.into());
         }
+        self.stream.set_read_timeout(Some(left))?;
+        self.stream.read(buf)
     }
 }
 
@@ -171,7 +366,10 @@ fn read_request(r: &mut impl BufRead) -> Result<Request, &'static str> {
         let limit = (MAX_HEAD - head.len()) as u64 + 1;
         let n = std::io::Read::take(&mut *r, limit)
             .read_until(b'\n', &mut head)
-            .map_err(|_| "unreadable request")?;
+            .map_err(|e| match e.kind() {
+                std::io::ErrorKind::TimedOut | std::io::ErrorKind::WouldBlock => HEAD_TOO_SLOW,
+                _ => "unreadable request",
+            })?;
         if n == 0 {
             return Err("incomplete request");
         }
@@ -249,14 +447,22 @@ fn respond(
     w.flush()
 }
 
-fn serve(stream: TcpStream, shared: &Shared) -> std::io::Result<()> {
-    stream.set_read_timeout(Some(CLIENT_TIMEOUT))?;
+/// Answers one request on `stream`, whose head must have arrived by
+/// `deadline`.
+fn serve(stream: TcpStream, deadline: Instant, shared: &Shared) -> std::io::Result<()> {
     stream.set_write_timeout(Some(CLIENT_TIMEOUT))?;
-    let mut reader = BufReader::new(stream.try_clone()?);
+    let req = read_request(&mut BufReader::new(DeadlineReader {
+        stream: &stream,
+        deadline,
+    }));
     let mut out = std::io::BufWriter::new(stream);
     let text = "text/plain; charset=utf-8";
-    let req = match read_request(&mut reader) {
+    let req = match req {
         Ok(r) => r,
+        Err(HEAD_TOO_SLOW) => {
+            let why = HEAD_TOO_SLOW.as_bytes();
+            return respond(&mut out, "408 Request Timeout", text, why, false);
+        }
         Err(why) => return respond(&mut out, "400 Bad Request", text, why.as_bytes(), false),
     };
     if shared.loopback
@@ -300,17 +506,17 @@ fn serve(stream: TcpStream, shared: &Shared) -> std::io::Result<()> {
         }
         "/image" => {
             shared.watch.viewer_seen();
-            let frame = shared.watch.state().frame.clone();
-            match frame {
-                Some(f) => {
+            match shared.image() {
+                Some(e) => {
+                    let body = e.bytes.as_slice();
                     respond(
                         &mut out,
                         "200 OK",
                         "application/octet-stream",
-                        &encode_image(&f),
+                        body,
                         head_only,
                     )?;
-                    if f.snapshot.done && !head_only {
+                    if e.done && !head_only {
                         shared.final_image_served.store(true, Ordering::Relaxed);
                     }
                     Ok(())

@@ -621,3 +621,36 @@ fn a_closed_output_pipe_is_not_a_panic() {
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(!stderr(&o).contains("panicked"));
 }
+
+/// An EXR's string attributes, its channel names and the file name are
+/// printed by `info` with their control characters escaped: an ESC
+/// sequence in them would otherwise act on the terminal, and a newline
+/// would forge a line of the report.
+#[test]
+fn info_escapes_control_characters_of_exr_attributes() {
+    let d = dir("info-escape");
+    let path = d.join("e\u{1b}[2J.exr");
+    let md = ImageMetadata {
+        strings: [(
+            "note\u{1b}]0;owned\u{7}".to_string(),
+            vec!["a\u{1b}[31mred".to_string(), "two\nlines".to_string()],
+        )]
+        .into_iter()
+        .collect(),
+        ..Default::default()
+    };
+    Image::from_f32(vec![1.0], Point2i::new(1, 1), &["Y\u{1b}"])
+        .unwrap()
+        .write(&path, &md)
+        .unwrap();
+    let o = imgtool(&["info", path.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let s = stdout(&o);
+    assert!(!s.contains('\u{1b}') && !s.contains('\u{7}'), "{s:?}");
+    assert!(
+        s.contains(r#""note\u{1b}]0;owned\u{7}": [ "a\u{1b}[31mred" "two\u{a}lines" ]"#),
+        "{s}"
+    );
+    assert!(s.contains(r"e\u{1b}[2J.exr:"), "{s}");
+    assert!(s.contains(r"  Y\u{1b}: min 1 max 1"), "{s}");
+}
