@@ -298,6 +298,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
             .as_ref()
             .map(|w| Arc::clone(w) as Arc<dyn rpbrt_render::integrator::RenderObserver>),
         wavefront,
+        simd: None,
     };
     let tev = match (&watch, &opts.display_server) {
         (Some(w), Some(address)) => {

@@ -11,6 +11,7 @@ use std::path::PathBuf;
 
 mod common;
 use common::{assert_same_pixels, render_scene, render_with};
+use rpbrt_render::simd::SimdLevel;
 
 fn out_path(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("rpbrt-integrators-{}", std::process::id()));
@@ -625,6 +626,12 @@ fn wavefront_matches_scalar_bit_for_bit() {
         let (two, _) = render_with(&text, 2, true);
         assert_same_pixels(&scalar, &one, &text);
         assert_same_pixels(&scalar, &two, &text);
+        // At every SIMD width this processor runs (camera-ray packets of
+        // 1, 4 or 8 rays).
+        for level in SimdLevel::available() {
+            let im = common::render_opts(&text, 2, true, Some(level));
+            assert_same_pixels(&scalar, &im, &format!("{level:?}\n{text}"));
+        }
         // The scene is not black: the comparison compares something.
         assert!(mean_rgb(&scalar) > 0.01, "{sampler}: mean {}", mean_rgb(&scalar));
     }

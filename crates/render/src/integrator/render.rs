@@ -41,6 +41,10 @@ pub struct RenderOptions {
     /// per thread at once; the same image) where the integrator has one
     /// ([`crate::integrator::Integrator::has_wavefront`]).
     pub wavefront: bool,
+    /// The SIMD level the wavefront's kernels run at; `None`: the
+    /// process's ([`crate::simd::level`]). Tests set it to compare widths
+    /// within one process.
+    pub simd: Option<crate::simd::SimdLevel>,
 }
 
 /// The image of a render in progress, as the film would write its R, G

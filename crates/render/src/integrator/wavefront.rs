@@ -170,7 +170,7 @@ impl TileIntegrator for WavefrontPath<'_> {
         let mut shadow_lanes: Vec<(usize, SampledSpectrum)> = Vec::with_capacity(LANES);
         let mut blocked: Vec<bool> = Vec::with_capacity(LANES);
         let mut started = 0;
-        let level = crate::simd::level();
+        let level = opts.simd.unwrap_or_else(crate::simd::level);
         loop {
             // Refill the pool in the tile's sample order. Once
             // interrupted, no sample starts; those in flight finish.

@@ -22,19 +22,37 @@ pub fn render_scene(text: &str, threads: usize) -> Image {
 /// Renders scene text with or without `--wavefront`; also says whether
 /// the integrator has a wavefront form.
 pub fn render_with(text: &str, threads: usize, wavefront: bool) -> (Image, bool) {
+    let has = created(text).integrator.has_wavefront();
+    (render_opts(text, threads, wavefront, None), has)
+}
+
+/// The scene of `text`, created.
+fn created(text: &str) -> rpbrt_render::scene::assemble::CreatedScene {
     let (desc, _) = build_scene_from_str(text, &BuildOptions::default())
         .unwrap_or_else(|d| panic!("{}", d.render()));
-    let created = match create_scene(&desc, &CreateOptions::default()) {
+    match create_scene(&desc, &CreateOptions::default()) {
         Ok(c) => c,
         Err(e) => panic!(
             "{:?}",
             e.iter().map(|d| d.message.clone()).collect::<Vec<_>>()
         ),
-    };
+    }
+}
+
+/// Renders scene text with or without `--wavefront`, its kernels at
+/// `simd` (`None`: the process's level).
+pub fn render_opts(
+    text: &str,
+    threads: usize,
+    wavefront: bool,
+    simd: Option<rpbrt_render::simd::SimdLevel>,
+) -> Image {
+    let created = created(text);
     let mut scene = created.scene;
     let opts = RenderOptions {
         nthreads: threads,
         wavefront,
+        simd,
         ..Default::default()
     };
     let mut md = ImageMetadata::default();
@@ -43,10 +61,9 @@ pub fn render_with(text: &str, threads: usize, wavefront: bool) -> (Image, bool)
         .render(&mut scene, &opts, &mut md, &|_| {})
         .unwrap();
     let path = scene.film.filename().to_string();
-    let image = Image::read(std::path::Path::new(&path), None)
+    Image::read(std::path::Path::new(&path), None)
         .unwrap()
-        .image;
-    (image, created.integrator.has_wavefront())
+        .image
 }
 
 /// The two images have the same channels and bit-identical values.
