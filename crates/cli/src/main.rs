@@ -382,7 +382,11 @@ fn render_command(opts: &args::Options) -> ExitCode {
         diagln!("  Render                     {:>10.3} s", secs);
         diagln!(
             "  Design                     {:>10}  (SIMD {})",
-            if render_opts.wavefront && integrator.has_wavefront() { "wavefront" } else { "scalar" },
+            if render_opts.wavefront && integrator.has_wavefront() {
+                "wavefront"
+            } else {
+                "scalar"
+            },
             rpbrt_render::simd::level().name()
         );
         diagln!(

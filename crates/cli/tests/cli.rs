@@ -859,7 +859,8 @@ fn ctrl_c_is_honoured_between_samples_of_one_pixel() {
             "LookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\"\nSampler \"independent\" \"integer pixelsamples\" 2147483647\nFilm \"rgb\" \"integer xresolution\" 2 \"integer yresolution\" 2\nWorldBegin\nLightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\nMaterial \"diffuse\"\nShape \"sphere\" \"float radius\" 1\n",
         );
         let mut cmd = rpbrt();
-        cmd.args(["--quiet", "--nthreads", "2", "--outfile"]).arg(&out);
+        cmd.args(["--quiet", "--nthreads", "2", "--outfile"])
+            .arg(&out);
         if let Some(d) = design {
             cmd.arg(d);
         }

@@ -564,7 +564,13 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
                     );
                 }
             }
-            print_result(&mesh.name, name, threads, [build, c, i, s], &(default.to_string() + &extra));
+            print_result(
+                &mesh.name,
+                name,
+                threads,
+                [build, c, i, s],
+                &(default.to_string() + &extra),
+            );
         }
     }
 

@@ -19,7 +19,6 @@ fn out_path(tag: &str) -> PathBuf {
     dir.join(format!("{tag}.exr"))
 }
 
-
 fn mean_rgb(im: &Image) -> f64 {
     let v = im.to_f32_vec();
     v.iter().map(|&x| x as f64).sum::<f64>() / v.len() as f64
@@ -617,7 +616,12 @@ AttributeEnd
 /// not powers of two, on one and on two threads.
 #[test]
 fn wavefront_matches_scalar_bit_for_bit() {
-    for (sampler, spp) in [("zsobol", 8), ("independent", 5), ("halton", 6), ("pmj02bn", 3)] {
+    for (sampler, spp) in [
+        ("zsobol", 8),
+        ("independent", 5),
+        ("halton", 6),
+        ("pmj02bn", 3),
+    ] {
         let tag = format!("wavefront-varied-{sampler}");
         let text = varied_scene(&tag, sampler, spp);
         let (scalar, has) = render_with(&text, 2, false);
@@ -633,6 +637,10 @@ fn wavefront_matches_scalar_bit_for_bit() {
             assert_same_pixels(&scalar, &im, &format!("{level:?}\n{text}"));
         }
         // The scene is not black: the comparison compares something.
-        assert!(mean_rgb(&scalar) > 0.01, "{sampler}: mean {}", mean_rgb(&scalar));
+        assert!(
+            mean_rgb(&scalar) > 0.01,
+            "{sampler}: mean {}",
+            mean_rgb(&scalar)
+        );
     }
 }

@@ -17,7 +17,6 @@ fn out_path(tag: &str) -> PathBuf {
     dir.join(format!("{tag}.exr"))
 }
 
-
 fn mean_rgb(im: &Image) -> f64 {
     let v = im.to_f32_vec();
     assert!(v.iter().all(|x| x.is_finite()), "non-finite pixel");

@@ -177,7 +177,9 @@ fn packet_closest<L: F32Lanes, F>(
                 // Every ray enters each slab by the same plane: the
                 // single-ray test's planes, chosen once per packet.
                 for a in 0..3 {
-                    let near = L::splat(b[oct.near[a]][c]).sub(oct.o_near[a]).mul(pr.inv[a]);
+                    let near = L::splat(b[oct.near[a]][c])
+                        .sub(oct.o_near[a])
+                        .mul(pr.inv[a]);
                     let far = L::splat(b[oct.far[a]][c]).sub(oct.o_far[a]).mul(pr.inv[a]);
                     t0 = t0.max(near);
                     t1 = t1.min(far.mul(pad));

@@ -121,9 +121,13 @@ impl Integrator {
         // One match per render: each arm runs a loop built for its
         // integrator (no dispatch per ray).
         let mut result = match self {
-            Integrator::Path(i) if opts.wavefront => {
-                tile::render_tiles(&wavefront::WavefrontPath(i), scene, opts, metadata, progress)
-            }
+            Integrator::Path(i) if opts.wavefront => tile::render_tiles(
+                &wavefront::WavefrontPath(i),
+                scene,
+                opts,
+                metadata,
+                progress,
+            ),
             Integrator::Path(i) => {
                 tile::render_tiles(&tile::RayTiles(i), scene, opts, metadata, progress)
             }

@@ -4,11 +4,11 @@
 
 use super::direct::{sample_ld_deferred, ShadowQuery};
 use super::{skip_intersection, RayIntegrator, Scene, VertexOrigins};
-use crate::primitive::PrimitiveIntersection;
 use crate::bxdf::{BxDFReflTransFlags, TransportMode};
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
 use crate::lightsampler::LightSampler;
+use crate::primitive::PrimitiveIntersection;
 use crate::sampler::Sampler;
 use crate::sampling::power_heuristic;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};

@@ -304,13 +304,7 @@ pub(crate) fn add_estimate(
     if l.has_nan() || !l.y(lambda).is_finite() {
         l = SampledSpectrum::new(0.0);
     }
-    tile.add_sample(
-        p_pixel,
-        l,
-        lambda,
-        visible.filter(|v| v.set),
-        filter_weight,
-    );
+    tile.add_sample(p_pixel, l, lambda, visible.filter(|v| v.set), filter_weight);
 }
 
 /// The samples of the wave after `[start, end)`: pbrt-v4's schedule,

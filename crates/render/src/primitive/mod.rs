@@ -5,12 +5,12 @@
 
 use crate::accel::packet::MAX_PACKET;
 use crate::accel::{AccelParams, Accelerator, Aggregate};
-use crate::simd::SimdLevel;
 use crate::shape::triangle::{
     intersect_prepared_triangle, intersect_triangle, triangle_is_nondegenerate, TriangleFrame,
     TriangleOf, TriangleRay,
 };
 use crate::shape::{Shape, ShapeMethods, TriangleMesh};
+use crate::simd::SimdLevel;
 use crate::texture::{FloatTextureRef, TextureEvalContext};
 use rpbrt_geometry::animated::AnimatedTransform;
 use rpbrt_geometry::float::Float;
@@ -713,20 +713,20 @@ impl PrimitiveAggregate {
             &mut t_max[..n],
             &mut best[..n],
             |lane: usize, slot: u32, i: u32, ray: &Ray, t: Float| {
-                    let tr = &trs[lane];
-                    if let Some(Some([p0, p1, p2])) = self.triangle_vertices.get(slot as usize) {
-                        let (b0, b1, b2, t_hit) = intersect_prepared_triangle(tr, t, *p0, *p1, *p2)?;
-                        records[lane] = Some(HitRecord {
-                            primitive: i,
-                            t_hit,
-                            kind: HitKind::Triangle(b0, b1, b2),
-                        });
-                        return Some(t_hit);
-                    }
-                    let record = self.record_other(i, ray, tr, t)?;
-                    records[lane] = Some(record);
-                    Some(record.t_hit)
-                },
+                let tr = &trs[lane];
+                if let Some(Some([p0, p1, p2])) = self.triangle_vertices.get(slot as usize) {
+                    let (b0, b1, b2, t_hit) = intersect_prepared_triangle(tr, t, *p0, *p1, *p2)?;
+                    records[lane] = Some(HitRecord {
+                        primitive: i,
+                        t_hit,
+                        kind: HitKind::Triangle(b0, b1, b2),
+                    });
+                    return Some(t_hit);
+                }
+                let record = self.record_other(i, ray, tr, t)?;
+                records[lane] = Some(record);
+                Some(record.t_hit)
+            },
         );
         out[..n].copy_from_slice(&records[..n]);
     }

@@ -91,7 +91,11 @@ pub fn level() -> SimdLevel {
     static LEVEL: OnceLock<SimdLevel> = OnceLock::new();
     *LEVEL.get_or_init(|| {
         let best = SimdLevel::detected();
-        match std::env::var("RPBRT_SIMD").ok().as_deref().and_then(SimdLevel::parse) {
+        match std::env::var("RPBRT_SIMD")
+            .ok()
+            .as_deref()
+            .and_then(SimdLevel::parse)
+        {
             Some(forced) => forced.min(best),
             None => best,
         }

@@ -121,6 +121,12 @@ fn levels_parse_and_order() {
     assert!(SimdLevel::Scalar < SimdLevel::Sse4 && SimdLevel::Sse4 < SimdLevel::Avx2);
     // Asking for more than the processor has runs what it has.
     assert!(level() <= SimdLevel::detected());
-    let sum = dispatch(SimdLevel::Avx2, AllOps { a: &[1.0; 16], b: &[2.0; 16] });
+    let sum = dispatch(
+        SimdLevel::Avx2,
+        AllOps {
+            a: &[1.0; 16],
+            b: &[2.0; 16],
+        },
+    );
     assert!(sum.iter().all(|r| r[0] == 3.0f32.to_bits()));
 }

@@ -76,5 +76,8 @@ pub fn assert_same_pixels(a: &Image, b: &Image, what: &str) {
         .zip(&vb)
         .filter(|(x, y)| x.to_bits() != y.to_bits())
         .count();
-    assert_eq!(differing, 0, "wavefront and scalar differ in {differing} values:\n{what}");
+    assert_eq!(
+        differing, 0,
+        "wavefront and scalar differ in {differing} values:\n{what}"
+    );
 }
