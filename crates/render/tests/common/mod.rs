@@ -22,8 +22,9 @@ pub fn render_scene(text: &str, threads: usize) -> Image {
 /// Renders scene text with or without `--wavefront`; also says whether
 /// the integrator has a wavefront form.
 pub fn render_with(text: &str, threads: usize, wavefront: bool) -> (Image, bool) {
-    let has = created(text).integrator.has_wavefront();
-    (render_opts(text, threads, wavefront, None), has)
+    let created = created(text);
+    let has = created.integrator.has_wavefront();
+    (render_created(created, threads, wavefront, None), has)
 }
 
 /// The scene of `text`, created.
@@ -47,7 +48,16 @@ pub fn render_opts(
     wavefront: bool,
     simd: Option<rpbrt_render::simd::SimdLevel>,
 ) -> Image {
-    let created = created(text);
+    render_created(created(text), threads, wavefront, simd)
+}
+
+/// Renders a created scene (see [`render_opts`]).
+fn render_created(
+    created: rpbrt_render::scene::assemble::CreatedScene,
+    threads: usize,
+    wavefront: bool,
+    simd: Option<rpbrt_render::simd::SimdLevel>,
+) -> Image {
     let mut scene = created.scene;
     let opts = RenderOptions {
         nthreads: threads,
