@@ -254,9 +254,8 @@ fn render_command(opts: &args::Options) -> ExitCode {
     let wavefront = opts.wavefront || desc_flag(&desc, "wavefront");
     if wavefront && !integrator.has_wavefront() && !opts.quiet {
         diagln!(
-            "rpbrt: warning: --wavefront: the \"{}\" integrator{} has no wavefront form yet; rendering it with the scalar loop",
+            "rpbrt: warning: --wavefront: the \"{}\" integrator has no wavefront form yet; rendering it with the scalar loop",
             integrator.name(),
-            if integrator.name() == "volpath" { " with participating media" } else { "" }
         );
     }
 

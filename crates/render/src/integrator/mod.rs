@@ -42,6 +42,7 @@ mod simple;
 mod simplevolpath;
 mod sppm;
 pub mod tile;
+mod vertex;
 mod volpath;
 mod volume;
 mod wavefront;
@@ -121,13 +122,12 @@ impl Integrator {
         // One match per render: each arm runs a loop built for its
         // integrator (no dispatch per ray).
         let mut result = match self {
-            Integrator::Path(i) if opts.wavefront => tile::render_tiles(
-                &wavefront::WavefrontPath(i),
-                scene,
-                opts,
-                metadata,
-                progress,
-            ),
+            Integrator::Path(i) if opts.wavefront => {
+                tile::render_tiles(&wavefront::Wavefront(i), scene, opts, metadata, progress)
+            }
+            Integrator::VolPath(i) if opts.wavefront => {
+                tile::render_tiles(&wavefront::Wavefront(i), scene, opts, metadata, progress)
+            }
             Integrator::Path(i) => {
                 tile::render_tiles(&tile::RayTiles(i), scene, opts, metadata, progress)
             }
@@ -164,10 +164,10 @@ impl Integrator {
     }
 
     /// True when `--wavefront` ([`RenderOptions::wavefront`]) renders this
-    /// integrator with the wavefront path tracer; the others (and
-    /// `volpath` with media, for now) keep their scalar loops.
+    /// integrator with the wavefront path tracer (`path` and `volpath`);
+    /// the others keep their scalar loops.
     pub fn has_wavefront(&self) -> bool {
-        matches!(self, Integrator::Path(_))
+        matches!(self, Integrator::Path(_) | Integrator::VolPath(_))
     }
 
     /// The integrator's name in scene files.

@@ -3,17 +3,18 @@
 //! optional BSDF regularization.
 
 use super::direct::{sample_ld_deferred, ShadowQuery};
+use super::vertex::{li_by_vertices, VertexIntegrator, VertexStep};
 use super::{skip_intersection, RayIntegrator, Scene, VertexOrigins};
 use crate::bxdf::{BxDFReflTransFlags, TransportMode};
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
 use crate::lightsampler::LightSampler;
-use crate::primitive::PrimitiveIntersection;
+use crate::primitive::{HitRecord, PrimitiveIntersection};
 use crate::sampler::Sampler;
 use crate::sampling::power_heuristic;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::Float;
-use rpbrt_geometry::ray::RayDifferential;
+use rpbrt_geometry::ray::{Ray, RayDifferential};
 use rpbrt_geometry::tuple::*;
 
 /// The state of a path being traced: the locals of pbrt-v4's
@@ -81,43 +82,45 @@ impl RayIntegrator for PathIntegrator {
         ray: RayDifferential,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
-        mut visible: Option<&mut VisibleSurface>,
+        visible: Option<&mut VisibleSurface>,
     ) -> SampledSpectrum {
-        let mut s = PathState::new(ray);
-        loop {
-            // Matched by reference: moving the (large) intersection out of
-            // the `Option` would copy it.
-            let mut closest = scene.intersect(&s.ray.ray, Float::INFINITY);
-            let step = self.vertex(
-                scene,
-                &mut s,
-                closest.as_mut(),
-                lambda,
-                sampler,
-                visible.as_deref_mut(),
-            );
-            if let Some(q) = step.shadow {
-                if !scene.intersect_p(&q.ray, q.t_max) {
-                    s.l += q.ld;
-                }
-            }
-            if step.done {
-                break;
-            }
-        }
-        s.l
+        li_by_vertices(self, scene, ray, lambda, sampler, visible)
     }
 }
 
-/// What a path vertex leaves to the caller: a shadow ray whose
-/// contribution counts if nothing blocks it, and whether the path ends
-/// (after that contribution).
-pub(crate) struct VertexStep {
-    /// The light sample's shadow query, its contribution already
-    /// multiplied by the path throughput.
-    pub shadow: Option<ShadowQuery>,
-    /// The path ends here.
-    pub done: bool,
+impl VertexIntegrator for PathIntegrator {
+    type State = PathState;
+
+    #[inline(always)]
+    fn start(&self, ray: RayDifferential) -> PathState {
+        PathState::new(ray)
+    }
+
+    #[inline(always)]
+    fn ray(s: &PathState) -> &Ray {
+        &s.ray.ray
+    }
+
+    #[inline(always)]
+    fn radiance(s: &mut PathState) -> &mut SampledSpectrum {
+        &mut s.l
+    }
+
+    #[inline(always)]
+    fn vertex(
+        &self,
+        scene: &Scene,
+        s: &mut PathState,
+        record: Option<HitRecord>,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+        visible: Option<&mut VisibleSurface>,
+    ) -> VertexStep {
+        // Built in place and matched by reference: moving the (large)
+        // intersection out of the `Option` would copy it.
+        let mut closest = record.and_then(|h| scene.aggregate.interaction(&s.ray.ray, &h));
+        self.surface_vertex(scene, s, closest.as_mut(), lambda, sampler, visible)
+    }
 }
 
 impl PathIntegrator {
@@ -128,7 +131,7 @@ impl PathIntegrator {
     /// through here, so they give the same pixels; they differ only in
     /// when they trace the rays.
     #[inline(always)]
-    pub(crate) fn vertex(
+    pub(crate) fn surface_vertex(
         &self,
         scene: &Scene,
         s: &mut PathState,
@@ -137,10 +140,7 @@ impl PathIntegrator {
         sampler: &mut Sampler,
         visible: Option<&mut VisibleSurface>,
     ) -> VertexStep {
-        const DONE: VertexStep = VertexStep {
-            shadow: None,
-            done: true,
-        };
+        const DONE: VertexStep = VertexStep::DONE;
         let light_sampler: &LightSampler = &scene.light_sampler;
         let Some(hit) = hit else {
             // Escaped: infinite lights, weighted by MIS unless the last
@@ -180,10 +180,7 @@ impl PathIntegrator {
         let Some(bsdf) = bsdf_slot.as_mut() else {
             s.specular_bounce = true;
             s.ray = skip_intersection(&s.ray, hit);
-            return VertexStep {
-                shadow: None,
-                done: false,
-            };
+            return VertexStep::NEXT;
         };
         if s.depth == 0 {
             if let Some(v) = visible {

@@ -4,7 +4,9 @@
 //! light sampling through media and interfaces by ratio tracking, medium
 //! emission, and subsurface scattering through the materials' BSSRDFs.
 
+use super::direct::ShadowQuery;
 use super::direct::{light_sample_culled, surface_light_context};
+use super::vertex::{li_by_vertices, VertexIntegrator, VertexStep};
 use super::volume::{
     hit_medium_toward, medium_toward, segment_rng, shadow_transmittance, ShadowTransmittance,
 };
@@ -14,13 +16,15 @@ use crate::bxdf::{BxDFReflTransFlags, TransportMode, BSDF};
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
 use crate::medium::{sample_t_maj, HGPhaseFunction};
-use crate::primitive::MediumInterface;
+use crate::primitive::{HitRecord, MediumInterface};
 use crate::rng::{mix_bits, Rng};
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::interaction::SurfaceInteraction;
-use rpbrt_geometry::ray::{spawn_ray_from_origin_to_surface, MediumId, Ray, RayDifferential};
+use rpbrt_geometry::ray::{
+    spawn_ray_from_origin_to_surface, MediumId, Ray, RayDifferential, SHADOW_EPSILON,
+};
 use rpbrt_geometry::tuple::*;
 
 /// pbrt-v4's `volpath` integrator.
@@ -90,7 +94,30 @@ impl VolPathIntegrator {
         beta: SampledSpectrum,
         r_p: SampledSpectrum,
     ) -> SampledSpectrum {
-        let zero = SampledSpectrum::new(0.0);
+        match self.sample_ld_or_defer(scene, vertex, lambda, u, u_light, beta, r_p, false) {
+            Ld::Now(l) => l,
+            // Not asked for: `defer` is false.
+            Ld::Deferred(_) => SampledSpectrum::new(0.0),
+        }
+    }
+
+    /// [`VolPathIntegrator::sample_ld`], its shadow ray left to the caller
+    /// when `defer` is set and the scene has no media or interfaces (the
+    /// shadow ray is then a plain occlusion test; the contribution is the
+    /// one a transmittance of one gives, bit for bit).
+    #[allow(clippy::too_many_arguments)]
+    fn sample_ld_or_defer(
+        &self,
+        scene: &Scene,
+        vertex: LdVertex,
+        lambda: &SampledWavelengths,
+        u: Float,
+        u_light: Point2f,
+        beta: SampledSpectrum,
+        r_p: SampledSpectrum,
+        defer: bool,
+    ) -> Ld {
+        let zero = Ld::Now(SampledSpectrum::new(0.0));
         let mut vertex = vertex;
         let ctx = match &mut vertex {
             LdVertex::Surface { origins, bsdf, .. } => surface_light_context(origins, bsdf),
@@ -155,19 +182,40 @@ impl VolPathIntegrator {
                 (SampledSpectrum::new(v), phase.pdf(wo, wi), ray)
             }
         };
-        let Some(ShadowTransmittance { t_ray, r_u, r_l }) =
-            shadow_transmittance(scene, ray, ls.p_light, ls.n_light, lambda)
-        else {
-            return zero;
+        let delta = light.light_type().is_delta();
+        let value = |st: ShadowTransmittance| {
+            let ShadowTransmittance { t_ray, r_u, r_l } = st;
+            let r_l = r_l * r_p * light_pdf;
+            let r_u = r_u * r_p * scatter_pdf;
+            if delta {
+                beta * f_hat * t_ray * ls.l / r_l.average()
+            } else {
+                beta * f_hat * t_ray * ls.l / (r_l + r_u).average()
+            }
         };
-        let r_l = r_l * r_p * light_pdf;
-        let r_u = r_u * r_p * scatter_pdf;
-        if light.light_type().is_delta() {
-            beta * f_hat * t_ray * ls.l / r_l.average()
-        } else {
-            beta * f_hat * t_ray * ls.l / (r_l + r_u).average()
+        if defer && !scene.has_volumes {
+            let one = SampledSpectrum::new(1.0);
+            return Ld::Deferred(ShadowQuery {
+                ray,
+                t_max: 1.0 - SHADOW_EPSILON,
+                ld: value(ShadowTransmittance {
+                    t_ray: one,
+                    r_u: one,
+                    r_l: one,
+                }),
+            });
+        }
+        match shadow_transmittance(scene, ray, ls.p_light, ls.n_light, lambda) {
+            Some(st) => Ld::Now(value(st)),
+            None => zero,
         }
     }
+}
+
+/// A light sample's contribution, or its shadow query.
+enum Ld {
+    Now(SampledSpectrum),
+    Deferred(ShadowQuery),
 }
 
 /// A probe-ray hit kept by the reservoir: the surface point light enters
@@ -177,6 +225,31 @@ struct ProbeHit {
     si: SurfaceInteraction,
 }
 
+/// The state of a path being traced: the locals of pbrt-v4's
+/// `VolPathIntegrator::Li`, updated at every vertex.
+pub(crate) struct VolPathState {
+    /// The ray leaving the last vertex (the camera ray at first).
+    ray: RayDifferential,
+    /// The radiance gathered so far.
+    l: SampledSpectrum,
+    /// The path throughput.
+    beta: SampledSpectrum,
+    /// The rescaled unidirectional path probability.
+    r_u: SampledSpectrum,
+    /// The rescaled light-sampling path probability.
+    r_l: SampledSpectrum,
+    /// The last bounce was specular (or passed an interface).
+    specular_bounce: bool,
+    /// Some bounce so far was not specular (for BSDF regularization).
+    any_non_specular: bool,
+    /// Scattering events so far.
+    depth: i32,
+    /// The product of the squared relative indices of refraction crossed.
+    eta_scale: Float,
+    /// The last scattering vertex, for MIS densities of emission hit.
+    prev_ctx: LightSampleContext,
+}
+
 impl RayIntegrator for VolPathIntegrator {
     fn li(
         &self,
@@ -184,268 +257,309 @@ impl RayIntegrator for VolPathIntegrator {
         ray: RayDifferential,
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
-        mut visible: Option<&mut VisibleSurface>,
+        visible: Option<&mut VisibleSurface>,
     ) -> SampledSpectrum {
+        li_by_vertices(self, scene, ray, lambda, sampler, visible)
+    }
+}
+
+impl VertexIntegrator for VolPathIntegrator {
+    type State = VolPathState;
+
+    #[inline(always)]
+    fn start(&self, ray: RayDifferential) -> VolPathState {
+        VolPathState {
+            ray,
+            l: SampledSpectrum::new(0.0),
+            beta: SampledSpectrum::new(1.0),
+            r_u: SampledSpectrum::new(1.0),
+            r_l: SampledSpectrum::new(1.0),
+            specular_bounce: false,
+            any_non_specular: false,
+            depth: 0,
+            eta_scale: 1.0,
+            prev_ctx: LightSampleContext::default(),
+        }
+    }
+
+    #[inline(always)]
+    fn ray(s: &VolPathState) -> &Ray {
+        &s.ray.ray
+    }
+
+    #[inline(always)]
+    fn radiance(s: &mut VolPathState) -> &mut SampledSpectrum {
+        &mut s.l
+    }
+
+    /// One pass of pbrt-v4's `VolPathIntegrator::Li` loop: delta tracking
+    /// through the ray's medium up to `record`, then the surface there.
+    /// The surface's light sample is deferred (returned as the step's
+    /// shadow query) in scenes without media or interfaces; every other
+    /// light sample is traced here.
+    fn vertex(
+        &self,
+        scene: &Scene,
+        s: &mut VolPathState,
+        record: Option<HitRecord>,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+        visible: Option<&mut VisibleSurface>,
+    ) -> VertexStep {
         let light_sampler = &scene.light_sampler;
         let max_depth = self.max_depth;
-        let mut ray = ray;
-        let mut l = SampledSpectrum::new(0.0);
-        let mut beta = SampledSpectrum::new(1.0);
-        let mut r_u = SampledSpectrum::new(1.0);
-        let mut r_l = SampledSpectrum::new(1.0);
-        let mut specular_bounce = false;
-        let mut any_non_specular = false;
-        let mut depth = 0i32;
-        let mut eta_scale: Float = 1.0;
-        let mut prev_ctx = LightSampleContext::default();
-        loop {
-            let mut closest;
-            if let Some(m) = ray.ray.medium {
-                // Delta tracking through the medium up to the surface: only
-                // the surface's distance is needed unless the ray gets
-                // there, so its interaction is built afterwards.
-                let record = scene.intersect_record(&ray.ray, Float::INFINITY);
-                let medium = &scene.media[m as usize];
-                let mut scattered = false;
-                let mut terminated = false;
-                let t_max = record.as_ref().map_or(Float::INFINITY, |h| h.t_hit);
-                let mut rng = segment_rng(sampler);
-                let u = sampler.get_1d();
-                let r = ray.ray;
-                let wo = -r.d.normalize();
-                let lambda_ref: &SampledWavelengths = lambda;
-                let t_maj = sample_t_maj(
-                    medium,
-                    &r,
-                    t_max,
-                    u,
-                    &mut rng,
-                    lambda_ref,
-                    |p, mp, sigma_maj, t_maj, rng| {
-                        if beta.is_black() {
+        let mut closest;
+        if let Some(m) = s.ray.ray.medium {
+            // Delta tracking through the medium up to the surface: only
+            // the surface's distance is needed unless the ray gets
+            // there, so its interaction is built afterwards.
+            let medium = &scene.media[m as usize];
+            let mut scattered = false;
+            let mut terminated = false;
+            let t_max = record.as_ref().map_or(Float::INFINITY, |h| h.t_hit);
+            let mut rng = segment_rng(sampler);
+            let u = sampler.get_1d();
+            let r = s.ray.ray;
+            let wo = -r.d.normalize();
+            let lambda_ref: &SampledWavelengths = lambda;
+            let t_maj = sample_t_maj(
+                medium,
+                &r,
+                t_max,
+                u,
+                &mut rng,
+                lambda_ref,
+                |p, mp, sigma_maj, t_maj, rng| {
+                    if s.beta.is_black() {
+                        terminated = true;
+                        return false;
+                    }
+                    // Emission at the collision, as if it were an absorption.
+                    if s.depth < max_depth && !mp.le.is_black() {
+                        let pdf = sigma_maj[0] * t_maj[0];
+                        let betap = s.beta * t_maj / pdf;
+                        let r_e = s.r_u * sigma_maj * t_maj / pdf;
+                        if !r_e.is_black() {
+                            s.l += betap * mp.sigma_a * mp.le / r_e.average();
+                        }
+                    }
+                    let um = rng.uniform_float();
+                    match sample_event(mp.sigma_a[0], mp.sigma_s[0], sigma_maj[0], um) {
+                        0 => {
                             terminated = true;
-                            return false;
+                            false
                         }
-                        // Emission at the collision, as if it were an absorption.
-                        if depth < max_depth && !mp.le.is_black() {
-                            let pdf = sigma_maj[0] * t_maj[0];
-                            let betap = beta * t_maj / pdf;
-                            let r_e = r_u * sigma_maj * t_maj / pdf;
-                            if !r_e.is_black() {
-                                l += betap * mp.sigma_a * mp.le / r_e.average();
-                            }
-                        }
-                        let um = rng.uniform_float();
-                        match sample_event(mp.sigma_a[0], mp.sigma_s[0], sigma_maj[0], um) {
-                            0 => {
+                        1 => {
+                            if s.depth >= max_depth {
                                 terminated = true;
-                                false
+                                return false;
                             }
-                            1 => {
-                                if depth >= max_depth {
-                                    terminated = true;
-                                    return false;
-                                }
-                                depth += 1;
-                                let pdf = t_maj[0] * mp.sigma_s[0];
-                                beta *= t_maj * mp.sigma_s / pdf;
-                                r_u *= t_maj * mp.sigma_s / pdf;
-                                if !beta.is_black() && !r_u.is_black() {
-                                    let (u_l, u_l2) = (sampler.get_1d(), sampler.get_2d());
-                                    let vertex = LdVertex::Medium {
-                                        p,
-                                        wo,
-                                        time: r.time,
-                                        phase: mp.phase,
-                                        medium: Some(m),
-                                    };
-                                    l += self
-                                        .sample_ld(scene, vertex, lambda_ref, u_l, u_l2, beta, r_u);
-                                    let u = sampler.get_2d();
-                                    match mp.phase.sample_p(wo, u) {
-                                        Some(ps) if ps.pdf > 0.0 => {
-                                            beta *= ps.p / ps.pdf;
-                                            r_l = r_u / ps.pdf;
-                                            prev_ctx = LightSampleContext::from_point(p);
-                                            scattered = true;
-                                            ray = RayDifferential::new(Ray::with_time(
-                                                p,
-                                                ps.wi,
-                                                r.time,
-                                                Some(m),
-                                            ));
-                                            specular_bounce = false;
-                                            any_non_specular = true;
-                                        }
-                                        _ => terminated = true,
+                            s.depth += 1;
+                            let pdf = t_maj[0] * mp.sigma_s[0];
+                            s.beta *= t_maj * mp.sigma_s / pdf;
+                            s.r_u *= t_maj * mp.sigma_s / pdf;
+                            if !s.beta.is_black() && !s.r_u.is_black() {
+                                let (u_l, u_l2) = (sampler.get_1d(), sampler.get_2d());
+                                let vertex = LdVertex::Medium {
+                                    p,
+                                    wo,
+                                    time: r.time,
+                                    phase: mp.phase,
+                                    medium: Some(m),
+                                };
+                                s.l += self
+                                    .sample_ld(scene, vertex, lambda_ref, u_l, u_l2, s.beta, s.r_u);
+                                let u = sampler.get_2d();
+                                match mp.phase.sample_p(wo, u) {
+                                    Some(ps) if ps.pdf > 0.0 => {
+                                        s.beta *= ps.p / ps.pdf;
+                                        s.r_l = s.r_u / ps.pdf;
+                                        s.prev_ctx = LightSampleContext::from_point(p);
+                                        scattered = true;
+                                        s.ray = RayDifferential::new(Ray::with_time(
+                                            p,
+                                            ps.wi,
+                                            r.time,
+                                            Some(m),
+                                        ));
+                                        s.specular_bounce = false;
+                                        s.any_non_specular = true;
                                     }
+                                    _ => terminated = true,
                                 }
-                                false
                             }
-                            _ => {
-                                let sigma_n = (sigma_maj - mp.sigma_a - mp.sigma_s).clamp_zero();
-                                let pdf = t_maj[0] * sigma_n[0];
-                                beta *= t_maj * sigma_n / pdf;
-                                if pdf == 0.0 {
-                                    beta = SampledSpectrum::new(0.0);
-                                }
-                                r_u *= t_maj * sigma_n / pdf;
-                                r_l *= t_maj * sigma_maj / pdf;
-                                !beta.is_black() && !r_u.is_black()
-                            }
+                            false
                         }
-                    },
-                );
-                if terminated || beta.is_black() || r_u.is_black() || r_u.has_nan() {
-                    return l;
-                }
-                if scattered {
+                        _ => {
+                            let sigma_n = (sigma_maj - mp.sigma_a - mp.sigma_s).clamp_zero();
+                            let pdf = t_maj[0] * sigma_n[0];
+                            s.beta *= t_maj * sigma_n / pdf;
+                            if pdf == 0.0 {
+                                s.beta = SampledSpectrum::new(0.0);
+                            }
+                            s.r_u *= t_maj * sigma_n / pdf;
+                            s.r_l *= t_maj * sigma_maj / pdf;
+                            !s.beta.is_black() && !s.r_u.is_black()
+                        }
+                    }
+                },
+            );
+            if terminated || s.beta.is_black() || s.r_u.is_black() || s.r_u.has_nan() {
+                return VertexStep::DONE;
+            }
+            if scattered {
+                return VertexStep::NEXT;
+            }
+            if !(t_maj[0] > 0.0) {
+                return VertexStep::DONE;
+            }
+            s.beta *= t_maj / t_maj[0];
+            s.r_u *= t_maj / t_maj[0];
+            s.r_l *= t_maj / t_maj[0];
+        }
+        closest = record.and_then(|h| scene.aggregate.interaction(&s.ray.ray, &h));
+
+        let Some(hit) = closest.as_mut() else {
+            // Escaped: infinite lights.
+            for &li in &scene.infinite_lights {
+                let light = &scene.lights[li as usize];
+                let le = light.le(&s.ray.ray, lambda);
+                if le.is_black() {
                     continue;
                 }
-                if !(t_maj[0] > 0.0) {
-                    return l;
-                }
-                beta *= t_maj / t_maj[0];
-                r_u *= t_maj / t_maj[0];
-                r_l *= t_maj / t_maj[0];
-                closest = record.and_then(|h| scene.aggregate.interaction(&r, &h));
-            } else {
-                closest = scene.intersect(&ray.ray, Float::INFINITY);
-            }
-
-            let Some(hit) = closest.as_mut() else {
-                // Escaped: infinite lights.
-                for &li in &scene.infinite_lights {
-                    let light = &scene.lights[li as usize];
-                    let le = light.le(&ray.ray, lambda);
-                    if le.is_black() {
-                        continue;
-                    }
-                    if depth == 0 || specular_bounce {
-                        l += beta * le / r_u.average();
-                    } else {
-                        let p_l = light_sampler.pmf(&prev_ctx, li)
-                            * light.pdf_li(&prev_ctx, ray.ray.d, true);
-                        let r_l = r_l * p_l;
-                        l += beta * le / (r_u + r_l).average();
-                    }
-                }
-                break;
-            };
-            // Emission from a surface that was hit.
-            let le = scene.le(hit, -ray.ray.d, lambda);
-            if !le.is_black() {
-                if depth == 0 || specular_bounce {
-                    l += beta * le / r_u.average();
-                } else if let Some(al) = hit.area_light {
-                    let light = &scene.lights[al as usize];
-                    let p_l =
-                        light_sampler.pmf(&prev_ctx, al) * light.pdf_li(&prev_ctx, ray.ray.d, true);
-                    r_l *= p_l;
-                    l += beta * le / (r_u + r_l).average();
+                if s.depth == 0 || s.specular_bounce {
+                    s.l += s.beta * le / s.r_u.average();
+                } else {
+                    let p_l = light_sampler.pmf(&s.prev_ctx, li)
+                        * light.pdf_li(&s.prev_ctx, s.ray.ray.d, true);
+                    let r_l = s.r_l * p_l;
+                    s.l += s.beta * le / (s.r_u + r_l).average();
                 }
             }
-            let mut bsdf_slot = scene.get_bsdf(hit, &ray, lambda, sampler);
-            let Some(bsdf) = bsdf_slot.as_mut() else {
-                ray = skip_intersection(&ray, hit);
-                continue;
-            };
-            if depth == 0 {
-                if let Some(v) = visible.take() {
-                    *v = scene.visible_surface(hit, bsdf);
-                }
-            }
-            if depth >= max_depth {
-                return l;
-            }
-            depth += 1;
-            if self.regularize && any_non_specular {
-                bsdf.regularize();
-            }
-            let ray_medium = ray.ray.medium;
-            let si = &hit.si;
-            let mut origins = VertexOrigins::new(si);
-            let (u, u2) = if bsdf.flags().is_non_specular() {
-                let (u_light, u_light_2d, u, u2) = sampler.get_vertex_samples();
-                let vertex = LdVertex::Surface {
-                    origins: &mut origins,
-                    bsdf,
-                    interface: hit.medium_interface,
-                    ray_medium,
-                };
-                l += self.sample_ld(scene, vertex, lambda, u_light, u_light_2d, beta, r_u);
-                (u, u2)
-            } else {
-                (sampler.get_1d(), sampler.get_2d())
-            };
-            prev_ctx = LightSampleContext::from_si(si);
-            let wo = si.wo;
-            let Some(bs) =
-                bsdf.sample_f(wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL)
-            else {
-                break;
-            };
-            beta *= bs.f * (abs_dot(bs.wi, si.shading.n) / bs.pdf);
-            r_l = if bs.pdf_is_proportional {
-                r_u / bsdf.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL)
-            } else {
-                r_u / bs.pdf
-            };
-            specular_bounce = bs.is_specular();
-            any_non_specular |= !bs.is_specular();
-            if bs.is_transmission() {
-                eta_scale *= bs.eta * bs.eta;
-            }
-            let mut next = origins.spawn_ray(bs.wi);
-            next.medium = hit_medium_toward(hit, ray_medium, bs.wi);
-            ray = RayDifferential::new(next);
-
-            // Subsurface scattering: light leaving through the boundary
-            // re-emerges elsewhere on the same material.
-            if bs.is_transmission() {
-                if let Some(bssrdf) = hit
-                    .material
-                    .and_then(|m| scene.materials.get_bssrdf(m, &hit.si, lambda))
-                {
-                    match self.subsurface(
-                        scene,
-                        &bssrdf,
-                        hit.material,
-                        ray.ray.time,
-                        lambda,
-                        sampler,
-                        &mut beta,
-                        &mut r_u,
-                        &mut r_l,
-                        &mut l,
-                        &mut prev_ctx,
-                    ) {
-                        Some((next_ray, specular)) => {
-                            ray = next_ray;
-                            specular_bounce = specular;
-                            any_non_specular = true;
-                        }
-                        None => break,
-                    }
-                }
-            }
-
-            // Russian roulette.
-            if beta.is_black() {
-                break;
-            }
-            let rr_beta = beta * eta_scale / r_u.average();
-            let u_rr = sampler.get_1d();
-            let m = rr_beta.max_component_value();
-            if m < 1.0 && depth > 1 {
-                let q = (1.0 - m).max(0.0);
-                if u_rr < q {
-                    break;
-                }
-                beta /= 1.0 - q;
+            return VertexStep::DONE;
+        };
+        // Emission from a surface that was hit.
+        let le = scene.le(hit, -s.ray.ray.d, lambda);
+        if !le.is_black() {
+            if s.depth == 0 || s.specular_bounce {
+                s.l += s.beta * le / s.r_u.average();
+            } else if let Some(al) = hit.area_light {
+                let light = &scene.lights[al as usize];
+                let p_l = light_sampler.pmf(&s.prev_ctx, al)
+                    * light.pdf_li(&s.prev_ctx, s.ray.ray.d, true);
+                s.r_l *= p_l;
+                s.l += s.beta * le / (s.r_u + s.r_l).average();
             }
         }
-        l
+        let mut bsdf_slot = scene.get_bsdf(hit, &s.ray, lambda, sampler);
+        let Some(bsdf) = bsdf_slot.as_mut() else {
+            s.ray = skip_intersection(&s.ray, hit);
+            return VertexStep::NEXT;
+        };
+        if s.depth == 0 {
+            if let Some(v) = visible {
+                *v = scene.visible_surface(hit, bsdf);
+            }
+        }
+        if s.depth >= max_depth {
+            return VertexStep::DONE;
+        }
+        s.depth += 1;
+        if self.regularize && s.any_non_specular {
+            bsdf.regularize();
+        }
+        let ray_medium = s.ray.ray.medium;
+        let si = &hit.si;
+        let mut origins = VertexOrigins::new(si);
+        let mut shadow = None;
+        let (u, u2) = if bsdf.flags().is_non_specular() {
+            let (u_light, u_light_2d, u, u2) = sampler.get_vertex_samples();
+            let vertex = LdVertex::Surface {
+                origins: &mut origins,
+                bsdf,
+                interface: hit.medium_interface,
+                ray_medium,
+            };
+            match self.sample_ld_or_defer(
+                scene, vertex, lambda, u_light, u_light_2d, s.beta, s.r_u, true,
+            ) {
+                Ld::Now(l) => s.l += l,
+                Ld::Deferred(q) => shadow = Some(q),
+            }
+            (u, u2)
+        } else {
+            (sampler.get_1d(), sampler.get_2d())
+        };
+        let done = VertexStep { shadow, done: true };
+        s.prev_ctx = LightSampleContext::from_si(si);
+        let wo = si.wo;
+        let Some(bs) = bsdf.sample_f(wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL)
+        else {
+            return done;
+        };
+        s.beta *= bs.f * (abs_dot(bs.wi, si.shading.n) / bs.pdf);
+        s.r_l = if bs.pdf_is_proportional {
+            s.r_u / bsdf.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL)
+        } else {
+            s.r_u / bs.pdf
+        };
+        s.specular_bounce = bs.is_specular();
+        s.any_non_specular |= !bs.is_specular();
+        if bs.is_transmission() {
+            s.eta_scale *= bs.eta * bs.eta;
+        }
+        let mut next = origins.spawn_ray(bs.wi);
+        next.medium = hit_medium_toward(hit, ray_medium, bs.wi);
+        s.ray = RayDifferential::new(next);
+
+        // Subsurface scattering: light leaving through the boundary
+        // re-emerges elsewhere on the same material.
+        if bs.is_transmission() {
+            if let Some(bssrdf) = hit
+                .material
+                .and_then(|m| scene.materials.get_bssrdf(m, &hit.si, lambda))
+            {
+                match self.subsurface(
+                    scene,
+                    &bssrdf,
+                    hit.material,
+                    s.ray.ray.time,
+                    lambda,
+                    sampler,
+                    &mut s.beta,
+                    &mut s.r_u,
+                    &mut s.r_l,
+                    &mut s.l,
+                    &mut s.prev_ctx,
+                ) {
+                    Some((next_ray, specular)) => {
+                        s.ray = next_ray;
+                        s.specular_bounce = specular;
+                        s.any_non_specular = true;
+                    }
+                    None => return done,
+                }
+            }
+        }
+
+        // Russian roulette.
+        if s.beta.is_black() {
+            return done;
+        }
+        let rr_beta = s.beta * s.eta_scale / s.r_u.average();
+        let u_rr = sampler.get_1d();
+        let m = rr_beta.max_component_value();
+        if m < 1.0 && s.depth > 1 {
+            let q = (1.0 - m).max(0.0);
+            if u_rr < q {
+                return done;
+            }
+            s.beta /= 1.0 - q;
+        }
+        VertexStep {
+            shadow: done.shadow,
+            done: false,
+        }
     }
 }
 

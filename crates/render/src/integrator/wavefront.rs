@@ -13,24 +13,26 @@
 //!
 //! 1. **trace**: the closest hit of every path's ray, as one batch
 //!    ([`PrimitiveAggregate::intersect_records`]);
-//! 2. **shade**: each path's vertex ([`PathIntegrator::vertex`], the code
-//!    the scalar path tracer runs): emission, the BSDF, a light sample and
-//!    the next ray;
+//! 2. **shade**: each path's vertex ([`VertexIntegrator::vertex`], the
+//!    code the scalar loop runs, of `path` or `volpath`): delta tracking
+//!    through media, emission, the BSDF, a light sample and the next ray;
 //! 3. **shadow**: the light samples' shadow rays, as one batch, adding the
-//!    contributions of the unblocked ones.
+//!    contributions of the unblocked ones. (In scenes with media or
+//!    interfaces `volpath` traces its shadow rays in the shade stage, by
+//!    ratio tracking, as its scalar loop does.)
 //!
-//! Every path's arithmetic is the scalar path tracer's, its sampler
+//! Every path's arithmetic is the scalar loop's, its sampler
 //! dimensions drawn in the same order (each lane keeps a
 //! [`SamplerCursor`] into the thread's one sampler), and finished samples
 //! are added to the tile in the scalar loop's order through a bounded
-//! reorder buffer: the image is the scalar path tracer's, bit for bit, for
+//! reorder buffer: the image is the scalar loop's, bit for bit, for
 //! any thread count.
 //!
 //! [`PrimitiveAggregate::intersect_records`]: crate::primitive::PrimitiveAggregate::intersect_records
 
-use super::path::{PathIntegrator, PathState};
 use super::render::RenderOptions;
-use super::tile::{add_estimate, CameraRaySample, RayTiles, TileIntegrator};
+use super::tile::{add_estimate, CameraRaySample, RayIntegrator, RayTiles, TileIntegrator};
+use super::vertex::VertexIntegrator;
 use super::Scene;
 use crate::film::{FilmTile, SplatBuffer, VisibleSurface};
 use crate::primitive::HitRecord;
@@ -50,11 +52,11 @@ const LANES: usize = 256;
 /// sample's slot is free, so one long path holds back at most this many.
 const REORDER: usize = 4 * LANES;
 
-/// The path tracer under the wavefront loop.
-pub(crate) struct WavefrontPath<'a>(pub &'a PathIntegrator);
+/// A path tracer (`path` or `volpath`) under the wavefront loop.
+pub(crate) struct Wavefront<'a, I>(pub &'a I);
 
 /// A path in flight.
-struct Lane {
+struct Lane<S> {
     /// The sample's position in the tile's order.
     seq: usize,
     /// Its pixel.
@@ -64,7 +66,7 @@ struct Lane {
     /// Its wavelengths.
     lambda: SampledWavelengths,
     /// Its path.
-    path: PathState,
+    path: S,
     /// The camera ray's weight.
     camera_weight: Float,
     /// The filter's weight.
@@ -125,7 +127,7 @@ impl ReorderBuffer {
     }
 }
 
-impl TileIntegrator for WavefrontPath<'_> {
+impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
     fn evaluate_pixel_sample(
         &self,
         scene: &Scene,
@@ -163,7 +165,7 @@ impl TileIntegrator for WavefrontPath<'_> {
         let total = pixels.len() * per_pixel;
         let gbuffer = scene.film.uses_visible_surface();
         let mut reorder = ReorderBuffer::new();
-        let mut lanes: Vec<Lane> = Vec::with_capacity(LANES);
+        let mut lanes: Vec<Lane<I::State>> = Vec::with_capacity(LANES);
         let mut rays: Vec<Ray> = Vec::with_capacity(LANES);
         let mut hits: Vec<Option<HitRecord>> = Vec::with_capacity(LANES);
         let mut shadow_rays: Vec<(Ray, Float)> = Vec::with_capacity(LANES);
@@ -201,7 +203,7 @@ impl TileIntegrator for WavefrontPath<'_> {
                     p_pixel,
                     cursor: sampler.cursor(),
                     lambda: cs.lambda,
-                    path: PathState::new(ray),
+                    path: self.0.start(ray),
                     camera_weight,
                     filter_weight: cs.cs.filter_weight,
                     visible: gbuffer.then(VisibleSurface::default),
@@ -223,7 +225,7 @@ impl TileIntegrator for WavefrontPath<'_> {
                 }
             }
             rays.clear();
-            rays.extend(lanes.iter().map(|l| l.path.ray.ray));
+            rays.extend(lanes.iter().map(|l| *I::ray(&l.path)));
             scene.intersect_records(&rays, coherent, level, &mut hits);
 
             // Shade: one vertex of every path.
@@ -231,11 +233,10 @@ impl TileIntegrator for WavefrontPath<'_> {
             shadow_lanes.clear();
             for (i, (lane, hit)) in lanes.iter_mut().zip(&hits).enumerate() {
                 sampler.set_cursor(&lane.cursor);
-                let mut isect = hit.and_then(|h| scene.aggregate.interaction(&rays[i], &h));
                 let step = self.0.vertex(
                     scene,
                     &mut lane.path,
-                    isect.as_mut(),
+                    *hit,
                     &mut lane.lambda,
                     sampler,
                     lane.visible.as_mut(),
@@ -253,7 +254,7 @@ impl TileIntegrator for WavefrontPath<'_> {
             scene.intersect_ps(&shadow_rays, &mut blocked);
             for (&(i, ld), &b) in shadow_lanes.iter().zip(&blocked) {
                 if !b {
-                    lanes[i].path.l += ld;
+                    *I::radiance(&mut lanes[i].path) += ld;
                 }
             }
 
@@ -261,10 +262,10 @@ impl TileIntegrator for WavefrontPath<'_> {
             let mut i = 0;
             while i < lanes.len() {
                 if lanes[i].done {
-                    let lane = lanes.swap_remove(i);
+                    let mut lane = lanes.swap_remove(i);
                     let f = Finished {
                         p_pixel: lane.p_pixel,
-                        l: lane.path.l * lane.camera_weight,
+                        l: *I::radiance(&mut lane.path) * lane.camera_weight,
                         lambda: lane.lambda,
                         visible: lane.visible,
                         filter_weight: lane.filter_weight,

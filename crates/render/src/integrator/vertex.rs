@@ -1,0 +1,99 @@
+//! Path tracers written one vertex at a time: the form both execution
+//! designs share. The scalar loop ([`li_by_vertices`]) traces each ray as
+//! soon as it is made; the wavefront loop (`wavefront.rs`) traces a batch
+//! of paths' rays together. Both call the same [`VertexIntegrator::vertex`]
+//! in the same sampler order, so they give the same pixels.
+
+use super::direct::ShadowQuery;
+use super::Scene;
+use crate::film::VisibleSurface;
+use crate::primitive::HitRecord;
+use crate::sampler::Sampler;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use rpbrt_geometry::float::Float;
+use rpbrt_geometry::ray::{Ray, RayDifferential};
+
+/// What a path vertex leaves to the caller: a shadow ray whose
+/// contribution counts if nothing blocks it, and whether the path ends
+/// (after that contribution).
+pub(crate) struct VertexStep {
+    /// The light sample's shadow query, its contribution already
+    /// multiplied by the path throughput.
+    pub shadow: Option<ShadowQuery>,
+    /// The path ends here.
+    pub done: bool,
+}
+
+impl VertexStep {
+    /// The path goes on, with no shadow ray.
+    pub(crate) const NEXT: VertexStep = VertexStep {
+        shadow: None,
+        done: false,
+    };
+    /// The path ends, with no shadow ray.
+    pub(crate) const DONE: VertexStep = VertexStep {
+        shadow: None,
+        done: true,
+    };
+}
+
+/// A path tracer as a function from a path's state and its ray's closest
+/// hit to the next state.
+pub(crate) trait VertexIntegrator: Sync {
+    /// A path in flight: its ray, radiance so far and throughput.
+    type State: Send;
+
+    /// The state of a path starting with a camera ray.
+    fn start(&self, ray: RayDifferential) -> Self::State;
+
+    /// The ray whose closest hit the next vertex needs.
+    fn ray(s: &Self::State) -> &Ray;
+
+    /// The radiance the path has gathered.
+    fn radiance(s: &mut Self::State) -> &mut SampledSpectrum;
+
+    /// One vertex: `record` is the closest hit of [`VertexIntegrator::ray`]
+    /// with no bound on the ray parameter (`None`: the ray escaped).
+    fn vertex(
+        &self,
+        scene: &Scene,
+        s: &mut Self::State,
+        record: Option<HitRecord>,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+        visible: Option<&mut VisibleSurface>,
+    ) -> VertexStep;
+}
+
+/// The scalar loop: the radiance along `ray`, each vertex's rays traced
+/// as soon as they are made (the `li` of the integrators that have a
+/// vertex form).
+pub(crate) fn li_by_vertices<I: VertexIntegrator>(
+    integrator: &I,
+    scene: &Scene,
+    ray: RayDifferential,
+    lambda: &mut SampledWavelengths,
+    sampler: &mut Sampler,
+    mut visible: Option<&mut VisibleSurface>,
+) -> SampledSpectrum {
+    let mut s = integrator.start(ray);
+    loop {
+        let record = scene.intersect_record(I::ray(&s), Float::INFINITY);
+        let step = integrator.vertex(
+            scene,
+            &mut s,
+            record,
+            lambda,
+            sampler,
+            visible.as_deref_mut(),
+        );
+        if let Some(q) = step.shadow {
+            if !scene.intersect_p(&q.ray, q.t_max) {
+                *I::radiance(&mut s) += q.ld;
+            }
+        }
+        if step.done {
+            return *I::radiance(&mut s);
+        }
+    }
+}
