@@ -6,7 +6,7 @@
 
 use super::Scene;
 use crate::bxdf::BSDF;
-use crate::light::LightSampleContext;
+use crate::light::{LightLiSample, LightSampleContext};
 use crate::lightsampler::LightSampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::Float;
@@ -36,6 +36,19 @@ impl<'a> VertexOrigins<'a> {
             si,
             sides: [None, None],
         }
+    }
+
+    /// The origins `sides` computed for `si` earlier ([`Self::sides`]).
+    #[inline]
+    pub fn with_sides(si: &'a SurfaceInteraction, sides: [Option<Point3f>; 2]) -> Self {
+        VertexOrigins { si, sides }
+    }
+
+    /// The origins computed so far, to continue with later
+    /// ([`Self::with_sides`]).
+    #[inline]
+    pub fn sides(&self) -> [Option<Point3f>; 2] {
+        self.sides
     }
 
     /// `si.offset_ray_origin(w)`.
@@ -87,44 +100,110 @@ pub(crate) fn sample_ld(
     u: Float,
     u_light: Point2f,
 ) -> SampledSpectrum {
-    match sample_ld_deferred(scene, light_sampler, origins, bsdf, lambda, u, u_light) {
+    // In three steps, which the wavefront loop runs apart (answering its
+    // lanes' requests together): the request, the light's sample, the
+    // shadow query.
+    let req = light_request(origins, bsdf, u, u_light);
+    let query = answer_light(scene, light_sampler, &req, lambda)
+        .and_then(|a| light_shadow_query(scene, origins, bsdf, &a));
+    match query {
         Some(q) if !scene.intersect_p(&q.ray, q.t_max) => q.ld,
         _ => SampledSpectrum::new(0.0),
     }
 }
 
-/// [`sample_ld`] with its shadow ray left to the caller (the wavefront
-/// integrator traces a batch of them together): `None` when the sample
-/// contributes nothing whatever the visibility.
+/// What choosing and sampling a light needs of a surface vertex.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LightRequest {
+    /// The light-sampling context ([`surface_light_context`]).
+    pub ctx: LightSampleContext,
+    /// The draw that chooses the light.
+    pub u: Float,
+    /// The draw that chooses the point on it.
+    pub u_light: Point2f,
+    /// For a BSDF that is zero across hemispheres, its shading normal and
+    /// ωo's component along it (light culling, [`light_culled`]).
+    pub hemisphere: Option<(Vector3f, Float)>,
+}
+
+/// A chosen light and its sample, before the BSDF and the shadow ray.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LightAnswer {
+    /// The light's index.
+    pub light: u32,
+    /// The probability of choosing it.
+    pub p: Float,
+    /// Its sample.
+    pub ls: LightLiSample,
+}
+
+/// The light request of a surface vertex with the BSDF `bsdf`.
 #[inline]
-pub(crate) fn sample_ld_deferred(
-    scene: &Scene,
-    light_sampler: &LightSampler,
+pub(crate) fn light_request(
     origins: &mut VertexOrigins,
     bsdf: &BSDF,
-    lambda: &SampledWavelengths,
     u: Float,
     u_light: Point2f,
-) -> Option<ShadowQuery> {
-    let si = origins.si;
+) -> LightRequest {
     let ctx = surface_light_context(origins, bsdf);
-    let sampled = light_sampler.sample(&ctx, u)?;
-    if light_sample_culled(scene, sampled.light, ctx.p(), bsdf, si) {
+    let hemisphere = bsdf.bxdf.zero_across_hemispheres().then(|| {
+        let z = bsdf.shading_frame.z;
+        (z, dot(origins.si.wo, z))
+    });
+    LightRequest {
+        ctx,
+        u,
+        u_light,
+        hemisphere,
+    }
+}
+
+/// Chooses a light for `req` and samples it: `None` when the choice
+/// fails, is culled, or its sample carries nothing.
+#[inline]
+pub(crate) fn answer_light(
+    scene: &Scene,
+    light_sampler: &LightSampler,
+    req: &LightRequest,
+    lambda: &SampledWavelengths,
+) -> Option<LightAnswer> {
+    let sampled = light_sampler.sample(&req.ctx, req.u)?;
+    if light_culled(scene, sampled.light, req.ctx.p(), req.hemisphere) {
         return None;
     }
     let light = &scene.lights[sampled.light as usize];
-    let ls = light.sample_li(&ctx, u_light, lambda, true)?;
+    let ls = light.sample_li(&req.ctx, req.u_light, lambda, true)?;
     if ls.l.is_black() || ls.pdf == 0.0 {
         return None;
     }
+    Some(LightAnswer {
+        light: sampled.light,
+        p: sampled.p,
+        ls,
+    })
+}
+
+/// The shadow query of a light sample at a surface vertex: the BSDF's
+/// value toward it, weighted by multiple importance sampling; `None` when
+/// the BSDF is zero there.
+#[inline]
+pub(crate) fn light_shadow_query(
+    scene: &Scene,
+    origins: &mut VertexOrigins,
+    bsdf: &BSDF,
+    a: &LightAnswer,
+) -> Option<ShadowQuery> {
+    let si = origins.si;
+    let ls = &a.ls;
     let wo = si.wo;
     let wi = ls.wi;
     let f = bsdf.f(wo, wi, crate::bxdf::TransportMode::Radiance) * abs_dot(wi, si.shading.n);
     if f.is_black() {
         return None;
     }
+    let light = &scene.lights[a.light as usize];
     let (ray, t_max) = scene.shadow_ray_from(origins, ls.p_light, ls.n_light);
-    let p_l = sampled.p * ls.pdf;
+    let p_l = a.p * ls.pdf;
     let ld = if light.light_type().is_delta() {
         ls.l * f / p_l
     } else {
@@ -184,4 +263,21 @@ pub(crate) fn light_sample_culled(
         }
     }
     false
+}
+
+/// [`light_sample_culled`] given the BSDF's [`LightRequest::hemisphere`].
+#[inline]
+pub(crate) fn light_culled(
+    scene: &Scene,
+    light: u32,
+    p: Point3f,
+    hemisphere: Option<(Vector3f, Float)>,
+) -> bool {
+    let Some(Some(cull)) = scene.light_cull.get(light as usize) else {
+        return false;
+    };
+    if cull.faces_away_from(p) {
+        return true;
+    }
+    matches!(hemisphere, Some((z, wo_z)) if cull.behind(p, z, wo_z))
 }

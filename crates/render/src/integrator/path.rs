@@ -2,10 +2,10 @@
 //! estimation with multiple importance sampling, Russian roulette and
 //! optional BSDF regularization.
 
-use super::direct::{sample_ld_deferred, ShadowQuery};
-use super::vertex::{li_by_vertices, VertexIntegrator, VertexStep};
+use super::direct::{light_request, light_shadow_query, LightAnswer, ShadowQuery};
+use super::vertex::{li_by_vertices, Begin, VertexIntegrator, VertexStep};
 use super::{skip_intersection, RayIntegrator, Scene, VertexOrigins};
-use crate::bxdf::{BxDFReflTransFlags, TransportMode};
+use crate::bxdf::{BxDFReflTransFlags, TransportMode, BSDF};
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
 use crate::lightsampler::LightSampler;
@@ -88,8 +88,20 @@ impl RayIntegrator for PathIntegrator {
     }
 }
 
+/// A surface vertex between its two halves: the hit, its BSDF, the
+/// offset origins computed so far and the BSDF's sampler draws.
+#[derive(Default)]
+pub(crate) struct SurfaceScratch {
+    hit: Option<PrimitiveIntersection>,
+    bsdf: Option<BSDF>,
+    sides: [Option<Point3f>; 2],
+    u: Float,
+    u2: Point2f,
+}
+
 impl VertexIntegrator for PathIntegrator {
     type State = PathState;
+    type Scratch = SurfaceScratch;
 
     #[inline(always)]
     fn start(&self, ray: RayDifferential) -> PathState {
@@ -106,8 +118,12 @@ impl VertexIntegrator for PathIntegrator {
         &mut s.l
     }
 
+    /// The first half of one vertex of pbrt-v4's `PathIntegrator::Li`: the
+    /// ray `s.ray` ended at `record` (`None`: it escaped). Adds emission to
+    /// `s.l`, builds the BSDF and takes the vertex's sampler draws; a
+    /// non-specular BSDF then asks for a light sample.
     #[inline(always)]
-    fn vertex(
+    fn begin(
         &self,
         scene: &Scene,
         s: &mut PathState,
@@ -115,34 +131,14 @@ impl VertexIntegrator for PathIntegrator {
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
         visible: Option<&mut VisibleSurface>,
-    ) -> VertexStep {
-        // Built in place and matched by reference: moving the (large)
-        // intersection out of the `Option` would copy it.
-        let mut closest = record.and_then(|h| scene.aggregate.interaction(&s.ray.ray, &h));
-        self.surface_vertex(scene, s, closest.as_mut(), lambda, sampler, visible)
-    }
-}
-
-impl PathIntegrator {
-    /// One vertex of pbrt-v4's `PathIntegrator::Li`: the ray `s.ray`
-    /// ended at `hit` (`None`: it escaped). Adds emission to `s.l`, samples
-    /// the lights and the BSDF, and leaves `s.ray` on the next bounce. The
-    /// scalar path tracer and the wavefront one both run every vertex
-    /// through here, so they give the same pixels; they differ only in
-    /// when they trace the rays.
-    #[inline(always)]
-    pub(crate) fn surface_vertex(
-        &self,
-        scene: &Scene,
-        s: &mut PathState,
-        hit: Option<&mut PrimitiveIntersection>,
-        lambda: &mut SampledWavelengths,
-        sampler: &mut Sampler,
-        visible: Option<&mut VisibleSurface>,
-    ) -> VertexStep {
-        const DONE: VertexStep = VertexStep::DONE;
+        scratch: &mut SurfaceScratch,
+    ) -> Begin {
+        const DONE: Begin = Begin::Step(VertexStep::DONE);
         let light_sampler: &LightSampler = &scene.light_sampler;
-        let Some(hit) = hit else {
+        // Built in place and used by reference: the intersection and the
+        // BSDF are large.
+        scratch.hit = record.and_then(|h| scene.aggregate.interaction(&s.ray.ray, &h));
+        let Some(hit) = scratch.hit.as_mut() else {
             // Escaped: infinite lights, weighted by MIS unless the last
             // bounce could not have been light-sampled.
             for &li in &scene.infinite_lights {
@@ -175,12 +171,11 @@ impl PathIntegrator {
                 s.l += s.beta * le * w_l;
             }
         }
-        // Borrowed in place: moving the (large) BSDF out would copy it.
-        let mut bsdf_slot = scene.get_bsdf(hit, &s.ray, lambda, sampler);
-        let Some(bsdf) = bsdf_slot.as_mut() else {
+        scratch.bsdf = scene.get_bsdf(hit, &s.ray, lambda, sampler);
+        let Some(bsdf) = scratch.bsdf.as_mut() else {
             s.specular_bounce = true;
             s.ray = skip_intersection(&s.ray, hit);
-            return VertexStep::NEXT;
+            return Begin::Step(VertexStep::NEXT);
         };
         if s.depth == 0 {
             if let Some(v) = visible {
@@ -194,30 +189,45 @@ impl PathIntegrator {
             return DONE;
         }
         s.depth += 1;
-        let si = &hit.si;
-        let mut origins = VertexOrigins::new(si);
         // Sampler draws in pbrt-v4's order: the light's two, then the
         // BSDF's two (taken together when there is a light sample).
-        let mut shadow = None;
-        let (u, u2) = if bsdf.flags().is_non_specular() {
+        if bsdf.flags().is_non_specular() {
             let (u_light, u_light_2d, u, u2) = sampler.get_vertex_samples();
-            shadow = sample_ld_deferred(
-                scene,
-                light_sampler,
-                &mut origins,
-                bsdf,
-                lambda,
-                u_light,
-                u_light_2d,
-            )
+            (scratch.u, scratch.u2) = (u, u2);
+            let mut origins = VertexOrigins::new(&hit.si);
+            let req = light_request(&mut origins, bsdf, u_light, u_light_2d);
+            scratch.sides = origins.sides();
+            Begin::Light(req)
+        } else {
+            (scratch.u, scratch.u2) = (sampler.get_1d(), sampler.get_2d());
+            scratch.sides = [None, None];
+            Begin::Step(self.finish(scene, s, sampler, scratch, None))
+        }
+    }
+
+    /// The second half: the light sample's shadow query, then the BSDF
+    /// sample that continues the path, and Russian roulette.
+    #[inline(always)]
+    fn finish(
+        &self,
+        scene: &Scene,
+        s: &mut PathState,
+        sampler: &mut Sampler,
+        scratch: &mut SurfaceScratch,
+        light: Option<&LightAnswer>,
+    ) -> VertexStep {
+        let (Some(hit), Some(bsdf)) = (scratch.hit.as_ref(), scratch.bsdf.as_ref()) else {
+            return VertexStep::DONE;
+        };
+        let si = &hit.si;
+        let mut origins = VertexOrigins::with_sides(si, scratch.sides);
+        let shadow = light
+            .and_then(|a| light_shadow_query(scene, &mut origins, bsdf, a))
             .map(|q| ShadowQuery {
                 ld: s.beta * q.ld,
                 ..q
             });
-            (u, u2)
-        } else {
-            (sampler.get_1d(), sampler.get_2d())
-        };
+        let (u, u2) = (scratch.u, scratch.u2);
         s.prev_ctx = LightSampleContext::from_si(si);
         let wo = -s.ray.ray.d;
         let Some(bs) = bsdf.sample_f(wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL)

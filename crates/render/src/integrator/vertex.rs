@@ -1,10 +1,12 @@
 //! Path tracers written one vertex at a time: the form both execution
 //! designs share. The scalar loop ([`li_by_vertices`]) traces each ray as
 //! soon as it is made; the wavefront loop (`wavefront.rs`) traces a batch
-//! of paths' rays together. Both call the same [`VertexIntegrator::vertex`]
-//! in the same sampler order, so they give the same pixels.
+//! of paths' rays together and answers their light samples together. Both
+//! call the same [`VertexIntegrator::begin`] and
+//! [`VertexIntegrator::finish`] in the same sampler order, so they give
+//! the same pixels.
 
-use super::direct::ShadowQuery;
+use super::direct::{answer_light, LightAnswer, LightRequest, ShadowQuery};
 use super::Scene;
 use crate::film::VisibleSurface;
 use crate::primitive::HitRecord;
@@ -37,11 +39,25 @@ impl VertexStep {
     };
 }
 
+/// The first half of a vertex: either the whole step, or a light sample
+/// to take before the second half ([`VertexIntegrator::finish`]).
+pub(crate) enum Begin {
+    /// The vertex is done.
+    Step(VertexStep),
+    /// The vertex needs this light sample answered ([`answer_light`]).
+    Light(LightRequest),
+}
+
 /// A path tracer as a function from a path's state and its ray's closest
-/// hit to the next state.
+/// hit to the next state, in two halves around the vertex's light sample
+/// (so that the wavefront loop can answer many paths' light samples
+/// together).
 pub(crate) trait VertexIntegrator: Sync {
     /// A path in flight: its ray, radiance so far and throughput.
     type State: Send;
+
+    /// What a vertex keeps between its halves (its hit and BSDF).
+    type Scratch: Default;
 
     /// The state of a path starting with a camera ray.
     fn start(&self, ray: RayDifferential) -> Self::State;
@@ -52,9 +68,11 @@ pub(crate) trait VertexIntegrator: Sync {
     /// The radiance the path has gathered.
     fn radiance(s: &mut Self::State) -> &mut SampledSpectrum;
 
-    /// One vertex: `record` is the closest hit of [`VertexIntegrator::ray`]
-    /// with no bound on the ray parameter (`None`: the ray escaped).
-    fn vertex(
+    /// A vertex's first half: `record` is the closest hit of
+    /// [`VertexIntegrator::ray`] with no bound on the ray parameter
+    /// (`None`: the ray escaped).
+    #[allow(clippy::too_many_arguments)]
+    fn begin(
         &self,
         scene: &Scene,
         s: &mut Self::State,
@@ -62,6 +80,18 @@ pub(crate) trait VertexIntegrator: Sync {
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
         visible: Option<&mut VisibleSurface>,
+        scratch: &mut Self::Scratch,
+    ) -> Begin;
+
+    /// A vertex's second half, after [`Begin::Light`], given the answer
+    /// to its request; the sampler continues where `begin` left it.
+    fn finish(
+        &self,
+        scene: &Scene,
+        s: &mut Self::State,
+        sampler: &mut Sampler,
+        scratch: &mut Self::Scratch,
+        light: Option<&LightAnswer>,
     ) -> VertexStep;
 }
 
@@ -77,16 +107,24 @@ pub(crate) fn li_by_vertices<I: VertexIntegrator>(
     mut visible: Option<&mut VisibleSurface>,
 ) -> SampledSpectrum {
     let mut s = integrator.start(ray);
+    let mut scratch = I::Scratch::default();
     loop {
         let record = scene.intersect_record(I::ray(&s), Float::INFINITY);
-        let step = integrator.vertex(
+        let step = match integrator.begin(
             scene,
             &mut s,
             record,
             lambda,
             sampler,
             visible.as_deref_mut(),
-        );
+            &mut scratch,
+        ) {
+            Begin::Step(step) => step,
+            Begin::Light(req) => {
+                let answer = answer_light(scene, &scene.light_sampler, &req, lambda);
+                integrator.finish(scene, &mut s, sampler, &mut scratch, answer.as_ref())
+            }
+        };
         if let Some(q) = step.shadow {
             if !scene.intersect_p(&q.ray, q.t_max) {
                 *I::radiance(&mut s) += q.ld;

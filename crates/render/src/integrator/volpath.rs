@@ -4,9 +4,10 @@
 //! light sampling through media and interfaces by ratio tracking, medium
 //! emission, and subsurface scattering through the materials' BSSRDFs.
 
+use super::direct::LightAnswer;
 use super::direct::ShadowQuery;
 use super::direct::{light_sample_culled, surface_light_context};
-use super::vertex::{li_by_vertices, VertexIntegrator, VertexStep};
+use super::vertex::{li_by_vertices, Begin, VertexIntegrator, VertexStep};
 use super::volume::{
     hit_medium_toward, medium_toward, segment_rng, shadow_transmittance, ShadowTransmittance,
 };
@@ -265,6 +266,7 @@ impl RayIntegrator for VolPathIntegrator {
 
 impl VertexIntegrator for VolPathIntegrator {
     type State = VolPathState;
+    type Scratch = ();
 
     #[inline(always)]
     fn start(&self, ray: RayDifferential) -> VolPathState {
@@ -292,6 +294,36 @@ impl VertexIntegrator for VolPathIntegrator {
         &mut s.l
     }
 
+    /// The whole vertex ([`VolPathIntegrator::vertex`]): its light samples
+    /// are not answered apart (yet).
+    #[inline(always)]
+    fn begin(
+        &self,
+        scene: &Scene,
+        s: &mut VolPathState,
+        record: Option<HitRecord>,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+        visible: Option<&mut VisibleSurface>,
+        _scratch: &mut (),
+    ) -> Begin {
+        Begin::Step(self.vertex(scene, s, record, lambda, sampler, visible))
+    }
+
+    /// Never called: [`VertexIntegrator::begin`] always finishes.
+    fn finish(
+        &self,
+        _scene: &Scene,
+        _s: &mut VolPathState,
+        _sampler: &mut Sampler,
+        _scratch: &mut (),
+        _light: Option<&LightAnswer>,
+    ) -> VertexStep {
+        VertexStep::DONE
+    }
+}
+
+impl VolPathIntegrator {
     /// One pass of pbrt-v4's `VolPathIntegrator::Li` loop: delta tracking
     /// through the ray's medium up to `record`, then the surface there.
     /// The surface's light sample is deferred (returned as the step's

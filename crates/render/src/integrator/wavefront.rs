@@ -9,14 +9,19 @@
 //! measured 5–10× slower than its own scalar path): each worker thread
 //! keeps a small pool of [`LANES`] paths that stays in cache (MoonRay's
 //! per-core queues), refilled from its tile's pixel samples as paths end.
-//! A pass over the pool runs three stages:
+//! A pass over the pool runs four stages:
 //!
 //! 1. **trace**: the closest hit of every path's ray, as one batch
 //!    ([`PrimitiveAggregate::intersect_records`]);
-//! 2. **shade**: each path's vertex ([`VertexIntegrator::vertex`], the
-//!    code the scalar loop runs, of `path` or `volpath`): delta tracking
-//!    through media, emission, the BSDF, a light sample and the next ray;
-//! 3. **shadow**: the light samples' shadow rays, as one batch, adding the
+//! 2. **shade**: each path's vertex (the code the scalar loop runs, of
+//!    `path` or `volpath`), in two halves: [`VertexIntegrator::begin`]
+//!    (delta tracking through media, emission, the BSDF, the sampler
+//!    draws) up to the vertex's light-sample request, and, after the
+//!    light stage, [`VertexIntegrator::finish`] (the BSDF toward the
+//!    light sample, the next ray);
+//! 3. **light**: the requests' lights chosen and sampled together
+//!    ([`answer_light`]);
+//! 4. **shadow**: the light samples' shadow rays, as one batch, adding the
 //!    contributions of the unblocked ones. (In scenes with media or
 //!    interfaces `volpath` traces its shadow rays in the shade stage, by
 //!    ratio tracking, as its scalar loop does.)
@@ -30,9 +35,10 @@
 //!
 //! [`PrimitiveAggregate::intersect_records`]: crate::primitive::PrimitiveAggregate::intersect_records
 
+use super::direct::{answer_light, LightAnswer, LightRequest};
 use super::render::RenderOptions;
 use super::tile::{add_estimate, CameraRaySample, RayIntegrator, RayTiles, TileIntegrator};
-use super::vertex::VertexIntegrator;
+use super::vertex::{Begin, VertexIntegrator};
 use super::Scene;
 use crate::film::{FilmTile, SplatBuffer, VisibleSurface};
 use crate::primitive::HitRecord;
@@ -171,6 +177,9 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let mut shadow_rays: Vec<(Ray, Float)> = Vec::with_capacity(LANES);
         let mut shadow_lanes: Vec<(usize, SampledSpectrum)> = Vec::with_capacity(LANES);
         let mut blocked: Vec<bool> = Vec::with_capacity(LANES);
+        let mut scratch: Vec<I::Scratch> = Vec::new();
+        let mut requests: Vec<(usize, LightRequest)> = Vec::with_capacity(LANES);
+        let mut answers: Vec<Option<LightAnswer>> = Vec::with_capacity(LANES);
         let mut started = 0;
         let level = opts.simd.unwrap_or_else(crate::simd::level);
         loop {
@@ -228,22 +237,61 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             rays.extend(lanes.iter().map(|l| *I::ray(&l.path)));
             scene.intersect_records(&rays, coherent, level, &mut hits);
 
-            // Shade: one vertex of every path.
+            // Shade, first half: one vertex of every path, up to its light
+            // sample's request.
             shadow_rays.clear();
             shadow_lanes.clear();
+            requests.clear();
+            if scratch.len() < lanes.len() {
+                scratch.resize_with(lanes.len(), Default::default);
+            }
             for (i, (lane, hit)) in lanes.iter_mut().zip(&hits).enumerate() {
                 sampler.set_cursor(&lane.cursor);
-                let step = self.0.vertex(
+                let begun = self.0.begin(
                     scene,
                     &mut lane.path,
                     *hit,
                     &mut lane.lambda,
                     sampler,
                     lane.visible.as_mut(),
+                    &mut scratch[i],
+                );
+                lane.cursor = sampler.cursor();
+                lane.camera = false;
+                match begun {
+                    Begin::Step(step) => {
+                        lane.done = step.done;
+                        if let Some(q) = step.shadow {
+                            shadow_rays.push((q.ray, q.t_max));
+                            shadow_lanes.push((i, q.ld));
+                        }
+                    }
+                    Begin::Light(req) => requests.push((i, req)),
+                }
+            }
+
+            // Light: every request's light and its sample.
+            answers.clear();
+            answers.extend(
+                requests.iter().map(|(i, req)| {
+                    answer_light(scene, &scene.light_sampler, req, &lanes[*i].lambda)
+                }),
+            );
+
+            // Shade, second half: the light samples' shadow queries and the
+            // next rays.
+            for (&(i, _), answer) in requests.iter().zip(&answers) {
+                let lane = &mut lanes[i];
+                sampler.set_cursor(&lane.cursor);
+                let step = self.0.finish(
+                    scene,
+                    &mut lane.path,
+                    sampler,
+                    &mut scratch[i],
+                    answer.as_ref(),
                 );
                 lane.cursor = sampler.cursor();
                 lane.done = step.done;
-                lane.camera = false;
                 if let Some(q) = step.shadow {
                     shadow_rays.push((q.ray, q.t_max));
                     shadow_lanes.push((i, q.ld));
