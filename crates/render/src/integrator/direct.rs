@@ -6,8 +6,10 @@
 
 use super::Scene;
 use crate::bxdf::BSDF;
-use crate::light::{LightLiSample, LightSampleContext};
-use crate::lightsampler::LightSampler;
+use crate::light::{Light, LightLiSample, LightSampleContext};
+use crate::lightsampler::{LightSampler, SampledLight};
+use crate::shape::{sample_solid_angle_batch, SolidAngleCore, SolidAngleQuery};
+use crate::simd::SimdLevel;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::interaction::SurfaceInteraction;
@@ -167,12 +169,29 @@ pub(crate) fn answer_light(
     req: &LightRequest,
     lambda: &SampledWavelengths,
 ) -> Option<LightAnswer> {
-    let sampled = light_sampler.sample(&req.ctx, req.u)?;
-    if light_culled(scene, sampled.light, req.ctx.p(), req.hemisphere) {
-        return None;
-    }
+    let sampled = choose_light(scene, light_sampler, req)?;
     let light = &scene.lights[sampled.light as usize];
-    let ls = light.sample_li(&req.ctx, req.u_light, lambda, true)?;
+    answer_with(
+        sampled,
+        light.sample_li(&req.ctx, req.u_light, lambda, true),
+    )
+}
+
+/// The light the light sampler chooses for `req`, unless it is culled.
+#[inline(always)]
+fn choose_light(
+    scene: &Scene,
+    light_sampler: &LightSampler,
+    req: &LightRequest,
+) -> Option<SampledLight> {
+    let sampled = light_sampler.sample(&req.ctx, req.u)?;
+    (!light_culled(scene, sampled.light, req.ctx.p(), req.hemisphere)).then_some(sampled)
+}
+
+/// The answer of a chosen light and its sample, if that carries light.
+#[inline(always)]
+fn answer_with(sampled: SampledLight, ls: Option<LightLiSample>) -> Option<LightAnswer> {
+    let ls = ls?;
     if ls.l.is_black() || ls.pdf == 0.0 {
         return None;
     }
@@ -181,6 +200,58 @@ pub(crate) fn answer_light(
         p: sampled.p,
         ls,
     })
+}
+
+/// The buffers of [`answer_lights`], kept from batch to batch.
+#[derive(Default)]
+pub(crate) struct LightBatch {
+    queries: Vec<SolidAngleQuery>,
+    pending: Vec<(usize, SampledLight)>,
+    cores: Vec<SolidAngleCore>,
+}
+
+/// [`answer_light`] of every request in `requests` (`lambda(k)` gives
+/// request `k`'s wavelengths), into `out` (cleared first): the same
+/// answers, with the triangle lights' solid-angle samples, the costly
+/// part, taken lane-parallel at `level`'s width.
+pub(crate) fn answer_lights<'w>(
+    scene: &Scene,
+    light_sampler: &LightSampler,
+    level: SimdLevel,
+    requests: &[LightRequest],
+    lambda: impl Fn(usize) -> &'w SampledWavelengths,
+    batch: &mut LightBatch,
+    out: &mut Vec<Option<LightAnswer>>,
+) {
+    out.clear();
+    batch.queries.clear();
+    batch.pending.clear();
+    for (k, req) in requests.iter().enumerate() {
+        let Some(sampled) = choose_light(scene, light_sampler, req) else {
+            out.push(None);
+            continue;
+        };
+        let light = &scene.lights[sampled.light as usize];
+        if let Light::DiffuseArea(area) = light {
+            if let Some(q) = area.triangle_query(&req.ctx, req.u_light) {
+                batch.queries.push(q);
+                batch.pending.push((k, sampled));
+                out.push(None);
+                continue;
+            }
+        }
+        let ls = light.sample_li(&req.ctx, req.u_light, lambda(k), true);
+        out.push(answer_with(sampled, ls));
+    }
+    sample_solid_angle_batch(level, &batch.queries, &mut batch.cores);
+    for (&(k, sampled), &core) in batch.pending.iter().zip(&batch.cores) {
+        let Light::DiffuseArea(area) = &scene.lights[sampled.light as usize] else {
+            continue;
+        };
+        let req = &requests[k];
+        let ls = area.sample_li_from_core(&req.ctx, req.u_light, core, lambda(k));
+        out[k] = answer_with(sampled, ls);
+    }
 }
 
 /// The shadow query of a light sample at a surface vertex: the BSDF's

@@ -20,7 +20,8 @@
 //!    light stage, [`VertexIntegrator::finish`] (the BSDF toward the
 //!    light sample, the next ray);
 //! 3. **light**: the requests' lights chosen and sampled together
-//!    ([`answer_light`]);
+//!    ([`answer_lights`]: triangle lights' solid-angle samples run
+//!    lane-parallel, at the SIMD level's width);
 //! 4. **shadow**: the light samples' shadow rays, as one batch, adding the
 //!    contributions of the unblocked ones. (In scenes with media or
 //!    interfaces `volpath` traces its shadow rays in the shade stage, by
@@ -35,7 +36,7 @@
 //!
 //! [`PrimitiveAggregate::intersect_records`]: crate::primitive::PrimitiveAggregate::intersect_records
 
-use super::direct::{answer_light, LightAnswer, LightRequest};
+use super::direct::{answer_lights, LightAnswer, LightBatch, LightRequest};
 use super::render::RenderOptions;
 use super::tile::{add_estimate, CameraRaySample, RayIntegrator, RayTiles, TileIntegrator};
 use super::vertex::{Begin, VertexIntegrator};
@@ -178,7 +179,9 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let mut shadow_lanes: Vec<(usize, SampledSpectrum)> = Vec::with_capacity(LANES);
         let mut blocked: Vec<bool> = Vec::with_capacity(LANES);
         let mut scratch: Vec<I::Scratch> = Vec::new();
-        let mut requests: Vec<(usize, LightRequest)> = Vec::with_capacity(LANES);
+        let mut requests: Vec<LightRequest> = Vec::with_capacity(LANES);
+        let mut request_lanes: Vec<usize> = Vec::with_capacity(LANES);
+        let mut light_batch = LightBatch::default();
         let mut answers: Vec<Option<LightAnswer>> = Vec::with_capacity(LANES);
         let mut started = 0;
         let level = opts.simd.unwrap_or_else(crate::simd::level);
@@ -242,6 +245,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             shadow_rays.clear();
             shadow_lanes.clear();
             requests.clear();
+            request_lanes.clear();
             if scratch.len() < lanes.len() {
                 scratch.resize_with(lanes.len(), Default::default);
             }
@@ -266,21 +270,27 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                             shadow_lanes.push((i, q.ld));
                         }
                     }
-                    Begin::Light(req) => requests.push((i, req)),
+                    Begin::Light(req) => {
+                        requests.push(req);
+                        request_lanes.push(i);
+                    }
                 }
             }
 
             // Light: every request's light and its sample.
-            answers.clear();
-            answers.extend(
-                requests.iter().map(|(i, req)| {
-                    answer_light(scene, &scene.light_sampler, req, &lanes[*i].lambda)
-                }),
+            answer_lights(
+                scene,
+                &scene.light_sampler,
+                level,
+                &requests,
+                |k| &lanes[request_lanes[k]].lambda,
+                &mut light_batch,
+                &mut answers,
             );
 
             // Shade, second half: the light samples' shadow queries and the
             // next rays.
-            for (&(i, _), answer) in requests.iter().zip(&answers) {
+            for (&i, answer) in request_lanes.iter().zip(&answers) {
                 let lane = &mut lanes[i];
                 sampler.set_cursor(&lane.cursor);
                 let step = self.0.finish(

@@ -12,7 +12,10 @@ use super::{
 use crate::image::{Image, WrapMode, WrapMode2D};
 use crate::rng::mix_bits;
 use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
-use crate::shape::{SampledTriangle, Shape, ShapeMethods, ShapeSampleContext};
+use crate::shape::{
+    SampledTriangle, Shape, ShapeMethods, ShapeSample, ShapeSampleContext, SolidAngleCore,
+    SolidAngleQuery,
+};
 use crate::spectrum::{RgbColorSpace, SampledSpectrum, SampledWavelengths, Spectrum};
 use crate::texture::{FloatTextureRef, TextureEvalContext};
 
@@ -142,6 +145,45 @@ impl DiffuseAreaLight {
             Some(t) => t.sample(&sctx, u),
             None => self.shape.sample(&sctx, u),
         }?;
+        self.li_sample_from(ctx, ss, lambda)
+    }
+
+    /// For a triangle light, the lane-parallel part of
+    /// [`DiffuseAreaLight::sample_li`] as a query for
+    /// [`crate::shape::sample_solid_angle_batch`]; `None` for other shapes.
+    #[inline]
+    pub(crate) fn triangle_query(
+        &self,
+        ctx: &LightSampleContext,
+        u: Point2f,
+    ) -> Option<SolidAngleQuery> {
+        let t = self.sampled_triangle.as_ref()?;
+        Some(t.solid_angle_query(&Self::shape_ctx(ctx), u))
+    }
+
+    /// [`DiffuseAreaLight::sample_li`] of a triangle light given the core
+    /// of its [`DiffuseAreaLight::triangle_query`]: the same value.
+    #[inline]
+    pub(crate) fn sample_li_from_core(
+        &self,
+        ctx: &LightSampleContext,
+        u: Point2f,
+        core: SolidAngleCore,
+        lambda: &SampledWavelengths,
+    ) -> Option<LightLiSample> {
+        let t = self.sampled_triangle.as_ref()?;
+        let ss = t.finish_sample(&Self::shape_ctx(ctx), u, core)?;
+        self.li_sample_from(ctx, ss, lambda)
+    }
+
+    /// The light sample of the shape sample `ss`.
+    #[inline(always)]
+    fn li_sample_from(
+        &self,
+        ctx: &LightSampleContext,
+        ss: ShapeSample,
+        lambda: &SampledWavelengths,
+    ) -> Option<LightLiSample> {
         if ss.pdf == 0.0 || (ss.p() - ctx.p()).length_squared() == 0.0 {
             return None;
         }

@@ -7,6 +7,8 @@
 // `!(x > 0.0)` is deliberate throughout: it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+use crate::simd::math::{self, V3};
+use crate::simd::{F32Lanes, Scalar1};
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::frame::Frame;
 use rpbrt_geometry::tuple::*;
@@ -16,9 +18,26 @@ use rpbrt_geometry::tuple::*;
 /// Oosterom and Strackee, which stays accurate for tiny triangles.
 #[inline]
 pub fn spherical_triangle_area(a: Vector3f, b: Vector3f, c: Vector3f) -> Float {
-    let num = dot(a, cross(b, c));
-    let den = 1.0 + dot(a, b) + dot(a, c) + dot(b, c);
-    (2.0 * num.atan2(den)).abs()
+    spherical_triangle_area_lanes::<Scalar1>(lanes(a), lanes(b), lanes(c)).0
+}
+
+/// A vector as one lane.
+#[inline(always)]
+fn lanes(v: Vector3f) -> V3<Scalar1> {
+    V3 {
+        x: Scalar1(v.x),
+        y: Scalar1(v.y),
+        z: Scalar1(v.z),
+    }
+}
+
+/// [`spherical_triangle_area`] of each lane (the scalar function is this
+/// at width one, so both give the same bits).
+#[inline(always)]
+pub(crate) fn spherical_triangle_area_lanes<L: F32Lanes>(a: V3<L>, b: V3<L>, c: V3<L>) -> L {
+    let num = a.dot(b.cross(c));
+    let den = L::splat(1.0).add(a.dot(b)).add(a.dot(c)).add(b.dot(c));
+    L::splat(2.0).mul(math::atan2(num, den)).abs()
 }
 
 /// Area of the spherical quadrilateral with unit-vector vertices `a`, `b`,
@@ -96,22 +115,6 @@ pub fn sample_spherical_triangle(
     sample_spherical(&st, v, p, u)
 }
 
-/// [`sample_spherical_triangle`] given the unit directions `dirs` from `p`
-/// to the vertices (`(v[i] - p).normalize()`, all finite) and the solid
-/// angle `area` they subtend ([`spherical_triangle_area`] of them), which
-/// the caller has already computed.
-#[inline(always)]
-pub(crate) fn sample_spherical_triangle_dirs(
-    v: [Point3f; 3],
-    p: Point3f,
-    dirs: [Vector3f; 3],
-    area: Float,
-    u: Point2f,
-) -> Option<([Float; 3], Float)> {
-    let st = SphericalTriangle::with_area(dirs[0], dirs[1], dirs[2], area)?;
-    sample_spherical(&st, v, p, u)
-}
-
 #[inline(always)]
 fn sample_spherical(
     st: &SphericalTriangle,
@@ -119,66 +122,105 @@ fn sample_spherical(
     p: Point3f,
     u: Point2f,
 ) -> Option<([Float; 3], Float)> {
-    let (a, b, c) = (st.a, st.b, st.c);
-    let area = st.area;
-    let pdf = 1.0 / area;
+    let pt = |q: Point3f| lanes(Vector3f::new(q.x, q.y, q.z));
+    let out = sample_spherical_lanes::<Scalar1>(
+        [lanes(st.a), lanes(st.b), lanes(st.c)],
+        Scalar1(st.area),
+        [pt(v[0]), pt(v[1]), pt(v[2])],
+        pt(p),
+        [Scalar1(u.x), Scalar1(u.y)],
+    );
+    out.ok.then_some((out.b.map(|b| b.0), out.pdf.0))
+}
+
+/// A spherical triangle sample of each lane: barycentrics of the point
+/// reached, the density per unit solid angle, and whether the lane has a
+/// sample (the scalar code's `Some`).
+pub(crate) struct SphericalSampleLanes<L: F32Lanes> {
+    pub b: [L; 3],
+    pub pdf: L,
+    pub ok: L::Mask,
+}
+
+/// [`sample_spherical_triangle`] of each lane, given the unit directions
+/// `dirs` to the vertices `v` from `p` and their solid angle `area`
+/// (positive). Every lane runs every step; where the scalar code returns
+/// early, the lane's `ok` is false.
+#[inline(always)]
+pub(crate) fn sample_spherical_lanes<L: F32Lanes>(
+    dirs: [V3<L>; 3],
+    area: L,
+    v: [V3<L>; 3],
+    p: V3<L>,
+    u: [L; 2],
+) -> SphericalSampleLanes<L> {
+    let sp = L::splat;
+    let [a, b, c] = dirs;
+    let pdf = sp(1.0).div(area);
 
     // The interior angle α at a, between the planes of the edges ab and
     // ac, by its sine and cosine.
-    let n_ab = cross(a, b).try_normalize()?;
-    let n_ac = cross(a, c).try_normalize()?;
-    let cos_alpha = clamp(dot(n_ab, n_ac), -1.0, 1.0);
-    let sin_alpha = cross(n_ab, n_ac).length().min(1.0);
+    let (n_ab, ok_ab) = a.cross(b).try_normalize();
+    let (n_ac, ok_ac) = a.cross(c).try_normalize();
+    let cos_alpha = math::clamp(n_ab.dot(n_ac), -1.0, 1.0);
+    let sin_alpha = n_ab.cross(n_ac).length().min(sp(1.0));
 
     // Pick the area A' of the sub-triangle (a, b, c') uniformly, then find
     // cos of the arc length from a to c' that yields it. The sub-triangle's
     // angle sum is A' + π, whose sine and cosine are −sin A' and −cos A'.
-    let (sin_a, cos_a) = (u.x * area).sin_cos();
-    let (sin_ap, cos_ap) = (-sin_a, -cos_a);
-    let sin_phi = sin_ap * cos_alpha - cos_ap * sin_alpha;
-    let cos_phi = cos_ap * cos_alpha + sin_ap * sin_alpha;
-    let k1 = cos_phi + cos_alpha;
-    let k2 = sin_phi - sin_alpha * dot(a, b);
-    let cos_bp = (k2 + difference_of_products(k2, cos_phi, k1, sin_phi) * cos_alpha)
-        / (sum_of_products(k2, sin_phi, k1, cos_phi) * sin_alpha);
+    let (sin_a, cos_a) = math::sin_cos(u[0].mul(area));
+    let (sin_ap, cos_ap) = (sin_a.neg(), cos_a.neg());
+    let sin_phi = sin_ap.mul(cos_alpha).sub(cos_ap.mul(sin_alpha));
+    let cos_phi = cos_ap.mul(cos_alpha).add(sin_ap.mul(sin_alpha));
+    let k1 = cos_phi.add(cos_alpha);
+    let k2 = sin_phi.sub(sin_alpha.mul(a.dot(b)));
+    let cos_bp = k2
+        .add(L::difference_of_products(k2, cos_phi, k1, sin_phi).mul(cos_alpha))
+        .div(L::sum_of_products(k2, sin_phi, k1, cos_phi).mul(sin_alpha));
     // NaN when the triangle covers (nearly) a whole hemisphere.
-    if cos_bp.is_nan() {
-        return None;
-    }
-    let cos_bp = clamp(cos_bp, -1.0, 1.0);
-    let sin_bp = safe_sqrt(1.0 - sqr(cos_bp));
-    let c_perp = c.gram_schmidt(a).try_normalize()?;
-    let cp = a * cos_bp + c_perp * sin_bp;
+    let ok_bp = L::not(cos_bp.is_nan());
+    let cos_bp = math::clamp(cos_bp, -1.0, 1.0);
+    let sin_bp = math::safe_sqrt(sp(1.0).sub(cos_bp.mul(cos_bp)));
+    let (c_perp, ok_perp) = c.gram_schmidt(a).try_normalize();
+    let cp = a.scale(cos_bp).add(c_perp.scale(sin_bp));
 
     // Sample uniformly in solid angle along the arc from b to c'.
-    let cos_theta = 1.0 - u.y * (1.0 - dot(cp, b));
-    let sin_theta = safe_sqrt(1.0 - sqr(cos_theta));
-    let w = match cp.gram_schmidt(b).try_normalize() {
-        Some(perp) => b * cos_theta + perp * sin_theta,
-        None => b,
-    };
+    let cos_theta = sp(1.0).sub(u[1].mul(sp(1.0).sub(cp.dot(b))));
+    let sin_theta = math::safe_sqrt(sp(1.0).sub(cos_theta.mul(cos_theta)));
+    let (perp, has_perp) = cp.gram_schmidt(b).try_normalize();
+    let w = V3::select(has_perp, b.scale(cos_theta).add(perp.scale(sin_theta)), b);
 
     // Barycentrics of the point where the ray (p, w) meets the triangle
     // (Möller–Trumbore with the ray's origin at p).
-    let e1 = v[1] - v[0];
-    let e2 = v[2] - v[0];
-    let s1 = cross(w, e2);
-    let divisor = dot(s1, e1);
-    if divisor == 0.0 || !divisor.is_finite() {
-        // The sampled ray grazes the triangle's plane: only possible for
-        // triangles covering nearly a hemisphere.
-        return Some(([1.0 / 3.0; 3], pdf));
+    let e1 = v[1].sub(v[0]);
+    let e2 = v[2].sub(v[0]);
+    let s1 = w.cross(e2);
+    let divisor = s1.dot(e1);
+    // The sampled ray grazes the triangle's plane: only possible for
+    // triangles covering nearly a hemisphere.
+    let graze = L::or(
+        divisor.eq(sp(0.0)),
+        L::not(divisor.abs().lt(sp(f32::INFINITY))),
+    );
+    let inv_divisor = sp(1.0).div(divisor);
+    let s = p.sub(v[0]);
+    let b1 = math::clamp(s.dot(s1).mul(inv_divisor), 0.0, 1.0);
+    let b2 = math::clamp(w.dot(s.cross(e1)).mul(inv_divisor), 0.0, 1.0);
+    let sum = b1.add(b2);
+    let over = sum.gt(sp(1.0));
+    let b1 = L::select(over, b1.div(sum), b1);
+    let b2 = L::select(over, b2.div(sum), b2);
+    let b0 = sp(1.0).sub(b1).sub(b2);
+    let third = sp(1.0 / 3.0);
+    SphericalSampleLanes {
+        b: [
+            L::select(graze, third, b0),
+            L::select(graze, third, b1),
+            L::select(graze, third, b2),
+        ],
+        pdf,
+        ok: L::and(L::and(L::and(ok_ab, ok_ac), ok_bp), ok_perp),
     }
-    let inv_divisor = 1.0 / divisor;
-    let s = p - v[0];
-    let mut b1 = clamp(dot(s, s1) * inv_divisor, 0.0, 1.0);
-    let mut b2 = clamp(dot(w, cross(s, e1)) * inv_divisor, 0.0, 1.0);
-    if b1 + b2 > 1.0 {
-        let sum = b1 + b2;
-        b1 /= sum;
-        b2 /= sum;
-    }
-    Some(([1.0 - b1 - b2, b1, b2], pdf))
 }
 
 /// The sample `u` for which [`sample_spherical_triangle`] returns the

@@ -10,9 +10,12 @@ use super::{
     ShapeSample, ShapeSampleContext,
 };
 use crate::sampling::spherical::{
-    invert_spherical_triangle_sample_dirs, sample_spherical_triangle_dirs, spherical_triangle_area,
+    invert_spherical_triangle_sample_dirs, sample_spherical_lanes, spherical_triangle_area,
+    spherical_triangle_area_lanes,
 };
-use crate::sampling::{bilinear_pdf, sample_bilinear, sample_uniform_triangle};
+use crate::sampling::{bilinear_pdf, sample_uniform_triangle};
+use crate::simd::math::{self, V3};
+use crate::simd::{dispatch, F32Lanes, Kernel, Scalar1, SimdLevel};
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::interaction::{ShadingGeometry, SurfaceInteraction};
 use rpbrt_geometry::ray::Ray;
@@ -1001,6 +1004,35 @@ impl SampledTriangle {
     pub fn sample(&self, ctx: &ShapeSampleContext, u: Point2f) -> Option<ShapeSample> {
         sample_solid_angle(self, ctx, u)
     }
+
+    /// [`SampledTriangle::sample`] in two steps, so that many samples'
+    /// lane-parallel parts run together ([`sample_solid_angle_batch`]):
+    /// the query of a sample ...
+    #[inline]
+    pub(crate) fn solid_angle_query(
+        &self,
+        ctx: &ShapeSampleContext,
+        u: Point2f,
+    ) -> SolidAngleQuery {
+        SolidAngleQuery {
+            v: self.v,
+            p: ctx.p(),
+            ns: ctx.ns,
+            u,
+        }
+    }
+
+    /// ... and the sample, given its query's core (the same value as
+    /// [`SampledTriangle::sample`]).
+    #[inline]
+    pub(crate) fn finish_sample(
+        &self,
+        ctx: &ShapeSampleContext,
+        u: Point2f,
+        core: SolidAngleCore,
+    ) -> Option<ShapeSample> {
+        finish_solid_angle(self, ctx, u, core)
+    }
 }
 
 impl TriangleGeometry for SampledTriangle {
@@ -1078,36 +1110,223 @@ fn sample_area<T: TriangleGeometry>(t: &T, u: Point2f) -> Option<ShapeSample> {
 
 /// pbrt-v4's `Triangle::Sample(ctx, u)`: uniform in the solid angle the
 /// triangle subtends, warped by the cos θ approximation at the reference
-/// point; by area when the solid angle is too small or too large.
+/// point; by area when the solid angle is too small or too large. The
+/// arithmetic is [`solid_angle_lanes`] at width one, the same that
+/// [`sample_solid_angle_batch`] runs on many samples at once.
 #[inline(always)]
 fn sample_solid_angle<T: TriangleGeometry>(
     t: &T,
     ctx: &ShapeSampleContext,
     u: Point2f,
 ) -> Option<ShapeSample> {
-    let dirs = directions_to(t.corners(), ctx.p());
-    let sa = spherical_triangle_area(dirs[0], dirs[1], dirs[2]);
-    if !(MIN_SPHERICAL_SAMPLE_AREA..=MAX_SPHERICAL_SAMPLE_AREA).contains(&sa) {
+    let q = SolidAngleQuery {
+        v: t.corners(),
+        p: ctx.p(),
+        ns: ctx.ns,
+        u,
+    };
+    let core = SolidAngleCore::of_lane(&solid_angle_lanes::<Scalar1>(&[q]), 0);
+    finish_solid_angle(t, ctx, u, core)
+}
+
+/// The shape sample of a solid-angle sample's core: by area where the
+/// core says so, else at its barycentrics.
+#[inline(always)]
+fn finish_solid_angle<T: TriangleGeometry>(
+    t: &T,
+    ctx: &ShapeSampleContext,
+    u: Point2f,
+    core: SolidAngleCore,
+) -> Option<ShapeSample> {
+    if core.by_area {
         let mut ss = sample_area(t, u)?;
         ss.time = ctx.time;
         return area_sample_to_solid_angle(ctx, ss);
     }
+    core.ok.then(|| sample_at(t, core.b, core.pdf, ctx.time))
+}
+
+/// One solid-angle sample of a triangle to take: its corners, the
+/// reference point, its shading normal (zero: no cos θ warp) and the
+/// sample.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SolidAngleQuery {
+    pub v: [Point3f; 3],
+    pub p: Point3f,
+    pub ns: Normal3f,
+    pub u: Point2f,
+}
+
+/// The part of a solid-angle sample that runs lane-parallel: the
+/// barycentrics and density of the sample (`ok`: there is one), or the
+/// verdict that the triangle is sampled by area instead.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct SolidAngleCore {
+    pub b: [Float; 3],
+    pub pdf: Float,
+    pub ok: bool,
+    pub by_area: bool,
+}
+
+/// Lane results of [`solid_angle_lanes`].
+pub(crate) struct SolidAngleLanes<L: F32Lanes> {
+    b: [L; 3],
+    pdf: L,
+    ok: L::Mask,
+    by_area: L::Mask,
+}
+
+impl SolidAngleCore {
+    /// Lane `i` of `l`.
+    #[inline(always)]
+    fn of_lane<L: F32Lanes>(l: &SolidAngleLanes<L>, i: usize) -> SolidAngleCore {
+        let get = |x: L| {
+            let mut a = [0.0; 16];
+            x.store(&mut a);
+            a[i]
+        };
+        SolidAngleCore {
+            b: [get(l.b[0]), get(l.b[1]), get(l.b[2])],
+            pdf: get(l.pdf),
+            ok: (L::bits(l.ok) >> i) & 1 != 0,
+            by_area: (L::bits(l.by_area) >> i) & 1 != 0,
+        }
+    }
+}
+
+/// The solid-angle sampling of `q[..L::N]` (shorter: the first query
+/// fills the rest), one per lane, in the operations of the scalar code it
+/// replaced: the solid angle, the bilinear cos θ warp and the spherical
+/// triangle sample.
+#[inline(always)]
+fn solid_angle_lanes<L: F32Lanes>(q: &[SolidAngleQuery]) -> SolidAngleLanes<L> {
+    let sp = L::splat;
+    let mut cols = [[[0.0f32; 3]; 16]; 5];
+    let mut us = [[0.0f32; 16]; 2];
+    for i in 0..L::N {
+        let x = q.get(i).unwrap_or(&q[0]);
+        for (k, c) in x.v.iter().enumerate() {
+            cols[k][i] = [c.x, c.y, c.z];
+        }
+        cols[3][i] = [x.p.x, x.p.y, x.p.z];
+        cols[4][i] = [x.ns.x, x.ns.y, x.ns.z];
+        us[0][i] = x.u.x;
+        us[1][i] = x.u.y;
+    }
+    let v = [
+        V3::<L>::gather(&cols[0]),
+        V3::gather(&cols[1]),
+        V3::gather(&cols[2]),
+    ];
+    let p = V3::<L>::gather(&cols[3]);
+    let ns = V3::<L>::gather(&cols[4]);
+    let u = [L::load(&us[0]), L::load(&us[1])];
+
+    let dirs = [
+        v[0].sub(p).normalize(),
+        v[1].sub(p).normalize(),
+        v[2].sub(p).normalize(),
+    ];
+    let sa = spherical_triangle_area_lanes(dirs[0], dirs[1], dirs[2]);
+    let in_range = L::and(
+        sa.ge(sp(MIN_SPHERICAL_SAMPLE_AREA)),
+        sa.le(sp(MAX_SPHERICAL_SAMPLE_AREA)),
+    );
     // Warp u by an approximation of the cos θ factor at the reference
-    // point, then sample the spherical triangle uniformly.
-    let mut pdf = 1.0;
-    let mut u = u;
-    if !ctx.ns.is_zero() {
-        let w = cos_weights(ctx, &dirs);
-        u = sample_bilinear(u, w);
-        pdf *= bilinear_pdf(u, w);
+    // point (where there is a normal), then sample the spherical
+    // triangle uniformly.
+    let zero = sp(0.0);
+    let no_normal = L::and(L::and(ns.x.eq(zero), ns.y.eq(zero)), ns.z.eq(zero));
+    let w = |d: V3<L>| ns.dot(d).abs().max(sp(0.01));
+    let (w0, w1, w2) = (w(dirs[0]), w(dirs[1]), w(dirs[2]));
+    let weights = [w1, w1, w0, w2];
+    let warped = sample_bilinear_lanes(u, weights);
+    let warp_pdf = bilinear_pdf_lanes(warped, weights);
+    let u = [
+        L::select(no_normal, u[0], warped[0]),
+        L::select(no_normal, u[1], warped[1]),
+    ];
+    let pdf = L::select(no_normal, sp(1.0), sp(1.0).mul(warp_pdf));
+    // In range the solid angle is finite and positive, so the directions
+    // are the ones `try_normalize` would give.
+    let tri = sample_spherical_lanes(dirs, sa, v, p, u);
+    let ok = L::and(tri.ok, tri.pdf.gt(zero));
+    SolidAngleLanes {
+        b: tri.b,
+        pdf: pdf.mul(tri.pdf),
+        ok,
+        by_area: L::not(in_range),
     }
-    // In this branch the solid angle is finite and positive, so the
-    // directions are the ones `try_normalize` would give.
-    let (b, tri_pdf) = sample_spherical_triangle_dirs(t.corners(), ctx.p(), dirs, sa, u)?;
-    if !(tri_pdf > 0.0) {
-        return None;
+}
+
+/// [`crate::sampling::sample_linear`] of each lane.
+#[inline(always)]
+fn sample_linear_lanes<L: F32Lanes>(u: L, a: L, b: L) -> L {
+    let zero = L::splat(0.0);
+    let x = u
+        .mul(a.add(b))
+        .div(a.add(math::lerp(u, a.mul(a), b.mul(b)).sqrt()));
+    let x = x.min(L::splat(ONE_MINUS_EPSILON));
+    L::select(L::and(u.eq(zero), a.eq(zero)), zero, x)
+}
+
+/// [`sample_bilinear`] of each lane.
+#[inline(always)]
+fn sample_bilinear_lanes<L: F32Lanes>(u: [L; 2], w: [L; 4]) -> [L; 2] {
+    let y = sample_linear_lanes(u[1], w[0].add(w[1]), w[2].add(w[3]));
+    let x = sample_linear_lanes(u[0], math::lerp(y, w[0], w[2]), math::lerp(y, w[1], w[3]));
+    [x, y]
+}
+
+/// [`bilinear_pdf`] of each lane.
+#[inline(always)]
+fn bilinear_pdf_lanes<L: F32Lanes>(p: [L; 2], w: [L; 4]) -> L {
+    let (zero, one) = (L::splat(0.0), L::splat(1.0));
+    let inside = |x: L| L::and(x.ge(zero), x.le(one));
+    let sum = w[0].add(w[1]).add(w[2]).add(w[3]);
+    let (x, y) = (p[0], p[1]);
+    let (nx, ny) = (one.sub(x), one.sub(y));
+    let f = nx
+        .mul(ny)
+        .mul(w[0])
+        .add(x.mul(ny).mul(w[1]))
+        .add(nx.mul(y).mul(w[2]))
+        .add(x.mul(y).mul(w[3]));
+    let pdf = L::splat(4.0).mul(f).div(sum);
+    let pdf = L::select(sum.eq(zero), one, pdf);
+    L::select(L::and(inside(x), inside(y)), pdf, zero)
+}
+
+/// Runs [`solid_angle_lanes`] over every query.
+struct SolidAngleKernel<'a> {
+    queries: &'a [SolidAngleQuery],
+    out: &'a mut Vec<SolidAngleCore>,
+}
+
+impl Kernel for SolidAngleKernel<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: F32Lanes>(self) {
+        for chunk in self.queries.chunks(L::N) {
+            let l = solid_angle_lanes::<L>(chunk);
+            for i in 0..chunk.len() {
+                self.out.push(SolidAngleCore::of_lane(&l, i));
+            }
+        }
     }
-    Some(sample_at(t, b, pdf * tri_pdf, ctx.time))
+}
+
+/// The cores of many solid-angle samples (of any triangles) at once, at
+/// `level`'s width, into `out` (cleared first): the same values
+/// [`Triangle`]'s and [`SampledTriangle`]'s `sample` compute one by one.
+pub(crate) fn sample_solid_angle_batch(
+    level: SimdLevel,
+    queries: &[SolidAngleQuery],
+    out: &mut Vec<SolidAngleCore>,
+) {
+    out.clear();
+    out.reserve(queries.len());
+    dispatch(level, SolidAngleKernel { queries, out });
 }
 
 #[cfg(test)]

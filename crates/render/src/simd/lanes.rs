@@ -41,6 +41,40 @@ pub trait F32Lanes: Copy {
     fn bits(m: Self::Mask) -> u32;
     /// The mask whose lane `i` is bit `i` of `bits`.
     fn from_bits(bits: u32) -> Self::Mask;
+    /// Lane-wise `self / o`.
+    fn div(self, o: Self) -> Self;
+    /// Lane-wise square root.
+    fn sqrt(self) -> Self;
+    /// Lane-wise absolute value (the sign bit cleared).
+    fn abs(self) -> Self;
+    /// Lane-wise negation (the sign bit flipped).
+    fn neg(self) -> Self;
+    /// Lane-wise largest integer not above the value.
+    fn floor(self) -> Self;
+    /// Lane-wise `self == o` (false where either is NaN).
+    fn eq(self, o: Self) -> Self::Mask;
+    /// Lane-wise: `self` is NaN.
+    fn is_nan(self) -> Self::Mask;
+    /// Lane-wise `a || b`.
+    fn or(a: Self::Mask, b: Self::Mask) -> Self::Mask;
+    /// Lane-wise `!a`.
+    fn not(a: Self::Mask) -> Self::Mask;
+    /// Lane-wise `a·b − c·d` with the products exact (in `f64`), rounded
+    /// once to `f64` and once to `f32`, as
+    /// [`rpbrt_geometry::float::difference_of_products`].
+    fn difference_of_products(a: Self, b: Self, c: Self, d: Self) -> Self;
+    /// Lane-wise `a·b + c·d`, as [`rpbrt_geometry::float::sum_of_products`].
+    fn sum_of_products(a: Self, b: Self, c: Self, d: Self) -> Self;
+    /// Lane-wise `self > o`.
+    #[inline(always)]
+    fn gt(self, o: Self) -> Self::Mask {
+        o.lt(self)
+    }
+    /// Lane-wise `self >= o`.
+    #[inline(always)]
+    fn ge(self, o: Self) -> Self::Mask {
+        o.le(self)
+    }
 }
 
 /// One lane: the scalar code itself, for processors without vector units
@@ -118,6 +152,52 @@ impl F32Lanes for Scalar1 {
     #[inline(always)]
     fn from_bits(bits: u32) -> bool {
         bits & 1 != 0
+    }
+    #[inline(always)]
+    fn div(self, o: Self) -> Self {
+        Scalar1(self.0 / o.0)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        Scalar1(self.0.sqrt())
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Scalar1(self.0.abs())
+    }
+    #[inline(always)]
+    fn neg(self) -> Self {
+        Scalar1(-self.0)
+    }
+    #[inline(always)]
+    fn floor(self) -> Self {
+        Scalar1(self.0.floor())
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> bool {
+        self.0 == o.0
+    }
+    #[inline(always)]
+    fn is_nan(self) -> bool {
+        self.0.is_nan()
+    }
+    #[inline(always)]
+    fn or(a: bool, b: bool) -> bool {
+        a || b
+    }
+    #[inline(always)]
+    fn not(a: bool) -> bool {
+        !a
+    }
+    #[inline(always)]
+    fn difference_of_products(a: Self, b: Self, c: Self, d: Self) -> Self {
+        Scalar1(rpbrt_geometry::float::difference_of_products(
+            a.0, b.0, c.0, d.0,
+        ))
+    }
+    #[inline(always)]
+    fn sum_of_products(a: Self, b: Self, c: Self, d: Self) -> Self {
+        Scalar1(rpbrt_geometry::float::sum_of_products(a.0, b.0, c.0, d.0))
     }
 }
 
@@ -209,6 +289,86 @@ mod x86 {
                 _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(b, lane), lane))
             }
         }
+        #[inline(always)]
+        fn div(self, o: Self) -> Self {
+            unsafe { F32x8(_mm256_div_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn sqrt(self) -> Self {
+            unsafe { F32x8(_mm256_sqrt_ps(self.0)) }
+        }
+        #[inline(always)]
+        fn abs(self) -> Self {
+            unsafe { F32x8(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0)) }
+        }
+        #[inline(always)]
+        fn neg(self) -> Self {
+            unsafe { F32x8(_mm256_xor_ps(_mm256_set1_ps(-0.0), self.0)) }
+        }
+        #[inline(always)]
+        fn floor(self) -> Self {
+            unsafe { F32x8(_mm256_floor_ps(self.0)) }
+        }
+        #[inline(always)]
+        fn eq(self, o: Self) -> __m256 {
+            unsafe { _mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0) }
+        }
+        #[inline(always)]
+        fn is_nan(self) -> __m256 {
+            unsafe { _mm256_cmp_ps::<_CMP_UNORD_Q>(self.0, self.0) }
+        }
+        #[inline(always)]
+        fn or(a: __m256, b: __m256) -> __m256 {
+            unsafe { _mm256_or_ps(a, b) }
+        }
+        #[inline(always)]
+        fn not(a: __m256) -> __m256 {
+            unsafe { _mm256_xor_ps(a, _mm256_castsi256_ps(_mm256_set1_epi32(-1))) }
+        }
+        #[inline(always)]
+        fn difference_of_products(a: Self, b: Self, c: Self, d: Self) -> Self {
+            unsafe {
+                let (lo, hi) = products_pd(a.0, b.0, c.0, d.0);
+                let l = _mm256_cvtpd_ps(_mm256_sub_pd(lo.0, lo.1));
+                let h = _mm256_cvtpd_ps(_mm256_sub_pd(hi.0, hi.1));
+                F32x8(_mm256_set_m128(h, l))
+            }
+        }
+        #[inline(always)]
+        fn sum_of_products(a: Self, b: Self, c: Self, d: Self) -> Self {
+            unsafe {
+                let (lo, hi) = products_pd(a.0, b.0, c.0, d.0);
+                let l = _mm256_cvtpd_ps(_mm256_add_pd(lo.0, lo.1));
+                let h = _mm256_cvtpd_ps(_mm256_add_pd(hi.0, hi.1));
+                F32x8(_mm256_set_m128(h, l))
+            }
+        }
+    }
+
+    /// The exact products `a·b` and `c·d` in `f64`, of the low four lanes
+    /// and of the high four.
+    #[inline(always)]
+    #[allow(clippy::type_complexity)]
+    unsafe fn products_pd(
+        a: __m256,
+        b: __m256,
+        c: __m256,
+        d: __m256,
+    ) -> ((__m256d, __m256d), (__m256d, __m256d)) {
+        let (al, bl) = (_mm256_castps256_ps128(a), _mm256_castps256_ps128(b));
+        let (cl, dl) = (_mm256_castps256_ps128(c), _mm256_castps256_ps128(d));
+        let (ah, bh) = (_mm256_extractf128_ps::<1>(a), _mm256_extractf128_ps::<1>(b));
+        let (ch, dh) = (_mm256_extractf128_ps::<1>(c), _mm256_extractf128_ps::<1>(d));
+        (
+            (
+                _mm256_mul_pd(_mm256_cvtps_pd(al), _mm256_cvtps_pd(bl)),
+                _mm256_mul_pd(_mm256_cvtps_pd(cl), _mm256_cvtps_pd(dl)),
+            ),
+            (
+                _mm256_mul_pd(_mm256_cvtps_pd(ah), _mm256_cvtps_pd(bh)),
+                _mm256_mul_pd(_mm256_cvtps_pd(ch), _mm256_cvtps_pd(dh)),
+            ),
+        )
     }
 
     impl F32Lanes for F32x4 {
@@ -274,6 +434,84 @@ mod x86 {
                 let lane = _mm_setr_epi32(1, 2, 4, 8);
                 let b = _mm_set1_epi32(bits as i32);
                 _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(b, lane), lane))
+            }
+        }
+        #[inline(always)]
+        fn div(self, o: Self) -> Self {
+            unsafe { F32x4(_mm_div_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn sqrt(self) -> Self {
+            unsafe { F32x4(_mm_sqrt_ps(self.0)) }
+        }
+        #[inline(always)]
+        fn abs(self) -> Self {
+            unsafe { F32x4(_mm_andnot_ps(_mm_set1_ps(-0.0), self.0)) }
+        }
+        #[inline(always)]
+        fn neg(self) -> Self {
+            unsafe { F32x4(_mm_xor_ps(_mm_set1_ps(-0.0), self.0)) }
+        }
+        #[inline(always)]
+        fn floor(self) -> Self {
+            unsafe { F32x4(_mm_floor_ps(self.0)) }
+        }
+        #[inline(always)]
+        fn eq(self, o: Self) -> __m128 {
+            unsafe { _mm_cmpeq_ps(self.0, o.0) }
+        }
+        #[inline(always)]
+        fn is_nan(self) -> __m128 {
+            unsafe { _mm_cmpunord_ps(self.0, self.0) }
+        }
+        #[inline(always)]
+        fn or(a: __m128, b: __m128) -> __m128 {
+            unsafe { _mm_or_ps(a, b) }
+        }
+        #[inline(always)]
+        fn not(a: __m128) -> __m128 {
+            unsafe { _mm_xor_ps(a, _mm_castsi128_ps(_mm_set1_epi32(-1))) }
+        }
+        #[inline(always)]
+        fn difference_of_products(a: Self, b: Self, c: Self, d: Self) -> Self {
+            unsafe {
+                let (a, b, c, d) = (a.0, b.0, c.0, d.0);
+                let l = _mm_sub_pd(
+                    _mm_mul_pd(_mm_cvtps_pd(a), _mm_cvtps_pd(b)),
+                    _mm_mul_pd(_mm_cvtps_pd(c), _mm_cvtps_pd(d)),
+                );
+                let (a, b, c, d) = (
+                    _mm_movehl_ps(a, a),
+                    _mm_movehl_ps(b, b),
+                    _mm_movehl_ps(c, c),
+                    _mm_movehl_ps(d, d),
+                );
+                let h = _mm_sub_pd(
+                    _mm_mul_pd(_mm_cvtps_pd(a), _mm_cvtps_pd(b)),
+                    _mm_mul_pd(_mm_cvtps_pd(c), _mm_cvtps_pd(d)),
+                );
+                F32x4(_mm_movelh_ps(_mm_cvtpd_ps(l), _mm_cvtpd_ps(h)))
+            }
+        }
+        #[inline(always)]
+        fn sum_of_products(a: Self, b: Self, c: Self, d: Self) -> Self {
+            unsafe {
+                let (a, b, c, d) = (a.0, b.0, c.0, d.0);
+                let l = _mm_add_pd(
+                    _mm_mul_pd(_mm_cvtps_pd(a), _mm_cvtps_pd(b)),
+                    _mm_mul_pd(_mm_cvtps_pd(c), _mm_cvtps_pd(d)),
+                );
+                let (a, b, c, d) = (
+                    _mm_movehl_ps(a, a),
+                    _mm_movehl_ps(b, b),
+                    _mm_movehl_ps(c, c),
+                    _mm_movehl_ps(d, d),
+                );
+                let h = _mm_add_pd(
+                    _mm_mul_pd(_mm_cvtps_pd(a), _mm_cvtps_pd(b)),
+                    _mm_mul_pd(_mm_cvtps_pd(c), _mm_cvtps_pd(d)),
+                );
+                F32x4(_mm_movelh_ps(_mm_cvtpd_ps(l), _mm_cvtpd_ps(h)))
             }
         }
     }

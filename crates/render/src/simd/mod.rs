@@ -14,6 +14,7 @@
 //! processors that have it run the AVX2 kernels.
 
 mod lanes;
+pub mod math;
 
 pub use lanes::{F32Lanes, Scalar1};
 #[cfg(target_arch = "x86_64")]

@@ -793,3 +793,71 @@ fn flawed_vertex_data_is_mended_with_warnings() {
     let sn = hit.intr.shading.n;
     assert!((sn.z + 1.0).abs() < 1e-5, "shading normal {sn:?}");
 }
+
+/// The batched solid-angle sampling of many triangles gives, at every SIMD
+/// width, the samples `SampledTriangle::sample` gives one at a time, bit
+/// for bit (reference points near and far, with and without a normal,
+/// including ones that fall back to sampling by area).
+#[test]
+fn batched_solid_angle_samples_match_single_ones() {
+    let mut r = Rng::with_sequence(33);
+    let mut tris = Vec::new();
+    while tris.len() < 40 {
+        let p = vec![rp(&mut r, 1.0), rp(&mut r, 1.0), rp(&mut r, 1.0)];
+        let Ok((m, _)) = TriangleMesh::new(
+            &Transform::default(),
+            false,
+            vec![0, 1, 2],
+            p,
+            vec![],
+            vec![],
+            vec![],
+            vec![],
+        ) else {
+            continue;
+        };
+        if let Some(t) = SampledTriangle::new(&Triangle::new(m, 0)) {
+            tris.push(t);
+        }
+    }
+    let mut cases = Vec::new();
+    for k in 0..tris.len() {
+        for j in 0..50 {
+            let scale = [0.5, 2.0, 30.0, 0.05][j % 4];
+            let p = Point3f::from(Vector3f::from(rp(&mut r, 1.0)) * scale);
+            let ns = if j % 5 == 0 {
+                Normal3f::default()
+            } else {
+                Normal3f::from(Vector3f::from(rp(&mut r, 1.0)).normalize())
+            };
+            let ctx = ShapeSampleContext {
+                pi: Point3fi::from(p),
+                n: ns,
+                ns,
+                time: 0.0,
+            };
+            cases.push((k, ctx, ru(&mut r)));
+        }
+    }
+    let queries: Vec<_> = cases
+        .iter()
+        .map(|(k, ctx, u)| tris[*k].solid_angle_query(ctx, *u))
+        .collect();
+    let bits = |s: &Option<ShapeSample>| {
+        s.map(|s| [s.p().x, s.p().y, s.p().z, s.pdf, s.uv.x, s.uv.y].map(f32::to_bits))
+    };
+    let (mut by_area, mut sampled) = (0, 0);
+    for level in crate::simd::SimdLevel::available() {
+        let mut cores = Vec::new();
+        sample_solid_angle_batch(level, &queries, &mut cores);
+        assert_eq!(cores.len(), cases.len());
+        for ((k, ctx, u), core) in cases.iter().zip(&cores) {
+            let single = tris[*k].sample(ctx, *u);
+            let batched = tris[*k].finish_sample(ctx, *u, *core);
+            assert_eq!(bits(&single), bits(&batched), "{level:?}: {ctx:?} {u:?}");
+            by_area += core.by_area as usize;
+            sampled += single.is_some() as usize;
+        }
+    }
+    assert!(by_area > 0 && sampled > by_area, "{by_area} {sampled}");
+}
