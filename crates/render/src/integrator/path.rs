@@ -201,7 +201,7 @@ impl VertexIntegrator for PathIntegrator {
         } else {
             (scratch.u, scratch.u2) = (sampler.get_1d(), sampler.get_2d());
             scratch.sides = [None, None];
-            Begin::Step(self.finish(scene, s, sampler, scratch, None))
+            Begin::Step(self.finish(scene, s, lambda, sampler, scratch, None))
         }
     }
 
@@ -212,6 +212,7 @@ impl VertexIntegrator for PathIntegrator {
         &self,
         scene: &Scene,
         s: &mut PathState,
+        _lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
         scratch: &mut SurfaceScratch,
         light: Option<&LightAnswer>,

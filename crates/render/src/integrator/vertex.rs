@@ -89,6 +89,7 @@ pub(crate) trait VertexIntegrator: Sync {
         &self,
         scene: &Scene,
         s: &mut Self::State,
+        lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
         scratch: &mut Self::Scratch,
         light: Option<&LightAnswer>,
@@ -122,7 +123,14 @@ pub(crate) fn li_by_vertices<I: VertexIntegrator>(
             Begin::Step(step) => step,
             Begin::Light(req) => {
                 let answer = answer_light(scene, &scene.light_sampler, &req, lambda);
-                integrator.finish(scene, &mut s, sampler, &mut scratch, answer.as_ref())
+                integrator.finish(
+                    scene,
+                    &mut s,
+                    lambda,
+                    sampler,
+                    &mut scratch,
+                    answer.as_ref(),
+                )
             }
         };
         if let Some(q) = step.shadow {

@@ -4,8 +4,8 @@
 //! light sampling through media and interfaces by ratio tracking, medium
 //! emission, and subsurface scattering through the materials' BSSRDFs.
 
-use super::direct::LightAnswer;
 use super::direct::ShadowQuery;
+use super::direct::{light_request, LightAnswer};
 use super::direct::{light_sample_culled, surface_light_context};
 use super::vertex::{li_by_vertices, Begin, VertexIntegrator, VertexStep};
 use super::volume::{
@@ -17,7 +17,7 @@ use crate::bxdf::{BxDFReflTransFlags, TransportMode, BSDF};
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
 use crate::medium::{sample_t_maj, HGPhaseFunction};
-use crate::primitive::{HitRecord, MediumInterface};
+use crate::primitive::{HitRecord, MediumInterface, PrimitiveIntersection};
 use crate::rng::{mix_bits, Rng};
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -95,30 +95,7 @@ impl VolPathIntegrator {
         beta: SampledSpectrum,
         r_p: SampledSpectrum,
     ) -> SampledSpectrum {
-        match self.sample_ld_or_defer(scene, vertex, lambda, u, u_light, beta, r_p, false) {
-            Ld::Now(l) => l,
-            // Not asked for: `defer` is false.
-            Ld::Deferred(_) => SampledSpectrum::new(0.0),
-        }
-    }
-
-    /// [`VolPathIntegrator::sample_ld`], its shadow ray left to the caller
-    /// when `defer` is set and the scene has no media or interfaces (the
-    /// shadow ray is then a plain occlusion test; the contribution is the
-    /// one a transmittance of one gives, bit for bit).
-    #[allow(clippy::too_many_arguments)]
-    fn sample_ld_or_defer(
-        &self,
-        scene: &Scene,
-        vertex: LdVertex,
-        lambda: &SampledWavelengths,
-        u: Float,
-        u_light: Point2f,
-        beta: SampledSpectrum,
-        r_p: SampledSpectrum,
-        defer: bool,
-    ) -> Ld {
-        let zero = Ld::Now(SampledSpectrum::new(0.0));
+        let zero = SampledSpectrum::new(0.0);
         let mut vertex = vertex;
         let ctx = match &mut vertex {
             LdVertex::Surface { origins, bsdf, .. } => surface_light_context(origins, bsdf),
@@ -183,40 +160,20 @@ impl VolPathIntegrator {
                 (SampledSpectrum::new(v), phase.pdf(wo, wi), ray)
             }
         };
-        let delta = light.light_type().is_delta();
-        let value = |st: ShadowTransmittance| {
-            let ShadowTransmittance { t_ray, r_u, r_l } = st;
-            let r_l = r_l * r_p * light_pdf;
-            let r_u = r_u * r_p * scatter_pdf;
-            if delta {
-                beta * f_hat * t_ray * ls.l / r_l.average()
-            } else {
-                beta * f_hat * t_ray * ls.l / (r_l + r_u).average()
-            }
-        };
-        if defer && !scene.has_volumes {
-            let one = SampledSpectrum::new(1.0);
-            return Ld::Deferred(ShadowQuery {
-                ray,
-                t_max: 1.0 - SHADOW_EPSILON,
-                ld: value(ShadowTransmittance {
-                    t_ray: one,
-                    r_u: one,
-                    r_l: one,
-                }),
-            });
-        }
         match shadow_transmittance(scene, ray, ls.p_light, ls.n_light, lambda) {
-            Some(st) => Ld::Now(value(st)),
+            Some(st) => ld_value(
+                light.light_type().is_delta(),
+                beta,
+                f_hat,
+                ls.l,
+                st,
+                r_p,
+                light_pdf,
+                scatter_pdf,
+            ),
             None => zero,
         }
     }
-}
-
-/// A light sample's contribution, or its shadow query.
-enum Ld {
-    Now(SampledSpectrum),
-    Deferred(ShadowQuery),
 }
 
 /// A probe-ray hit kept by the reservoir: the surface point light enters
@@ -266,7 +223,7 @@ impl RayIntegrator for VolPathIntegrator {
 
 impl VertexIntegrator for VolPathIntegrator {
     type State = VolPathState;
-    type Scratch = ();
+    type Scratch = VolPathScratch;
 
     #[inline(always)]
     fn start(&self, ray: RayDifferential) -> VolPathState {
@@ -294,8 +251,6 @@ impl VertexIntegrator for VolPathIntegrator {
         &mut s.l
     }
 
-    /// The whole vertex ([`VolPathIntegrator::vertex`]): its light samples
-    /// are not answered apart (yet).
     #[inline(always)]
     fn begin(
         &self,
@@ -305,31 +260,34 @@ impl VertexIntegrator for VolPathIntegrator {
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
         visible: Option<&mut VisibleSurface>,
-        _scratch: &mut (),
+        scratch: &mut VolPathScratch,
     ) -> Begin {
-        Begin::Step(self.vertex(scene, s, record, lambda, sampler, visible))
+        VolPathIntegrator::begin(self, scene, s, record, lambda, sampler, visible, scratch)
     }
 
-    /// Never called: [`VertexIntegrator::begin`] always finishes.
+    #[inline(always)]
     fn finish(
         &self,
-        _scene: &Scene,
-        _s: &mut VolPathState,
-        _sampler: &mut Sampler,
-        _scratch: &mut (),
-        _light: Option<&LightAnswer>,
+        scene: &Scene,
+        s: &mut VolPathState,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+        scratch: &mut VolPathScratch,
+        light: Option<&LightAnswer>,
     ) -> VertexStep {
-        VertexStep::DONE
+        self.finish_vertex(scene, s, lambda, sampler, scratch, light)
     }
 }
 
 impl VolPathIntegrator {
-    /// One pass of pbrt-v4's `VolPathIntegrator::Li` loop: delta tracking
-    /// through the ray's medium up to `record`, then the surface there.
-    /// The surface's light sample is deferred (returned as the step's
-    /// shadow query) in scenes without media or interfaces; every other
-    /// light sample is traced here.
-    fn vertex(
+    /// The first half of one pass of pbrt-v4's `VolPathIntegrator::Li`
+    /// loop: delta tracking through the ray's medium up to `record`, then
+    /// the surface there up to its light sample. In scenes without media
+    /// or interfaces the surface's light sample is asked for
+    /// ([`Begin::Light`]) and its shadow ray left to the caller; every
+    /// other light sample is traced here.
+    #[allow(clippy::too_many_arguments)]
+    fn begin(
         &self,
         scene: &Scene,
         s: &mut VolPathState,
@@ -337,10 +295,10 @@ impl VolPathIntegrator {
         lambda: &mut SampledWavelengths,
         sampler: &mut Sampler,
         visible: Option<&mut VisibleSurface>,
-    ) -> VertexStep {
+        scratch: &mut VolPathScratch,
+    ) -> Begin {
         let light_sampler = &scene.light_sampler;
         let max_depth = self.max_depth;
-        let mut closest;
         if let Some(m) = s.ray.ray.medium {
             // Delta tracking through the medium up to the surface: only
             // the surface's distance is needed unless the ray gets
@@ -437,21 +395,20 @@ impl VolPathIntegrator {
                 },
             );
             if terminated || s.beta.is_black() || s.r_u.is_black() || s.r_u.has_nan() {
-                return VertexStep::DONE;
+                return Begin::Step(VertexStep::DONE);
             }
             if scattered {
-                return VertexStep::NEXT;
+                return Begin::Step(VertexStep::NEXT);
             }
             if !(t_maj[0] > 0.0) {
-                return VertexStep::DONE;
+                return Begin::Step(VertexStep::DONE);
             }
             s.beta *= t_maj / t_maj[0];
             s.r_u *= t_maj / t_maj[0];
             s.r_l *= t_maj / t_maj[0];
         }
-        closest = record.and_then(|h| scene.aggregate.interaction(&s.ray.ray, &h));
-
-        let Some(hit) = closest.as_mut() else {
+        scratch.hit = record.and_then(|h| scene.aggregate.interaction(&s.ray.ray, &h));
+        let Some(hit) = scratch.hit.as_mut() else {
             // Escaped: infinite lights.
             for &li in &scene.infinite_lights {
                 let light = &scene.lights[li as usize];
@@ -468,7 +425,7 @@ impl VolPathIntegrator {
                     s.l += s.beta * le / (s.r_u + r_l).average();
                 }
             }
-            return VertexStep::DONE;
+            return Begin::Step(VertexStep::DONE);
         };
         // Emission from a surface that was hit.
         let le = scene.le(hit, -s.ray.ray.d, lambda);
@@ -483,10 +440,10 @@ impl VolPathIntegrator {
                 s.l += s.beta * le / (s.r_u + s.r_l).average();
             }
         }
-        let mut bsdf_slot = scene.get_bsdf(hit, &s.ray, lambda, sampler);
-        let Some(bsdf) = bsdf_slot.as_mut() else {
+        scratch.bsdf = scene.get_bsdf(hit, &s.ray, lambda, sampler);
+        let Some(bsdf) = scratch.bsdf.as_mut() else {
             s.ray = skip_intersection(&s.ray, hit);
-            return VertexStep::NEXT;
+            return Begin::Step(VertexStep::NEXT);
         };
         if s.depth == 0 {
             if let Some(v) = visible {
@@ -494,34 +451,58 @@ impl VolPathIntegrator {
             }
         }
         if s.depth >= max_depth {
-            return VertexStep::DONE;
+            return Begin::Step(VertexStep::DONE);
         }
         s.depth += 1;
         if self.regularize && s.any_non_specular {
             bsdf.regularize();
         }
         let ray_medium = s.ray.ray.medium;
-        let si = &hit.si;
-        let mut origins = VertexOrigins::new(si);
-        let mut shadow = None;
-        let (u, u2) = if bsdf.flags().is_non_specular() {
+        scratch.ray_medium = ray_medium;
+        let mut origins = VertexOrigins::new(&hit.si);
+        if bsdf.flags().is_non_specular() {
             let (u_light, u_light_2d, u, u2) = sampler.get_vertex_samples();
+            (scratch.u, scratch.u2) = (u, u2);
+            if !scene.has_volumes {
+                // A plain occlusion test: answered with the other paths'.
+                let req = light_request(&mut origins, bsdf, u_light, u_light_2d);
+                scratch.sides = origins.sides();
+                return Begin::Light(req);
+            }
             let vertex = LdVertex::Surface {
                 origins: &mut origins,
                 bsdf,
                 interface: hit.medium_interface,
                 ray_medium,
             };
-            match self.sample_ld_or_defer(
-                scene, vertex, lambda, u_light, u_light_2d, s.beta, s.r_u, true,
-            ) {
-                Ld::Now(l) => s.l += l,
-                Ld::Deferred(q) => shadow = Some(q),
-            }
-            (u, u2)
+            s.l += self.sample_ld(scene, vertex, lambda, u_light, u_light_2d, s.beta, s.r_u);
         } else {
-            (sampler.get_1d(), sampler.get_2d())
+            (scratch.u, scratch.u2) = (sampler.get_1d(), sampler.get_2d());
+        }
+        scratch.sides = origins.sides();
+        Begin::Step(self.finish_vertex(scene, s, lambda, sampler, scratch, None))
+    }
+
+    /// The second half: the light sample's shadow query (when asked
+    /// for), the BSDF sample that continues the path, subsurface
+    /// scattering and Russian roulette.
+    fn finish_vertex(
+        &self,
+        scene: &Scene,
+        s: &mut VolPathState,
+        lambda: &mut SampledWavelengths,
+        sampler: &mut Sampler,
+        scratch: &mut VolPathScratch,
+        light: Option<&LightAnswer>,
+    ) -> VertexStep {
+        let (Some(hit), Some(bsdf)) = (scratch.hit.as_ref(), scratch.bsdf.as_ref()) else {
+            return VertexStep::DONE;
         };
+        let si = &hit.si;
+        let ray_medium = scratch.ray_medium;
+        let mut origins = VertexOrigins::with_sides(si, scratch.sides);
+        let shadow = light.and_then(|a| surface_shadow_query(scene, &mut origins, bsdf, a, s));
+        let (u, u2) = (scratch.u, scratch.u2);
         let done = VertexStep { shadow, done: true };
         s.prev_ctx = LightSampleContext::from_si(si);
         let wo = si.wo;
@@ -593,6 +574,89 @@ impl VolPathIntegrator {
             done: false,
         }
     }
+}
+
+/// The shadow query of a light sample at a surface vertex of a path
+/// through a scene without media or interfaces: the contribution
+/// [`VolPathIntegrator::sample_ld`] gives there with a transmittance of
+/// one (the same bits), if nothing blocks the ray.
+fn surface_shadow_query(
+    scene: &Scene,
+    origins: &mut VertexOrigins,
+    bsdf: &BSDF,
+    a: &LightAnswer,
+    s: &VolPathState,
+) -> Option<ShadowQuery> {
+    let si = origins.si;
+    let ls = &a.ls;
+    let wi = ls.wi;
+    let f_hat = bsdf.f(si.wo, wi, TransportMode::Radiance) * abs_dot(wi, si.shading.n);
+    if f_hat.is_black() {
+        return None;
+    }
+    let scatter_pdf = bsdf.pdf(si.wo, wi, TransportMode::Radiance, BxDFReflTransFlags::ALL);
+    let p_to = ls.p_light.midpoint();
+    let pf = origins.toward(p_to - si.p());
+    let ray = spawn_ray_from_origin_to_surface(pf, si.time, p_to, ls.p_light.error(), ls.n_light);
+    let light_pdf = a.p * ls.pdf;
+    let one = SampledSpectrum::new(1.0);
+    let ld = ld_value(
+        scene.lights[a.light as usize].light_type().is_delta(),
+        s.beta,
+        f_hat,
+        ls.l,
+        ShadowTransmittance {
+            t_ray: one,
+            r_u: one,
+            r_l: one,
+        },
+        s.r_u,
+        light_pdf,
+        scatter_pdf,
+    );
+    Some(ShadowQuery {
+        ray,
+        t_max: 1.0 - SHADOW_EPSILON,
+        ld,
+    })
+}
+
+/// A light sample's contribution (pbrt-v4 `VolPathIntegrator::SampleLd`'s
+/// end): `beta` and `r_p` are the path's throughput and rescaled
+/// unidirectional probability at the vertex.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn ld_value(
+    delta: bool,
+    beta: SampledSpectrum,
+    f_hat: SampledSpectrum,
+    l: SampledSpectrum,
+    st: ShadowTransmittance,
+    r_p: SampledSpectrum,
+    light_pdf: Float,
+    scatter_pdf: Float,
+) -> SampledSpectrum {
+    let ShadowTransmittance { t_ray, r_u, r_l } = st;
+    let r_l = r_l * r_p * light_pdf;
+    let r_u = r_u * r_p * scatter_pdf;
+    if delta {
+        beta * f_hat * t_ray * l / r_l.average()
+    } else {
+        beta * f_hat * t_ray * l / (r_l + r_u).average()
+    }
+}
+
+/// A surface vertex between its two halves (see
+/// [`crate::integrator::path`]'s `SurfaceScratch`), with the medium the
+/// ray arrived in.
+#[derive(Default)]
+pub(crate) struct VolPathScratch {
+    hit: Option<PrimitiveIntersection>,
+    bsdf: Option<BSDF>,
+    sides: [Option<Point3f>; 2],
+    u: Float,
+    u2: Point2f,
+    ray_medium: Option<MediumId>,
 }
 
 impl VolPathIntegrator {

@@ -296,6 +296,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 let step = self.0.finish(
                     scene,
                     &mut lane.path,
+                    &mut lane.lambda,
                     sampler,
                     &mut scratch[i],
                     answer.as_ref(),
