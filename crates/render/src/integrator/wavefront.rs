@@ -172,8 +172,15 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let total = pixels.len() * per_pixel;
         let gbuffer = scene.film.uses_visible_surface();
         let mut reorder = ReorderBuffer::new();
+        // The paths in flight stay in their slots from start to end (a
+        // lane is a few hundred bytes: moving lanes around costs more
+        // than indexing them).
         let mut lanes: Vec<Lane<I::State>> = Vec::with_capacity(LANES);
+        let mut active: Vec<usize> = Vec::with_capacity(LANES);
+        let mut free: Vec<usize> = Vec::with_capacity(LANES);
+        let mut order: Vec<usize> = Vec::with_capacity(LANES);
         let mut rays: Vec<Ray> = Vec::with_capacity(LANES);
+        let mut traced: Vec<Option<HitRecord>> = Vec::with_capacity(LANES);
         let mut hits: Vec<Option<HitRecord>> = Vec::with_capacity(LANES);
         let mut shadow_rays: Vec<(Ray, Float)> = Vec::with_capacity(LANES);
         let mut shadow_lanes: Vec<(usize, SampledSpectrum)> = Vec::with_capacity(LANES);
@@ -188,7 +195,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         loop {
             // Refill the pool in the tile's sample order. Once
             // interrupted, no sample starts; those in flight finish.
-            while lanes.len() < LANES
+            while active.len() < LANES
                 && started < total
                 && reorder.has_room(started)
                 && !opts.interrupted()
@@ -210,7 +217,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     reorder.finish(seq, f, tile);
                     continue;
                 };
-                lanes.push(Lane {
+                let lane = Lane {
                     seq,
                     p_pixel,
                     cursor: sampler.cursor(),
@@ -221,24 +228,35 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     visible: gbuffer.then(VisibleSurface::default),
                     done: false,
                     camera: true,
-                });
+                };
+                match free.pop() {
+                    Some(slot) => {
+                        lanes[slot] = lane;
+                        active.push(slot);
+                    }
+                    None => {
+                        active.push(lanes.len());
+                        lanes.push(lane);
+                    }
+                }
             }
-            if lanes.is_empty() {
+            if active.is_empty() {
                 break;
             }
 
             // Trace: every path's closest hit, camera rays first (as
             // packets: they are consecutive samples of a few pixels).
-            let mut coherent = 0;
-            for i in 0..lanes.len() {
-                if lanes[i].camera {
-                    lanes.swap(coherent, i);
-                    coherent += 1;
-                }
-            }
+            order.clear();
+            order.extend(active.iter().filter(|&&i| lanes[i].camera));
+            let coherent = order.len();
+            order.extend(active.iter().filter(|&&i| !lanes[i].camera));
             rays.clear();
-            rays.extend(lanes.iter().map(|l| *I::ray(&l.path)));
-            scene.intersect_records(&rays, coherent, level, &mut hits);
+            rays.extend(order.iter().map(|&i| *I::ray(&lanes[i].path)));
+            scene.intersect_records(&rays, coherent, level, &mut traced);
+            hits.resize(lanes.len(), None);
+            for (&i, &h) in order.iter().zip(&traced) {
+                hits[i] = h;
+            }
 
             // Shade, first half: one vertex of every path, up to its light
             // sample's request.
@@ -249,12 +267,13 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             if scratch.len() < lanes.len() {
                 scratch.resize_with(lanes.len(), Default::default);
             }
-            for (i, (lane, hit)) in lanes.iter_mut().zip(&hits).enumerate() {
+            for &i in &active {
+                let lane = &mut lanes[i];
                 sampler.set_cursor(&lane.cursor);
                 let begun = self.0.begin(
                     scene,
                     &mut lane.path,
-                    *hit,
+                    hits[i],
                     &mut lane.lambda,
                     sampler,
                     lane.visible.as_mut(),
@@ -317,23 +336,23 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 }
             }
 
-            // Retire the paths that ended.
-            let mut i = 0;
-            while i < lanes.len() {
-                if lanes[i].done {
-                    let mut lane = lanes.swap_remove(i);
-                    let f = Finished {
-                        p_pixel: lane.p_pixel,
-                        l: *I::radiance(&mut lane.path) * lane.camera_weight,
-                        lambda: lane.lambda,
-                        visible: lane.visible,
-                        filter_weight: lane.filter_weight,
-                    };
-                    reorder.finish(lane.seq, f, tile);
-                } else {
-                    i += 1;
+            // Retire the paths that ended, freeing their slots.
+            active.retain(|&i| {
+                let lane = &mut lanes[i];
+                if !lane.done {
+                    return true;
                 }
-            }
+                let f = Finished {
+                    p_pixel: lane.p_pixel,
+                    l: *I::radiance(&mut lane.path) * lane.camera_weight,
+                    lambda: lane.lambda,
+                    visible: lane.visible.take(),
+                    filter_weight: lane.filter_weight,
+                };
+                reorder.finish(lane.seq, f, tile);
+                free.push(i);
+                false
+            });
         }
         debug_assert_eq!(reorder.next, started);
         started as u64
