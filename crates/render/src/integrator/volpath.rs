@@ -251,35 +251,6 @@ impl VertexIntegrator for VolPathIntegrator {
         &mut s.l
     }
 
-    #[inline(always)]
-    fn begin(
-        &self,
-        scene: &Scene,
-        s: &mut VolPathState,
-        record: Option<HitRecord>,
-        lambda: &mut SampledWavelengths,
-        sampler: &mut Sampler,
-        visible: Option<&mut VisibleSurface>,
-        scratch: &mut VolPathScratch,
-    ) -> Begin {
-        VolPathIntegrator::begin(self, scene, s, record, lambda, sampler, visible, scratch)
-    }
-
-    #[inline(always)]
-    fn finish(
-        &self,
-        scene: &Scene,
-        s: &mut VolPathState,
-        lambda: &mut SampledWavelengths,
-        sampler: &mut Sampler,
-        scratch: &mut VolPathScratch,
-        light: Option<&LightAnswer>,
-    ) -> VertexStep {
-        self.finish_vertex(scene, s, lambda, sampler, scratch, light)
-    }
-}
-
-impl VolPathIntegrator {
     /// The first half of one pass of pbrt-v4's `VolPathIntegrator::Li`
     /// loop: delta tracking through the ray's medium up to `record`, then
     /// the surface there up to its light sample. In scenes without media
@@ -480,13 +451,13 @@ impl VolPathIntegrator {
             (scratch.u, scratch.u2) = (sampler.get_1d(), sampler.get_2d());
         }
         scratch.sides = origins.sides();
-        Begin::Step(self.finish_vertex(scene, s, lambda, sampler, scratch, None))
+        Begin::Step(self.finish(scene, s, lambda, sampler, scratch, None))
     }
 
     /// The second half: the light sample's shadow query (when asked
     /// for), the BSDF sample that continues the path, subsurface
     /// scattering and Russian roulette.
-    fn finish_vertex(
+    fn finish(
         &self,
         scene: &Scene,
         s: &mut VolPathState,

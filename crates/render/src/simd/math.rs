@@ -16,7 +16,7 @@ use super::F32Lanes;
 const FOUR_OVER_PI: f32 = 1.273_239_5;
 /// π/4 in three parts whose products with small integers are exact.
 const PI4_A: f32 = 0.785_156_25;
-const PI4_B: f32 = 2.418_756_484_985_351_562_5e-4;
+const PI4_B: f32 = 2.418_756_5e-4;
 const PI4_C: f32 = 3.774_895e-8;
 /// sin r ≈ r + r³ (S1 + r² (S2 + r² S3)) on [−π/4, π/4].
 const S1: f32 = -1.666_665_5e-1;
@@ -159,6 +159,9 @@ pub struct V3<L> {
     pub z: L,
 }
 
+// Named as the lane operations are (`F32Lanes::add`, …): a kernel reads
+// the same with vectors and with lanes.
+#[allow(clippy::should_implement_trait)]
 impl<L: F32Lanes> V3<L> {
     /// Lanes from one `[x, y, z]` per lane (`v.len()` at least `L::N`).
     #[inline(always)]

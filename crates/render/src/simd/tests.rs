@@ -151,8 +151,9 @@ impl Kernel for MathOps<'_> {
             s.store(&mut v[0]);
             c.store(&mut v[1]);
             t.store(&mut v[2]);
-            for i in 0..L::N {
-                out.push([v[0][i].to_bits(), v[1][i].to_bits(), v[2][i].to_bits()]);
+            let [vs, vc, vt] = v;
+            for ((s, c), t) in vs.iter().zip(&vc).zip(&vt).take(L::N) {
+                out.push([s.to_bits(), c.to_bits(), t.to_bits()]);
             }
         }
         out
