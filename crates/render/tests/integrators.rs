@@ -557,19 +557,26 @@ fn whitted_direct_light_and_a_mirror() {
 
 /// A scene with a bit of everything the path tracer's vertex meets:
 /// diffuse, conductor, dielectric and coated surfaces, a checkerboard
-/// texture (filtered with ray differentials) and a bump map, a sphere and
-/// bilinear-patch emitters, spot and uniform infinite lights, a G-buffer
+/// texture (filtered with ray differentials) and a bump map, sphere,
+/// bilinear-patch and triangle emitters (the last sampled lane-parallel
+/// under `--wavefront`), spot and uniform infinite lights, a G-buffer
 /// film and a crop window.
-fn varied_scene(tag: &str, sampler: &str, spp: i32) -> String {
+fn varied_scene(tag: &str, sampler: &str, spp: i32, integrator: &str) -> String {
     format!(
         r#"LookAt 0 1 -5  0 0.5 0  0 1 0
 Camera "perspective" "float fov" 50
 Sampler "{sampler}" "integer pixelsamples" {spp}
 Film "gbuffer" "integer xresolution" 24 "integer yresolution" 20
     "float cropwindow" [ 0.1 0.95 0 0.9 ] "string filename" "{}"
-Integrator "path" "integer maxdepth" 6
+Integrator "{integrator}" "integer maxdepth" 6
 WorldBegin
 LightSource "infinite" "rgb L" [ 0.2 0.25 0.3 ]
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [ 3 2 1 ]
+  Material "diffuse"
+  Shape "trianglemesh" "point3 P" [ 0.8 1.8 -0.8  1.6 1.8 -0.8  1.2 2.2 -0.4 ]
+      "integer indices" [ 0 1 2 ]
+AttributeEnd
 LightSource "spot" "point3 from" [ 2 4 -2 ] "point3 to" [ 0 0 0 ] "rgb I" [ 20 18 15 ]
 Texture "checks" "spectrum" "checkerboard" "float uscale" 8 "float vscale" 8
     "rgb tex1" [ 0.8 0.8 0.8 ] "rgb tex2" [ 0.1 0.2 0.1 ]
@@ -611,19 +618,22 @@ AttributeEnd
     )
 }
 
-/// `--wavefront` gives the scalar path tracer's pixels bit for bit on a
-/// varied scene, with samplers of each kind and sample counts that are
-/// not powers of two, on one and on two threads.
+/// `--wavefront` gives the scalar loop's pixels bit for bit on a varied
+/// scene, for `path` and `volpath`, with samplers of each kind and sample
+/// counts that are not powers of two, on one and on two threads, at
+/// every SIMD width.
 #[test]
 fn wavefront_matches_scalar_bit_for_bit() {
-    for (sampler, spp) in [
-        ("zsobol", 8),
-        ("independent", 5),
-        ("halton", 6),
-        ("pmj02bn", 3),
+    for (sampler, spp, integrator) in [
+        ("zsobol", 8, "path"),
+        ("independent", 5, "path"),
+        ("halton", 6, "path"),
+        ("pmj02bn", 3, "path"),
+        ("zsobol", 8, "volpath"),
+        ("halton", 6, "volpath"),
     ] {
-        let tag = format!("wavefront-varied-{sampler}");
-        let text = varied_scene(&tag, sampler, spp);
+        let tag = format!("wavefront-varied-{sampler}-{integrator}");
+        let text = varied_scene(&tag, sampler, spp, integrator);
         let (scalar, has) = render_with(&text, 2, false);
         assert!(has);
         let (one, _) = render_with(&text, 1, true);
