@@ -894,6 +894,7 @@ fn parse_windowed(bytes: &[u8], window: usize) -> Result<PlyMesh, String> {
         std::io::BufReader::with_capacity(window, bytes),
         None,
         false,
+        &crate::budget::MemoryBudget::default(),
     )
     .map_err(|k| format!("{k:?}"))
 }
