@@ -174,17 +174,74 @@ impl Builder {
     fn account(&mut self) -> Result<(), ReadErr> {
         let held = self.held_bytes();
         if held > self.charged {
-            if self
-                .budget
-                .charge(held - self.charged, "this mesh")
-                .is_err()
-            {
-                self.budget.release(self.charged);
-                self.charged = 0;
-                return Err(ReadErr::Budget(self.budget.exceeded(held, "this mesh")));
-            }
-            self.charged = held;
+            self.charge(held - self.charged, held)?;
         }
+        Ok(())
+    }
+
+    /// Charges `bytes` more, the arrays then holding `held`; on failure,
+    /// gives back everything the mesh had charged.
+    fn charge(&mut self, bytes: u64, held: u64) -> Result<(), ReadErr> {
+        if self.budget.charge(bytes, "this mesh").is_err() {
+            self.budget.release(self.charged);
+            self.charged = 0;
+            return Err(ReadErr::Budget(self.budget.exceeded(held, "this mesh")));
+        }
+        self.charged += bytes;
+        Ok(())
+    }
+
+    /// Makes room for the face in `self.poly` (its triangles or quad and
+    /// their face indices), charging any growth before it is allocated:
+    /// polygons are what can make a mesh outgrow its header's counts.
+    fn reserve_face(&mut self, with_face_index: bool) -> Result<(), ReadErr> {
+        let (tris, quads) = match self.poly.len() {
+            0..=2 => return Ok(()),
+            3 => (1, 0),
+            4 => (0, 1),
+            n => (n - 2, 0),
+        };
+        let fi = usize::from(with_face_index);
+        // New capacities: doubled (from FIRST_RESERVE) when full.
+        let grown = |len: usize, cap: usize, extra: usize| {
+            if cap - len >= extra {
+                cap
+            } else {
+                (cap * 2).max(len + extra).max(FIRST_RESERVE)
+            }
+        };
+        let caps = [
+            grown(self.tris.len(), self.tris.capacity(), 3 * tris),
+            grown(self.quads.len(), self.quads.capacity(), 4 * quads),
+            grown(self.tri_faces.len(), self.tri_faces.capacity(), fi * tris),
+            grown(
+                self.quad_faces.len(),
+                self.quad_faces.capacity(),
+                fi * quads,
+            ),
+        ];
+        let now = [
+            self.tris.capacity(),
+            self.quads.capacity(),
+            self.tri_faces.capacity(),
+            self.quad_faces.capacity(),
+        ];
+        let extra: usize = caps.iter().zip(now).map(|(c, n)| c - n).sum();
+        if extra == 0 {
+            return Ok(());
+        }
+        let bytes = 4 * extra as u64;
+        self.charge(bytes, self.held_bytes() + bytes)?;
+        let len = [
+            self.tris.len(),
+            self.quads.len(),
+            self.tri_faces.len(),
+            self.quad_faces.len(),
+        ];
+        self.tris.reserve_exact(caps[0] - len[0]);
+        self.quads.reserve_exact(caps[1] - len[1]);
+        self.tri_faces.reserve_exact(caps[2] - len[2]);
+        self.quad_faces.reserve_exact(caps[3] - len[3]);
         Ok(())
     }
 
@@ -365,6 +422,7 @@ fn read_face_record<S: Source>(
             kind => skip_property(src, kind)?,
         }
     }
+    b.reserve_face(face_index.is_some())?;
     b.emit_face(face_index);
     b.account()
 }

@@ -523,7 +523,7 @@ pub fn create_scene(
         let pixels = film.pixel_bounds().area().max(0) as u64;
         if let Err(e) = desc.budget.charge(
             i.memory_bytes(pixels),
-            &format!("the \"{}\" integrator's buffers", i.name()),
+            &format!("the \"{}\" integrator", i.name()),
         ) {
             p.errors.push(Diagnostic::error(
                 desc.integrator.loc.clone(),
