@@ -313,8 +313,8 @@ fn claim_files() -> Vec<(String, Vec<u8>)> {
     qoi.extend(n.to_be_bytes());
     qoi.extend([3, 0]);
     let pixels = (n * n) as usize;
-    qoi.extend(std::iter::repeat(0xc0 | 61).take(pixels / 62));
-    qoi.extend(std::iter::repeat(0xc0).take(pixels % 62));
+    qoi.resize(qoi.len() + pixels / 62, 0xc0 | 61);
+    qoi.resize(qoi.len() + pixels % 62, 0xc0);
     qoi.extend([0, 0, 0, 0, 0, 0, 0, 1]);
     out.push(("qoi".to_string(), qoi));
     // PLY: 256 vertices, 40000 faces of 255 vertices each, gzip.
