@@ -56,6 +56,9 @@ pub struct Options {
     pub preview: Option<std::net::SocketAddr>,
     /// `--display-server host:port`: stream the image to tev.
     pub display_server: Option<String>,
+    /// `--max-memory <size>`: the memory budget, in bytes (default: from
+    /// the machine's memory).
+    pub max_memory: Option<u64>,
     /// `--format`: print the scene back as canonical pbrt-v4 text.
     pub format: bool,
     /// `--upgrade`: print a pbrt-v3 scene as pbrt-v4 text.
@@ -91,6 +94,10 @@ Rendering options:
   --disable-wavelength-jitter  Always sample the same four wavelengths of light.
   --display-server <host:port> Stream the image as it renders to the tev viewer.
   --force-diffuse              Replace every material with a diffuse one.
+  --max-memory <size>          The most memory the input may claim (e.g. 6G): scene
+                               text, meshes, images and textures, the film and the
+                               integrator's buffers. Past it, an error names the
+                               directive. Default: 3/4 of the machine's memory.
   --mse-reference-image <file> Compute the MSE against this image while rendering.
   --mse-reference-out <file>   Write the MSE per sample count to this file.
   --nthreads <n>               Use n threads (default: all cores).
@@ -342,6 +349,10 @@ pub fn parse_args(args: &[String]) -> Result<Options, ArgError> {
                 }
                 o.render_coord_sys = Some(v);
             }
+            "maxmemory" => {
+                let v = value(&mut i)?;
+                o.max_memory = Some(crate::imgtool::parse_max_memory(&v).map_err(ArgError)?);
+            }
             "msereferenceimage" => o.mse_reference_image = Some(value(&mut i)?),
             "msereferenceout" => o.mse_reference_out = Some(value(&mut i)?),
             "preview" => {
@@ -399,6 +410,8 @@ mod tests {
             assert_eq!(o.outfile.as_deref(), Some("x.exr"));
             assert_eq!(o.files, vec!["scene.pbrt"]);
         }
+        let o = p(&["--max-memory", "6G", "--MAX_MEMORY=512m"]).unwrap();
+        assert_eq!(o.max_memory, Some(512 << 20));
         let o = p(&["--spp=16", "--Disable_Pixel-Jitter", "a.pbrt"]).unwrap();
         assert_eq!(o.spp, Some(16));
         assert!(o.disable_pixel_jitter);
@@ -481,6 +494,9 @@ mod tests {
         }
         for bad in ["4", "4..4", "5..2", "-1..3", "a..b"] {
             assert!(p(&["--spp-range", bad]).is_err(), "{bad}");
+        }
+        for bad in ["0", "lots", "-1G", "6X"] {
+            assert!(p(&["--max-memory", bad]).is_err(), "{bad}");
         }
     }
 }

@@ -33,7 +33,7 @@ mod serve;
 mod tev;
 mod watch;
 
-use rpbrt_parser::{parse_files, FormattingTarget};
+use rpbrt_parser::{FormattingTarget, MemoryBudget, ParseOptions, Parser};
 use rpbrt_render::accel::Aggregate;
 use rpbrt_render::camera::RenderingCoordinateSystem;
 use rpbrt_render::film::{FilmOverrides, SampleRange};
@@ -89,7 +89,11 @@ fn format_scene(opts: &args::Options) -> ExitCode {
         let prefix = std::env::var("PLY_PREFIX").unwrap_or_else(|_| "mesh".to_string());
         target = target.with_toply(".", prefix);
     }
-    let result = parse_files(&opts.files, &mut target);
+    let parse = ParseOptions {
+        budget: memory_budget(opts),
+        ..ParseOptions::default()
+    };
+    let result = Parser::new(parse).parse_files(&opts.files, &mut target);
     let (diags, ok) = match result {
         Ok(d) => (d, true),
         Err(d) => (d, false),
@@ -114,6 +118,16 @@ fn print_product(s: &str) -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// The memory budget of `--max-memory` (or its default, from the
+/// machine's memory) that the scene text, the description and the render
+/// objects are charged to.
+fn memory_budget(opts: &args::Options) -> MemoryBudget {
+    let limit = opts
+        .max_memory
+        .unwrap_or_else(rpbrt_parser::budget::default_limit);
+    MemoryBudget::labelled(limit, "--max-memory")
 }
 
 /// Peak resident memory in bytes (Linux), for `--stats`.
@@ -155,7 +169,9 @@ fn render_command(opts: &args::Options) -> ExitCode {
         },
         _ => None,
     };
+    let budget = memory_budget(opts);
     let mut build = BuildOptions::default();
+    build.parse.budget = budget.clone();
     if let Some(r) = opts
         .render_coord_sys
         .as_deref()
@@ -269,13 +285,16 @@ fn render_command(opts: &args::Options) -> ExitCode {
     );
     let _ = signal_hook::flag::register(signal_hook::consts::SIGINT, Arc::clone(&interrupt));
     let mse_reference = match &opts.mse_reference_image {
-        Some(path) => match rpbrt_render::image::Image::read(std::path::Path::new(path), None) {
-            Ok(im) => Some(im.image),
-            Err(e) => {
-                diagln!("rpbrt: error: --mse-reference-image: {e}");
-                return ExitCode::FAILURE;
+        Some(path) => {
+            match rpbrt_render::image::Image::read_within(std::path::Path::new(path), None, &budget)
+            {
+                Ok(im) => Some(im.image),
+                Err(e) => {
+                    diagln!("rpbrt: error: --mse-reference-image: {e}");
+                    return ExitCode::FAILURE;
+                }
             }
-        },
+        }
         None => None,
     };
     if opts.mse_reference_out.is_some() && mse_reference.is_none() {
@@ -414,6 +433,11 @@ fn render_command(opts: &args::Options) -> ExitCode {
             "  Accelerator memory         {:>10} bytes ({:.1} bytes/primitive)",
             scene.aggregate.accelerator().memory_bytes(),
             scene.aggregate.accelerator().memory_bytes() as f64 / prims as f64
+        );
+        diagln!(
+            "  Memory budget              {:>10.1} MiB of {:.1} MiB (--max-memory)",
+            budget.used() as f64 / (1024.0 * 1024.0),
+            budget.limit() as f64 / (1024.0 * 1024.0)
         );
         if let Some(m) = peak_memory_bytes() {
             diagln!(

@@ -892,3 +892,198 @@ fn ctrl_c_is_honoured_between_samples_of_one_pixel() {
         assert!(out.exists(), "{design:?}: no image written");
     }
 }
+
+// ---- issue 34, finding 6: one memory budget, --max-memory ----------------
+
+/// Runs `rpbrt` with `args`, expecting exit 1 and one located error: its
+/// stderr.
+fn one_located_error(args: &[&str], scene: &std::path::Path) -> String {
+    let t = std::time::Instant::now();
+    let out = rpbrt().args(args).arg(scene).output().unwrap();
+    let e = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(1), "{e}");
+    assert_eq!(e.matches("error:").count(), 1, "{e}");
+    // Refused from the claims, not after allocating them.
+    assert!(t.elapsed() < std::time::Duration::from_secs(20), "{e}");
+    e
+}
+
+#[test]
+fn oom_film_16384_squared_is_a_located_error() {
+    let p = temp_scene(
+        "oom-film.pbrt",
+        "Film \"rgb\" \"integer xresolution\" [ 16384 ] \"integer yresolution\" [ 16384 ]\n\
+         WorldBegin\nShape \"sphere\"\n",
+    );
+    let e = one_located_error(&["--max-memory", "6G"], &p);
+    assert!(
+        e.contains("oom-film.pbrt:1:1: error: this film needs 20.0 GiB; --max-memory is 6.0 GiB"),
+        "{e}"
+    );
+    // The default budget comes from the machine's memory: a spectral film
+    // of 2^28 pixels and 1024 buckets (8 TiB) is past it on any machine.
+    let p = temp_scene(
+        "oom-film-default.pbrt",
+        "Film \"spectral\" \"integer xresolution\" [ 16384 ] \"integer yresolution\" [ 16384 ]\n\
+         \"integer nbuckets\" 1024 \"string filename\" \"x.exr\"\nWorldBegin\nShape \"sphere\"\n",
+    );
+    let e = one_located_error(&[], &p);
+    assert!(
+        e.contains("oom-film-default.pbrt:1:1: error: this film needs 8.0 TiB; --max-memory is"),
+        "{e}"
+    );
+}
+
+#[test]
+fn oom_sphere_directives_end_in_one_located_error() {
+    let mut text = String::from(
+        "Film \"rgb\" \"integer xresolution\" 4 \"integer yresolution\" 4\nWorldBegin\n",
+    );
+    text.push_str(&"Shape \"sphere\"\n".repeat(200_000));
+    let p = temp_scene("oom-spheres.pbrt", &text);
+    let e = one_located_error(&["--max-memory", "32M"], &p);
+    assert!(
+        e.contains("oom-spheres.pbrt:")
+            && e.contains(":1: error: this Shape needs ")
+            && e.contains("--max-memory is 32.0 MiB"),
+        "{e}"
+    );
+}
+
+#[test]
+fn oom_png_imagemap_is_a_located_error() {
+    use rpbrt_render::image::{ColorEncoding, Image, ImageMetadata, PixelFormat};
+    let dir = std::env::temp_dir().join(format!("rpbrt-cli-oom-png-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let im = Image::new(
+        PixelFormat::U256,
+        rpbrt_render::geometry::Point2i::new(2000, 2000),
+        &["R", "G", "B"],
+        ColorEncoding::SRGB,
+    );
+    im.write(dir.join("big.png"), &ImageMetadata::default())
+        .unwrap();
+    let p = dir.join("tex.pbrt");
+    std::fs::write(
+        &p,
+        "Film \"rgb\" \"integer xresolution\" 4 \"integer yresolution\" 4\nWorldBegin\n\
+         Texture \"t\" \"spectrum\" \"imagemap\" \"string filename\" \"big.png\"\n\
+         Material \"diffuse\" \"texture reflectance\" \"t\"\nShape \"sphere\"\n",
+    )
+    .unwrap();
+    let e = one_located_error(&["--max-memory", "16M"], &p);
+    assert!(
+        e.contains("tex.pbrt:3:35: error: imagemap texture \"t\": unable to read image")
+            && e.contains("this image needs 22.9 MiB; --max-memory is 16.0 MiB"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn oom_loopsubdiv_is_a_located_error_before_it_refines() {
+    let p = temp_scene(
+        "oom-loop.pbrt",
+        "Film \"rgb\" \"integer xresolution\" 4 \"integer yresolution\" 4\nWorldBegin\n\
+         Shape \"loopsubdiv\" \"integer levels\" 30 \"point3 P\" [ 0 0 0 1 0 0 0 1 0 1 1 0 ]\n\
+         \"integer indices\" [ 0 1 2 2 1 3 ]\n",
+    );
+    let e = one_located_error(&["--max-memory", "64M"], &p);
+    assert!(
+        e.contains(
+            "oom-loop.pbrt:3:1: error: this subdivision (2097152 triangles after 10 levels) \
+             needs 192.0 MiB; --max-memory is 64.0 MiB"
+        ),
+        "{e}"
+    );
+}
+
+#[test]
+fn oom_imgtool_outputs_are_refused_before_they_are_made() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-cli-oom-imgtool-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let small = dir.join("small.exr");
+    let p = dir.join("tiny.pbrt");
+    std::fs::write(&p, TINY_SCENE).unwrap();
+    let run = rpbrt()
+        .args(["--quiet", "--outfile"])
+        .arg(&small)
+        .arg(&p)
+        .output()
+        .unwrap();
+    assert!(run.status.success());
+    let check = |args: &[&str], expected: &str| {
+        let t = std::time::Instant::now();
+        let out = rpbrt().arg("imgtool").args(args).output().unwrap();
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {e}");
+        assert!(e.contains(expected), "{args:?}: {e}");
+        assert!(t.elapsed() < std::time::Duration::from_secs(20));
+    };
+    let s = small.to_str().unwrap();
+    let out = dir.join("out.exr");
+    let o = out.to_str().unwrap();
+    check(
+        &["convert", "--max-memory", "1G", "--repeatpix", "2000", s, o],
+        "convert: --repeatpix 2000: the 8000x8000 output image needs 1.4 GiB; --max-memory is 1.0 GiB",
+    );
+    check(
+        &["convert", "--repeatpix", "2000000000", s, o],
+        "is larger than an image may be",
+    );
+    // Past any machine's default budget.
+    check(
+        &["makesky", "--resolution", "1000000", "--outfile", o],
+        "makesky: the 1000000x1000000 sky map needs 21.8 TiB; --max-memory is",
+    );
+    check(
+        &["makeequiarea", "--resolution", "1000000", s, o],
+        "makeequiarea: the 1000000x1000000 output image needs 21.8 TiB; --max-memory is",
+    );
+    // Inputs are charged too, and the flag is checked.
+    check(
+        &["info", "--max-memory=100", s],
+        "--max-memory is 100 bytes",
+    );
+    check(
+        &["info", "--max-memory", "0", s],
+        "--max-memory must be more than 0",
+    );
+    check(
+        &["info", "--max-memory", "lots", s],
+        "\"lots\" is not a size",
+    );
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn max_memory_flag_is_checked_and_listed() {
+    for bad in ["0", "lots", "-1G", "6X"] {
+        let out = rpbrt()
+            .args(["--max-memory", bad, "x.pbrt"])
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(1), "{bad}");
+        assert!(
+            String::from_utf8_lossy(&out.stderr).contains("--max-memory"),
+            "{bad}"
+        );
+    }
+    let out = rpbrt().arg("--help").output().unwrap();
+    assert!(String::from_utf8_lossy(&out.stdout).contains("--max-memory <size>"));
+    // --stats reports what was charged against it.
+    let p = temp_scene("stats-budget.pbrt", TINY_SCENE);
+    let out = rpbrt()
+        .args(["--stats", "--quiet", "--max-memory", "512M", "--outfile"])
+        .arg(std::env::temp_dir().join(format!("rpbrt-stats-{}.exr", std::process::id())))
+        .arg(&p)
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{e}");
+    assert!(
+        e.contains("Memory budget") && e.contains("MiB of 512.0 MiB (--max-memory)"),
+        "{e}"
+    );
+}

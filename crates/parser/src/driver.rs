@@ -12,6 +12,7 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use crate::budget::MemoryBudget;
 use crate::diag::{Diagnostic, Diagnostics, Severity};
 use crate::input;
 use crate::loc::FileLoc;
@@ -36,6 +37,9 @@ pub struct ParseOptions {
     /// `false` parses them in place. The target sees the same directives
     /// in the same order either way.
     pub parallel_import: bool,
+    /// The memory budget scene text is charged to while it is parsed
+    /// (shared with whatever builds the scene from it).
+    pub budget: MemoryBudget,
 }
 
 impl Default for ParseOptions {
@@ -47,6 +51,7 @@ impl Default for ParseOptions {
             max_values: 1 << 30,
             max_file_bytes: input::DEFAULT_MAX_SCENE_FILE_BYTES,
             parallel_import: true,
+            budget: MemoryBudget::default(),
         }
     }
 }
@@ -315,6 +320,9 @@ struct Run<'a> {
     /// for an import): kept until it is known whether a diagnostic points
     /// into them.
     held: Vec<(Arc<str>, Arc<[u8]>)>,
+    /// Bytes of scene text charged to the budget, given back when the
+    /// parse ends.
+    text_charged: u64,
 }
 
 impl<'a> Run<'a> {
@@ -339,6 +347,7 @@ impl<'a> Run<'a> {
             deferred: Vec::new(),
             is_import: false,
             held: Vec::new(),
+            text_charged: 0,
         }
     }
 
@@ -424,6 +433,9 @@ impl<'a> Run<'a> {
                 message: format!("{} more warnings not shown", self.dropped_warnings),
             });
         }
+        // The text is dropped with the run (but for the few files that
+        // diagnostics quote).
+        self.opts.budget.release(self.text_charged);
         if self.diags.has_errors() {
             Err(self.diags)
         } else {
@@ -466,7 +478,10 @@ impl<'a> Run<'a> {
     /// `/dev/zero`) would otherwise be read up to the size limit. Files
     /// named on the command line may be pipes (`rpbrt /dev/stdin`), bounded
     /// by the limit alone.
-    fn open(&self, path: &Path, included: bool) -> Result<Source, String> {
+    ///
+    /// The text is charged to the memory budget while the parse runs: a
+    /// file is read no further than the budget has room for.
+    fn open(&mut self, path: &Path, included: bool) -> Result<Source, String> {
         if included {
             match std::fs::metadata(path) {
                 Ok(m) if !m.is_file() => {
@@ -476,8 +491,21 @@ impl<'a> Run<'a> {
                 _ => {}
             }
         }
-        let data = input::read_file_limited(path, self.opts.max_file_bytes)
+        let budget = &self.opts.budget;
+        let room = budget.available();
+        let limit = self.opts.max_file_bytes.min(room);
+        let what = "this scene file";
+        let data = input::read_file_limited(path, limit).map_err(|e| {
+            if input::is_too_large(&e) && limit == room {
+                format!("{}: {}", path.display(), budget.exceeded(room, what))
+            } else {
+                format!("{}: {e}", path.display())
+            }
+        })?;
+        budget
+            .charge(data.len() as u64, what)
             .map_err(|e| format!("{}: {e}", path.display()))?;
+        self.text_charged += data.len() as u64;
         let dir = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
@@ -622,6 +650,11 @@ impl<'a> Run<'a> {
             match self.directive(directive, loc) {
                 Ok(r) => self.drain(r),
                 Err(Abort) => self.resync(),
+            }
+            // Past the memory budget nothing more fits: the first error
+            // says where, and the parse ends there.
+            if self.opts.budget.exhausted() && self.errors > 0 {
+                self.stopped = true;
             }
         }
     }

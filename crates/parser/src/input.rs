@@ -185,6 +185,36 @@ pub fn gzip_size_hint(bytes: &[u8]) -> Option<u64> {
     Some(u64::from(isize).min(len.saturating_mul(MAX_HINT_RATIO)))
 }
 
+/// The error inside the [`io::Error`] of a read that passed its limit
+/// (see [`is_too_large`]).
+#[derive(Debug)]
+pub struct TooLarge {
+    /// What was measured ("file size", "decompressed size").
+    pub what: String,
+    /// The limit, in bytes.
+    pub limit: u64,
+}
+
+impl std::fmt::Display for TooLarge {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} exceeds the limit of {} bytes", self.what, self.limit)
+    }
+}
+
+impl std::error::Error for TooLarge {}
+
+fn too_large(what: &str, limit: u64) -> io::Error {
+    io::Error::other(TooLarge {
+        what: what.to_string(),
+        limit,
+    })
+}
+
+/// True when `e` says a read passed its size limit (rather than failing).
+pub fn is_too_large(e: &io::Error) -> bool {
+    e.get_ref().is_some_and(|inner| inner.is::<TooLarge>())
+}
+
 /// Reads all of `reader` into memory, failing when it yields more than `limit`
 /// bytes. `what` names the size in the error ("file size", "decompressed
 /// size"). `capacity` is an initial reservation (clamped to the limit).
@@ -198,9 +228,7 @@ pub fn read_to_end_limited(
     let mut out = Vec::with_capacity(capacity);
     reader.take(limit.saturating_add(1)).read_to_end(&mut out)?;
     if out.len() as u64 > limit {
-        return Err(io::Error::other(format!(
-            "{what} exceeds the limit of {limit} bytes"
-        )));
+        return Err(too_large(what, limit));
     }
     Ok(out)
 }
@@ -217,9 +245,7 @@ pub fn read_file_limited(path: impl AsRef<Path>, limit: u64) -> io::Result<Vec<u
     match reader.content_len() {
         Some(len) => {
             if len > limit {
-                return Err(io::Error::other(format!(
-                    "file size exceeds the limit of {limit} bytes"
-                )));
+                return Err(too_large("file size", limit));
             }
             // The file may still grow while it is read: keep the limit.
             read_to_end_limited(reader, limit, len, "file size")
@@ -281,6 +307,8 @@ mod tests {
         let empty = temp("empty.txt", b"");
         let e = read_file_limited(&plain, 9).unwrap_err();
         assert_eq!(e.to_string(), "file size exceeds the limit of 9 bytes");
+        assert!(is_too_large(&e));
+        assert!(!is_too_large(&io::Error::other("other")));
         let e = read_file_limited(&gz, 9).unwrap_err();
         assert_eq!(
             e.to_string(),

@@ -11,11 +11,14 @@
 //!   with the source line and a caret.
 //! - [`input`]: opening files, with transparent gzip decompression, as a
 //!   stream ([`input::FileReader`]) or whole ([`input::read_file_limited`]).
+//! - [`MemoryBudget`]: the limit on the memory input may claim, shared by
+//!   the parser, the scene builder and the renderer ([`budget`]).
 //! - [`FormattingTarget`]: prints a scene back as canonical pbrt-v4 text,
 //!   optionally upgrading pbrt-v3 constructs with the mappings in [`upgrade`].
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+pub mod budget;
 pub mod diag;
 pub mod driver;
 pub mod format;
@@ -27,6 +30,7 @@ pub mod target;
 pub mod tokenizer;
 pub mod upgrade;
 
+pub use budget::{MemoryBudget, OverBudget};
 pub use diag::{Diagnostic, Diagnostics, Severity, SourceMap};
 pub use driver::{parse_files, parse_string, read_scene_file, ParseOptions, Parser};
 pub use format::FormattingTarget;

@@ -134,6 +134,24 @@ impl PartialEq for ParsedParameter {
 }
 
 impl ParsedParameter {
+    /// The memory the parameter holds, in bytes: itself, its names and its
+    /// values (for the memory budget).
+    pub fn memory_bytes(&self) -> usize {
+        use crate::budget::heap;
+        std::mem::size_of::<Self>()
+            + heap(self.ty.capacity())
+            + heap(self.name.capacity())
+            + heap(self.floats.capacity() * std::mem::size_of::<f32>())
+            + heap(self.ints.capacity() * std::mem::size_of::<i32>())
+            + heap(self.bools.capacity())
+            + heap(self.strings.capacity() * std::mem::size_of::<String>())
+            + self
+                .strings
+                .iter()
+                .map(|s| heap(s.capacity()))
+                .sum::<usize>()
+    }
+
     /// A parameter without values.
     pub fn new(ty: impl Into<String>, name: impl Into<String>, loc: FileLoc) -> Self {
         ParsedParameter {
@@ -307,6 +325,15 @@ pub struct ParameterDictionary {
 const FLOAT_TEX: &str = "texture";
 
 impl ParameterDictionary {
+    /// The memory the parameters (own and inherited) hold, in bytes.
+    pub fn memory_bytes(&self) -> usize {
+        self.params
+            .iter()
+            .chain(&self.inherited)
+            .map(ParsedParameter::memory_bytes)
+            .sum()
+    }
+
     /// Wraps a directive's parameters.
     pub fn new(params: Vec<ParsedParameter>) -> Self {
         ParameterDictionary {

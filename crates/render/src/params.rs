@@ -15,7 +15,7 @@ use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 
 use rpbrt_parser::params::canonical_type;
-use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary};
+use rpbrt_parser::{Diagnostic, FileLoc, MemoryBudget, ParameterDictionary};
 
 use crate::spectrum::{spectrum_from_param, RgbColorSpace, Spectrum, SpectrumType};
 
@@ -60,6 +60,7 @@ pub struct ParamReader<'a> {
     loc: &'a FileLoc,
     color_space: &'static RgbColorSpace,
     warnings: RefCell<Vec<Diagnostic>>,
+    budget: MemoryBudget,
 }
 
 impl<'a> ParamReader<'a> {
@@ -90,7 +91,28 @@ impl<'a> ParamReader<'a> {
             loc,
             color_space,
             warnings: RefCell::new(Vec::new()),
+            budget: MemoryBudget::default(),
         }
+    }
+
+    /// The reader charging what its creator allocates for the input to
+    /// `budget` (by default, a budget of its own with the default limit).
+    pub fn with_budget(mut self, budget: &MemoryBudget) -> Self {
+        self.budget = budget.clone();
+        self
+    }
+
+    /// The memory budget creators charge what the input sizes to.
+    pub fn budget(&self) -> &MemoryBudget {
+        &self.budget
+    }
+
+    /// Charges `bytes`, what `what` ("this film") needs, to the memory
+    /// budget; when it does not fit, an error located at the directive.
+    pub fn charge(&self, bytes: u64, what: &str) -> Result<(), Diagnostic> {
+        self.budget
+            .charge(bytes, what)
+            .map_err(|e| self.error(e.to_string()))
     }
 
     /// A reader for parameters without colours (RGB values in sRGB).

@@ -8,12 +8,22 @@
 //!
 //! The files are every such file under `../shared/scenes` (when present)
 //! plus small ones written here, so the test means something on a fresh
-//! clone too. `RPBRT_FUZZ_ITERS` sets the mutations per file (default 60);
+//! clone too. EXR files also get header damage aimed at their attributes
+//! (sizes, windows, channel lists, compression, chunk counts) and offset
+//! tables. Resource claims: small files whose valid headers claim images
+//! and meshes far larger than the memory budget they are read with (a
+//! zero-filled PNG, EXR and QOI, a gzip PLY of many-sided polygons), so
+//! that the budget checks after headers and while inflating are fuzzed
+//! too; every read is held against a budget, and running past it is an
+//! error like any other.
+//!
+//! `RPBRT_FUZZ_ITERS` sets the mutations per file (default 60);
 //! `RPBRT_FUZZ_SECONDS`, if set, keeps going over fresh seeds until that
 //! much time has passed and prints the count.
 
 use rpbrt_geometry::Point2i;
-use rpbrt_parser::ply::parse_ply;
+use rpbrt_parser::ply::parse_ply_within;
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::{ColorEncoding, Image, ImageMetadata, PixelFormat};
 use rpbrt_render::medium::nanovdb::read_float_grid_from_bytes;
 use rpbrt_render::rng::Rng;
@@ -82,12 +92,104 @@ fn mutate(src: &[u8], rng: &mut Rng) -> Vec<u8> {
     v
 }
 
-/// Hands mutated bytes to the reader for `ext`; the result is ignored,
-/// only panics matter.
-fn read(ext: &str, bytes: &[u8], scratch: &Path) {
+/// One attribute of an EXR header: where its size field and value lie.
+struct ExrAttribute {
+    name: String,
+    size_at: usize,
+    value: std::ops::Range<usize>,
+}
+
+/// The attributes of the first header of an EXR file, and where the
+/// header ends (the offset table follows for single-part files).
+fn exr_attributes(b: &[u8]) -> (Vec<ExrAttribute>, usize) {
+    let mut out = Vec::new();
+    let mut pos = 8;
+    let cstr = |pos: &mut usize| -> Option<String> {
+        let end = *pos + b.get(*pos..)?.iter().position(|&c| c == 0)?;
+        let s = String::from_utf8_lossy(&b[*pos..end]).into_owned();
+        *pos = end + 1;
+        Some(s)
+    };
+    while let Some(name) = cstr(&mut pos) {
+        if name.is_empty() {
+            break;
+        }
+        let Some(_ty) = cstr(&mut pos) else { break };
+        let Some(size) = b.get(pos..pos + 4) else {
+            break;
+        };
+        let size = u32::from_le_bytes([size[0], size[1], size[2], size[3]]) as usize;
+        let value = pos + 4..(pos + 4 + size).min(b.len());
+        out.push(ExrAttribute {
+            name,
+            size_at: pos,
+            value: value.clone(),
+        });
+        pos = value.end;
+    }
+    (out, pos)
+}
+
+/// Damages an EXR header where readers trust it: an attribute's size, a
+/// 32-bit field of its value (window corners, channel types and
+/// samplings, chunk counts), the compression byte, or an offset-table
+/// entry, each set to an extreme or random value.
+fn damage_exr_header(src: &[u8], rng: &mut Rng) -> Vec<u8> {
+    let mut v = src.to_vec();
+    let (attrs, end) = exr_attributes(&v);
+    let put = |v: &mut Vec<u8>, at: usize, x: u32| {
+        for (k, byte) in x.to_le_bytes().iter().enumerate() {
+            if let Some(slot) = v.get_mut(at + k) {
+                *slot = *byte;
+            }
+        }
+    };
+    let extreme = |rng: &mut Rng| match rng.uniform_bounded(3) {
+        0 => rng.uniform_u32(),
+        _ => EXTREMES[rng.uniform_bounded(EXTREMES.len() as u32) as usize],
+    };
+    let n = 1 + rng.uniform_bounded(3);
+    for _ in 0..n {
+        if attrs.is_empty() || rng.uniform_bounded(5) == 0 {
+            // An offset-table entry (8 bytes each after the header).
+            let entries = (v.len().saturating_sub(end) / 8).max(1) as u32;
+            let at = end + 8 * rng.uniform_bounded(entries.min(64)) as usize;
+            let x = extreme(rng);
+            put(&mut v, at + 4 * rng.uniform_bounded(2) as usize, x);
+            continue;
+        }
+        let a = &attrs[rng.uniform_bounded(attrs.len() as u32) as usize];
+        match rng.uniform_bounded(4) {
+            0 => {
+                let x = extreme(rng);
+                put(&mut v, a.size_at, x);
+            }
+            1 if a.name == "compression" && !a.value.is_empty() => {
+                v[a.value.start] = rng.uniform_bounded(12) as u8;
+            }
+            _ if a.value.len() >= 4 => {
+                let slots = (a.value.len() / 4) as u32;
+                let at = a.value.start + 4 * rng.uniform_bounded(slots) as usize;
+                let x = extreme(rng);
+                put(&mut v, at, x);
+            }
+            _ => {
+                if let Some(b) = v.get_mut(a.value.start) {
+                    *b = rng.uniform_u32() as u8;
+                }
+            }
+        }
+    }
+    v
+}
+
+/// Hands mutated bytes to the reader for `ext`, against a memory budget
+/// of `budget` bytes; the result is ignored, only panics matter.
+fn read(ext: &str, bytes: &[u8], scratch: &Path, budget: u64) {
+    let budget = MemoryBudget::new(budget);
     match ext {
         "ply" => {
-            let _ = parse_ply(bytes);
+            let _ = parse_ply_within(bytes, &budget);
         }
         "nvdb" => {
             let _ = read_float_grid_from_bytes(bytes, "density");
@@ -98,7 +200,7 @@ fn read(ext: &str, bytes: &[u8], scratch: &Path) {
             }
         }
         _ => {
-            let _ = Image::read_from_bytes(bytes, &format!("x.{ext}"), None);
+            let _ = Image::read_from_bytes_within(bytes, &format!("x.{ext}"), None, &budget);
         }
     }
 }
@@ -153,6 +255,94 @@ fn builtin_files(dir: &Path) -> Vec<PathBuf> {
     out
 }
 
+/// The memory budget the built-in and shared files are read with.
+const BUDGET: u64 = 256 << 20;
+
+/// The budget the resource-claim files are read with: far below what they
+/// claim.
+const CLAIM_BUDGET: u64 = 4 << 20;
+
+/// A PNG chunk: length, type, data and CRC.
+fn png_chunk(out: &mut Vec<u8>, ty: &[u8; 4], data: &[u8]) {
+    out.extend((data.len() as u32).to_be_bytes());
+    let mut crc = flate2::Crc::new();
+    crc.update(ty);
+    crc.update(data);
+    out.extend(ty);
+    out.extend(data);
+    out.extend(crc.sum().to_be_bytes());
+}
+
+/// Files whose valid headers claim far more memory than [`CLAIM_BUDGET`],
+/// in few bytes: a 4000² grey PNG and a 2048² EXR of zeros, a 4000² QOI of
+/// one colour, and a gzip PLY whose 40000 faces of 255 vertices become ten
+/// million triangles (its header's counts fit the budget; its triangles do
+/// not).
+fn claim_files() -> Vec<(String, Vec<u8>)> {
+    use std::io::Write;
+    let mut out = Vec::new();
+    // PNG: 4000 x 4000, 8-bit grey, every row filter 0 and zeros.
+    let n = 4000u32;
+    let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
+    let row = vec![0u8; n as usize + 1];
+    for _ in 0..n {
+        z.write_all(&row).expect("in memory");
+    }
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = Vec::new();
+    ihdr.extend(n.to_be_bytes());
+    ihdr.extend(n.to_be_bytes());
+    ihdr.extend([8, 0, 0, 0, 0]);
+    png_chunk(&mut png, b"IHDR", &ihdr);
+    png_chunk(&mut png, b"IDAT", &z.finish().expect("in memory"));
+    png_chunk(&mut png, b"IEND", &[]);
+    out.push(("png".to_string(), png));
+    // EXR: 2048 x 2048 half zeros, compressed by rpbrt's writer.
+    let im = Image::new(
+        PixelFormat::Half,
+        Point2i::new(2048, 2048),
+        &["Y"],
+        ColorEncoding::Linear,
+    );
+    if let Ok(b) = im.encode("claim.exr", &ImageMetadata::default()) {
+        out.push(("exr".to_string(), b));
+    }
+    // QOI: 4000 x 4000 RGB, runs of 62 pixels of the start colour.
+    let mut qoi = b"qoif".to_vec();
+    qoi.extend(n.to_be_bytes());
+    qoi.extend(n.to_be_bytes());
+    qoi.extend([3, 0]);
+    let pixels = (n * n) as usize;
+    qoi.resize(qoi.len() + pixels / 62, 0xc0 | 61);
+    qoi.resize(qoi.len() + pixels % 62, 0xc0);
+    qoi.extend([0, 0, 0, 0, 0, 0, 0, 1]);
+    out.push(("qoi".to_string(), qoi));
+    // PLY: 256 vertices, 40000 faces of 255 vertices each, gzip.
+    let faces = 40_000;
+    let mut ply = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex 256\n\
+         property float x\nproperty float y\nproperty float z\n\
+         element face {faces}\nproperty list uchar int vertex_indices\nend_header\n"
+    )
+    .into_bytes();
+    for i in 0..256u32 {
+        for c in [i as f32, (i * 7 % 13) as f32, 0.0] {
+            ply.extend(c.to_le_bytes());
+        }
+    }
+    let mut face = vec![255u8];
+    for i in 0..255i32 {
+        face.extend(i.to_le_bytes());
+    }
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    gz.write_all(&ply).expect("in memory");
+    for _ in 0..faces {
+        gz.write_all(&face).expect("in memory");
+    }
+    out.push(("ply".to_string(), gz.finish().expect("in memory")));
+    out
+}
+
 fn shared_files() -> Vec<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
     let mut out = Vec::new();
@@ -186,14 +376,27 @@ fn mutated_data_files_never_panic() {
     let scratch = dir.join("mutated.spd");
     let mut files = builtin_files(&dir);
     files.extend(shared_files());
-    let loaded: Vec<(String, Vec<u8>)> = files
+    let mut loaded: Vec<(String, Vec<u8>, u64)> = files
         .iter()
         .filter_map(|p| {
             let ext = p.extension()?.to_str()?.to_string();
-            Some((ext, std::fs::read(p).ok()?))
+            Some((ext, std::fs::read(p).ok()?, BUDGET))
         })
         .collect();
     assert!(loaded.len() >= 6, "the built-in files were not written");
+    let claims = claim_files();
+    assert_eq!(claims.len(), 4, "the resource-claim files were not made");
+    // Unmutated, each claim is refused by the budget, not decoded.
+    for (ext, bytes) in &claims {
+        let budget = MemoryBudget::new(CLAIM_BUDGET);
+        let refused = if ext == "ply" {
+            parse_ply_within(bytes, &budget).is_err()
+        } else {
+            Image::read_from_bytes_within(bytes, &format!("x.{ext}"), None, &budget).is_err()
+        };
+        assert!(refused && budget.exhausted(), "{ext} claim was not refused");
+    }
+    loaded.extend(claims.into_iter().map(|(e, b)| (e, b, CLAIM_BUDGET)));
     let iters: u32 = std::env::var("RPBRT_FUZZ_ITERS")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -206,10 +409,17 @@ fn mutated_data_files_never_panic() {
     let mut round = 0u64;
     let mut total = 0u64;
     loop {
-        for (k, (ext, bytes)) in loaded.iter().enumerate() {
+        for (k, (ext, bytes, budget)) in loaded.iter().enumerate() {
             let mut rng = Rng::new(0xda7a + k as u64, round);
-            for _ in 0..iters {
-                read(ext, &mutate(bytes, &mut rng), &scratch);
+            for i in 0..iters {
+                // EXR files: every other mutation aims at the header's
+                // attributes and offset table.
+                let m = if ext == "exr" && i % 2 == 1 {
+                    damage_exr_header(bytes, &mut rng)
+                } else {
+                    mutate(bytes, &mut rng)
+                };
+                read(ext, &m, &scratch, *budget);
                 total += 1;
             }
         }

@@ -5,11 +5,17 @@
 //! only requirement is that nothing panics or hangs: every outcome must be
 //! a scene or located diagnostics.
 //!
+//! Resource claims are among the mutations: large resolutions, counts and
+//! subdivision levels are spliced in, and every scene is built and
+//! created against a memory budget of [`BUDGET`], so a claim past it must
+//! end in a located error like any other mistake.
+//!
 //! Without `../shared` the test mutates a built-in scene only. The number
 //! of mutations per scene is `RPBRT_FUZZ_ITERS` (default 150); with
 //! `RPBRT_FUZZ_SECONDS` it runs rounds of fresh seeds for that long.
 //! Crashes it ever finds are kept below as regression tests.
 
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::film::FilmOverrides;
 use rpbrt_render::image::ImageMetadata;
 use rpbrt_render::integrator::RenderOptions;
@@ -142,7 +148,22 @@ const TOKENS: &[&str] = &[
     "2147483647",
     "-2147483648",
     "0",
+    // Resource claims.
+    "16384",
+    "65536",
+    "1000000",
+    "\"integer xresolution\"",
+    "\"integer yresolution\"",
+    "\"integer levels\"",
+    "\"loopsubdiv\"",
+    "\"integer nz\"",
+    "\"integer nbuckets\"",
+    "\"gbuffer\"",
+    "\"spectral\"",
 ];
+
+/// The memory budget each mutated scene is built and created with.
+const BUDGET: u64 = 256 << 20;
 
 fn mutate(src: &[u8], rng: &mut Rng) -> Vec<u8> {
     let mut v = src.to_vec();
@@ -181,20 +202,23 @@ fn mutate(src: &[u8], rng: &mut Rng) -> Vec<u8> {
 }
 
 fn run_one(name: &str, bytes: &[u8], dir: &Path) {
-    let opts = BuildOptions::default();
-    if let Ok((desc, _)) = build_scene_from_bytes(name, bytes, dir, &opts) {
+    let mut opts = BuildOptions::default();
+    opts.parse.budget = MemoryBudget::new(BUDGET);
+    if let Ok((mut desc, _)) = build_scene_from_bytes(name, bytes, dir, &opts) {
         // Skip shape creation for scenes whose meshes are huge (killeroos):
         // the parse is the point there, and creating them each time is slow.
         if desc.shapes.len() < 2000 {
             let _ = create_scene_shapes(&desc);
             // The whole render-object creation (film, camera, sampler,
             // textures, materials, lights, aggregate, integrator) must
-            // also turn any input into a scene or located errors. Films are
-            // kept small so that a mutated resolution does not allocate
-            // gigabytes here.
-            let px = |n: &str, d: i32| desc.film.params.get_one_int(n, d).unwrap_or(d) as i64;
-            if px("xresolution", 1280) * px("yresolution", 720) <= 1 << 20 {
+            // also turn any input into a scene or located errors; a film,
+            // mesh or texture past the budget is one of them. Each
+            // creation gets a fresh budget (what the last one charged was
+            // dropped with it).
+            {
+                desc.budget = MemoryBudget::new(BUDGET);
                 let _ = create_scene(&desc, &CreateOptions::default());
+                desc.budget = MemoryBudget::new(BUDGET);
                 // And render a few pixels at one sample each: shading code
                 // must not panic on whatever parameters the scene has.
                 let out =
@@ -318,6 +342,12 @@ fn fuzz_regressions() {
         // A film of 2e9 x 2e9 pixels and negative sample counts parse; the
         // renderer rejects them when it creates the film and sampler.
         "Film \"rgb\" \"integer xresolution\" 2000000000 \"integer yresolution\" 2000000000\nSampler \"halton\" \"integer pixelsamples\" -5\nWorldBegin\n",
+        // Claims past the budget: a 16384² film (20 GiB of sums), a
+        // subdivision to 4^10 times its triangles, an image texture of
+        // a million pixels a side that is not there.
+        "Film \"rgb\" \"integer xresolution\" 16384 \"integer yresolution\" 16384\nWorldBegin\nShape \"sphere\"\n",
+        "Film \"gbuffer\" \"integer xresolution\" 8000 \"integer yresolution\" 8000 \"string filename\" \"x.exr\"\nWorldBegin\nShape \"sphere\"\n",
+        "WorldBegin\nShape \"loopsubdiv\" \"integer levels\" 10 \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 1] \"integer indices\" [0 1 2 2 1 3 0 2 3 0 3 1]\n",
         // Absurd numbers in shapes.
         "WorldBegin\nShape \"sphere\" \"float radius\" 1e38 \"float zmin\" -1e38\nShape \"loopsubdiv\" \"integer levels\" 2147483647 \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 2]\n",
         "WorldBegin\nShape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3] \"integer splitdepth\" 2147483647\n",

@@ -1,6 +1,7 @@
 //! `imgtool assemble`: join crops (tiles) of one image into the whole.
 
 use super::args::{Arg, Args};
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::assemble::assemble;
 use rpbrt_render::image::{Image, ImageMetadata};
 use std::path::Path;
@@ -15,8 +16,11 @@ usage: rpbrt imgtool assemble --outfile <file> <images...>
 ";
 
 /// Reads an image with its metadata.
-pub(crate) fn load_with_metadata(path: &str) -> Result<(Image, ImageMetadata), String> {
-    Image::read(Path::new(path), None)
+pub(crate) fn load_with_metadata(
+    path: &str,
+    budget: &MemoryBudget,
+) -> Result<(Image, ImageMetadata), String> {
+    Image::read_within(Path::new(path), None, budget)
         .map(|im| (im.image, im.metadata))
         .map_err(|e| e.to_string())
 }
@@ -44,11 +48,11 @@ pub(crate) fn outfile_and_files(
 }
 
 /// Runs `imgtool assemble`.
-pub fn run(args: &[String]) -> Result<(), String> {
+pub fn run(args: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let (outfile, files) = outfile_and_files("assemble", args)?;
     let loaded = files
         .iter()
-        .map(|f| load_with_metadata(f))
+        .map(|f| load_with_metadata(f, budget))
         .collect::<Result<Vec<_>, _>>()?;
     let parts: Vec<_> = files
         .iter()

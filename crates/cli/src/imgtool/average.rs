@@ -2,6 +2,7 @@
 
 use super::args::{Arg, Args};
 use super::load;
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::ops::average;
 use rpbrt_render::image::ImageMetadata;
 use std::path::Path;
@@ -38,7 +39,7 @@ pub(crate) fn matching_filenames(base: &str) -> Result<Vec<std::path::PathBuf>, 
 }
 
 /// Runs `imgtool average`.
-pub fn run(args: &[String]) -> Result<(), String> {
+pub fn run(args: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let mut a = Args::new("average", args);
     let mut outfile: Option<String> = None;
     let mut base: Option<String> = None;
@@ -64,7 +65,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
     }
     let mut images = Vec::with_capacity(files.len());
     for f in &files {
-        images.push(load(&f.to_string_lossy())?);
+        images.push(load(&f.to_string_lossy(), budget)?);
     }
     let avg = average(&images).map_err(|e| match e {
         rpbrt_render::image::ImageError::Invalid(m) => {

@@ -2,6 +2,7 @@
 
 use super::args::{Arg, Args};
 use super::{load_md, save};
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::ops::filter::bloom;
 
 /// Usage of `imgtool bloom`.
@@ -19,7 +20,7 @@ options:
 ";
 
 /// Runs `imgtool bloom`.
-pub fn run(argv: &[String]) -> Result<(), String> {
+pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let mut a = Args::new("bloom", argv);
     let (mut level, mut width, mut iterations, mut scale) = (f32::INFINITY, 15, 5, 0.3f32);
     let (mut infile, mut outfile) = (None, None);
@@ -39,7 +40,7 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     }
     let outfile = outfile.ok_or_else(|| a.err("--outfile must be specified"))?;
     let infile = infile.ok_or_else(|| a.err("input filename must be specified"))?;
-    let im = load_md(&infile)?;
+    let im = load_md(&infile, budget)?;
     let b = bloom(&im.image, level, width, iterations, scale)
         .map_err(|e| a.err(format!("{infile}: {e}")))?;
     if b.width != width {

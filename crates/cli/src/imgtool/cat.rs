@@ -2,6 +2,7 @@
 
 use super::args::{Arg, Args};
 use super::{emit, load_md};
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::ops::compose::pixel_listing;
 
 /// Usage of `imgtool cat`.
@@ -17,7 +18,7 @@ options:
 ";
 
 /// Runs `imgtool cat`.
-pub fn run(argv: &[String]) -> Result<(), String> {
+pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let mut a = Args::new("cat", argv);
     if argv.is_empty() {
         return Err(a.err("no filenames provided"));
@@ -39,7 +40,7 @@ pub fn run(argv: &[String]) -> Result<(), String> {
                 if sort && list {
                     return Err(a.err("--sort and --list don't make sense together"));
                 }
-                let im = load_md(&file)?;
+                let im = load_md(&file, budget)?;
                 if list {
                     if im.image.n_channels() != 1 {
                         return Err(a.err(format!(

@@ -2,7 +2,8 @@
 //! `--fp16` and an output file given as a second name.
 
 use super::args::{crop, Arg, Args};
-use super::{load_md, save};
+use super::{charge_output, load_md, save};
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::ops::convert::{convert, ConvertOptions};
 use rpbrt_render::image::ops::split_channel_list;
 use std::path::Path;
@@ -38,7 +39,7 @@ options:
 ";
 
 /// Runs `imgtool convert`.
-pub fn run(argv: &[String]) -> Result<(), String> {
+pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let mut a = Args::new("convert", argv);
     let mut o = ConvertOptions::default();
     let mut exposure = 0.0f32;
@@ -80,7 +81,21 @@ pub fn run(argv: &[String]) -> Result<(), String> {
         return Err(a.err("--exposure must be finite"));
     }
     o.scale *= exposure.exp2();
-    let im = load_md(&input)?;
+    let im = load_md(&input, budget)?;
+    if o.repeat > 1 {
+        // The output's size before it is made (crops come first and only
+        // shrink it, so the input's size bounds it).
+        let res = im.image.resolution();
+        let (w, h) = (i64::from(res.x), i64::from(res.y));
+        let r = i64::from(o.repeat);
+        let what = format!(
+            "--repeatpix {}: the {}x{} output image",
+            o.repeat,
+            w * r,
+            h * r
+        );
+        charge_output(budget, w * r, h * r, im.image.n_channels(), &what).map_err(|e| a.err(e))?;
+    }
     if let Some(spec) = channels {
         o.channels = Some(split_channel_list(&spec, im.image.channel_names()));
     }

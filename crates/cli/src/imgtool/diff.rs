@@ -5,6 +5,7 @@
 
 use super::args::{crop, Arg, Args};
 use super::{emit, load_md, save};
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::ops::flip::{flip, FlipOptions};
 use rpbrt_render::image::ops::metrics::{metric_error, zero_infinities, Metric};
 use rpbrt_render::image::ops::{diff, split_channel_list, worst_block, BLOCK_SIZE};
@@ -50,7 +51,7 @@ fn select(im: &ImageAndMetadata, file: &str, chans: &[String]) -> Result<Image, 
 }
 
 /// Runs `imgtool diff`.
-pub fn run(argv: &[String]) -> Result<(), String> {
+pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let mut a = Args::new("diff", argv);
     let (mut reference, mut outfile, mut channels, mut window) = (None, None, None, None);
     let (mut metric, mut difftol) = (None, None);
@@ -87,8 +88,8 @@ pub fn run(argv: &[String]) -> Result<(), String> {
         ([_], None) => return Err(a.err("must specify --reference image")),
         _ => return Err(a.err(format!("{}: excess argument", files[files.len() - 1]))),
     };
-    let im = load_md(&image_file)?;
-    let rf = load_md(&ref_file)?;
+    let im = load_md(&image_file, budget)?;
+    let rf = load_md(&ref_file, budget)?;
     let chans = match channels {
         Some(spec) => split_channel_list(&spec, im.image.channel_names()),
         None => im.image.channel_names().to_vec(),

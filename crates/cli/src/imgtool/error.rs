@@ -5,6 +5,7 @@
 use super::args::{crop, fmt_g, Arg, Args};
 use super::average::matching_filenames;
 use super::{emit, load_md, save};
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::ops::metrics::{estimate_error, Metric};
 use rpbrt_render::image::ImageMetadata;
 use std::path::Path;
@@ -25,7 +26,7 @@ options:
 ";
 
 /// Runs `imgtool error`.
-pub fn run(argv: &[String]) -> Result<(), String> {
+pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let mut a = Args::new("error", argv);
     let (mut reference, mut errorfile, mut window, mut base) = (None, None, None, None);
     let mut metric = Metric::Mse;
@@ -51,7 +52,7 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     }
     let base = base.ok_or_else(|| a.err("must provide base filename"))?;
     let reference = reference.ok_or_else(|| a.err("must provide --reference file"))?;
-    let mut refim = load_md(&reference)?.image;
+    let mut refim = load_md(&reference, budget)?.image;
     if let Some(w) = window {
         refim = refim
             .crop(w)
@@ -73,7 +74,7 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     let mut spp: Option<(i32, String)> = None;
     for f in &files {
         let name = f.to_string_lossy().into_owned();
-        let im = load_md(&name)?;
+        let im = load_md(&name, budget)?;
         if let Some(s) = im.metadata.samples_per_pixel {
             match &spp {
                 Some((s0, f0)) if *s0 != s => {

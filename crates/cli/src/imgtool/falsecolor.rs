@@ -3,6 +3,7 @@
 
 use super::args::{Arg, Args};
 use super::{load, save};
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::ops::falsecolor::{false_color, ramp_image};
 use rpbrt_render::image::ImageMetadata;
 
@@ -21,7 +22,7 @@ options:
 ";
 
 /// Runs `imgtool falsecolor`.
-pub fn run(argv: &[String]) -> Result<(), String> {
+pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let mut a = Args::new("falsecolor", argv);
     let (mut infile, mut outfile, mut max_value) = (None, None, None);
     let (mut plus_minus, mut ramp) = (false, false);
@@ -42,7 +43,8 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     let image = if ramp {
         ramp_image()
     } else {
-        load(&infile.ok_or_else(|| a.err("expecting input image filename"))?)?
+        let infile = infile.ok_or_else(|| a.err("expecting input image filename"))?;
+        load(&infile, budget)?
     };
     save(
         &false_color(&image, max_value, plus_minus),

@@ -3,6 +3,7 @@
 
 use super::{emit, load_md};
 use rpbrt_parser::diag::escape_controls;
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::ops::info;
 use rpbrt_render::image::ImageMetadata;
 
@@ -84,7 +85,7 @@ fn metadata_lines(md: &ImageMetadata) -> Vec<String> {
 }
 
 /// Runs `imgtool info`.
-pub fn run(args: &[String]) -> Result<(), String> {
+pub fn run(args: &[String], budget: &MemoryBudget) -> Result<(), String> {
     if args.is_empty() {
         return Err("info: needs at least one image".into());
     }
@@ -92,7 +93,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
         return Err(format!("info: {f}: unknown option (info takes no options)"));
     }
     for f in args {
-        let im = load_md(f)?;
+        let im = load_md(f, budget)?;
         let mut s = format!("{}:\n", shown(f));
         for l in metadata_lines(&im.metadata) {
             s += &format!("  {l}\n");
@@ -102,6 +103,8 @@ pub fn run(args: &[String]) -> Result<(), String> {
             c.name = shown(&c.name);
         }
         s += &stats.to_string();
+        // Each image is done with before the next is read.
+        budget.release(im.image.bytes_used() as u64);
         emit(&s)?;
     }
     Ok(())

@@ -3,6 +3,7 @@
 
 use super::args::{Arg, Args};
 use super::{emit, load};
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::ops::compose::make_emitters;
 
 /// Usage of `imgtool makeemitters`.
@@ -15,7 +16,7 @@ options:
 ";
 
 /// Runs `imgtool makeemitters`.
-pub fn run(argv: &[String]) -> Result<(), String> {
+pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let mut a = Args::new("makeemitters", argv);
     let (mut infile, mut rate) = (None, 1);
     while let Some(arg) = a.next_arg() {
@@ -29,7 +30,7 @@ pub fn run(argv: &[String]) -> Result<(), String> {
         }
     }
     let infile = infile.ok_or_else(|| a.err("missing image filename"))?;
-    let image = load(&infile)?;
+    let image = load(&infile, budget)?;
     let emitters = make_emitters(&image, rate).map_err(|e| a.err(format!("{infile}: {e}")))?;
     let mut out =
         String::from("AttributeBegin\nMaterial \"diffuse\" \"rgb reflectance\" [0 0 0]\n");

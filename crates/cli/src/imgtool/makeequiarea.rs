@@ -3,6 +3,8 @@
 //! resampling is `rpbrt_render::image::equiarea`'s, the one the infinite
 //! light uses on pbrt-v3 maps.
 
+use super::charge_output;
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::equiarea::equirect_to_equal_area;
 use rpbrt_render::image::{Image, ImageMetadata};
 use std::path::Path;
@@ -21,7 +23,7 @@ options:
 ";
 
 /// Runs `imgtool makeequiarea`.
-pub fn run(args: &[String]) -> Result<(), String> {
+pub fn run(args: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let mut outfile: Option<String> = None;
     let mut infile: Option<String> = None;
     let mut resolution: Option<i32> = None;
@@ -65,7 +67,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
     }
     let infile = infile.ok_or("makeequiarea: input image filename must be provided.")?;
     let outfile = outfile.ok_or("makeequiarea: output image filename must be provided.")?;
-    let read = Image::read(Path::new(&infile), None).map_err(|e| e.to_string())?;
+    let read = Image::read_within(Path::new(&infile), None, budget).map_err(|e| e.to_string())?;
     let res = read.image.resolution();
     if res.x != 2 * res.y {
         diagln!(
@@ -76,6 +78,9 @@ pub fn run(args: &[String]) -> Result<(), String> {
         );
     }
     let n = resolution.unwrap_or(res.x);
+    let what = format!("the {n}x{n} output image");
+    charge_output(budget, n.into(), n.into(), read.image.n_channels(), &what)
+        .map_err(|e| format!("makeequiarea: {e}"))?;
     let out = equirect_to_equal_area(&read.image, n).map_err(|e| format!("{infile}: {e}"))?;
     let metadata = ImageMetadata {
         camera_from_world: read.metadata.camera_from_world,

@@ -1,6 +1,8 @@
 //! `imgtool makesky`: pbrt-v4's Hosek–Wilkie sky environment map; the
 //! model and the map are `rpbrt_render::image::sky`'s.
 
+use super::charge_output;
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::sky::make_sky;
 use std::path::Path;
 
@@ -26,7 +28,7 @@ fn number<T: std::str::FromStr>(args: &[String], i: usize, flag: &str) -> Result
 }
 
 /// Runs `imgtool makesky`.
-pub fn run(args: &[String]) -> Result<(), String> {
+pub fn run(args: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let mut outfile: Option<String> = None;
     let (mut albedo, mut turbidity, mut elevation) = (0.5f32, 3.0f32, 10.0f32);
     let mut resolution = 2048i32;
@@ -59,6 +61,11 @@ pub fn run(args: &[String]) -> Result<(), String> {
         i += 2;
     }
     let outfile = outfile.ok_or("makesky: --outfile must be specified")?;
+    if resolution >= 1 {
+        let what = format!("the {resolution}x{resolution} sky map");
+        charge_output(budget, resolution.into(), resolution.into(), 3, &what)
+            .map_err(|e| format!("makesky: {e}"))?;
+    }
     let (image, metadata) =
         make_sky(albedo, elevation, turbidity, resolution).map_err(|e| format!("makesky: {e}"))?;
     image

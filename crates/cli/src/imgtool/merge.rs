@@ -1,6 +1,7 @@
 //! `imgtool merge`: join sample ranges of the same pixels into one image.
 
 use super::assemble::{load_with_metadata, outfile_and_files};
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::film::merge_sample_ranges;
 use std::path::Path;
 
@@ -15,11 +16,11 @@ usage: rpbrt imgtool merge --outfile <file> <images...>
 ";
 
 /// Runs `imgtool merge`.
-pub fn run(args: &[String]) -> Result<(), String> {
+pub fn run(args: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let (outfile, files) = outfile_and_files("merge", args)?;
     let loaded = files
         .iter()
-        .map(|f| load_with_metadata(f))
+        .map(|f| load_with_metadata(f, budget))
         .collect::<Result<Vec<_>, _>>()?;
     let parts: Vec<_> = files
         .iter()

@@ -2,6 +2,8 @@
 //! command, each with its `USAGE` and `run`; the numbers come from
 //! `rpbrt_render::image::ops`, these modules only parse arguments and print.
 
+use rpbrt_parser::budget::{default_limit, parse_size};
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::{Image, ImageAndMetadata, ImageMetadata};
 use std::path::Path;
 use std::process::ExitCode;
@@ -29,7 +31,7 @@ struct Command {
     name: &'static str,
     summary: &'static str,
     usage: &'static str,
-    run: fn(&[String]) -> Result<(), String>,
+    run: fn(&[String], &MemoryBudget) -> Result<(), String>,
 }
 
 /// Every command, in the order `help` lists them.
@@ -139,6 +141,8 @@ fn overview() -> String {
         s += &format!("  {:<16}{}\n", c.name, c.summary);
     }
     s += "\nrpbrt imgtool help <command> (or <command> --help) prints a command's usage.\n";
+    s += "Every command takes --max-memory <size> (e.g. 4G): the most memory its images\n";
+    s += "may take (default: 3/4 of the machine's memory).\n";
     s
 }
 
@@ -154,14 +158,82 @@ pub(crate) fn emit(s: &str) -> Result<(), String> {
     }
 }
 
-/// Reads an image, with the file name in any error.
-pub(crate) fn load(path: &str) -> Result<Image, String> {
-    load_md(path).map(|im| im.image)
+/// Reads an image, with the file name in any error; the image is charged
+/// to `budget`.
+pub(crate) fn load(path: &str, budget: &MemoryBudget) -> Result<Image, String> {
+    load_md(path, budget).map(|im| im.image)
 }
 
-/// Reads an image and its metadata, with the file name in any error.
-pub(crate) fn load_md(path: &str) -> Result<ImageAndMetadata, String> {
-    Image::read(Path::new(path), None).map_err(|e| e.to_string())
+/// Reads an image and its metadata, with the file name in any error; the
+/// image is charged to `budget`.
+pub(crate) fn load_md(path: &str, budget: &MemoryBudget) -> Result<ImageAndMetadata, String> {
+    Image::read_within(Path::new(path), None, budget).map_err(|e| e.to_string())
+}
+
+/// Charges an output image of `w` × `h` pixels with `channels` channels,
+/// which a command is about to make, to `budget`: its float pixels and the
+/// encoded file. A size past what an image may have is an error too.
+pub(crate) fn charge_output(
+    budget: &MemoryBudget,
+    w: i64,
+    h: i64,
+    channels: usize,
+    what: &str,
+) -> Result<(), String> {
+    if w > i64::from(i32::MAX) || h > i64::from(i32::MAX) {
+        return Err(format!(
+            "{what} is larger than an image may be (at most {} pixels a side)",
+            i32::MAX
+        ));
+    }
+    let pixels = (w.max(0) as u64).saturating_mul(h.max(0) as u64);
+    let bytes = pixels.saturating_mul(channels as u64 * 4 * 2);
+    budget.charge(bytes, what).map_err(|e| e.to_string())
+}
+
+/// Takes `--max-memory <size>` (or `=<size>`, any spelling of the flag's
+/// dashes) out of `args`: the budget every command's images are charged to.
+fn take_max_memory(args: &[String]) -> Result<(Vec<String>, MemoryBudget), String> {
+    let mut rest = Vec::with_capacity(args.len());
+    let mut limit = None;
+    let mut i = 0;
+    while i < args.len() {
+        let a = &args[i];
+        i += 1;
+        let body = a.trim_start_matches('-');
+        let (name, inline) = match body.split_once('=') {
+            Some((n, v)) => (n, Some(v.to_string())),
+            None => (body, None),
+        };
+        let is_flag = a.starts_with('-')
+            && name
+                .replace(['-', '_'], "")
+                .eq_ignore_ascii_case("maxmemory");
+        if !is_flag {
+            rest.push(a.clone());
+            continue;
+        }
+        let value = match inline {
+            Some(v) => v,
+            None => {
+                let v = args.get(i).ok_or("--max-memory needs a size (e.g. 4G)")?;
+                i += 1;
+                v.clone()
+            }
+        };
+        limit = Some(parse_max_memory(&value)?);
+    }
+    let limit = limit.unwrap_or_else(default_limit);
+    Ok((rest, MemoryBudget::labelled(limit, "--max-memory")))
+}
+
+/// A `--max-memory` value: a positive size.
+pub(crate) fn parse_max_memory(value: &str) -> Result<u64, String> {
+    match parse_size(value) {
+        Ok(0) => Err("--max-memory must be more than 0".to_string()),
+        Ok(n) => Ok(n),
+        Err(e) => Err(format!("--max-memory: {e}")),
+    }
 }
 
 /// Writes an image (format by extension), with the file name in any error.
@@ -181,7 +253,14 @@ pub fn run(args: &[String]) -> ExitCode {
         diag!("{}", overview());
         return ExitCode::FAILURE;
     };
-    let rest = &args[1..];
+    let (rest, budget) = match take_max_memory(&args[1..]) {
+        Ok(r) => r,
+        Err(e) => {
+            diagln!("rpbrt imgtool: error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let rest = &rest[..];
     let result = match cmd.as_str() {
         "help" | "--help" | "-h" => match rest.first() {
             None => emit(&overview()),
@@ -195,7 +274,7 @@ pub fn run(args: &[String]) -> ExitCode {
         },
         name => match find(name) {
             Some(c) if rest.iter().any(|a| a == "--help" || a == "-h") => emit(c.usage),
-            Some(c) => (c.run)(rest),
+            Some(c) => (c.run)(rest, &budget),
             None => Err(format!(
                 "unknown imgtool command \"{name}\"\n\n{}",
                 overview()

@@ -3,6 +3,7 @@
 
 use super::args::{Arg, Args};
 use super::{load_md, save};
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::ops::color::scale_normal_map;
 
 /// Usage of `imgtool scalenormalmap`.
@@ -16,7 +17,7 @@ options:
 ";
 
 /// Runs `imgtool scalenormalmap`.
-pub fn run(argv: &[String]) -> Result<(), String> {
+pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let mut a = Args::new("scalenormalmap", argv);
     let (mut infile, mut outfile, mut scale) = (None, None, 1.0f32);
     while let Some(arg) = a.next_arg() {
@@ -32,7 +33,7 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     }
     let infile = infile.ok_or_else(|| a.err("must provide an input filename"))?;
     let outfile = outfile.ok_or_else(|| a.err("must provide --outfile"))?;
-    let im = load_md(&infile)?;
+    let im = load_md(&infile, budget)?;
     let out = scale_normal_map(&im.image, scale).map_err(|e| a.err(format!("{infile}: {e}")))?;
     save(&out, &outfile, &im.metadata)
 }

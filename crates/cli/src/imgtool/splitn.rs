@@ -3,6 +3,7 @@
 
 use super::args::{Arg, Args};
 use super::{load_md, save};
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::geometry::Point2i;
 use rpbrt_render::image::ops::compose::splitn;
 use rpbrt_render::image::ImageMetadata;
@@ -22,7 +23,7 @@ options:
 ";
 
 /// Runs `imgtool splitn`.
-pub fn run(argv: &[String]) -> Result<(), String> {
+pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let mut a = Args::new("splitn", argv);
     if argv.is_empty() {
         return Err(a.err("no filenames provided"));
@@ -55,7 +56,7 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     }
     let mut images = Vec::new();
     for f in &infiles {
-        let im = load_md(f)?;
+        let im = load_md(f, budget)?;
         images.push((im.image, im.metadata));
     }
     let corners: Vec<Point2i> = crops.iter().map(|c| c.0).collect();

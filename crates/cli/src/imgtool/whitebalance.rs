@@ -3,6 +3,7 @@
 
 use super::args::{Arg, Args};
 use super::{load_md, save};
+use rpbrt_parser::MemoryBudget;
 use rpbrt_render::image::ops::color::{illuminant_white, temperature_white, white_balance_image};
 
 /// Usage of `imgtool whitebalance`.
@@ -19,7 +20,7 @@ options:
 ";
 
 /// Runs `imgtool whitebalance`.
-pub fn run(argv: &[String]) -> Result<(), String> {
+pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let mut a = Args::new("whitebalance", argv);
     let (mut infile, mut outfile, mut illuminant) = (None, None, None::<String>);
     let (mut temperature, mut xy) = (0.0f32, None::<[f32; 2]>);
@@ -55,7 +56,7 @@ pub fn run(argv: &[String]) -> Result<(), String> {
     } else {
         return Err(a.err("must provide one of --illuminant, --primaries, or --temperature"));
     };
-    let im = load_md(&infile)?;
+    let im = load_md(&infile, budget)?;
     let out = white_balance_image(&im.image, &im.metadata, src)
         .map_err(|e| a.err(format!("{infile}: {e}")))?;
     save(&out, &outfile, &im.metadata)

@@ -22,6 +22,7 @@
 
 use std::path::Path;
 
+use crate::budget::MemoryBudget;
 use crate::input::{has_gz_extension, FileReader};
 
 mod header;
@@ -34,12 +35,18 @@ pub use types::{PlyError, PlyErrorKind, PlyMesh};
 pub use write::{encode_ply, write_ply};
 
 /// Parses a PLY file held in memory; gzip-compressed data (recognised by its
-/// magic bytes) is inflated as it is decoded.
+/// magic bytes) is inflated as it is decoded. The mesh is held against the
+/// default memory budget ([`MemoryBudget::default`]).
 pub fn parse_ply(bytes: &[u8]) -> Result<PlyMesh, PlyError> {
+    parse_ply_within(bytes, &MemoryBudget::default())
+}
+
+/// [`parse_ply`], with the mesh's arrays charged to `budget`.
+pub fn parse_ply_within(bytes: &[u8], budget: &MemoryBudget) -> Result<PlyMesh, PlyError> {
     let mesh = if crate::input::is_gzip(bytes) {
-        read::parse_gzip(bytes)
+        read::parse_gzip(bytes, budget)
     } else {
-        read::parse_reader(bytes, Some(bytes.len() as u64), true)
+        read::parse_reader(bytes, Some(bytes.len() as u64), true, budget)
     };
     mesh.map_err(|kind| PlyError::new(None, kind))
 }
@@ -49,14 +56,23 @@ pub fn parse_ply(bytes: &[u8]) -> Result<PlyMesh, PlyError> {
 ///
 /// The body is decoded as it is read (and inflated), so memory use is the
 /// mesh's arrays plus a small window of the file, never the whole file.
+/// The mesh is held against the default memory budget
+/// ([`MemoryBudget::default`]).
 pub fn read_ply(path: &Path) -> Result<PlyMesh, PlyError> {
+    read_ply_within(path, &MemoryBudget::default())
+}
+
+/// [`read_ply`], with the mesh's arrays charged to `budget`: a header whose
+/// counts need more than the budget has left, or a body that inflates past
+/// it, is a [`PlyErrorKind::OverBudget`] error.
+pub fn read_ply_within(path: &Path, budget: &MemoryBudget) -> Result<PlyMesh, PlyError> {
     let err = |kind| PlyError::new(Some(path), kind);
     let reader = if has_gz_extension(path) {
         FileReader::open_gzip(path)
     } else {
         FileReader::open(path)
     };
-    read::parse_file(reader.map_err(|e| err(PlyErrorKind::Io(e)))?).map_err(err)
+    read::parse_file(reader.map_err(|e| err(PlyErrorKind::Io(e)))?, budget).map_err(err)
 }
 
 #[cfg(test)]

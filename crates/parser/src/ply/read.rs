@@ -7,6 +7,7 @@ use std::io::{BufRead, BufReader};
 use super::header::{parse_header, Element, Format, Header, PropKind, Scalar};
 use super::stream::{decode_f32, decode_num, AsciiSource, BinarySource, Input, ReadErr, Source};
 use super::types::{PlyErrorKind, PlyMesh};
+use crate::budget::MemoryBudget;
 
 // ---------------------------------------------------------------------------
 // What to extract from the vertex and face elements
@@ -138,6 +139,10 @@ fn reserve_upto<T>(v: &mut Vec<T>, n: usize, total: usize) {
 }
 
 struct Builder {
+    /// What the arrays are charged to.
+    budget: MemoryBudget,
+    /// Bytes charged for the arrays so far.
+    charged: u64,
     vertex_count: u64,
     positions: Vec<[f32; 3]>,
     normals: Vec<[f32; 3]>,
@@ -153,6 +158,93 @@ struct Builder {
 }
 
 impl Builder {
+    /// Bytes the mesh's arrays hold (their capacity).
+    fn held_bytes(&self) -> u64 {
+        let f32x3 = std::mem::size_of::<[f32; 3]>();
+        let f32x2 = std::mem::size_of::<[f32; 2]>();
+        let n = (self.positions.capacity() + self.normals.capacity()) * f32x3
+            + self.uvs.capacity() * f32x2
+            + (self.tris.capacity() + self.quads.capacity()) * 4
+            + (self.tri_faces.capacity() + self.quad_faces.capacity()) * 4;
+        n as u64
+    }
+
+    /// Charges what the arrays grew by since the last call: a mesh that
+    /// inflates past the budget stops here, with the error.
+    fn account(&mut self) -> Result<(), ReadErr> {
+        let held = self.held_bytes();
+        if held > self.charged {
+            self.charge(held - self.charged, held)?;
+        }
+        Ok(())
+    }
+
+    /// Charges `bytes` more, the arrays then holding `held`; on failure,
+    /// gives back everything the mesh had charged.
+    fn charge(&mut self, bytes: u64, held: u64) -> Result<(), ReadErr> {
+        if self.budget.charge(bytes, "this mesh").is_err() {
+            self.budget.release(self.charged);
+            self.charged = 0;
+            return Err(ReadErr::Budget(self.budget.exceeded(held, "this mesh")));
+        }
+        self.charged += bytes;
+        Ok(())
+    }
+
+    /// Makes room for the face in `self.poly` (its triangles or quad and
+    /// their face indices), charging any growth before it is allocated:
+    /// polygons are what can make a mesh outgrow its header's counts.
+    fn reserve_face(&mut self, with_face_index: bool) -> Result<(), ReadErr> {
+        let (tris, quads) = match self.poly.len() {
+            0..=2 => return Ok(()),
+            3 => (1, 0),
+            4 => (0, 1),
+            n => (n - 2, 0),
+        };
+        let fi = usize::from(with_face_index);
+        // New capacities: doubled (from FIRST_RESERVE) when full.
+        let grown = |len: usize, cap: usize, extra: usize| {
+            if cap - len >= extra {
+                cap
+            } else {
+                (cap * 2).max(len + extra).max(FIRST_RESERVE)
+            }
+        };
+        let caps = [
+            grown(self.tris.len(), self.tris.capacity(), 3 * tris),
+            grown(self.quads.len(), self.quads.capacity(), 4 * quads),
+            grown(self.tri_faces.len(), self.tri_faces.capacity(), fi * tris),
+            grown(
+                self.quad_faces.len(),
+                self.quad_faces.capacity(),
+                fi * quads,
+            ),
+        ];
+        let now = [
+            self.tris.capacity(),
+            self.quads.capacity(),
+            self.tri_faces.capacity(),
+            self.quad_faces.capacity(),
+        ];
+        let extra: usize = caps.iter().zip(now).map(|(c, n)| c - n).sum();
+        if extra == 0 {
+            return Ok(());
+        }
+        let bytes = 4 * extra as u64;
+        self.charge(bytes, self.held_bytes() + bytes)?;
+        let len = [
+            self.tris.len(),
+            self.quads.len(),
+            self.tri_faces.len(),
+            self.quad_faces.len(),
+        ];
+        self.tris.reserve_exact(caps[0] - len[0]);
+        self.quads.reserve_exact(caps[1] - len[1]);
+        self.tri_faces.reserve_exact(caps[2] - len[2]);
+        self.quad_faces.reserve_exact(caps[3] - len[3]);
+        Ok(())
+    }
+
     #[inline]
     fn push_vertex(&mut self, v: &[f32; SLOT_COUNT], normals: bool, uvs: bool) {
         self.positions.push([v[0], v[1], v[2]]);
@@ -238,6 +330,7 @@ fn map_err(e: ReadErr, el: &Element, record: u64, vertex_count: u64) -> PlyError
             vertex_count,
         },
         ReadErr::Io(e) => PlyErrorKind::Io(e),
+        ReadErr::Budget(e) => PlyErrorKind::OverBudget(e),
     }
 }
 
@@ -294,6 +387,7 @@ fn read_vertices_general<S: Source>(
         }
         b.grow_vertices(1, total, layout);
         b.push_vertex(&v, layout.normals, layout.uvs);
+        b.account().map_err(|e| map_err(e, el, rec, 0))?;
     }
     Ok(())
 }
@@ -328,8 +422,9 @@ fn read_face_record<S: Source>(
             kind => skip_property(src, kind)?,
         }
     }
+    b.reserve_face(face_index.is_some())?;
     b.emit_face(face_index);
-    Ok(())
+    b.account()
 }
 
 fn read_faces_general<S: Source>(
@@ -452,12 +547,14 @@ fn read_vertices_fixed<R: BufRead, const BE: bool>(
         let n = (buf.len() / record_size).min(left);
         if n > 0 {
             b.grow_vertices(n, total, layout);
+            b.account().map_err(|e| map_err(e, el, read, 0))?;
             fields.decode::<BE>(&buf[..n * record_size], record_size, b);
             input.consume(n * record_size);
             read += n as u64;
         } else {
             // One record straddles the end of the window (or the data ends).
             b.grow_vertices(1, total, layout);
+            b.account().map_err(|e| map_err(e, el, read, 0))?;
             input
                 .with_bytes(record_size, |rec| fields.decode::<BE>(rec, record_size, b))
                 .map_err(|e| map_err(e, el, read, 0))?;
@@ -556,6 +653,8 @@ fn read_faces_fast<R: BufRead, const BE: bool>(
         if with_face_index {
             reserve_upto(&mut b.tri_faces, in_window, total);
         }
+        b.account()
+            .map_err(|e| map_err(e, el, rec, b.vertex_count))?;
         let mut pos = 0;
         while rec < el.count {
             let rest = &buf[pos..];
@@ -738,6 +837,7 @@ fn io_kind(e: ReadErr) -> PlyErrorKind {
         ReadErr::Eof => PlyErrorKind::Io(std::io::ErrorKind::UnexpectedEof.into()),
         ReadErr::Bad(m) => PlyErrorKind::Io(std::io::Error::other(m)),
         ReadErr::Index(i) => PlyErrorKind::Io(std::io::Error::other(format!("index {i}"))),
+        ReadErr::Budget(e) => PlyErrorKind::OverBudget(e),
     }
 }
 
@@ -746,16 +846,25 @@ fn io_kind(e: ReadErr) -> PlyErrorKind {
 /// reading it; it sizes reservations, and an exact one lets a short body be
 /// reported before it is read. Errors from `r` come back as
 /// [`PlyErrorKind::Io`].
+///
+/// The mesh's arrays are charged to `budget`: after the header, what its
+/// counts need is checked against it (counts that a body of known size
+/// cannot hold are left to the truncation checks), and as the arrays grow
+/// they are charged. On an error the charges are given back.
 pub(super) fn parse_reader<R: BufRead>(
     mut r: R,
     total: Option<u64>,
     exact: bool,
+    budget: &MemoryBudget,
 ) -> Result<PlyMesh, PlyErrorKind> {
     let header = parse_header(&mut r)?;
     let plan = plan(&header)?;
     let body = total.map(|t| t.saturating_sub(header.data_start as u64));
+    check_claim(&header, &plan, body.filter(|_| exact), budget)?;
     let mut input = Input::new(r, body, exact);
     let mut b = Builder {
+        budget: budget.clone(),
+        charged: 0,
         vertex_count: header.elements[plan.vertex].count,
         positions: Vec::new(),
         normals: Vec::new(),
@@ -768,18 +877,67 @@ pub(super) fn parse_reader<R: BufRead>(
         fans: 0,
         ignored: 0,
     };
+    let result = read_body(&mut input, &header, &plan, &mut b);
+    if result.is_err() {
+        budget.release(b.charged);
+    }
+    result
+}
+
+/// Holds what the header's element counts need against the budget, before
+/// any of the body is read. With `body`, the exact size of the body, a
+/// count is believed only as far as the body can hold its records.
+fn check_claim(
+    header: &Header,
+    plan: &Plan,
+    body: Option<u64>,
+    budget: &MemoryBudget,
+) -> Result<(), PlyErrorKind> {
+    let believed = |el: &Element| -> u64 {
+        let min_size = match header.format {
+            Format::Ascii => el.props.len(),
+            _ => el.min_binary_size(),
+        };
+        match body {
+            Some(b) => el.count.min(b / min_size.max(1) as u64),
+            None => el.count,
+        }
+    };
+    let (vertices, faces) = (&header.elements[plan.vertex], &header.elements[plan.face]);
+    let layout = &plan.vertex_layout;
+    let per_vertex = 12 + 12 * u64::from(layout.normals) + 8 * u64::from(layout.uvs);
+    // A face is at least a triangle (12 bytes) and a quad takes 16.
+    let per_face = 12 + 4 * u64::from(plan.face_layout.face_index.is_some());
+    let (nv, nf) = (believed(vertices), believed(faces));
+    let bytes = nv
+        .saturating_mul(per_vertex)
+        .saturating_add(nf.saturating_mul(per_face));
+    let what = format!(
+        "this mesh ({} vertices, {} faces)",
+        vertices.count, faces.count
+    );
+    budget.check(bytes, &what).map_err(PlyErrorKind::OverBudget)
+}
+
+/// Decodes the body into `b` and assembles the mesh.
+fn read_body<R: BufRead>(
+    input: &mut Input<R>,
+    header: &Header,
+    plan: &Plan,
+    b: &mut Builder,
+) -> Result<PlyMesh, PlyErrorKind> {
     let mut warnings = Vec::new();
     match header.format {
         Format::Ascii => {
-            if read_ascii(&mut input, &header, &plan, &mut b)? {
+            if read_ascii(input, header, plan, b)? {
                 warnings.push("ignored trailing data after the last element".to_string());
             }
         }
         Format::BinaryLittleEndian | Format::BinaryBigEndian => {
             let trailing = if header.format == Format::BinaryBigEndian {
-                read_binary::<R, true>(&mut input, &header, &plan, &mut b)?
+                read_binary::<R, true>(input, header, plan, b)?
             } else {
-                read_binary::<R, false>(&mut input, &header, &plan, &mut b)?
+                read_binary::<R, false>(input, header, plan, b)?
             };
             if trailing > 0 {
                 warnings.push(format!(
@@ -810,20 +968,22 @@ pub(super) fn parse_reader<R: BufRead>(
             "{non_finite} vertices have non-finite (NaN or infinite) coordinates"
         ));
     }
-    if let Some(w) = unused_properties(&header, &plan) {
+    if let Some(w) = unused_properties(header, plan) {
         warnings.push(w);
     }
     let mut face_indices = Vec::new();
     if plan.face_layout.face_index.is_some() {
-        face_indices = b.tri_faces;
+        face_indices = std::mem::take(&mut b.tri_faces);
         face_indices.extend_from_slice(&b.quad_faces);
+        b.account()
+            .map_err(|e| map_err(e, &header.elements[plan.face], 0, b.vertex_count))?;
     }
     Ok(PlyMesh {
-        positions: b.positions,
-        normals: b.normals,
-        uvs: b.uvs,
-        tri_indices: b.tris,
-        quad_indices: b.quads,
+        positions: std::mem::take(&mut b.positions),
+        normals: std::mem::take(&mut b.normals),
+        uvs: std::mem::take(&mut b.uvs),
+        tri_indices: std::mem::take(&mut b.tris),
+        quad_indices: std::mem::take(&mut b.quads),
         face_indices,
         warnings,
     })
@@ -831,18 +991,21 @@ pub(super) fn parse_reader<R: BufRead>(
 
 /// Parses a gzip-compressed PLY file held in memory, inflating it as it is
 /// decoded. Errors from the decompressor come back as [`PlyErrorKind::Gzip`].
-pub(super) fn parse_gzip(bytes: &[u8]) -> Result<PlyMesh, PlyErrorKind> {
+pub(super) fn parse_gzip(bytes: &[u8], budget: &MemoryBudget) -> Result<PlyMesh, PlyErrorKind> {
     let hint = crate::input::gzip_size_hint(bytes);
     let r = BufReader::with_capacity(WINDOW, flate2::read::MultiGzDecoder::new(bytes));
-    parse_reader(r, hint, false).map_err(gzip_kind)
+    parse_reader(r, hint, false, budget).map_err(gzip_kind)
 }
 
 /// Parses a PLY stream from a file (see [`crate::input::FileReader`]).
-pub(super) fn parse_file(reader: crate::input::FileReader) -> Result<PlyMesh, PlyErrorKind> {
+pub(super) fn parse_file(
+    reader: crate::input::FileReader,
+    budget: &MemoryBudget,
+) -> Result<PlyMesh, PlyErrorKind> {
     let gzip = reader.is_gzip();
     let total = reader.size_hint();
     let r = BufReader::with_capacity(WINDOW, reader);
-    let mesh = parse_reader(r, total, !gzip);
+    let mesh = parse_reader(r, total, !gzip, budget);
     if gzip {
         mesh.map_err(gzip_kind)
     } else {

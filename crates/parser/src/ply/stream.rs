@@ -21,6 +21,8 @@ pub(super) enum ReadErr {
     Index(i64),
     /// The underlying reader failed (for gzip: corrupt or truncated data).
     Io(io::Error),
+    /// The mesh grew past the memory budget.
+    Budget(crate::budget::OverBudget),
 }
 
 #[inline(always)]

@@ -894,6 +894,7 @@ fn parse_windowed(bytes: &[u8], window: usize) -> Result<PlyMesh, String> {
         std::io::BufReader::with_capacity(window, bytes),
         None,
         false,
+        &crate::budget::MemoryBudget::default(),
     )
     .map_err(|k| format!("{k:?}"))
 }
@@ -965,4 +966,64 @@ fn unused_properties_and_elements_are_named_in_one_warning() {
         "{}",
         w[0]
     );
+}
+
+/// Issue 34, finding 6: a mesh past the memory budget is an error naming
+/// the budget, whether its header's counts say so or its polygons only
+/// grow past it as the gzip stream inflates.
+#[test]
+fn oom_ply_past_the_budget_is_an_error_not_an_allocation() {
+    let budget = |mib: u64| crate::budget::MemoryBudget::labelled(mib << 20, "--max-memory");
+    let gzip = |parts: &[&[u8]], repeat_last: usize| {
+        let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+        for p in parts {
+            gz.write_all(p).unwrap();
+        }
+        for _ in 1..repeat_last {
+            gz.write_all(parts[parts.len() - 1]).unwrap();
+        }
+        gz.finish().unwrap()
+    };
+    let xyz = "property float x\nproperty float y\nproperty float z\n";
+    let faces = "property list uchar int vertex_indices\n";
+    // The header claims 2^24 vertices (192 MiB): refused before the body.
+    let header = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex 16777216\n{xyz}\
+         element face 0\n{faces}end_header\n"
+    );
+    let b = budget(16);
+    let e = parse_ply_within(&gzip(&[header.as_bytes()], 1), &b).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "<memory>: this mesh (16777216 vertices, 0 faces) needs 192.0 MiB; --max-memory is 16.0 MiB"
+    );
+    assert_eq!(b.used(), 0);
+    // 20000 faces of 255 vertices (12 bytes each by the header's count)
+    // fan into five million triangles as they are read.
+    let header = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex 255\n{xyz}\
+         element face 20000\n{faces}end_header\n"
+    );
+    let vertices = vec![0u8; 255 * 12];
+    let mut face = vec![255u8];
+    for i in 0..255i32 {
+        face.extend(i.to_le_bytes());
+    }
+    let bytes = gzip(&[header.as_bytes(), &vertices, &face], 20000);
+    let b = budget(16);
+    let e = parse_ply_within(&bytes, &b).unwrap_err();
+    assert!(matches!(e.kind, PlyErrorKind::OverBudget(_)), "{e}");
+    let msg = e.to_string();
+    assert!(
+        msg.starts_with("<memory>: this mesh needs more than ")
+            && msg.ends_with(" MiB; --max-memory is 16.0 MiB"),
+        "{msg}"
+    );
+    // What the mesh had charged is given back.
+    assert_eq!(b.used(), 0);
+    // With room, it is read, and what it holds stays charged.
+    let b = budget(256);
+    let m = parse_ply_within(&bytes, &b).unwrap();
+    assert_eq!(m.triangle_count(), 20000 * 253);
+    assert!(b.used() >= (m.tri_indices.len() * 4) as u64);
 }

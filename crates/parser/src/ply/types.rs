@@ -121,6 +121,9 @@ pub enum PlyErrorKind {
     },
     /// The mesh given to the writer is inconsistent.
     InvalidMesh(String),
+    /// The mesh needs more memory than the budget has left (see
+    /// [`MemoryBudget`](crate::budget::MemoryBudget)).
+    OverBudget(crate::budget::OverBudget),
 }
 
 impl PlyError {
@@ -183,6 +186,7 @@ impl fmt::Display for PlyErrorKind {
                 "face {face}: vertex index {index} is out of range [0, {vertex_count})"
             ),
             PlyErrorKind::InvalidMesh(m) => write!(f, "invalid mesh: {m}"),
+            PlyErrorKind::OverBudget(e) => write!(f, "{e}"),
         }
     }
 }

@@ -185,8 +185,12 @@ fn screen_window(cp: &ParamReader, film: &FilmGeometry) -> Result<Bounds2f, Diag
 
 /// Reads an aperture image file (pbrt-v4: RGB images are averaged to one
 /// channel; the image is flipped and normalised by `ApertureImage`).
-fn read_aperture_image(path: &Path) -> Result<ApertureImage, String> {
-    let image = crate::image::Image::read(path, Some(crate::image::ColorEncoding::Linear))
+fn read_aperture_image(
+    path: &Path,
+    budget: &rpbrt_parser::MemoryBudget,
+) -> Result<ApertureImage, String> {
+    let encoding = Some(crate::image::ColorEncoding::Linear);
+    let image = crate::image::Image::read_within(path, encoding, budget)
         .map_err(|e| e.to_string())?
         .image;
     let res = image.resolution();
@@ -298,12 +302,14 @@ fn create_realistic(cp: &ParamReader, base: CameraBase) -> Result<Camera, Diagno
         match ApertureImage::builtin(&aperture) {
             Some(img) => Some(img),
             None => Some(
-                read_aperture_image(&cp.resolve("aperture", &aperture)).map_err(|m| {
-                    Diagnostic::error(
-                        cp.param_loc("aperture"),
-                        format!("aperture \"{aperture}\": {m}"),
-                    )
-                })?,
+                read_aperture_image(&cp.resolve("aperture", &aperture), cp.budget()).map_err(
+                    |m| {
+                        Diagnostic::error(
+                            cp.param_loc("aperture"),
+                            format!("aperture \"{aperture}\": {m}"),
+                        )
+                    },
+                )?,
             ),
         }
     };

@@ -325,6 +325,7 @@ pub fn create_film(
         }
         _ => KindConfig::Rgb,
     };
+    fp.charge(FilmCore::memory_bytes(pixel_bounds, &kind), "this film")?;
     let core = FilmCore::new(
         FilmParams {
             full_resolution: full,

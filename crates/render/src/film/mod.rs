@@ -109,6 +109,26 @@ pub struct FilmParams {
 }
 
 impl FilmCore {
+    /// The memory a film over `pixel_bounds` of kind `kind` needs, in
+    /// bytes: its sums and splats per pixel, and the float image it writes
+    /// with the encoded file (for the memory budget, before the film is made).
+    pub fn memory_bytes(pixel_bounds: Bounds2i, kind: &KindConfig) -> u64 {
+        let n = pixel_bounds.area().max(0) as u64;
+        let f64s = std::mem::size_of::<f64>();
+        let (extra, channels) = match kind {
+            KindConfig::Rgb => (0, 3),
+            KindConfig::GBuffer { .. } => (
+                std::mem::size_of::<pixels::GBufferPixel>(),
+                3 + GBUFFER_CHANNELS.len(),
+            ),
+            // Bucket sums, weights and splats.
+            KindConfig::Spectral { n_buckets, .. } => (3 * f64s * n_buckets, 3 + n_buckets),
+        };
+        // RGB and weight sums, RGB splats; the image and its file in floats.
+        let per_pixel = 4 * f64s + 3 * f64s + extra + 2 * 4 * channels;
+        n.saturating_mul(per_pixel as u64)
+    }
+
     /// A film core; `pixel_bounds` must be non-empty and valid.
     pub fn new(p: FilmParams, filter: Filter, sensor: PixelSensor, kind: KindConfig) -> Self {
         debug_assert!(!p.pixel_bounds.is_empty());

@@ -9,7 +9,8 @@ use std::sync::{Arc, Mutex};
 
 use rpbrt_geometry::{Point2f, Point2i, Vector2f};
 
-use super::{ColorEncoding, Image, ImageError, WrapMode, WrapMode2D};
+use super::{ColorEncoding, Image, ImageError, PixelFormat, WrapMode, WrapMode2D};
+use rpbrt_parser::MemoryBudget;
 
 /// How MIP-map lookups filter.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -172,16 +173,58 @@ impl MIPMap {
         }
     }
 
+    /// The memory the pyramid of an image of resolution `res` with `nc`
+    /// channels in `format` takes, and what building it needs for a
+    /// moment besides (the finest level in floats), in bytes.
+    pub fn memory_bytes(res: Point2i, nc: usize, format: PixelFormat) -> (u64, u64) {
+        let up = |v: i32| (v.max(1) as u32).next_power_of_two() as u64;
+        let samples = (up(res.x) * up(res.y)).saturating_mul(nc as u64);
+        let size = match format {
+            PixelFormat::U256 => 1,
+            PixelFormat::Half => 2,
+            PixelFormat::Float => 4,
+        };
+        // The levels below the finest add a third.
+        let pyramid = samples.saturating_mul(size) / 3 * 4;
+        (pyramid, samples.saturating_mul(4))
+    }
+
     /// Reads an image file and builds its MIP map. Multi-channel images are reduced to
-    /// R, G, B (and A unless alpha is 1 everywhere), as pbrt-v4 does.
+    /// R, G, B (and A unless alpha is 1 everywhere), as pbrt-v4 does. The
+    /// image and the map are held against the default memory budget.
     pub fn from_file(
         path: impl AsRef<Path>,
         options: MIPMapFilterOptions,
         wrap_mode: WrapMode,
         encoding: ColorEncoding,
     ) -> Result<MIPMap, ImageError> {
+        Self::from_file_within(path, options, wrap_mode, encoding, &MemoryBudget::default())
+    }
+
+    /// [`from_file`](Self::from_file), charging the image and then its
+    /// pyramid (which replaces it) to `budget`.
+    pub fn from_file_within(
+        path: impl AsRef<Path>,
+        options: MIPMapFilterOptions,
+        wrap_mode: WrapMode,
+        encoding: ColorEncoding,
+        budget: &MemoryBudget,
+    ) -> Result<MIPMap, ImageError> {
         let path = path.as_ref();
-        let read = Image::read(path, Some(encoding))?;
+        let read = Image::read_within(path, Some(encoding), budget)?;
+        let read_bytes = read.image.bytes_used() as u64;
+        let result = Self::from_read(path, read, options, wrap_mode, budget);
+        budget.release(read_bytes);
+        result
+    }
+
+    fn from_read(
+        path: &Path,
+        read: super::ImageAndMetadata,
+        options: MIPMapFilterOptions,
+        wrap_mode: WrapMode,
+        budget: &MemoryBudget,
+    ) -> Result<MIPMap, ImageError> {
         let mut image = read.image;
         if image.n_channels() != 1 {
             let rgba = image.get_channel_desc(&["R", "G", "B", "A"]);
@@ -203,6 +246,16 @@ impl MIPMap {
                 }
             };
         }
+        let (pyramid, scratch) =
+            Self::memory_bytes(image.resolution(), image.n_channels(), image.format());
+        let what = "this texture's MIP map";
+        budget
+            .check(pyramid.saturating_add(scratch), what)
+            .and_then(|()| budget.charge(pyramid, what))
+            .map_err(|e| ImageError::Format {
+                path: path.display().to_string(),
+                message: e.to_string(),
+            })?;
         Ok(MIPMap::new(
             &image,
             read.metadata.color_space_name(),
@@ -392,12 +445,22 @@ type CacheSlot = Arc<Mutex<Option<Arc<MIPMap>>>>;
 pub struct MIPMapCache {
     map: Mutex<HashMap<CacheKey, CacheSlot>>,
     files_read: AtomicUsize,
+    /// What the maps are charged to (`None`: the default budget).
+    budget: Option<MemoryBudget>,
 }
 
 impl MIPMapCache {
     /// An empty cache.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// An empty cache whose maps are charged to `budget`.
+    pub fn with_budget(budget: &MemoryBudget) -> Self {
+        MIPMapCache {
+            budget: Some(budget.clone()),
+            ..Self::default()
+        }
     }
 
     /// The MIP map for these settings, reading the file on first use. Failures are not
@@ -426,7 +489,11 @@ impl MIPMapCache {
             return Ok(m.clone());
         }
         self.files_read.fetch_add(1, Ordering::Relaxed);
-        let m = Arc::new(MIPMap::from_file(path, options, wrap_mode, encoding)?);
+        let m = match &self.budget {
+            Some(b) => MIPMap::from_file_within(path, options, wrap_mode, encoding, b)?,
+            None => MIPMap::from_file(path, options, wrap_mode, encoding)?,
+        };
+        let m = Arc::new(m);
         *slot = Some(m.clone());
         Ok(m)
     }

@@ -170,6 +170,36 @@ impl Integrator {
         matches!(self, Integrator::Path(_) | Integrator::VolPath(_))
     }
 
+    /// The memory the integrator's own buffers take over a film of
+    /// `pixels` pixels, in bytes, where its parameters or the film size
+    /// them (for the memory budget; per-thread scratch is not counted).
+    pub fn memory_bytes(&self, pixels: u64) -> u64 {
+        match self {
+            // Per pixel: the pixel's state, this iteration's flux and
+            // photon count, and the visible points' hash grid.
+            Integrator::Sppm(_) => {
+                let per_pixel = std::mem::size_of::<sppm::SppmPixel>() + 12 + 4 + 8 + 16;
+                pixels.saturating_mul(per_pixel as u64)
+            }
+            // The bootstrap weights and their distribution, and the
+            // chains' states.
+            Integrator::Mlt(m) => {
+                let depths = m.max_depth.max(0) as u64 + 1;
+                let bootstrap = (m.bootstrap_samples.max(1) as u64).saturating_mul(depths);
+                bootstrap
+                    .saturating_mul(12)
+                    .saturating_add((m.chains.max(1) as u64).saturating_mul(512))
+            }
+            // One RGB film per strategy when they are visualised.
+            Integrator::Bdpt(b) if b.visualize_strategies || b.visualize_weights => {
+                let d = b.max_depth.max(0) as u64;
+                let films = (1 + d).saturating_mul(6 + d) / 2;
+                films.saturating_mul(pixels).saturating_mul(80)
+            }
+            _ => 0,
+        }
+    }
+
     /// The integrator's name in scene files.
     pub fn name(&self) -> &'static str {
         match self {

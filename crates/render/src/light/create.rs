@@ -93,7 +93,8 @@ fn read_image(
     filename: &str,
 ) -> Result<(Image, &'static RgbColorSpace), Diagnostic> {
     let path = lp.resolve("filename", filename);
-    let im = Image::read(&path, None).map_err(|e| lp.error_at("filename", format!("{e}")))?;
+    let im = Image::read_within(&path, None, lp.budget())
+        .map_err(|e| lp.error_at("filename", format!("{e}")))?;
     let cs_name = im.metadata.color_space_name();
     let cs = RgbColorSpace::get(cs_name)
         .ok_or_else(|| lp.error_at("filename", format!("\"{cs_name}\": unknown colour space")))?;

@@ -5,6 +5,8 @@
 
 use std::path::Path;
 
+use rpbrt_parser::MemoryBudget;
+
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::interaction::SurfaceInteraction;
 use rpbrt_geometry::tuple::*;
@@ -74,9 +76,10 @@ pub fn normal_map(map: &Image, si: &SurfaceInteraction) -> (Vector3f, Vector3f) 
 }
 
 /// Reads a normal map as pbrt-v4 does: linear encoding, keeping the R, G
-/// and B channels.
-pub fn read_normal_map(path: &Path) -> Result<Image, String> {
-    let im = Image::read(path, Some(ColorEncoding::Linear)).map_err(|e| e.to_string())?;
+/// and B channels; the image is charged to `budget`.
+pub fn read_normal_map(path: &Path, budget: &MemoryBudget) -> Result<Image, String> {
+    let im =
+        Image::read_within(path, Some(ColorEncoding::Linear), budget).map_err(|e| e.to_string())?;
     let Some(desc) = im.image.get_channel_desc(&["R", "G", "B"]) else {
         return Err(format!(
             "{}: normal map image must contain R, G and B channels (it has {})",

@@ -178,8 +178,10 @@ fn perturbation(
         if let Some(im) = cache.get(&path) {
             Some(im.clone())
         } else {
-            let im =
-                Arc::new(read_normal_map(&path).map_err(|m| Diagnostic::error(loc.clone(), m))?);
+            let im = Arc::new(
+                read_normal_map(&path, tp.budget())
+                    .map_err(|m| Diagnostic::error(loc.clone(), m))?,
+            );
             cache.insert(path, im.clone());
             Some(im)
         }

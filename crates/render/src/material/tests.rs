@@ -484,7 +484,7 @@ fn flat_normal_map(rgb: [f32; 3], tag: &str) -> Arc<Image> {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("n.pfm");
     im.write(&path, &ImageMetadata::default()).unwrap();
-    let read = read_normal_map(&path).unwrap();
+    let read = read_normal_map(&path, &Default::default()).unwrap();
     let _ = std::fs::remove_dir_all(&dir);
     Arc::new(read)
 }
@@ -551,12 +551,16 @@ fn normal_map_needs_rgb_channels() {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("g.pfm");
     im.write(&path, &ImageMetadata::default()).unwrap();
-    let r = read_normal_map(&path);
+    let r = read_normal_map(&path, &Default::default());
     let _ = std::fs::remove_dir_all(&dir);
     // A one-channel PFM comes back as a single channel: no R, G, B.
     let err = r.unwrap_err();
     assert!(err.contains("R, G and B"), "{err}");
-    assert!(read_normal_map(std::path::Path::new("/nonexistent/n.png")).is_err());
+    assert!(read_normal_map(
+        std::path::Path::new("/nonexistent/n.png"),
+        &Default::default()
+    )
+    .is_err());
 }
 
 #[test]

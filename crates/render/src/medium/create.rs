@@ -5,7 +5,9 @@
 //! they share are here.
 
 use super::measured::get_medium_scattering_properties;
-use super::nanovdb::{read_float_grid, require_float_grid, FloatGrid, GridClass, NanoVdbError};
+use super::nanovdb::{
+    grid_bytes, read_float_grid, require_float_grid, FloatGrid, GridClass, NanoVdbError,
+};
 use super::{
     CloudMedium, GridMedium, HomogeneousMedium, Medium, NanoVdbMedium, NanoVdbTemperature,
     RgbGridMedium,
@@ -271,9 +273,16 @@ fn create_nanovdb(
     };
     let file_error = |e: NanoVdbError| mp.error_at("filename", format!("{}: {e}", path.display()));
     let grid_name = mp.string("gridname", "density")?;
+    let temperature_name = mp.string("temperaturename", "temperature")?;
+    // The grids as the file stores them, and the tables made of them, before
+    // they are inflated.
+    for name in [&grid_name, &temperature_name] {
+        if let Some(bytes) = grid_bytes(&path, name).map_err(file_error)? {
+            mp.charge(bytes.saturating_mul(2), &format!("the grid \"{name}\""))?;
+        }
+    }
     let density = require_float_grid(&path, &grid_name).map_err(file_error)?;
     check_vdb_grid(mp, &path, &density)?;
-    let temperature_name = mp.string("temperaturename", "temperature")?;
     let temperature_grid = read_float_grid(&path, &temperature_name).map_err(file_error)?;
     let le_scale = mp.float("Lescale", 1.0)?;
     let cutoff = mp.float("temperaturecutoff", 0.0)?;

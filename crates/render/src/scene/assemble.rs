@@ -8,7 +8,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use rpbrt_parser::Diagnostic;
+use rpbrt_parser::{Diagnostic, MemoryBudget};
 
 use super::entities::*;
 use super::materials::{create_materials, create_textures};
@@ -29,6 +29,10 @@ use crate::params::{unknown_type, ParamReader};
 use crate::primitive::{AnimatedPrimitive, Primitive, PrimitiveAggregate, TransformedPrimitive};
 use crate::sampler::{create_sampler, Sampler};
 use crate::texture::TextureOptions;
+
+/// What an object instance adds when the scene is created, in bytes: its
+/// primitive (boxed with its transformation) and accelerator entry.
+const INSTANCE_BYTES: u64 = 256;
 
 /// Command-line settings that change how the scene is created.
 #[derive(Clone, Debug, Default)]
@@ -99,8 +103,11 @@ impl Problems {
 }
 
 /// A directive's parameter reader in its colour space.
-pub(super) fn reader(e: &SceneEntity) -> Result<ParamReader<'_>, Diagnostic> {
-    ParamReader::new(&e.params, &e.loc, &e.color_space)
+pub(super) fn reader<'a>(
+    e: &'a SceneEntity,
+    budget: &MemoryBudget,
+) -> Result<ParamReader<'a>, Diagnostic> {
+    ParamReader::new(&e.params, &e.loc, &e.color_space).map(|r| r.with_budget(budget))
 }
 
 /// Reads an `Accelerator` directive's parameters.
@@ -136,7 +143,7 @@ fn create_media(desc: &SceneDescription, p: &mut Problems) -> (Vec<Medium>, Hash
     let mut media = Vec::new();
     let mut ids = HashMap::new();
     for m in &desc.media {
-        let Some(r) = p.take(reader(&m.base)) else {
+        let Some(r) = p.take(reader(&m.base, &desc.budget)) else {
             continue;
         };
         if m.render_from_object.is_animated() {
@@ -147,8 +154,10 @@ fn create_media(desc: &SceneDescription, p: &mut Problems) -> (Vec<Medium>, Hash
         // The builder keeps the type among the parameters as its
         // `"string type"`; reading it here marks it used (it is the
         // entity's name), so it is not reported as an unused parameter.
+        // Grids written in the scene copy their parameters' values.
         let medium = r
-            .string("type", &m.base.name)
+            .charge(m.base.params.memory_bytes() as u64, "this medium's data")
+            .and_then(|()| r.string("type", &m.base.name))
             .and_then(|ty| create_medium(&ty, &r, &m.render_from_object.start_transform));
         if let Some(medium) = p.finish(r, medium) {
             ids.insert(m.name.clone(), media.len() as u32);
@@ -261,12 +270,12 @@ pub fn create_scene(
     let medium_of = |name: &str| medium_ids.get(name).copied();
 
     // Filter, film, camera, sampler.
-    let filter = p.take(reader(&desc.filter)).and_then(|r| {
+    let filter = p.take(reader(&desc.filter, &desc.budget)).and_then(|r| {
         let f = create_filter(&desc.filter.name, &r);
         p.finish(r, f)
     });
     let camera_entity = &desc.camera;
-    let Some(camera_reader) = p.take(reader(&camera_entity.base)) else {
+    let Some(camera_reader) = p.take(reader(&camera_entity.base, &desc.budget)) else {
         return Err(problems.errors);
     };
     let exposure = camera_reader.float("shutterclose", 1.0).unwrap_or(1.0)
@@ -283,7 +292,7 @@ pub fn create_scene(
         ..opts.film.clone()
     };
     let film = filter.as_ref().and_then(|filter| {
-        let r = p.take(reader(&desc.film))?;
+        let r = p.take(reader(&desc.film, &desc.budget))?;
         let f = create_film(
             &desc.film.name,
             &r,
@@ -310,7 +319,7 @@ pub fn create_scene(
     };
     // Importance (pbrt-v4 `We`) depends on the film's filter.
     camera.set_filter_radius(filter.radius());
-    let sampler = p.take(reader(&desc.sampler)).and_then(|r| {
+    let sampler = p.take(reader(&desc.sampler, &desc.budget)).and_then(|r| {
         let s = create_sampler(
             &desc.sampler.name,
             &r,
@@ -322,7 +331,7 @@ pub fn create_scene(
     });
 
     // Textures and materials.
-    let cache = MIPMapCache::new();
+    let cache = MIPMapCache::with_budget(&desc.budget);
     let texture_options = TextureOptions {
         disable_texture_filtering: opts.disable_texture_filtering,
     };
@@ -331,19 +340,24 @@ pub fn create_scene(
         &desc.spectrum_textures,
         &cache,
         &texture_options,
+        &desc.budget,
         p,
     ) else {
         return Err(problems.errors);
     };
-    let Some((materials, named_material_ids)) =
-        create_materials(&desc.materials, &desc.named_materials, &textures, p)
-    else {
+    let Some((materials, named_material_ids)) = create_materials(
+        &desc.materials,
+        &desc.named_materials,
+        &textures,
+        &desc.budget,
+        p,
+    ) else {
         return Err(problems.errors);
     };
     // Lights.
     let mut lights: Vec<Light> = Vec::new();
     for l in &desc.lights {
-        let Some(r) = p.take(reader(&l.base)) else {
+        let Some(r) = p.take(reader(&l.base, &desc.budget)) else {
             continue;
         };
         let light = create_light(
@@ -432,6 +446,12 @@ pub fn create_scene(
         if def.primitives().is_empty() {
             continue;
         }
+        // The instance's primitive and its accelerator entry.
+        if let Err(e) = desc.budget.charge(INSTANCE_BYTES, "this object instance") {
+            p.errors
+                .push(Diagnostic::error(inst.loc.clone(), e.to_string()));
+            break;
+        }
         prims.push(match &inst.render_from_instance {
             InstanceTransform::Fixed(t) => Primitive::Transformed(Box::new(TransformedPrimitive {
                 primitive: def.clone(),
@@ -445,22 +465,24 @@ pub fn create_scene(
     }
 
     let accel = p
-        .take(reader(&desc.accelerator))
+        .take(reader(&desc.accelerator, &desc.budget))
         .and_then(|r| {
             let a = accel_params(&desc.accelerator.name, &r);
             p.finish(r, a)
         })
         .unwrap_or_default();
-    let integrator = p.take(reader(&desc.integrator)).and_then(|r| {
-        let iopts = IntegratorOptions {
-            spp: opts.spp,
-            seed: opts.seed,
-            outfile: opts.film.outfile.clone(),
-        };
-        let i = create_integrator(&desc.integrator.name, &r, &iopts)
-            .map(|i| v3_path_with_subsurface(desc, &materials, i));
-        p.finish(r, i)
-    });
+    let integrator = p
+        .take(reader(&desc.integrator, &desc.budget))
+        .and_then(|r| {
+            let iopts = IntegratorOptions {
+                spp: opts.spp,
+                seed: opts.seed,
+                outfile: opts.film.outfile.clone(),
+            };
+            let i = create_integrator(&desc.integrator.name, &r, &iopts)
+                .map(|i| v3_path_with_subsurface(desc, &materials, i));
+            p.finish(r, i)
+        });
     if let Some(i) = &integrator {
         let mut used = vec![false; materials.materials().len()];
         for prim in &prims {
@@ -494,6 +516,18 @@ pub fn create_scene(
             p.errors.push(Diagnostic::error(
                 desc.integrator.loc.clone(),
                 "\"sobol\" sampler should be replaced with \"paddedsobol\" for the \"function\" integrator.",
+            ));
+        }
+    }
+    if let Some(i) = &integrator {
+        let pixels = film.pixel_bounds().area().max(0) as u64;
+        if let Err(e) = desc.budget.charge(
+            i.memory_bytes(pixels),
+            &format!("the \"{}\" integrator", i.name()),
+        ) {
+            p.errors.push(Diagnostic::error(
+                desc.integrator.loc.clone(),
+                e.to_string(),
             ));
         }
     }

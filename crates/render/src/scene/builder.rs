@@ -15,8 +15,9 @@ use std::sync::Arc;
 use rpbrt_geometry::{
     AnimatedTransform, Point3f, SquareMatrix4, Transform, TransformError, Vector3f,
 };
+use rpbrt_parser::budget::{heap, vec_element};
 use rpbrt_parser::upgrade::{self, Upgraded};
-use rpbrt_parser::Diagnostic;
+use rpbrt_parser::{Diagnostic, MemoryBudget};
 use rpbrt_parser::{
     DirectiveResult, FileLoc, ParamList, ParameterDictionary, ParsedParameter, ParserTarget,
 };
@@ -27,6 +28,11 @@ use super::state::*;
 use crate::camera::{CameraTransform, RenderingCoordinateSystem};
 use crate::params::unknown_type;
 use crate::spectrum::RgbColorSpace;
+
+/// What one entry of the `AttributeBegin`/`TransformBegin`/`ObjectBegin`
+/// stack is charged: the graphics state it saves.
+const PUSHED_BYTES: usize =
+    2 * std::mem::size_of::<Pushed>() + std::mem::size_of::<GraphicsState>();
 
 /// A pbrt-v3 → pbrt-v4 mapping of the parser crate.
 type UpgradeFn = fn(&str, Vec<ParsedParameter>, &FileLoc) -> Upgraded;
@@ -90,6 +96,13 @@ impl SceneBuilder {
         }
     }
 
+    /// The builder charging the description to `budget` (by default, to
+    /// [`MemoryBudget::default`]); the description keeps it for creation.
+    pub fn with_budget(mut self, budget: MemoryBudget) -> Self {
+        self.scene.budget = budget;
+        self
+    }
+
     /// The description built so far (complete after `end_of_files`).
     pub fn scene(&self) -> &SceneDescription {
         &self.scene
@@ -103,6 +116,24 @@ impl SceneBuilder {
     /// Depth of the `AttributeBegin`/`ObjectBegin`/`TransformBegin` stack.
     pub fn nesting_depth(&self) -> usize {
         self.pushed.len()
+    }
+
+    // ---- the memory budget ------------------------------------------------
+
+    /// Charges `bytes`, what the directive `what` at `loc` adds to the
+    /// description, to the memory budget: a scene of millions of
+    /// directives ends in a located error when the budget runs out, not in
+    /// an allocation failure.
+    fn charge(&self, bytes: usize, what: &str, loc: &FileLoc) -> DirectiveResult {
+        self.scene
+            .budget
+            .charge(bytes as u64, &format!("this {what}"))
+            .map_err(|e| Diagnostic::error(loc.clone(), e.to_string()))
+    }
+
+    /// [`charge`](Self::charge) for an entity of type `T` whose heap part is `e`'s.
+    fn charge_entity<T>(&self, e: &SceneEntity, what: &str) -> DirectiveResult {
+        self.charge(vec_element::<T>() + e.heap_bytes(), what, &e.loc)
     }
 
     // ---- state checks ---------------------------------------------------
@@ -336,6 +367,7 @@ impl SceneBuilder {
                 ),
             )
         });
+        self.scene.budget.release(PUSHED_BYTES as u64);
         match top {
             Pushed::Attribute(state, _) => self.state = *state,
             Pushed::Transform(ctm, active, _) => {
@@ -412,7 +444,13 @@ impl ParserTarget for SceneBuilder {
         Ok(())
     }
 
-    fn coordinate_system(&mut self, name: &str, _loc: FileLoc) -> DirectiveResult {
+    fn coordinate_system(&mut self, name: &str, loc: FileLoc) -> DirectiveResult {
+        if !self.named_coordinate_systems.contains_key(name) {
+            // A map entry: the name, the transformations and the map's own
+            // bookkeeping (about a word per entry).
+            let bytes = name.len() + vec_element::<(String, TransformSet, u64)>();
+            self.charge(bytes, "CoordinateSystem", &loc)?;
+        }
         self.named_coordinate_systems
             .insert(name.to_string(), self.state.ctm);
         Ok(())
@@ -587,6 +625,7 @@ impl ParserTarget for SceneBuilder {
         );
         let attrs = self.state.medium_attributes.clone();
         let base = self.entity_with(ty, params, &attrs, loc);
+        self.charge_entity::<MediumSceneEntity>(&base, "MakeNamedMedium")?;
         let render_from_object = self.render_from_object();
         self.scene.media.push(MediumSceneEntity {
             name: name.to_string(),
@@ -599,6 +638,8 @@ impl ParserTarget for SceneBuilder {
     fn medium_interface(&mut self, inside: &str, outside: &str, loc: FileLoc) -> DirectiveResult {
         for n in [inside, outside] {
             if !n.is_empty() {
+                let bytes = vec_element::<(String, FileLoc)>() + heap(n.len());
+                self.charge(bytes, "MediumInterface", &loc)?;
                 self.medium_uses.push((n.to_string(), loc.clone()));
             }
         }
@@ -622,6 +663,12 @@ impl ParserTarget for SceneBuilder {
                 }
             }
         }
+        let text = match &value.value {
+            OptionValue::String(s) => s.len(),
+            _ => 0,
+        };
+        let bytes = vec_element::<SceneOption>() + heap(value.name.len()) + heap(text);
+        self.charge(bytes, "Option", &loc)?;
         self.scene.options.push(value);
         Ok(())
     }
@@ -644,6 +691,7 @@ impl ParserTarget for SceneBuilder {
 
     fn attribute_begin(&mut self, loc: FileLoc) -> DirectiveResult {
         self.verify_world("AttributeBegin", &loc)?;
+        self.charge(PUSHED_BYTES, "AttributeBegin", &loc)?;
         self.pushed
             .push(Pushed::Attribute(Box::new(self.state.clone()), loc));
         Ok(())
@@ -667,6 +715,7 @@ impl ParserTarget for SceneBuilder {
     }
 
     fn transform_begin(&mut self, loc: FileLoc) -> DirectiveResult {
+        self.charge(PUSHED_BYTES, "TransformBegin", &loc)?;
         self.pushed.push(Pushed::Transform(
             Box::new(self.state.ctm),
             self.state.active,
@@ -698,6 +747,11 @@ impl ParserTarget for SceneBuilder {
         };
         let mut params = params;
         upgrade::upgrade_param_types(&mut params);
+        let bytes: usize = params.iter().map(ParsedParameter::memory_bytes).sum();
+        self.scene
+            .budget
+            .charge(bytes as u64, "this Attribute")
+            .map_err(|e| Diagnostic::error(loc.clone(), e.to_string()))?;
         Arc::make_mut(attrs).extend(params);
         Ok(())
     }
@@ -739,6 +793,7 @@ impl ParserTarget for SceneBuilder {
         }
         let attrs = self.state.texture_attributes.clone();
         let base = self.entity_with(u.name, u.params, &attrs, loc);
+        self.charge_entity::<TextureSceneEntity>(&base, "Texture")?;
         let entity = TextureSceneEntity {
             name: name.to_string(),
             kind,
@@ -759,6 +814,7 @@ impl ParserTarget for SceneBuilder {
         EntityKind::Material.check(&name, &loc)?;
         let attrs = self.state.material_attributes.clone();
         let entity = self.entity_with(name, params, &attrs, loc);
+        self.charge_entity::<SceneEntity>(&entity, "Material")?;
         self.scene.materials.push(entity);
         self.state.material = MaterialRef::Index(self.scene.materials.len() - 1);
         Ok(())
@@ -793,12 +849,15 @@ impl ParserTarget for SceneBuilder {
         );
         let attrs = self.state.material_attributes.clone();
         let entity = self.entity_with(ty, params, &attrs, loc);
+        self.charge_entity::<(String, SceneEntity)>(&entity, "MakeNamedMaterial")?;
         self.scene.named_materials.push((name.to_string(), entity));
         Ok(())
     }
 
     fn named_material(&mut self, name: &str, loc: FileLoc) -> DirectiveResult {
         self.verify_world("NamedMaterial", &loc)?;
+        let bytes = vec_element::<(String, FileLoc)>() + heap(name.len());
+        self.charge(bytes, "NamedMaterial", &loc)?;
         self.named_material_uses.push((name.to_string(), loc));
         self.state.material = MaterialRef::Named(name.to_string());
         Ok(())
@@ -814,6 +873,7 @@ impl ParserTarget for SceneBuilder {
         EntityKind::Light.check(&name, &loc)?;
         let attrs = self.state.light_attributes.clone();
         let base = self.entity_with(name, params, &attrs, loc);
+        self.charge_entity::<LightSceneEntity>(&base, "LightSource")?;
         let light = LightSceneEntity {
             base,
             render_from_object: self.render_from_object(),
@@ -855,6 +915,27 @@ impl ParserTarget for SceneBuilder {
             }
         }
         EntityKind::Shape.check(&name, &loc)?;
+        // The description's entity (with a copy of the area light's) is
+        // charged here; the shapes made of it when the scene is created.
+        let own = vec_element::<ShapeSceneEntity>()
+            + params
+                .iter()
+                .map(ParsedParameter::memory_bytes)
+                .sum::<usize>()
+            + self
+                .state
+                .shape_attributes
+                .iter()
+                .map(ParsedParameter::memory_bytes)
+                .sum::<usize>()
+            + heap(name.capacity())
+            + heap(self.state.color_space.len());
+        let light = self
+            .state
+            .area_light
+            .as_ref()
+            .map_or(0, |al| vec_element::<SceneEntity>() + al.heap_bytes());
+        self.charge(own + light, "Shape", &loc)?;
         let light_index = match &self.state.area_light {
             Some(al) => {
                 if self.active_definition.is_some() {
@@ -899,6 +980,7 @@ impl ParserTarget for SceneBuilder {
 
     fn object_begin(&mut self, name: &str, loc: FileLoc) -> DirectiveResult {
         self.verify_world("ObjectBegin", &loc)?;
+        self.charge(PUSHED_BYTES + name.len(), "ObjectBegin", &loc)?;
         let state = Box::new(self.state.clone());
         let error = if self.active_definition.is_some() {
             Some(Diagnostic::error(
@@ -963,6 +1045,8 @@ impl ParserTarget for SceneBuilder {
         } else {
             InstanceTransform::Fixed(self.render_from_object_at(0) * world_from_render)
         };
+        let bytes = vec_element::<InstanceSceneEntity>() + heap(name.len());
+        self.charge(bytes, "ObjectInstance", &loc)?;
         self.scene.instances.push(InstanceSceneEntity {
             name: name.to_string(),
             loc,

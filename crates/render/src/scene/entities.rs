@@ -12,7 +12,7 @@ use std::fmt::Write as _;
 use std::sync::Arc;
 
 use rpbrt_geometry::{AnimatedTransform, Float, Transform};
-use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary, ParsedParameter};
+use rpbrt_parser::{Diagnostic, FileLoc, MemoryBudget, ParameterDictionary, ParsedParameter};
 
 use crate::camera::{CameraTransform, RenderingCoordinateSystem};
 
@@ -48,6 +48,13 @@ impl SceneEntity {
             loc,
             color_space: color_space.into(),
         }
+    }
+
+    /// The memory the entity holds beyond its own size (name, colour
+    /// space, parameters), in bytes, for the memory budget.
+    pub fn heap_bytes(&self) -> usize {
+        use rpbrt_parser::budget::heap;
+        heap(self.name.capacity()) + heap(self.color_space.capacity()) + self.params.memory_bytes()
     }
 
     /// A default entity of type `name` without parameters, in sRGB.
@@ -280,6 +287,9 @@ pub struct SceneDescription {
     /// pbrt-v4 (a `goniometric` or `projection` light without an image),
     /// such a scene gets pbrt-v3's meaning.
     pub pbrt_v3: Option<FileLoc>,
+    /// The memory budget the description is charged to; creating the
+    /// render objects charges the same one.
+    pub budget: MemoryBudget,
 }
 
 impl Default for SceneDescription {
@@ -310,6 +320,7 @@ impl Default for SceneDescription {
             options: Vec::new(),
             diagnostics: Vec::new(),
             pbrt_v3: None,
+            budget: MemoryBudget::default(),
         }
     }
 }

@@ -13,7 +13,7 @@
 
 use std::collections::{HashMap, HashSet};
 
-use rpbrt_parser::Diagnostic;
+use rpbrt_parser::{Diagnostic, MemoryBudget};
 
 use super::assemble::{reader, Problems};
 use super::entities::{SceneEntity, TextureKind, TextureSceneEntity};
@@ -40,6 +40,7 @@ pub(super) fn create_textures(
     spectrum_entities: &[TextureSceneEntity],
     cache: &MIPMapCache,
     options: &TextureOptions,
+    budget: &MemoryBudget,
     problems: &mut Problems,
 ) -> Option<NamedTextures> {
     let mut named = NamedTextures::default();
@@ -48,7 +49,7 @@ pub(super) fn create_textures(
         spectrum_entities.iter().map(|e| e.name.clone()).collect();
     for e in float_entities {
         debug_assert_eq!(e.kind, TextureKind::Float);
-        let Some(r) = problems.take(reader(&e.base)) else {
+        let Some(r) = problems.take(reader(&e.base, budget)) else {
             continue;
         };
         let tp = TextureParams::with_later_spectrum(r, &named, &spectrum_names);
@@ -64,7 +65,7 @@ pub(super) fn create_textures(
     ];
     for e in spectrum_entities {
         debug_assert_eq!(e.kind, TextureKind::Spectrum);
-        let Some(r) = problems.take(reader(&e.base)) else {
+        let Some(r) = problems.take(reader(&e.base, budget)) else {
             continue;
         };
         let tp = TextureParams::new(r, &named);
@@ -89,6 +90,7 @@ pub(super) fn create_materials(
     materials: &[SceneEntity],
     named_materials: &[(String, SceneEntity)],
     textures: &NamedTextures,
+    budget: &MemoryBudget,
     problems: &mut Problems,
 ) -> Option<(MaterialSet, HashMap<String, u32>)> {
     let n_anon = materials.len();
@@ -107,7 +109,7 @@ pub(super) fn create_materials(
                       visible: &dyn Fn(&str) -> Result<u32, String>,
                       problems: &mut Problems|
      -> Option<Material> {
-        let tp = TextureParams::new(problems.take(reader(e))?, textures);
+        let tp = TextureParams::new(problems.take(reader(e, budget))?, textures);
         let made = create_material(ty, &tp, visible, &mut normal_maps);
         problems.finish(tp.into_reader(), made)
     };

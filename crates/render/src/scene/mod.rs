@@ -30,7 +30,9 @@ pub use builder::SceneBuilder;
 pub use entities::*;
 pub use names::EntityKind;
 
-/// Settings for [`build_scene`].
+/// Settings for [`build_scene`]. The memory budget is the parser's
+/// (`parse.budget`): the scene text, the description and, when the scene is
+/// created, the render objects are all charged to it.
 #[derive(Clone, Debug, Default)]
 pub struct BuildOptions {
     /// The rendering coordinate system, unless the scene sets
@@ -83,7 +85,8 @@ pub fn build_scene(
     paths: &[PathBuf],
     options: &BuildOptions,
 ) -> Result<(SceneDescription, Diagnostics), Diagnostics> {
-    let mut builder = SceneBuilder::new(options.render_coord_sys);
+    let mut builder =
+        SceneBuilder::new(options.render_coord_sys).with_budget(options.parse.budget.clone());
     let result = Parser::new(options.parse.clone()).parse_files(paths, &mut builder);
     finish(builder, result, options)
 }
@@ -94,7 +97,8 @@ pub fn build_scene_from_str(
     text: &str,
     options: &BuildOptions,
 ) -> Result<(SceneDescription, Diagnostics), Diagnostics> {
-    let mut builder = SceneBuilder::new(options.render_coord_sys);
+    let mut builder =
+        SceneBuilder::new(options.render_coord_sys).with_budget(options.parse.budget.clone());
     let result = Parser::new(options.parse.clone()).parse_bytes(
         "<string>",
         Arc::from(text.as_bytes()),
@@ -113,7 +117,8 @@ pub fn build_scene_from_bytes(
     dir: &Path,
     options: &BuildOptions,
 ) -> Result<(SceneDescription, Diagnostics), Diagnostics> {
-    let mut builder = SceneBuilder::new(options.render_coord_sys);
+    let mut builder =
+        SceneBuilder::new(options.render_coord_sys).with_budget(options.parse.budget.clone());
     let result =
         Parser::new(options.parse.clone()).parse_bytes(name, Arc::from(bytes), dir, &mut builder);
     finish(builder, result, options)

@@ -6,7 +6,7 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use rpbrt_parser::Diagnostic;
+use rpbrt_parser::{Diagnostic, MemoryBudget};
 
 use super::assemble::Problems;
 use super::entities::{
@@ -38,9 +38,20 @@ pub(super) struct ShapeContext<'a> {
     pub medium_ids: &'a HashMap<String, u32>,
 }
 
-/// A shape entity's reader (shapes have no colours of their own).
-fn reader(e: &SceneEntity) -> ParamReader<'_> {
-    ParamReader::plain(&e.params, &e.loc)
+/// What one primitive adds to the accelerator, in bytes: its build
+/// reference and its share of the nodes (about what a 10M-triangle mesh's
+/// 4-wide BVH takes, build buffers included).
+const ACCEL_BYTES_PER_PRIMITIVE: usize = 64;
+
+/// What a shape other than a mesh triangle takes, in bytes: its box
+/// (quadrics keep two transformations and their parameters) and the enum
+/// that holds it.
+const SHAPE_BYTES: usize = 320;
+
+/// A shape entity's reader (shapes have no colours of their own),
+/// charging to `budget`.
+fn reader<'a>(e: &'a SceneEntity, budget: &MemoryBudget) -> ParamReader<'a> {
+    ParamReader::plain(&e.params, &e.loc).with_budget(budget)
 }
 
 /// pbrt-v4's alpha: a float texture or constant; 1 (the default) is opaque.
@@ -84,7 +95,12 @@ pub(super) fn create_primitives(
     problems: &mut Problems,
     out: &mut Vec<Primitive>,
 ) {
-    let tp = TextureParams::new(reader(&s.base), cx.textures);
+    // Once the budget has run out, the error said where; shapes after it
+    // would only repeat it.
+    if cx.desc.budget.exhausted() {
+        return;
+    }
+    let tp = TextureParams::new(reader(&s.base, &cx.desc.budget), cx.textures);
     // pbrt-v4 reads a displacement texture for `plymesh` alone.
     let displacement = if s.base.name == "plymesh" {
         match tp.float_texture_opt("displacement") {
@@ -111,6 +127,13 @@ pub(super) fn create_primitives(
         eval: &eval,
         edge_scale: displacement_edge_scale(cx.desc),
     };
+    // Meshes written in the scene copy their parameters' arrays.
+    let copied = s.base.params.memory_bytes() as u64;
+    if let Err(e) = tp.charge(copied, "this shape's data") {
+        problems.errors.push(e);
+        problems.warnings.extend(tp.take_warnings());
+        return;
+    }
     let shapes = create_shape_set(
         &s.base.name,
         &tp,
@@ -168,6 +191,30 @@ pub(super) fn create_primitives(
         }
         _ => None,
     };
+    // The primitives, before a mesh with an area light is cut into a shape
+    // (with a light) per triangle and before the accelerator is built.
+    let triangles = shapes.mesh.as_ref().map_or(0, |m| m.n_triangles());
+    let light = if area.is_some() {
+        std::mem::size_of::<Light>()
+    } else {
+        0
+    };
+    let per_triangle = ACCEL_BYTES_PER_PRIMITIVE
+        + if area.is_some() {
+            std::mem::size_of::<Shape>() + std::mem::size_of::<Primitive>() + light
+        } else {
+            0
+        };
+    let per_shape =
+        ACCEL_BYTES_PER_PRIMITIVE + SHAPE_BYTES + std::mem::size_of::<Primitive>() + light;
+    let bytes = (triangles as u64)
+        .saturating_mul(per_triangle as u64)
+        .saturating_add((shapes.shapes.len() as u64).saturating_mul(per_shape as u64));
+    if let Err(e) = tp.charge(bytes, "this shape's primitives") {
+        problems.errors.push(e);
+        problems.warnings.extend(tp.take_warnings());
+        return;
+    }
     let alpha_tex = match &alpha {
         Alpha::Texture(t) => Some(t.clone()),
         Alpha::Constant(a) => Some(Arc::new(FloatTexture::Constant(*a))),
@@ -280,7 +327,7 @@ pub struct SceneShapes {
 pub fn create_scene_shapes(desc: &SceneDescription) -> SceneShapes {
     let mut out = SceneShapes::default();
     let mut add = |base: &SceneEntity, xf: &Transform, ro: bool| {
-        let r = reader(base);
+        let r = reader(base, &desc.budget);
         match create_shapes(&base.name, &r, xf, ro, None) {
             Ok(shapes) => out.shapes.extend(shapes),
             Err(e) => out.diagnostics.push(e),

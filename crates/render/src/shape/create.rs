@@ -5,8 +5,8 @@
 
 use super::bilinear::{self, BilinearPatchMesh};
 use super::curve::create_curves;
-use super::displace::{displace, triangulate, DisplacedMesh};
-use super::loopsubdiv::loop_subdivide;
+use super::displace::{displace_within, triangulate, DisplacedMesh};
+use super::loopsubdiv::{loop_subdivide, MAX_LOOP_LEVELS};
 use super::triangle::{self, TriangleMesh};
 use super::{Cone, Cylinder, Disk, Hyperboloid, Paraboloid, Shape, ShapeError, Sphere};
 use crate::params::{unknown_type, ParamReader};
@@ -31,6 +31,15 @@ pub const SHAPE_NAMES: &[&str] = &[
     "sphere",
     "trianglemesh",
 ];
+
+/// The memory one triangle of a Loop-subdivided mesh takes while it is
+/// made, in bytes: its face and vertex records at the last two levels and
+/// the limit positions, normals and indices.
+const LOOP_TRIANGLE_BYTES: u64 = 96;
+
+/// The memory one triangle of a mesh with a vertex per two triangles
+/// keeps, in bytes: three indices and half a position and normal.
+const MESH_TRIANGLE_BYTES: u64 = 24;
 
 fn serr(loc: &FileLoc, name: &str, e: ShapeError) -> Diagnostic {
     let msg = e.to_string();
@@ -254,7 +263,7 @@ pub fn create_shape_set(
                 }
             };
             let path = sp.resolve("filename", &file);
-            let mesh = rpbrt_parser::ply::read_ply(&path)
+            let mesh = rpbrt_parser::ply::read_ply_within(&path, sp.budget())
                 .map_err(|e| Diagnostic::error(loc.clone(), format!("\"plymesh\" shape: {e}")))?;
             for w in &mesh.warnings {
                 sp.warn(format!("{}: {w}", path.display()));
@@ -269,7 +278,8 @@ pub fn create_shape_set(
                     uv: mesh.uvs.into_iter().map(Point2f::from).collect(),
                     face_indices,
                 };
-                let m = displace(m, &rfo, edge_length * d.edge_scale, d.eval).map_err(|e| {
+                let edge = edge_length * d.edge_scale;
+                let m = displace_within(m, &rfo, edge, d.eval, sp.budget()).map_err(|e| {
                     Diagnostic::error(
                         loc.clone(),
                         format!("\"plymesh\" shape: {}: {e}", path.display()),
@@ -383,6 +393,24 @@ pub fn create_shape_set(
                     "\"loopsubdiv\" shape: \"P\" and \"indices\" are required",
                 ));
             }
+            if levels > MAX_LOOP_LEVELS {
+                sp.warn_at(
+                    "levels",
+                    format!(
+                        "\"loopsubdiv\" shape: \"levels\" {levels} is more than the \
+                         {MAX_LOOP_LEVELS} rpbrt applies; using {MAX_LOOP_LEVELS}"
+                    ),
+                );
+            }
+            let levels = levels.min(MAX_LOOP_LEVELS);
+            // Each level makes four triangles of one; the refinement's
+            // working copies and the result, before any is made.
+            let triangles = (idx.len() as u64 / 3).saturating_mul(1 << (2 * levels.max(0)));
+            let what = format!("this subdivision ({triangles} triangles after {levels} levels)");
+            sp.budget()
+                .check(triangles.saturating_mul(LOOP_TRIANGLE_BYTES), &what)
+                .map_err(|e| sp.error(e.to_string()))?;
+            sp.charge(triangles.saturating_mul(MESH_TRIANGLE_BYTES), &what)?;
             let r = loop_subdivide(levels, &idx, &p).map_err(|e| serr(loc, name, e))?;
             push_triangles(
                 &mut set,

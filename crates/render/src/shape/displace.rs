@@ -94,6 +94,8 @@ pub enum DisplaceError {
         /// The edge length asked for.
         edge_length: Float,
     },
+    /// The refined mesh would need more memory than the budget has left.
+    OverBudget(rpbrt_parser::OverBudget),
 }
 
 impl std::fmt::Display for DisplaceError {
@@ -105,6 +107,7 @@ impl std::fmt::Display for DisplaceError {
                 "edge length {edge_length} would refine the mesh into more than \
                  {MAX_REFINED_TRIANGLES} triangles"
             ),
+            DisplaceError::OverBudget(e) => write!(f, "{e}"),
         }
     }
 }
@@ -204,12 +207,30 @@ impl Refiner<'_> {
 /// its vertex normals after refining it to edges shorter than `edge_length`
 /// in rendering space. Normals missing from the mesh are computed first;
 /// normals are recomputed afterwards. Displacement values are evaluated in
-/// parallel.
+/// parallel. The refined mesh is held against the default memory budget.
 pub fn displace(
     mesh: DisplacedMesh,
     render_from_object: &Transform,
     edge_length: Float,
     displacement: &(dyn Fn(Point3f, Point2f) -> Float + Sync),
+) -> Result<DisplacedMesh, DisplaceError> {
+    let budget = rpbrt_parser::MemoryBudget::default();
+    displace_within(mesh, render_from_object, edge_length, displacement, &budget)
+}
+
+/// The memory one triangle of a refined mesh takes while it is made, in
+/// bytes: its indices, its share of the vertices (position, normal, uv,
+/// displacement) and of the split-edge map.
+const REFINED_TRIANGLE_BYTES: u64 = 96;
+
+/// [`displace`], charging the refined mesh to `budget` (from the estimate
+/// of its size, before it is refined).
+pub fn displace_within(
+    mesh: DisplacedMesh,
+    render_from_object: &Transform,
+    edge_length: Float,
+    displacement: &(dyn Fn(Point3f, Point2f) -> Float + Sync),
+    budget: &rpbrt_parser::MemoryBudget,
 ) -> Result<DisplacedMesh, DisplaceError> {
     if mesh.uv.len() != mesh.p.len() || mesh.p.is_empty() {
         return Err(DisplaceError::NoUvs);
@@ -245,6 +266,11 @@ pub fn displace(
     if estimate > MAX_REFINED_TRIANGLES as f64 {
         return Err(DisplaceError::TooManyTriangles { edge_length });
     }
+    let bytes =
+        (estimate.max(triangles.len() as f64 / 3.0) as u64).saturating_mul(REFINED_TRIANGLE_BYTES);
+    budget
+        .charge(bytes, "this displaced mesh")
+        .map_err(DisplaceError::OverBudget)?;
     let mut out_indices = Vec::with_capacity(triangles.len());
     let mut out_faces = Vec::new();
     for (i, t) in triangles.chunks_exact(3).enumerate() {

@@ -15,7 +15,7 @@ use exr::prelude::{
 use half::f16;
 use rpbrt_geometry::{Bounds2i, Point2i};
 
-use super::{FmtResult, ImageAndMetadata, ImageMetadata};
+use super::{Claim, FmtResult, ImageAndMetadata, ImageMetadata};
 use crate::image::{Image, PixelFormat};
 
 /// Primaries and white point (x, y) of the colour spaces pbrt-v4 knows by name.
@@ -106,8 +106,9 @@ fn max_expansion(compression: exr::compression::Compression) -> u64 {
 /// that aborts the process. Beyond fixed limits, the claims are held
 /// against the bytes actually in the file: each chunk needs an 8-byte
 /// offset-table entry, and the samples must fit the stored data at the
-/// compression's best ratio ([`max_expansion`]).
-fn check_headers(data: &[u8]) -> FmtResult<()> {
+/// compression's best ratio ([`max_expansion`]). What passes is charged
+/// to the memory budget: the image, with the decoder's samples beside it.
+fn check_headers(data: &[u8], claim: &mut Claim) -> FmtResult<()> {
     let mut cursor = Cursor::new(data);
     let meta = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         exr::meta::MetaData::read_from_buffered(&mut cursor, false)
@@ -118,6 +119,10 @@ fn check_headers(data: &[u8]) -> FmtResult<()> {
     let mut total: u64 = 0;
     let mut chunks: u64 = 0;
     let mut expandable: u64 = 0;
+    // The decoder's samples, and the image made of them (floats, or
+    // halves when every channel is half).
+    let mut decoded: u64 = 0;
+    let mut all_half = true;
     for h in &meta.headers {
         let (w, hgt) = (h.layer_size.0 as u64, h.layer_size.1 as u64);
         super::check_resolution(
@@ -134,6 +139,8 @@ fn check_headers(data: &[u8]) -> FmtResult<()> {
             .map(|c| c.sample_type.bytes_per_sample() as u64)
             .sum();
         let raw = (w * hgt).saturating_mul(bytes_per_pixel);
+        decoded = decoded.saturating_add(raw);
+        all_half &= bytes_per_pixel == 2 * channels;
         // Samples per byte of stored data, scaled so headers of different
         // compressions add up: raw / ratio, rounded up.
         expandable = expandable.saturating_add(raw.div_ceil(max_expansion(h.compression)));
@@ -158,11 +165,16 @@ fn check_headers(data: &[u8]) -> FmtResult<()> {
              (truncated file or damaged header)"
         ));
     }
-    Ok(())
+    let image = if all_half {
+        decoded
+    } else {
+        total.saturating_mul(4)
+    };
+    claim.image(image, decoded)
 }
 
-pub(super) fn read(data: &[u8]) -> FmtResult<ImageAndMetadata> {
-    check_headers(data)?;
+pub(super) fn read(data: &[u8], claim: &mut Claim) -> FmtResult<ImageAndMetadata> {
+    check_headers(data, claim)?;
     // The exr crate is defensive, but a panic inside it must not escape to the caller.
     let decoded = std::panic::catch_unwind(|| {
         exr::prelude::read()
@@ -412,7 +424,7 @@ mod tests {
         );
         let mut buf = Cursor::new(Vec::new());
         im.write().non_parallel().to_buffered(&mut buf).unwrap();
-        let r = read(&buf.into_inner()).unwrap();
+        let r = super::super::Image::read_from_bytes(&buf.into_inner(), "x.exr", None).unwrap();
         assert_eq!(
             r.image.channel_names(),
             ["diffuse.G", "diffuse.R", "specular.B"]
@@ -426,7 +438,7 @@ mod tests {
         let vals: Vec<f32> = (0..10).map(|i| i as f32).collect();
         let im = Image::from_f32(vals, Point2i::new(2, 1), &names).unwrap();
         let bytes = write(&im, &ImageMetadata::default()).unwrap();
-        let r = read(&bytes).unwrap();
+        let r = super::super::Image::read_from_bytes(&bytes, "x.exr", None).unwrap();
         let desc = r.image.get_channel_desc(&names).unwrap();
         let back = r.image.select_channels(&desc);
         assert_eq!(back.to_f32_vec(), im.to_f32_vec());

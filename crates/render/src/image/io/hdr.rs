@@ -3,7 +3,7 @@
 //! stb_image, which pbrt-v4 uses: value = byte * 2^(exponent - 136), zero when the
 //! exponent byte is zero.
 
-use super::{check_resolution, ByteReader, FmtResult, ImageAndMetadata, ImageMetadata};
+use super::{check_resolution, ByteReader, Claim, FmtResult, ImageAndMetadata, ImageMetadata};
 use crate::image::Image;
 
 fn line<'a>(r: &mut ByteReader<'a>) -> FmtResult<&'a [u8]> {
@@ -26,7 +26,7 @@ fn rgbe_to_float(p: &[u8], out: &mut Vec<f32>) {
     }
 }
 
-pub(super) fn read(data: &[u8]) -> FmtResult<ImageAndMetadata> {
+pub(super) fn read(data: &[u8], claim: &mut Claim) -> FmtResult<ImageAndMetadata> {
     let mut r = ByteReader::new(data);
     let magic = line(&mut r)?;
     if magic != b"#?RADIANCE" && magic != b"#?RGBE" {
@@ -65,6 +65,7 @@ pub(super) fn read(data: &[u8]) -> FmtResult<ImageAndMetadata> {
     if hu.saturating_mul(min_row) > r.remaining() {
         return Err("premature end of file in HDR data".into());
     }
+    claim.image(12 * (wu * hu) as u64, 4 * wu as u64)?;
     let mut px = Vec::with_capacity(wu * hu * 3);
     let mut flat = !(8..0x8000).contains(&wu);
     let mut scan = vec![0u8; 4 * wu];

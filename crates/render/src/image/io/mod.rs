@@ -15,6 +15,7 @@ use std::fmt;
 use std::path::Path;
 
 use rpbrt_geometry::{Bounds2i, Point2i};
+use rpbrt_parser::MemoryBudget;
 
 use super::{ColorEncoding, Image};
 
@@ -249,45 +250,95 @@ fn extension(name: &str) -> String {
 impl Image {
     /// Reads an image file chosen by extension: exr, png, pfm, hdr, tga, qoi.
     /// `encoding` applies to 8- and 16-bit PNG, TGA and QOI (default sRGB).
+    /// The image is held against the default memory budget
+    /// ([`MemoryBudget::default`]).
     pub fn read(
         path: impl AsRef<Path>,
         encoding: Option<ColorEncoding>,
     ) -> Result<ImageAndMetadata, ImageError> {
+        Self::read_within(path, encoding, &MemoryBudget::default())
+    }
+
+    /// [`read`](Self::read), charging the decoded image to `budget`: the
+    /// file is read no further than the budget has room for, and a header
+    /// whose size needs more than that is an error before any pixel is
+    /// decoded.
+    pub fn read_within(
+        path: impl AsRef<Path>,
+        encoding: Option<ColorEncoding>,
+        budget: &MemoryBudget,
+    ) -> Result<ImageAndMetadata, ImageError> {
         let path = path.as_ref();
         let name = path.display().to_string();
         // The project's one file reader (gzip-compressed images are
-        // inflated as they are read).
-        let bytes = rpbrt_parser::input::read_file_limited(
-            path,
-            rpbrt_parser::input::DEFAULT_MAX_FILE_BYTES,
-        )
-        .map_err(|source| ImageError::Io {
-            path: name.clone(),
-            source,
+        // inflated as they are read). The file's bytes are held while the
+        // image is decoded.
+        let room = budget.available();
+        let limit = rpbrt_parser::input::DEFAULT_MAX_FILE_BYTES.min(room);
+        let bytes = rpbrt_parser::input::read_file_limited(path, limit).map_err(|source| {
+            if rpbrt_parser::input::is_too_large(&source) && limit == room {
+                ImageError::Format {
+                    path: name.clone(),
+                    message: budget.exceeded(room, "this image file").to_string(),
+                }
+            } else {
+                ImageError::Io {
+                    path: name.clone(),
+                    source,
+                }
+            }
         })?;
         // A `.gz` suffix is not the image's extension.
         let format_name = name.strip_suffix(".gz").unwrap_or(&name);
-        Self::read_from_bytes(&bytes, format_name, encoding)
+        budget
+            .charge(bytes.len() as u64, "this image file")
+            .map_err(|e| ImageError::Format {
+                path: name.clone(),
+                message: e.to_string(),
+            })?;
+        let image = Self::read_from_bytes_within(&bytes, format_name, encoding, budget);
+        budget.release(bytes.len() as u64);
+        image
     }
 
-    /// Decodes an in-memory file; `name` supplies the extension and the error messages.
+    /// Decodes an in-memory file; `name` supplies the extension and the
+    /// error messages. The image is held against the default memory
+    /// budget.
     pub fn read_from_bytes(
         bytes: &[u8],
         name: &str,
         encoding: Option<ColorEncoding>,
     ) -> Result<ImageAndMetadata, ImageError> {
+        Self::read_from_bytes_within(bytes, name, encoding, &MemoryBudget::default())
+    }
+
+    /// [`read_from_bytes`](Self::read_from_bytes), charging the decoded
+    /// image to `budget` (the charge stays with the image; see
+    /// [`Image::bytes_used`]).
+    pub fn read_from_bytes_within(
+        bytes: &[u8],
+        name: &str,
+        encoding: Option<ColorEncoding>,
+        budget: &MemoryBudget,
+    ) -> Result<ImageAndMetadata, ImageError> {
         let enc = encoding.unwrap_or(ColorEncoding::SRGB);
+        let mut claim = Claim { budget, charged: 0 };
         let r = match extension(name).as_str() {
-            "exr" => exr_io::read(bytes),
-            "png" => png_io::read(bytes, enc),
-            "pfm" => pfm::read(bytes),
-            "hdr" => hdr::read(bytes),
-            "tga" => tga::read(bytes, enc),
-            "qoi" => qoi::read(bytes, enc),
+            "exr" => exr_io::read(bytes, &mut claim),
+            "png" => png_io::read(bytes, enc, &mut claim),
+            "pfm" => pfm::read(bytes, &mut claim),
+            "hdr" => hdr::read(bytes, &mut claim),
+            "tga" => tga::read(bytes, enc, &mut claim),
+            "qoi" => qoi::read(bytes, enc, &mut claim),
             e => Err(format!(
                 "no support for reading images with extension \"{e}\""
             )),
         };
+        // What stays charged is what the image holds.
+        let r = r.and_then(|im| claim.settle(im.image.bytes_used() as u64).map(|()| im));
+        if r.is_err() {
+            budget.release(claim.charged);
+        }
         r.map_err(|message| ImageError::Format {
             path: name.to_string(),
             message,
@@ -395,6 +446,41 @@ impl<'a> ByteReader<'a> {
     pub fn u16_le(&mut self) -> FmtResult<u16> {
         let b = self.bytes(2)?;
         Ok(u16::from_le_bytes([b[0], b[1]]))
+    }
+}
+
+/// What a format reader charges the image it decodes to: once the header
+/// is read, and before any pixel is, [`image`](Claim::image) holds the
+/// size the header implies against the memory budget.
+pub(crate) struct Claim<'a> {
+    budget: &'a MemoryBudget,
+    /// Bytes charged so far.
+    charged: u64,
+}
+
+impl Claim<'_> {
+    /// Charges a decoded image of `image` bytes, after checking that
+    /// `scratch` bytes more (buffers the decoder drops before it returns)
+    /// fit beside it.
+    pub fn image(&mut self, image: u64, scratch: u64) -> FmtResult<()> {
+        let what = "this image";
+        self.budget
+            .check(image.saturating_add(scratch), what)
+            .map_err(|e| e.to_string())?;
+        self.budget.charge(image, what).map_err(|e| e.to_string())?;
+        self.charged += image;
+        Ok(())
+    }
+
+    /// Makes the charge `held` bytes, what the decoded image holds.
+    fn settle(&mut self, held: u64) -> FmtResult<()> {
+        if held > self.charged {
+            self.image(held - self.charged, 0)
+        } else {
+            self.budget.release(self.charged - held);
+            self.charged = held;
+            Ok(())
+        }
     }
 }
 

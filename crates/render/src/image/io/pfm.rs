@@ -1,7 +1,7 @@
 //! Portable float maps (PFM): "PF" (RGB) or "Pf" (grey), width, height, and a scale whose
 //! sign gives the byte order (negative: little endian); rows stored bottom to top.
 
-use super::{check_resolution, FmtResult, ImageAndMetadata, ImageMetadata};
+use super::{check_resolution, Claim, FmtResult, ImageAndMetadata, ImageMetadata};
 use crate::image::Image;
 
 fn is_space(b: u8) -> bool {
@@ -28,7 +28,7 @@ fn word<'a>(data: &'a [u8], pos: &mut usize) -> FmtResult<&'a str> {
     Ok(w)
 }
 
-pub(super) fn read(data: &[u8]) -> FmtResult<ImageAndMetadata> {
+pub(super) fn read(data: &[u8], claim: &mut Claim) -> FmtResult<ImageAndMetadata> {
     let mut pos = 0;
     let nc = match word(data, &mut pos)? {
         "Pf" => 1usize,
@@ -58,6 +58,7 @@ pub(super) fn read(data: &[u8]) -> FmtResult<ImageAndMetadata> {
     if (data.len() - pos) / 4 < n {
         return Err("premature end of file in PFM data".into());
     }
+    claim.image(4 * n as u64, 0)?;
     let little = scale < 0.0;
     let s = scale.abs();
     let mut px = vec![0.0f32; n];

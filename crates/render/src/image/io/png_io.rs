@@ -8,10 +8,14 @@ use std::io::Cursor;
 
 use half::f16;
 
-use super::{FmtResult, ImageAndMetadata, ImageMetadata};
+use super::{Claim, FmtResult, ImageAndMetadata, ImageMetadata};
 use crate::image::{linear_to_srgb8, ColorEncoding, Image};
 
-pub(super) fn read(data: &[u8], encoding: ColorEncoding) -> FmtResult<ImageAndMetadata> {
+pub(super) fn read(
+    data: &[u8],
+    encoding: ColorEncoding,
+    claim: &mut Claim,
+) -> FmtResult<ImageAndMetadata> {
     let mut decoder =
         png::Decoder::new_with_limits(Cursor::new(data), png::Limits { bytes: 1 << 32 });
     decoder.set_transformations(png::Transformations::EXPAND);
@@ -24,6 +28,8 @@ pub(super) fn read(data: &[u8], encoding: ColorEncoding) -> FmtResult<ImageAndMe
         (info.width, info.height)
     };
     let res = super::check_resolution(w as i64, h as i64)?;
+    // The image takes about as many bytes as the decoder's rows.
+    claim.image(size as u64, size as u64)?;
     let mut buf = vec![0u8; size];
     let info = reader.next_frame(&mut buf).map_err(|e| e.to_string())?;
     let names: &[&str] = match info.color_type {

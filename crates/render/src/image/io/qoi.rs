@@ -1,7 +1,7 @@
 //! The "Quite OK Image" format (QOI specification 1.0): a 14-byte header, then a stream
 //! of RGB, RGBA, index, diff, luma and run operations, ended by seven zero bytes and a one.
 
-use super::{check_resolution, png_io, FmtResult, ImageAndMetadata, ImageMetadata};
+use super::{check_resolution, png_io, Claim, FmtResult, ImageAndMetadata, ImageMetadata};
 use crate::image::Image;
 
 const OP_INDEX: u8 = 0x00;
@@ -20,6 +20,7 @@ fn hash(p: [u8; 4]) -> usize {
 pub(super) fn read(
     data: &[u8],
     encoding: crate::image::ColorEncoding,
+    claim: &mut Claim,
 ) -> FmtResult<ImageAndMetadata> {
     if data.len() < 14 + END.len() || &data[0..4] != b"qoif" {
         return Err("not a QOI file".into());
@@ -37,6 +38,7 @@ pub(super) fn read(
     if npix > 62 * chunks.len().max(1) {
         return Err("premature end of file in QOI data".into());
     }
+    claim.image((npix * channels) as u64, 0)?;
     let mut out = Vec::with_capacity(npix * channels);
     let mut index = [[0u8; 4]; 64];
     let mut px = [0u8, 0, 0, 255];

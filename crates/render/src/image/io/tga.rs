@@ -2,7 +2,9 @@
 //! colour-mapped images (types 1, 2, 3, 9, 10, 11). As pbrt-v4 (through stb_image)
 //! does, alpha is dropped: the result is "Y" or "R", "G", "B" with the caller's encoding.
 
-use super::{check_resolution, png_io, ByteReader, FmtResult, ImageAndMetadata, ImageMetadata};
+use super::{
+    check_resolution, png_io, ByteReader, Claim, FmtResult, ImageAndMetadata, ImageMetadata,
+};
 use crate::image::ColorEncoding;
 
 /// Expands a 5-bit value to 8 bits.
@@ -25,7 +27,11 @@ fn decode_pixel(p: &[u8], grey: bool, out: &mut Vec<u8>) {
     }
 }
 
-pub(super) fn read(data: &[u8], encoding: ColorEncoding) -> FmtResult<ImageAndMetadata> {
+pub(super) fn read(
+    data: &[u8],
+    encoding: ColorEncoding,
+    claim: &mut Claim,
+) -> FmtResult<ImageAndMetadata> {
     let mut r = ByteReader::new(data);
     let id_len = r.u8()? as usize;
     let cmap_type = r.u8()?;
@@ -77,6 +83,7 @@ pub(super) fn read(data: &[u8], encoding: ColorEncoding) -> FmtResult<ImageAndMe
         return Err("premature end of file in TGA data".into());
     }
     let nc = if grey { 1 } else { 3 };
+    claim.image((npix * nc) as u64, 0)?;
     let mut px = Vec::with_capacity(npix * nc);
     let put = |p: &[u8], px: &mut Vec<u8>| -> FmtResult<()> {
         if mapped {

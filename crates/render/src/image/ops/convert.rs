@@ -141,6 +141,14 @@ pub fn convert(
     if opts.repeat <= 0 {
         return invalid("--repeatpix value must be greater than zero".into());
     }
+    let res = image.resolution();
+    let r = opts.repeat;
+    if res.x.checked_mul(r).is_none() || res.y.checked_mul(r).is_none() {
+        return invalid(format!(
+            "--repeatpix {r}: a {}x{} image repeated is larger than an image may be",
+            res.x, res.y
+        ));
+    }
     if opts.scale == 0.0 {
         return invalid("--scale value must be non-zero".into());
     }

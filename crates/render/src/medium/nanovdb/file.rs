@@ -184,7 +184,7 @@ pub(super) struct GridEntry {
     /// How many bytes it occupies in the file.
     file_size: u64,
     /// The size of the (uncompressed) grid buffer.
-    grid_size: u64,
+    pub(super) grid_size: u64,
 }
 
 /// Lists the grids of the file, checking every header and that every grid's bytes are present.

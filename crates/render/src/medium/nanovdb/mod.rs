@@ -193,6 +193,16 @@ pub fn require_float_grid(path: &Path, name: &str) -> Result<FloatGrid, NanoVdbE
     require_from(&mut src, name)
 }
 
+/// The uncompressed size the file records for the grid called `name` (the
+/// first of that name), in bytes; `Ok(None)` when there is none. Read from
+/// the file's headers alone, so that the grid can be held against a memory
+/// budget before it is inflated.
+pub fn grid_bytes(path: &Path, name: &str) -> Result<Option<u64>, NanoVdbError> {
+    let mut src = file::FileSource::open(path)?;
+    let entries = file::scan(&mut src)?;
+    Ok(entries.iter().find(|e| e.name == name).map(|e| e.grid_size))
+}
+
 /// The names of all grids in a .nvdb file (of any value type), in file order.
 pub fn grid_names(path: &Path) -> Result<Vec<String>, NanoVdbError> {
     let mut src = file::FileSource::open(path)?;

@@ -2,6 +2,7 @@
 //! [`super::assemble`] and [`super::materials`] do with whole directives
 //! (orders, references between entities, located errors, warnings).
 
+mod budget;
 mod camera;
 mod materials;
 mod media;
@@ -50,6 +51,7 @@ fn create_textures_of(
         &desc.spectrum_textures,
         &MIPMapCache::new(),
         &TextureOptions::default(),
+        &desc.budget,
         &mut p,
     ) {
         Some(t) if p.errors.is_empty() => Ok((t, p.warnings)),
@@ -65,7 +67,13 @@ fn create_materials(
     textures: &NamedTextures,
 ) -> Result<(MaterialSet, HashMap<String, u32>, Vec<Diagnostic>), Vec<Diagnostic>> {
     let mut p = Problems::default();
-    match super::materials::create_materials(materials, named, textures, &mut p) {
+    match super::materials::create_materials(
+        materials,
+        named,
+        textures,
+        &Default::default(),
+        &mut p,
+    ) {
         Some((set, ids)) if p.errors.is_empty() => Ok((set, ids, p.warnings)),
         _ => Err(failed(p)),
     }
