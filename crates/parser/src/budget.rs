@@ -21,6 +21,7 @@
 //! a budget down (parser options, scene description, image readers) and
 //! never read a global one.
 
+use std::borrow::Cow;
 use std::fmt;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
@@ -39,7 +40,7 @@ struct Inner {
     exhausted: AtomicBool,
     /// What messages call the limit: "--max-memory" when the user set or
     /// can set it with that flag.
-    label: String,
+    label: Cow<'static, str>,
 }
 
 impl fmt::Debug for MemoryBudget {
@@ -67,13 +68,13 @@ impl MemoryBudget {
 
     /// A budget whose limit messages call `label` (say `"--max-memory"`,
     /// the flag that sets it).
-    pub fn labelled(limit: u64, label: &str) -> Self {
+    pub fn labelled(limit: u64, label: impl Into<Cow<'static, str>>) -> Self {
         MemoryBudget {
             inner: Arc::new(Inner {
                 limit,
                 used: AtomicU64::new(0),
                 exhausted: AtomicBool::new(false),
-                label: label.to_string(),
+                label: label.into(),
             }),
         }
     }
@@ -162,7 +163,7 @@ impl MemoryBudget {
             more: false,
             in_use,
             limit: self.inner.limit,
-            label: self.inner.label.clone(),
+            label: self.inner.label.to_string(),
         }
     }
 }

@@ -19,7 +19,9 @@
 //!
 //! `RPBRT_FUZZ_ITERS` sets the mutations per file (default 60);
 //! `RPBRT_FUZZ_SECONDS`, if set, keeps going over fresh seeds until that
-//! much time has passed and prints the count.
+//! much time has passed and prints the count; rounds of seeds start at
+//! `RPBRT_FUZZ_FIRST_ROUND` (default 0), so that runs in chunks need not
+//! repeat each other.
 
 use rpbrt_geometry::Point2i;
 use rpbrt_parser::ply::parse_ply_within;
@@ -406,7 +408,13 @@ fn mutated_data_files_never_panic() {
         .and_then(|s| s.parse().ok())
         .map(Duration::from_secs);
     let start = Instant::now();
-    let mut round = 0u64;
+    // Rounds of fresh seeds start here: runs in chunks continue where the
+    // last one stopped.
+    let first_round: u64 = std::env::var("RPBRT_FUZZ_FIRST_ROUND")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
+    let mut round = first_round;
     let mut total = 0u64;
     loop {
         for (k, (ext, bytes, budget)) in loaded.iter().enumerate() {
@@ -431,9 +439,10 @@ fn mutated_data_files_never_panic() {
     }
     if budget.is_some() {
         println!(
-            "data fuzz: {total} mutated files over {} inputs in {:.0} s",
+            "data fuzz: {total} mutated files over {} inputs in {:.0} s (rounds {first_round} to {})",
             loaded.len(),
-            start.elapsed().as_secs_f64()
+            start.elapsed().as_secs_f64(),
+            round - 1
         );
     }
     let _ = std::fs::remove_dir_all(&dir);
