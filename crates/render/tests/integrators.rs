@@ -602,6 +602,18 @@ AttributeBegin
   Shape "sphere" "float radius" 0.4
 AttributeEnd
 AttributeBegin
+  Translate -2.2 0.35 1.2
+  Material "coatedconductor" "float interface.roughness" 0.15
+      "float conductor.roughness" 0.3 "spectrum conductor.eta" "metal-Au-eta"
+      "spectrum conductor.k" "metal-Au-k"
+  Shape "sphere" "float radius" 0.35
+AttributeEnd
+AttributeBegin
+  Translate 2.3 0.3 1.0
+  Material "dielectric" "float eta" 1.33 "float roughness" 0.2
+  Shape "sphere" "float radius" 0.3
+AttributeEnd
+AttributeBegin
   Translate 0 2.5 1
   AreaLightSource "diffuse" "rgb L" [ 4 4 4 ]
   Material "diffuse"

@@ -5,11 +5,13 @@
 
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;
-use rpbrt_geometry::{abs_cos_theta, cos_theta, same_hemisphere};
+use rpbrt_geometry::{abs_cos_theta, cos_theta};
 
+use super::lanes::{self, gather_f, DielectricLanes, ToLanes, TrLanes};
 use super::microfacet::TrowbridgeReitzDistribution;
-use super::scattering::{fr_dielectric, reflect, refract};
+use super::scattering::fr_dielectric;
 use super::{BSDFSample, BxDFFlags, BxDFMethods, BxDFReflTransFlags, TransportMode};
+use crate::simd::F32Lanes;
 use crate::spectrum::SampledSpectrum;
 
 /// Probabilities of choosing reflection (`r`) or transmission (`t`) under
@@ -46,65 +48,30 @@ impl DielectricBxDF {
     pub fn eta(&self) -> Float {
         self.eta
     }
+}
 
-    /// True when scattering is a pair of delta lobes.
-    #[inline]
-    fn is_specular(&self) -> bool {
-        self.eta == 1.0 || self.mf_distrib.effectively_smooth()
-    }
-
-    /// The generalized half vector for the pair, facing +z, with the
-    /// relative index for transmission (1 for reflection); `None` for
-    /// degenerate configurations and back-facing microfacets.
-    #[inline]
-    fn half_vector(&self, wo: Vector3f, wi: Vector3f) -> Option<(Vector3f, Float, bool)> {
-        let cos_o = cos_theta(wo);
-        let cos_i = cos_theta(wi);
-        let reflect = cos_i * cos_o > 0.0;
-        let etap = if reflect {
-            1.0
-        } else if cos_o > 0.0 {
-            self.eta
-        } else {
-            1.0 / self.eta
-        };
-        let wm = wi * etap + wo;
-        if cos_i == 0.0 || cos_o == 0.0 || wm.length_squared() == 0.0 {
-            return None;
+impl ToLanes for DielectricBxDF {
+    type Lanes<L: F32Lanes> = DielectricLanes<L>;
+    #[inline(always)]
+    fn gather<L: F32Lanes>(items: &[&Self]) -> DielectricLanes<L> {
+        let n = items.len();
+        DielectricLanes {
+            eta: gather_f(n, |i| items[i].eta),
+            d: TrLanes {
+                ax: gather_f(n, |i| items[i].mf_distrib.alpha_x()),
+                ay: gather_f(n, |i| items[i].mf_distrib.alpha_y()),
+            },
         }
-        let wm = wm.normalize().face_forward(Vector3f::new(0.0, 0.0, 1.0));
-        if dot(wm, wi) * cos_i < 0.0 || dot(wm, wo) * cos_o < 0.0 {
-            return None;
-        }
-        Some((wm, etap, reflect))
     }
 }
 
 impl BxDFMethods for DielectricBxDF {
+    #[inline]
     fn f(&self, wo: Vector3f, wi: Vector3f, mode: TransportMode) -> SampledSpectrum {
-        if self.is_specular() {
-            return SampledSpectrum::new(0.0);
-        }
-        let Some((wm, etap, is_reflection)) = self.half_vector(wo, wi) else {
-            return SampledSpectrum::new(0.0);
-        };
-        let fr = fr_dielectric(dot(wo, wm), self.eta);
-        let d = &self.mf_distrib;
-        if is_reflection {
-            SampledSpectrum::new(
-                d.d(wm) * d.g(wo, wi) * fr / (4.0 * cos_theta(wi) * cos_theta(wo)).abs(),
-            )
-        } else {
-            let denom = sqr(dot(wi, wm) + dot(wo, wm) / etap) * cos_theta(wi) * cos_theta(wo);
-            let mut ft =
-                d.d(wm) * (1.0 - fr) * d.g(wo, wi) * (dot(wi, wm) * dot(wo, wm) / denom).abs();
-            if mode == TransportMode::Radiance {
-                ft /= sqr(etap);
-            }
-            SampledSpectrum::new(ft)
-        }
+        lanes::f1(&self.one(), wo, wi, mode)
     }
 
+    #[inline]
     fn sample_f(
         &self,
         wo: Vector3f,
@@ -113,111 +80,18 @@ impl BxDFMethods for DielectricBxDF {
         mode: TransportMode,
         sample_flags: BxDFReflTransFlags,
     ) -> Option<BSDFSample> {
-        if self.is_specular() {
-            let r = fr_dielectric(cos_theta(wo), self.eta);
-            let (pr, pt) = choice(r, 1.0 - r, sample_flags);
-            if pr == 0.0 && pt == 0.0 {
-                return None;
-            }
-            if uc < pr / (pr + pt) {
-                let wi = Vector3f::new(-wo.x, -wo.y, wo.z);
-                let fr = SampledSpectrum::new(r / abs_cos_theta(wi));
-                return Some(BSDFSample::new(
-                    fr,
-                    wi,
-                    pr / (pr + pt),
-                    BxDFFlags::SPECULAR_REFLECTION,
-                ));
-            }
-            let (wi, etap) = refract(wo, Normal3f::new(0.0, 0.0, 1.0), self.eta)?;
-            let mut ft = SampledSpectrum::new((1.0 - r) / abs_cos_theta(wi));
-            if mode == TransportMode::Radiance {
-                ft /= sqr(etap);
-            }
-            return Some(BSDFSample::with_eta(
-                ft,
-                wi,
-                pt / (pr + pt),
-                BxDFFlags::SPECULAR_TRANSMISSION,
-                etap,
-            ));
-        }
-
-        // Rough interface: sample a visible microfacet normal first.
-        let d = &self.mf_distrib;
-        let wm = d.sample_wm(wo, u);
-        let r = fr_dielectric(dot(wo, wm), self.eta);
-        let (pr, pt) = choice(r, 1.0 - r, sample_flags);
-        if pr == 0.0 && pt == 0.0 {
-            return None;
-        }
-        // D(ωm) and Λ(ωo) once for the density and the value (the same
-        // operations as `d.pdf` and `d.d`·`d.g`).
-        let dm = d.d(wm);
-        let lambda_o = d.lambda(wo);
-        let d_visible = (1.0 / (1.0 + lambda_o)) / abs_cos_theta(wo) * dm * abs_dot(wo, wm);
-        if uc < pr / (pr + pt) {
-            let wi = reflect(wo, wm);
-            if !same_hemisphere(wo, wi) {
-                return None;
-            }
-            let pdf = d_visible / (4.0 * abs_dot(wo, wm)) * pr / (pr + pt);
-            let f = SampledSpectrum::new(
-                dm * (1.0 / (1.0 + lambda_o + d.lambda(wi))) * r
-                    / (4.0 * cos_theta(wi) * cos_theta(wo)),
-            );
-            Some(BSDFSample::new(f, wi, pdf, BxDFFlags::GLOSSY_REFLECTION))
-        } else {
-            let (wi, etap) = refract(wo, Normal3f::from(wm), self.eta)?;
-            if same_hemisphere(wo, wi) || wi.z == 0.0 {
-                return None;
-            }
-            let denom = sqr(dot(wi, wm) + dot(wo, wm) / etap);
-            let dwm_dwi = abs_dot(wi, wm) / denom;
-            let pdf = d_visible * dwm_dwi * pt / (pr + pt);
-            let mut ft = (1.0 - r)
-                * dm
-                * (1.0 / (1.0 + lambda_o + d.lambda(wi)))
-                * (dot(wi, wm) * dot(wo, wm) / (cos_theta(wi) * cos_theta(wo) * denom)).abs();
-            if mode == TransportMode::Radiance {
-                ft /= sqr(etap);
-            }
-            Some(BSDFSample::with_eta(
-                SampledSpectrum::new(ft),
-                wi,
-                pdf,
-                BxDFFlags::GLOSSY_TRANSMISSION,
-                etap,
-            ))
-        }
+        lanes::sample_f1(&self.one(), wo, uc, u, mode, sample_flags)
     }
 
+    #[inline]
     fn pdf(
         &self,
         wo: Vector3f,
         wi: Vector3f,
-        _mode: TransportMode,
+        mode: TransportMode,
         sample_flags: BxDFReflTransFlags,
     ) -> Float {
-        if self.is_specular() {
-            return 0.0;
-        }
-        let Some((wm, etap, is_reflection)) = self.half_vector(wo, wi) else {
-            return 0.0;
-        };
-        let r = fr_dielectric(dot(wo, wm), self.eta);
-        let (pr, pt) = choice(r, 1.0 - r, sample_flags);
-        if pr == 0.0 && pt == 0.0 {
-            return 0.0;
-        }
-        let d = &self.mf_distrib;
-        if is_reflection {
-            d.pdf(wo, wm) / (4.0 * abs_dot(wo, wm)) * pr / (pr + pt)
-        } else {
-            let denom = sqr(dot(wi, wm) + dot(wo, wm) / etap);
-            let dwm_dwi = abs_dot(wi, wm) / denom;
-            d.pdf(wo, wm) * dwm_dwi * pt / (pr + pt)
-        }
+        lanes::pdf1(&self.one(), wo, wi, mode, sample_flags)
     }
 
     fn flags(&self) -> BxDFFlags {

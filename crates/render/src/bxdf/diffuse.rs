@@ -6,9 +6,11 @@ use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;
 use rpbrt_geometry::{abs_cos_theta, cos_theta, same_hemisphere};
 
+use super::lanes::{self, gather_s, DiffuseLanes, ToLanes};
 use super::scattering::{fr_dielectric, fresnel_moment1};
 use super::{BSDFSample, BxDFFlags, BxDFMethods, BxDFReflTransFlags, TransportMode};
 use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use crate::simd::F32Lanes;
 use crate::spectrum::SampledSpectrum;
 
 /// Cosine-weighted direction in the hemisphere of `wo`.
@@ -34,46 +36,43 @@ impl DiffuseBxDF {
     }
 }
 
-impl BxDFMethods for DiffuseBxDF {
-    fn f(&self, wo: Vector3f, wi: Vector3f, _mode: TransportMode) -> SampledSpectrum {
-        if !same_hemisphere(wo, wi) {
-            return SampledSpectrum::new(0.0);
+impl ToLanes for DiffuseBxDF {
+    type Lanes<L: F32Lanes> = DiffuseLanes<L>;
+    #[inline(always)]
+    fn gather<L: F32Lanes>(items: &[&Self]) -> DiffuseLanes<L> {
+        DiffuseLanes {
+            r: gather_s(items.len(), |i| items[i].r),
         }
-        self.r * INV_PI
+    }
+}
+
+impl BxDFMethods for DiffuseBxDF {
+    #[inline]
+    fn f(&self, wo: Vector3f, wi: Vector3f, mode: TransportMode) -> SampledSpectrum {
+        lanes::f1(&self.one(), wo, wi, mode)
     }
 
+    #[inline]
     fn sample_f(
         &self,
         wo: Vector3f,
-        _uc: Float,
+        uc: Float,
         u: Point2f,
-        _mode: TransportMode,
+        mode: TransportMode,
         sample_flags: BxDFReflTransFlags,
     ) -> Option<BSDFSample> {
-        if !sample_flags.contains(BxDFReflTransFlags::REFLECTION) {
-            return None;
-        }
-        let wi = cosine_in_hemisphere_of(wo, u);
-        let pdf = cosine_hemisphere_pdf(abs_cos_theta(wi));
-        Some(BSDFSample::new(
-            self.r * INV_PI,
-            wi,
-            pdf,
-            BxDFFlags::DIFFUSE_REFLECTION,
-        ))
+        lanes::sample_f1(&self.one(), wo, uc, u, mode, sample_flags)
     }
 
+    #[inline]
     fn pdf(
         &self,
         wo: Vector3f,
         wi: Vector3f,
-        _mode: TransportMode,
+        mode: TransportMode,
         sample_flags: BxDFReflTransFlags,
     ) -> Float {
-        if !sample_flags.contains(BxDFReflTransFlags::REFLECTION) || !same_hemisphere(wo, wi) {
-            return 0.0;
-        }
-        cosine_hemisphere_pdf(abs_cos_theta(wi))
+        lanes::pdf1(&self.one(), wo, wi, mode, sample_flags)
     }
 
     fn flags(&self) -> BxDFFlags {

@@ -11,10 +11,12 @@ use rpbrt_geometry::{abs_cos_theta, same_hemisphere};
 use super::conductor::ConductorBxDF;
 use super::dielectric::DielectricBxDF;
 use super::diffuse::DiffuseBxDF;
+use super::lanes::{self, gather_f, source, LayeredLanes, ToLanes, MAX_LANES};
 use super::scattering::{henyey_greenstein, sample_henyey_greenstein};
 use super::{BSDFSample, BxDFFlags, BxDFMethods, BxDFReflTransFlags, TransportMode};
 use crate::rng::Rng;
 use crate::sampling::power_heuristic;
+use crate::simd::{F32Lanes, Scalar1};
 use crate::spectrum::SampledSpectrum;
 
 /// A dielectric coating over a Lambertian base (two-sided).
@@ -52,7 +54,7 @@ fn murmur_hash64a(key: &[u8]) -> u64 {
 
 /// Hash of the little-endian bytes of an optional integer seed followed by
 /// floats, as pbrt-v4 packs `Hash(seed, v)` and `Hash(v)`.
-fn hash_floats(seed: Option<i32>, fs: &[Float]) -> u64 {
+pub(crate) fn hash_floats(seed: Option<i32>, fs: &[Float]) -> u64 {
     let mut buf = [0u8; 32];
     let mut n = 0;
     if let Some(s) = seed {
@@ -80,6 +82,25 @@ fn tr(dz: Float, w: Vector3f) -> Float {
 #[inline]
 fn sample_exponential(u: Float, a: Float) -> Float {
     -(1.0 - u).ln() / a
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Tests compare the lane walk with the scalar one, which otherwise
+    /// runs only for models with a medium.
+    pub(crate) static FORCE_SCALAR_WALK: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
+#[inline(always)]
+fn scalar_walk_forced() -> bool {
+    #[cfg(test)]
+    {
+        FORCE_SCALAR_WALK.with(|c| c.get())
+    }
+    #[cfg(not(test))]
+    {
+        false
+    }
 }
 
 /// One of the two interfaces of a layered BxDF.
@@ -219,27 +240,81 @@ fn v3(v: Vector3f) -> [Float; 3] {
     [v.x, v.y, v.z]
 }
 
-impl<Top: BxDFMethods, Bottom: BxDFMethods, const TWO_SIDED: bool> BxDFMethods
-    for LayeredBxDF<Top, Bottom, TWO_SIDED>
+// The lane forms are the crate's business: the methods below are
+// crate-private, but the bound names a crate-private trait.
+#[allow(private_bounds)]
+impl<Bottom: BxDFMethods + ToLanes, const TWO_SIDED: bool>
+    LayeredBxDF<DielectricBxDF, Bottom, TWO_SIDED>
+{
+    /// True when the lane walk (`lanes/layered.rs`) computes this model:
+    /// two-sided, with no medium between the interfaces.
+    #[inline(always)]
+    pub(crate) fn has_lane_walk(&self) -> bool {
+        TWO_SIDED && self.albedo.is_black() && !scalar_walk_forced()
+    }
+
+    /// The lane form of `items[..L::N]`, which must agree in depth,
+    /// sample count and seed (and have [`Self::has_lane_walk`]).
+    #[inline(always)]
+    pub(crate) fn gather_walk<L: F32Lanes>(items: &[&Self]) -> LayeredLanes<L, Bottom::Lanes<L>> {
+        let n = items.len();
+        let tops: [&DielectricBxDF; MAX_LANES] = std::array::from_fn(|i| &items[source(i, n)].top);
+        let bottoms: [&Bottom; MAX_LANES] = std::array::from_fn(|i| &items[source(i, n)].bottom);
+        let m = n.min(L::N);
+        LayeredLanes {
+            top: DielectricBxDF::gather::<L>(&tops[..m]),
+            bottom: Bottom::gather::<L>(&bottoms[..m]),
+            thickness: gather_f(n, |i| items[i].thickness),
+            max_depth: items[0].max_depth,
+            n_samples: items[0].n_samples,
+            seed: items[0].seed,
+        }
+    }
+
+    /// What a batch of these models must agree on.
+    #[inline(always)]
+    pub(crate) fn walk_key(&self) -> (u32, u32, i32) {
+        (self.max_depth, self.n_samples, self.seed)
+    }
+}
+
+/// The coated models' lane form: their walk (for models that have one,
+/// [`LayeredBxDF::has_lane_walk`]).
+#[allow(private_bounds)]
+impl<Bottom: BxDFMethods + ToLanes> ToLanes for LayeredBxDF<DielectricBxDF, Bottom, true> {
+    type Lanes<L: F32Lanes> = LayeredLanes<L, Bottom::Lanes<L>>;
+    #[inline(always)]
+    fn gather<L: F32Lanes>(items: &[&Self]) -> Self::Lanes<L> {
+        Self::gather_walk::<L>(items)
+    }
+}
+
+#[allow(private_bounds)]
+impl<Bottom: BxDFMethods + ToLanes, const TWO_SIDED: bool> BxDFMethods
+    for LayeredBxDF<DielectricBxDF, Bottom, TWO_SIDED>
 {
     fn f(&self, wo: Vector3f, wi: Vector3f, mode: TransportMode) -> SampledSpectrum {
+        if self.has_lane_walk() {
+            return lanes::f1(&Self::gather_walk::<Scalar1>(&[self]), wo, wi, mode);
+        }
         let (mut wo, mut wi) = (wo, wi);
         if TWO_SIDED && wo.z < 0.0 {
             wo = -wo;
             wi = -wi;
         }
         let entered_top = TWO_SIDED || wo.z > 0.0;
-        let enter: Layer<Top, Bottom> = if entered_top {
+        let enter: Layer<DielectricBxDF, Bottom> = if entered_top {
             Layer::Top(&self.top)
         } else {
             Layer::Bottom(&self.bottom)
         };
         let exits_bottom = same_hemisphere(wo, wi) ^ entered_top;
-        let (exit, non_exit): (Layer<Top, Bottom>, Layer<Top, Bottom>) = if exits_bottom {
-            (Layer::Bottom(&self.bottom), Layer::Top(&self.top))
-        } else {
-            (Layer::Top(&self.top), Layer::Bottom(&self.bottom))
-        };
+        let (exit, non_exit): (Layer<DielectricBxDF, Bottom>, Layer<DielectricBxDF, Bottom>) =
+            if exits_bottom {
+                (Layer::Bottom(&self.bottom), Layer::Top(&self.top))
+            } else {
+                (Layer::Top(&self.top), Layer::Bottom(&self.bottom))
+            };
         let exit_z = if exits_bottom { 0.0 } else { self.thickness };
         let n_samples = self.n_samples as Float;
 
@@ -414,6 +489,10 @@ impl<Top: BxDFMethods, Bottom: BxDFMethods, const TWO_SIDED: bool> BxDFMethods
     ) -> Option<BSDFSample> {
         // pbrt-v4 supports only unrestricted sampling of layered models.
         debug_assert!(sample_flags == BxDFReflTransFlags::ALL);
+        if self.has_lane_walk() {
+            let w = Self::gather_walk::<Scalar1>(&[self]);
+            return lanes::sample_f1(&w, wo, uc, u, mode, sample_flags);
+        }
         let mut wo = wo;
         let mut flip_wi = false;
         if TWO_SIDED && wo.z < 0.0 {
@@ -540,6 +619,10 @@ impl<Top: BxDFMethods, Bottom: BxDFMethods, const TWO_SIDED: bool> BxDFMethods
         sample_flags: BxDFReflTransFlags,
     ) -> Float {
         debug_assert!(sample_flags == BxDFReflTransFlags::ALL);
+        if self.has_lane_walk() {
+            let w = Self::gather_walk::<Scalar1>(&[self]);
+            return lanes::pdf1(&w, wo, wi, mode, sample_flags);
+        }
         let (mut wo, mut wi) = (wo, wi);
         if TWO_SIDED && wo.z < 0.0 {
             wo = -wo;
@@ -565,11 +648,12 @@ impl<Top: BxDFMethods, Bottom: BxDFMethods, const TWO_SIDED: bool> BxDFMethods
         for _ in 0..self.n_samples {
             if same_hemisphere(wo, wi) {
                 // Transmission, reflection inside, transmission (TRT).
-                let (r_if, t_if): (Layer<Top, Bottom>, Layer<Top, Bottom>) = if entered_top {
-                    (Layer::Bottom(&self.bottom), Layer::Top(&self.top))
-                } else {
-                    (Layer::Top(&self.top), Layer::Bottom(&self.bottom))
-                };
+                let (r_if, t_if): (Layer<DielectricBxDF, Bottom>, Layer<DielectricBxDF, Bottom>) =
+                    if entered_top {
+                        (Layer::Bottom(&self.bottom), Layer::Top(&self.top))
+                    } else {
+                        (Layer::Top(&self.top), Layer::Bottom(&self.bottom))
+                    };
                 let (uc, u) = (r(&mut rng), r2(&mut rng));
                 let wos = t_if.sample_f(wo, uc, u, mode, trans);
                 let (uc, u) = (r(&mut rng), r2(&mut rng));
@@ -602,11 +686,12 @@ impl<Top: BxDFMethods, Bottom: BxDFMethods, const TWO_SIDED: bool> BxDFMethods
                 }
             } else {
                 // Transmission through both interfaces (TT).
-                let (to_if, ti_if): (Layer<Top, Bottom>, Layer<Top, Bottom>) = if entered_top {
-                    (Layer::Top(&self.top), Layer::Bottom(&self.bottom))
-                } else {
-                    (Layer::Bottom(&self.bottom), Layer::Top(&self.top))
-                };
+                let (to_if, ti_if): (Layer<DielectricBxDF, Bottom>, Layer<DielectricBxDF, Bottom>) =
+                    if entered_top {
+                        (Layer::Top(&self.top), Layer::Bottom(&self.bottom))
+                    } else {
+                        (Layer::Bottom(&self.bottom), Layer::Top(&self.top))
+                    };
                 let (uc, u) = (r(&mut rng), r2(&mut rng));
                 let Some(wos) = usable(&to_if.sample_f(wo, uc, u, mode, all)) else {
                     continue;

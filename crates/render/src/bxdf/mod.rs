@@ -21,6 +21,7 @@ mod diffuse;
 mod disney;
 pub mod fourier;
 mod hair;
+pub(crate) mod lanes;
 mod layered;
 pub mod measured;
 mod microfacet;

@@ -4,6 +4,7 @@
 //! sampling; plus the vertex's cached offset ray origins the light sample,
 //! the shadow ray and the next bounce share.
 
+use super::bsdf_stage::BsdfAnswers;
 use super::Scene;
 use crate::bxdf::BSDF;
 use crate::light::{Light, LightLiSample, LightSampleContext};
@@ -107,7 +108,7 @@ pub(crate) fn sample_ld(
     // shadow query.
     let req = light_request(origins, bsdf, u, u_light);
     let query = answer_light(scene, light_sampler, &req, lambda)
-        .and_then(|a| light_shadow_query(scene, origins, bsdf, &a));
+        .and_then(|a| light_shadow_query(scene, origins, bsdf, &a, &BsdfAnswers::default()));
     match query {
         Some(q) if !scene.intersect_p(&q.ray, q.t_max) => q.ld,
         _ => SampledSpectrum::new(0.0),
@@ -263,12 +264,13 @@ pub(crate) fn light_shadow_query(
     origins: &mut VertexOrigins,
     bsdf: &BSDF,
     a: &LightAnswer,
+    pre: &BsdfAnswers,
 ) -> Option<ShadowQuery> {
     let si = origins.si;
     let ls = &a.ls;
     let wo = si.wo;
     let wi = ls.wi;
-    let f = bsdf.f(wo, wi, crate::bxdf::TransportMode::Radiance) * abs_dot(wi, si.shading.n);
+    let f = pre.light_f(bsdf, wo, wi) * abs_dot(wi, si.shading.n);
     if f.is_black() {
         return None;
     }
@@ -278,12 +280,7 @@ pub(crate) fn light_shadow_query(
     let ld = if light.light_type().is_delta() {
         ls.l * f / p_l
     } else {
-        let p_b = bsdf.pdf(
-            wo,
-            wi,
-            crate::bxdf::TransportMode::Radiance,
-            crate::bxdf::BxDFReflTransFlags::ALL,
-        );
+        let p_b = pre.light_pdf(bsdf, wo, wi);
         let w_l = crate::sampling::power_heuristic(1.0, p_l, 1.0, p_b);
         ls.l * f * (w_l / p_l)
     };

@@ -30,6 +30,7 @@
 //! pbrt-v3's Whitted ray tracer.
 
 pub(crate) mod bdpt;
+mod bsdf_stage;
 mod create;
 mod direct;
 mod function;

@@ -2,10 +2,11 @@
 //! estimation with multiple importance sampling, Russian roulette and
 //! optional BSDF regularization.
 
+use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
 use super::direct::{light_request, light_shadow_query, LightAnswer, ShadowQuery};
 use super::vertex::{li_by_vertices, Begin, VertexIntegrator, VertexStep};
 use super::{skip_intersection, RayIntegrator, Scene, VertexOrigins};
-use crate::bxdf::{BxDFReflTransFlags, TransportMode, BSDF};
+use crate::bxdf::BSDF;
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
 use crate::lightsampler::LightSampler;
@@ -97,6 +98,7 @@ pub(crate) struct SurfaceScratch {
     sides: [Option<Point3f>; 2],
     u: Float,
     u2: Point2f,
+    answers: BsdfAnswers,
 }
 
 impl VertexIntegrator for PathIntegrator {
@@ -116,6 +118,30 @@ impl VertexIntegrator for PathIntegrator {
     #[inline(always)]
     fn radiance(s: &mut PathState) -> &mut SampledSpectrum {
         &mut s.l
+    }
+
+    #[inline(always)]
+    fn bsdf_query<'a>(
+        s: &PathState,
+        scratch: &'a SurfaceScratch,
+        light: Option<&LightAnswer>,
+    ) -> Option<BsdfQuery<'a>> {
+        let (Some(hit), Some(bsdf)) = (scratch.hit.as_ref(), scratch.bsdf.as_ref()) else {
+            return None;
+        };
+        Some(BsdfQuery {
+            bsdf,
+            wo_light: hit.si.wo,
+            wi_light: light.map(|a| a.ls.wi),
+            wo: -s.ray.ray.d,
+            u: scratch.u,
+            u2: scratch.u2,
+        })
+    }
+
+    #[inline(always)]
+    fn bsdf_answers(scratch: &mut SurfaceScratch) -> &mut BsdfAnswers {
+        &mut scratch.answers
     }
 
     /// The first half of one vertex of pbrt-v4's `PathIntegrator::Li`: the
@@ -221,9 +247,10 @@ impl VertexIntegrator for PathIntegrator {
             return VertexStep::DONE;
         };
         let si = &hit.si;
+        let pre = std::mem::take(&mut scratch.answers);
         let mut origins = VertexOrigins::with_sides(si, scratch.sides);
         let shadow = light
-            .and_then(|a| light_shadow_query(scene, &mut origins, bsdf, a))
+            .and_then(|a| light_shadow_query(scene, &mut origins, bsdf, a, &pre))
             .map(|q| ShadowQuery {
                 ld: s.beta * q.ld,
                 ..q
@@ -231,16 +258,11 @@ impl VertexIntegrator for PathIntegrator {
         let (u, u2) = (scratch.u, scratch.u2);
         s.prev_ctx = LightSampleContext::from_si(si);
         let wo = -s.ray.ray.d;
-        let Some(bs) = bsdf.sample_f(wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL)
-        else {
+        let Some((bs, p_b)) = pre.sample(bsdf, wo, u, u2) else {
             return VertexStep { shadow, done: true };
         };
         s.beta *= bs.f * (abs_dot(bs.wi, si.shading.n) / bs.pdf);
-        s.p_b = if bs.pdf_is_proportional {
-            bsdf.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL)
-        } else {
-            bs.pdf
-        };
+        s.p_b = p_b;
         s.specular_bounce = bs.is_specular();
         s.any_non_specular |= !bs.is_specular();
         if bs.is_transmission() {

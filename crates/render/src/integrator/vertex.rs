@@ -6,6 +6,7 @@
 //! [`VertexIntegrator::finish`] in the same sampler order, so they give
 //! the same pixels.
 
+use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
 use super::direct::{answer_light, LightAnswer, LightRequest, ShadowQuery};
 use super::Scene;
 use crate::film::VisibleSurface;
@@ -67,6 +68,19 @@ pub(crate) trait VertexIntegrator: Sync {
 
     /// The radiance the path has gathered.
     fn radiance(s: &mut Self::State) -> &mut SampledSpectrum;
+
+    /// The BSDF queries the second half of a vertex that asked for
+    /// `light` will make (`None`: it makes none), for the wavefront's
+    /// batched BSDF stage.
+    fn bsdf_query<'a>(
+        s: &Self::State,
+        scratch: &'a Self::Scratch,
+        light: Option<&LightAnswer>,
+    ) -> Option<BsdfQuery<'a>>;
+
+    /// Where the BSDF stage leaves its answers for the second half (which
+    /// takes them, evaluating what is not answered).
+    fn bsdf_answers(scratch: &mut Self::Scratch) -> &mut BsdfAnswers;
 
     /// A vertex's first half: `record` is the closest hit of
     /// [`VertexIntegrator::ray`] with no bound on the ray parameter

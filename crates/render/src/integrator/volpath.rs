@@ -4,6 +4,7 @@
 //! light sampling through media and interfaces by ratio tracking, medium
 //! emission, and subsurface scattering through the materials' BSSRDFs.
 
+use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
 use super::direct::ShadowQuery;
 use super::direct::{light_request, LightAnswer};
 use super::direct::{light_sample_culled, surface_light_context};
@@ -251,6 +252,30 @@ impl VertexIntegrator for VolPathIntegrator {
         &mut s.l
     }
 
+    #[inline(always)]
+    fn bsdf_query<'a>(
+        _s: &VolPathState,
+        scratch: &'a VolPathScratch,
+        light: Option<&LightAnswer>,
+    ) -> Option<BsdfQuery<'a>> {
+        let (Some(hit), Some(bsdf)) = (scratch.hit.as_ref(), scratch.bsdf.as_ref()) else {
+            return None;
+        };
+        Some(BsdfQuery {
+            bsdf,
+            wo_light: hit.si.wo,
+            wi_light: light.map(|a| a.ls.wi),
+            wo: hit.si.wo,
+            u: scratch.u,
+            u2: scratch.u2,
+        })
+    }
+
+    #[inline(always)]
+    fn bsdf_answers(scratch: &mut VolPathScratch) -> &mut BsdfAnswers {
+        &mut scratch.answers
+    }
+
     /// The first half of one pass of pbrt-v4's `VolPathIntegrator::Li`
     /// loop: delta tracking through the ray's medium up to `record`, then
     /// the surface there up to its light sample. In scenes without media
@@ -471,22 +496,19 @@ impl VertexIntegrator for VolPathIntegrator {
         };
         let si = &hit.si;
         let ray_medium = scratch.ray_medium;
+        let pre = std::mem::take(&mut scratch.answers);
         let mut origins = VertexOrigins::with_sides(si, scratch.sides);
-        let shadow = light.and_then(|a| surface_shadow_query(scene, &mut origins, bsdf, a, s));
+        let shadow =
+            light.and_then(|a| surface_shadow_query(scene, &mut origins, bsdf, a, s, &pre));
         let (u, u2) = (scratch.u, scratch.u2);
         let done = VertexStep { shadow, done: true };
         s.prev_ctx = LightSampleContext::from_si(si);
         let wo = si.wo;
-        let Some(bs) = bsdf.sample_f(wo, u, u2, TransportMode::Radiance, BxDFReflTransFlags::ALL)
-        else {
+        let Some((bs, p_b)) = pre.sample(bsdf, wo, u, u2) else {
             return done;
         };
         s.beta *= bs.f * (abs_dot(bs.wi, si.shading.n) / bs.pdf);
-        s.r_l = if bs.pdf_is_proportional {
-            s.r_u / bsdf.pdf(wo, bs.wi, TransportMode::Radiance, BxDFReflTransFlags::ALL)
-        } else {
-            s.r_u / bs.pdf
-        };
+        s.r_l = s.r_u / p_b;
         s.specular_bounce = bs.is_specular();
         s.any_non_specular |= !bs.is_specular();
         if bs.is_transmission() {
@@ -557,15 +579,16 @@ fn surface_shadow_query(
     bsdf: &BSDF,
     a: &LightAnswer,
     s: &VolPathState,
+    pre: &BsdfAnswers,
 ) -> Option<ShadowQuery> {
     let si = origins.si;
     let ls = &a.ls;
     let wi = ls.wi;
-    let f_hat = bsdf.f(si.wo, wi, TransportMode::Radiance) * abs_dot(wi, si.shading.n);
+    let f_hat = pre.light_f(bsdf, si.wo, wi) * abs_dot(wi, si.shading.n);
     if f_hat.is_black() {
         return None;
     }
-    let scatter_pdf = bsdf.pdf(si.wo, wi, TransportMode::Radiance, BxDFReflTransFlags::ALL);
+    let scatter_pdf = pre.light_pdf(bsdf, si.wo, wi);
     let p_to = ls.p_light.midpoint();
     let pf = origins.toward(p_to - si.p());
     let ray = spawn_ray_from_origin_to_surface(pf, si.time, p_to, ls.p_light.error(), ls.n_light);
@@ -628,6 +651,7 @@ pub(crate) struct VolPathScratch {
     u: Float,
     u2: Point2f,
     ray_medium: Option<MediumId>,
+    answers: BsdfAnswers,
 }
 
 impl VolPathIntegrator {

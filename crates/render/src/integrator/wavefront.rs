@@ -36,6 +36,7 @@
 //!
 //! [`PrimitiveAggregate::intersect_records`]: crate::primitive::PrimitiveAggregate::intersect_records
 
+use super::bsdf_stage::{answer_bsdfs, BsdfAnswers, BsdfBatch, BsdfQuery};
 use super::direct::{answer_lights, LightAnswer, LightBatch, LightRequest};
 use super::render::RenderOptions;
 use super::tile::{add_estimate, CameraRaySample, RayIntegrator, RayTiles, TileIntegrator};
@@ -190,6 +191,8 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let mut request_lanes: Vec<usize> = Vec::with_capacity(LANES);
         let mut light_batch = LightBatch::default();
         let mut answers: Vec<Option<LightAnswer>> = Vec::with_capacity(LANES);
+        let mut bsdf_batch = BsdfBatch::default();
+        let mut bsdf_answers: Vec<BsdfAnswers> = Vec::with_capacity(LANES);
         let mut started = 0;
         let level = opts.simd.unwrap_or_else(crate::simd::level);
         loop {
@@ -306,6 +309,19 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 &mut light_batch,
                 &mut answers,
             );
+
+            // BSDF: every vertex's BSDF queries, lane-parallel for the
+            // models with a lane form.
+            let bsdf_queries: Vec<Option<BsdfQuery>> = request_lanes
+                .iter()
+                .zip(&answers)
+                .map(|(&i, a)| I::bsdf_query(&lanes[i].path, &scratch[i], a.as_ref()))
+                .collect();
+            answer_bsdfs(level, &bsdf_queries, &mut bsdf_batch, &mut bsdf_answers);
+            drop(bsdf_queries);
+            for (&i, a) in request_lanes.iter().zip(&bsdf_answers) {
+                *I::bsdf_answers(&mut scratch[i]) = *a;
+            }
 
             // Shade, second half: the light samples' shadow queries and the
             // next rays.

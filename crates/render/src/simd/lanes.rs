@@ -65,6 +65,9 @@ pub trait F32Lanes: Copy {
     fn difference_of_products(a: Self, b: Self, c: Self, d: Self) -> Self;
     /// Lane-wise `a·b + c·d`, as [`rpbrt_geometry::float::sum_of_products`].
     fn sum_of_products(a: Self, b: Self, c: Self, d: Self) -> Self;
+    /// Lane-wise 2ⁿ for lanes holding an integer `n` in [−126, 127] (built
+    /// from its exponent bits: exact).
+    fn pow2i(n: Self) -> Self;
     /// Lane-wise `self > o`.
     #[inline(always)]
     fn gt(self, o: Self) -> Self::Mask {
@@ -198,6 +201,10 @@ impl F32Lanes for Scalar1 {
     #[inline(always)]
     fn sum_of_products(a: Self, b: Self, c: Self, d: Self) -> Self {
         Scalar1(rpbrt_geometry::float::sum_of_products(a.0, b.0, c.0, d.0))
+    }
+    #[inline(always)]
+    fn pow2i(n: Self) -> Self {
+        Scalar1(f32::from_bits(((n.0 as i32 + 127) as u32) << 23))
     }
 }
 
@@ -341,6 +348,13 @@ mod x86 {
                 let l = _mm256_cvtpd_ps(_mm256_add_pd(lo.0, lo.1));
                 let h = _mm256_cvtpd_ps(_mm256_add_pd(hi.0, hi.1));
                 F32x8(_mm256_set_m128(h, l))
+            }
+        }
+        #[inline(always)]
+        fn pow2i(n: Self) -> Self {
+            unsafe {
+                let e = _mm256_add_epi32(_mm256_cvttps_epi32(n.0), _mm256_set1_epi32(127));
+                F32x8(_mm256_castsi256_ps(_mm256_slli_epi32::<23>(e)))
             }
         }
     }
@@ -512,6 +526,13 @@ mod x86 {
                     _mm_mul_pd(_mm_cvtps_pd(c), _mm_cvtps_pd(d)),
                 );
                 F32x4(_mm_movelh_ps(_mm_cvtpd_ps(l), _mm_cvtpd_ps(h)))
+            }
+        }
+        #[inline(always)]
+        fn pow2i(n: Self) -> Self {
+            unsafe {
+                let e = _mm_add_epi32(_mm_cvttps_epi32(n.0), _mm_set1_epi32(127));
+                F32x4(_mm_castsi128_ps(_mm_slli_epi32::<23>(e)))
             }
         }
     }

@@ -117,12 +117,51 @@ pub fn atan2<L: F32Lanes>(y: L, x: L) -> L {
 
 /// Lane-wise: the sign bit is set (negative numbers and −0).
 #[inline(always)]
-fn sign_bit<L: F32Lanes>(x: L) -> L::Mask {
+pub fn sign_bit<L: F32Lanes>(x: L) -> L::Mask {
     let zero = L::splat(0.0);
     L::or(
         x.lt(zero),
         L::and(x.eq(zero), L::splat(1.0).div(x).lt(zero)),
     )
+}
+
+/// log₂ e.
+const LOG2_E: f32 = std::f32::consts::LOG2_E;
+/// ln 2 in two parts (the first exact in few bits), for the reduction.
+const LN2_HI: f32 = 0.693_359_4;
+const LN2_LO: f32 = -2.121_944_4e-4;
+/// eʳ ≈ 1 + r + r² (E0 + r (E1 + r (E2 + r (E3 + r (E4 + r E5))))) on
+/// [−ln 2/2, ln 2/2] (reversed: E5 is the constant term's neighbour).
+const EXP_P: [f32; 6] = [
+    1.987_569_1e-4,
+    1.398_2e-3,
+    8.333_452e-3,
+    4.166_579_6e-2,
+    1.666_666_5e-1,
+    5.000_000_1e-1,
+];
+
+/// Lane-wise `eˣ` (the Cephes single-precision method: x = n ln 2 + r,
+/// a degree-7 polynomial for eʳ, then the exact scaling by 2ⁿ). Below
+/// −87.3 it gives 0 (the true value is below 2⁻¹²⁶), above 88 +∞, NaN
+/// stays NaN.
+#[inline(always)]
+pub fn exp<L: F32Lanes>(x: L) -> L {
+    let (lo, hi) = (-87.3f32, 88.0f32);
+    let xc = L::select(x.lt(L::splat(lo)), L::splat(lo), x);
+    let xc = L::select(xc.gt(L::splat(hi)), L::splat(hi), xc);
+    let xc = L::select(x.is_nan(), L::splat(0.0), xc);
+    let n = xc.mul(L::splat(LOG2_E)).add(L::splat(0.5)).floor();
+    let r = xc.sub(n.mul(L::splat(LN2_HI))).sub(n.mul(L::splat(LN2_LO)));
+    let mut y = L::splat(EXP_P[0]);
+    for &c in &EXP_P[1..] {
+        y = y.mul(r).add(L::splat(c));
+    }
+    let y = y.mul(r.mul(r)).add(r).add(L::splat(1.0));
+    let v = y.mul(L::pow2i(n));
+    let v = L::select(x.lt(L::splat(lo)), L::splat(0.0), v);
+    let v = L::select(x.gt(L::splat(hi)), L::splat(f32::INFINITY), v);
+    L::select(x.is_nan(), x, v)
 }
 
 /// `clamp(v, lo, hi)` as [`rpbrt_geometry::float::clamp`] computes it

@@ -139,28 +139,30 @@ struct MathOps<'a> {
 }
 
 impl Kernel for MathOps<'_> {
-    type Output = Vec<[u32; 3]>;
+    type Output = Vec<[u32; 4]>;
     #[inline(always)]
-    fn run<L: F32Lanes>(self) -> Vec<[u32; 3]> {
+    fn run<L: F32Lanes>(self) -> Vec<[u32; 4]> {
         let mut out = Vec::new();
         for (cx, cy) in self.x.chunks_exact(L::N).zip(self.y.chunks_exact(L::N)) {
             let (x, y) = (L::load(cx), L::load(cy));
             let (s, c) = math::sin_cos(x);
             let t = math::atan2(y, x);
-            let mut v = [[0.0f32; 16]; 3];
+            // e^(8y): arguments from −400 to 400 at the widest.
+            let e = math::exp(y.mul(L::splat(8.0)));
+            let mut v = [[0.0f32; 16]; 4];
             s.store(&mut v[0]);
             c.store(&mut v[1]);
             t.store(&mut v[2]);
-            let [vs, vc, vt] = v;
-            for ((s, c), t) in vs.iter().zip(&vc).zip(&vt).take(L::N) {
-                out.push([s.to_bits(), c.to_bits(), t.to_bits()]);
+            e.store(&mut v[3]);
+            for i in 0..L::N {
+                out.push([v[0][i], v[1][i], v[2][i], v[3][i]].map(f32::to_bits));
             }
         }
         out
     }
 }
 
-/// sin, cos and atan2 are within a few ulps of the correctly rounded
+/// sin, cos, atan2 and exp are within a few ulps of the correctly rounded
 /// values (on the arguments rpbrt gives them: angles of a few turns), and
 /// every width gives the same bits.
 #[test]
@@ -191,20 +193,33 @@ fn elementary_functions_are_accurate_and_the_same_at_every_width() {
         let ulp = (f32::from_bits(ulp + 1) - f32::from_bits(ulp)) as f64;
         (got as f64 - exact).abs() / ulp
     };
-    let mut worst = [0.0f64; 3];
+    let mut worst = [0.0f64; 4];
     for (i, r) in reference.iter().enumerate() {
         let (xi, yi) = (x[i] as f64, y[i] as f64);
         let got = r.map(f32::from_bits);
         worst[0] = worst[0].max(ulps(got[0], xi.sin()));
         worst[1] = worst[1].max(ulps(got[1], xi.cos()));
         worst[2] = worst[2].max(ulps(got[2], yi.atan2(xi)));
+        // exp: relative error where the result is a normal float, and the
+        // flush to zero or infinity outside.
+        let arg = (y[i] * 8.0) as f64;
+        let exact = arg.exp();
+        if (-87.3..=88.0).contains(&arg) {
+            let ulp = f32::from_bits((exact as f32).to_bits() + 1) as f64 - (exact as f32) as f64;
+            worst[3] = worst[3].max((got[3] as f64 - exact).abs() / ulp);
+        } else if arg < -87.3 {
+            assert_eq!(got[3], 0.0, "exp({arg})");
+        } else {
+            assert_eq!(got[3], f32::INFINITY, "exp({arg})");
+        }
     }
     assert!(
         worst.iter().all(|&w| w <= 4.0),
-        "worst errors (ulps) sin {} cos {} atan2 {}",
+        "worst errors (ulps) sin {} cos {} atan2 {} exp {}",
         worst[0],
         worst[1],
-        worst[2]
+        worst[2],
+        worst[3]
     );
     for level in SimdLevel::available() {
         let got = dispatch(level, MathOps { x: &x, y: &y });
