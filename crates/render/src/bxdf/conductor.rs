@@ -6,10 +6,10 @@
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;
 
-use super::lanes::{self, gather_f, gather_s, ConductorLanes, ToLanes, TrLanes};
+use super::lanes::{self, gather_f, gather_s, ConductorLanes, ToLanes, TrLanes, S4};
 use super::microfacet::TrowbridgeReitzDistribution;
 use super::{BSDFSample, BxDFFlags, BxDFMethods, BxDFReflTransFlags, TransportMode};
-use crate::simd::F32Lanes;
+use crate::simd::{F32Lanes, Scalar1};
 use crate::spectrum::SampledSpectrum;
 
 /// A smooth or rough metal with complex index `eta + i k` per wavelength.
@@ -48,6 +48,17 @@ impl ToLanes for ConductorBxDF {
             },
             eta: gather_s(n, |i| items[i].eta),
             k: gather_s(n, |i| items[i].k),
+        }
+    }
+    #[inline(always)]
+    fn one(&self) -> ConductorLanes<Scalar1> {
+        ConductorLanes {
+            d: TrLanes {
+                ax: Scalar1(self.mf_distrib.alpha_x()),
+                ay: Scalar1(self.mf_distrib.alpha_y()),
+            },
+            eta: S4(self.eta.values.map(Scalar1)),
+            k: S4(self.k.values.map(Scalar1)),
         }
     }
 }

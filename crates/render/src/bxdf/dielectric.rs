@@ -11,7 +11,7 @@ use super::lanes::{self, gather_f, DielectricLanes, ToLanes, TrLanes};
 use super::microfacet::TrowbridgeReitzDistribution;
 use super::scattering::fr_dielectric;
 use super::{BSDFSample, BxDFFlags, BxDFMethods, BxDFReflTransFlags, TransportMode};
-use crate::simd::F32Lanes;
+use crate::simd::{F32Lanes, Scalar1};
 use crate::spectrum::SampledSpectrum;
 
 /// Probabilities of choosing reflection (`r`) or transmission (`t`) under
@@ -60,6 +60,16 @@ impl ToLanes for DielectricBxDF {
             d: TrLanes {
                 ax: gather_f(n, |i| items[i].mf_distrib.alpha_x()),
                 ay: gather_f(n, |i| items[i].mf_distrib.alpha_y()),
+            },
+        }
+    }
+    #[inline(always)]
+    fn one(&self) -> DielectricLanes<Scalar1> {
+        DielectricLanes {
+            eta: Scalar1(self.eta),
+            d: TrLanes {
+                ax: Scalar1(self.mf_distrib.alpha_x()),
+                ay: Scalar1(self.mf_distrib.alpha_y()),
             },
         }
     }

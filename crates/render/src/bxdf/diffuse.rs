@@ -6,11 +6,11 @@ use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;
 use rpbrt_geometry::{abs_cos_theta, cos_theta, same_hemisphere};
 
-use super::lanes::{self, gather_s, DiffuseLanes, ToLanes};
+use super::lanes::{gather_s, DiffuseLanes, ToLanes, S4};
 use super::scattering::{fr_dielectric, fresnel_moment1};
 use super::{BSDFSample, BxDFFlags, BxDFMethods, BxDFReflTransFlags, TransportMode};
 use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
-use crate::simd::F32Lanes;
+use crate::simd::{F32Lanes, Scalar1};
 use crate::spectrum::SampledSpectrum;
 
 /// Cosine-weighted direction in the hemisphere of `wo`.
@@ -36,6 +36,10 @@ impl DiffuseBxDF {
     }
 }
 
+// The scalar methods stay plain scalar code: the wavefront does not batch
+// this model on its own (its few operations cost less than gathering
+// them into lanes), only as the base of `coateddiffuse`, whose walk runs
+// the lane form below at every width.
 impl ToLanes for DiffuseBxDF {
     type Lanes<L: F32Lanes> = DiffuseLanes<L>;
     #[inline(always)]
@@ -44,35 +48,54 @@ impl ToLanes for DiffuseBxDF {
             r: gather_s(items.len(), |i| items[i].r),
         }
     }
+    #[inline(always)]
+    fn one(&self) -> DiffuseLanes<Scalar1> {
+        DiffuseLanes {
+            r: S4(self.r.values.map(Scalar1)),
+        }
+    }
 }
 
 impl BxDFMethods for DiffuseBxDF {
-    #[inline]
-    fn f(&self, wo: Vector3f, wi: Vector3f, mode: TransportMode) -> SampledSpectrum {
-        lanes::f1(&self.one(), wo, wi, mode)
+    fn f(&self, wo: Vector3f, wi: Vector3f, _mode: TransportMode) -> SampledSpectrum {
+        if !same_hemisphere(wo, wi) {
+            return SampledSpectrum::new(0.0);
+        }
+        self.r * INV_PI
     }
 
-    #[inline]
     fn sample_f(
         &self,
         wo: Vector3f,
-        uc: Float,
+        _uc: Float,
         u: Point2f,
-        mode: TransportMode,
+        _mode: TransportMode,
         sample_flags: BxDFReflTransFlags,
     ) -> Option<BSDFSample> {
-        lanes::sample_f1(&self.one(), wo, uc, u, mode, sample_flags)
+        if !sample_flags.contains(BxDFReflTransFlags::REFLECTION) {
+            return None;
+        }
+        let wi = cosine_in_hemisphere_of(wo, u);
+        let pdf = cosine_hemisphere_pdf(abs_cos_theta(wi));
+        Some(BSDFSample::new(
+            self.r * INV_PI,
+            wi,
+            pdf,
+            BxDFFlags::DIFFUSE_REFLECTION,
+        ))
     }
 
-    #[inline]
     fn pdf(
         &self,
         wo: Vector3f,
         wi: Vector3f,
-        mode: TransportMode,
+        _mode: TransportMode,
         sample_flags: BxDFReflTransFlags,
     ) -> Float {
-        lanes::pdf1(&self.one(), wo, wi, mode, sample_flags)
+        if !sample_flags.contains(BxDFReflTransFlags::REFLECTION) || !same_hemisphere(wo, wi) {
+            return 0.0;
+        }
+        cosine_hemisphere_pdf(abs_cos_theta(wi))
     }
 
     fn flags(&self) -> BxDFFlags {

@@ -271,6 +271,19 @@ impl<Bottom: BxDFMethods + ToLanes, const TWO_SIDED: bool>
         }
     }
 
+    /// The lane walk at width one (for the scalar methods).
+    #[inline(always)]
+    fn walk1(&self) -> LayeredLanes<Scalar1, Bottom::Lanes<Scalar1>> {
+        LayeredLanes {
+            top: self.top.one(),
+            bottom: self.bottom.one(),
+            thickness: Scalar1(self.thickness),
+            max_depth: self.max_depth,
+            n_samples: self.n_samples,
+            seed: self.seed,
+        }
+    }
+
     /// What a batch of these models must agree on.
     #[inline(always)]
     pub(crate) fn walk_key(&self) -> (u32, u32, i32) {
@@ -295,7 +308,7 @@ impl<Bottom: BxDFMethods + ToLanes, const TWO_SIDED: bool> BxDFMethods
 {
     fn f(&self, wo: Vector3f, wi: Vector3f, mode: TransportMode) -> SampledSpectrum {
         if self.has_lane_walk() {
-            return lanes::f1(&Self::gather_walk::<Scalar1>(&[self]), wo, wi, mode);
+            return lanes::f1(&self.walk1(), wo, wi, mode);
         }
         let (mut wo, mut wi) = (wo, wi);
         if TWO_SIDED && wo.z < 0.0 {
@@ -490,7 +503,7 @@ impl<Bottom: BxDFMethods + ToLanes, const TWO_SIDED: bool> BxDFMethods
         // pbrt-v4 supports only unrestricted sampling of layered models.
         debug_assert!(sample_flags == BxDFReflTransFlags::ALL);
         if self.has_lane_walk() {
-            let w = Self::gather_walk::<Scalar1>(&[self]);
+            let w = self.walk1();
             return lanes::sample_f1(&w, wo, uc, u, mode, sample_flags);
         }
         let mut wo = wo;
@@ -620,7 +633,7 @@ impl<Bottom: BxDFMethods + ToLanes, const TWO_SIDED: bool> BxDFMethods
     ) -> Float {
         debug_assert!(sample_flags == BxDFReflTransFlags::ALL);
         if self.has_lane_walk() {
-            let w = Self::gather_walk::<Scalar1>(&[self]);
+            let w = self.walk1();
             return lanes::pdf1(&w, wo, wi, mode, sample_flags);
         }
         let (mut wo, mut wi) = (wo, wi);

@@ -488,16 +488,22 @@ impl<L: F32Lanes> BxDFLanes<L> for DielectricLanes<L> {
         let g = d.g(wo, wi);
         let four = L::splat(4.0);
         let vr = dm.mul(g).mul(fr).div(four.mul(wi.z).mul(wo.z).abs());
-        let denom = sqr(wi.dot(wm).add(wo.dot(wm).div(etap)))
-            .mul(wi.z)
-            .mul(wo.z);
-        let mut ft = dm
-            .mul(L::splat(1.0).sub(fr))
-            .mul(g)
-            .mul(wi.dot(wm).mul(wo.dot(wm)).div(denom).abs());
-        if mode == TransportMode::Radiance {
-            ft = ft.div(sqr(etap));
-        }
+        let ft = if any::<L>(and_not::<L>(ok, refl)) {
+            let denom = sqr(wi.dot(wm).add(wo.dot(wm).div(etap)))
+                .mul(wi.z)
+                .mul(wo.z);
+            let ft = dm
+                .mul(L::splat(1.0).sub(fr))
+                .mul(g)
+                .mul(wi.dot(wm).mul(wo.dot(wm)).div(denom).abs());
+            if mode == TransportMode::Radiance {
+                ft.div(sqr(etap))
+            } else {
+                ft
+            }
+        } else {
+            vr
+        };
         let v = L::select(refl, vr, ft);
         S4::uniform(L::select(ok, v, L::splat(0.0)))
     }
@@ -569,7 +575,13 @@ impl<L: F32Lanes> BxDFLanes<L> for DielectricLanes<L> {
                 .mul(wo.dot(wm).abs());
             let is_r = uc.lt(pr.div(pr.add(pt)));
             let wr = reflect(wo, wm);
-            let (wt, etap, no_tir) = refract(wo, wm, self.eta);
+            // The refracted branch only where some lane takes it.
+            let any_t = any::<L>(and_not::<L>(rough, is_r));
+            let (wt, etap, no_tir) = if any_t {
+                refract(wo, wm, self.eta)
+            } else {
+                (wr, one, f)
+            };
             let wi = V3::select(is_r, wr, wt);
             let g = one.div(one.add(lambda_o).add(d.lambda(wi)));
             // Reflection.
@@ -580,22 +592,27 @@ impl<L: F32Lanes> BxDFLanes<L> for DielectricLanes<L> {
             let f_r = dm.mul(g).mul(r).div(L::splat(4.0).mul(wi.z).mul(wo.z));
             let ok_r = same_hemisphere(wo, wr);
             // Transmission.
-            let denom = sqr(wt.dot(wm).add(wo.dot(wm).div(etap)));
-            let dwm_dwi = wt.dot(wm).abs().div(denom);
-            let pdf_t = d_visible.mul(dwm_dwi).mul(pt).div(pr.add(pt));
-            let mut f_t = one.sub(r).mul(dm).mul(g).mul(
-                wt.dot(wm)
-                    .mul(wo.dot(wm))
-                    .div(wt.z.mul(wo.z).mul(denom))
-                    .abs(),
-            );
-            if mode == TransportMode::Radiance {
-                f_t = f_t.div(sqr(etap));
-            }
-            let ok_t = L::and(
-                no_tir,
-                L::and(L::not(same_hemisphere(wo, wt)), L::not(wt.z.eq(zero))),
-            );
+            let (pdf_t, f_t, ok_t) = if any_t {
+                let denom = sqr(wt.dot(wm).add(wo.dot(wm).div(etap)));
+                let dwm_dwi = wt.dot(wm).abs().div(denom);
+                let pdf_t = d_visible.mul(dwm_dwi).mul(pt).div(pr.add(pt));
+                let mut f_t = one.sub(r).mul(dm).mul(g).mul(
+                    wt.dot(wm)
+                        .mul(wo.dot(wm))
+                        .div(wt.z.mul(wo.z).mul(denom))
+                        .abs(),
+                );
+                if mode == TransportMode::Radiance {
+                    f_t = f_t.div(sqr(etap));
+                }
+                let ok_t = L::and(
+                    no_tir,
+                    L::and(L::not(same_hemisphere(wo, wt)), L::not(wt.z.eq(zero))),
+                );
+                (pdf_t, f_t, ok_t)
+            } else {
+                (zero, zero, f)
+            };
             let rs = SampleLanes {
                 f: S4::uniform(L::select(is_r, f_r, f_t)),
                 wi,

@@ -57,7 +57,7 @@ impl Streams {
             a[k].store(&mut av[k]);
             b[k].store(&mut bv[k]);
         }
-        let mut rng: [Rng; MAX_LANES] = std::array::from_fn(|_| Rng::new(0, 0));
+        let mut rng: [Rng; MAX_LANES] = std::array::from_fn(|_| Rng::from_raw((0, 1)));
         for (i, r) in rng.iter_mut().enumerate().take(L::N) {
             if bit::<L>(m, i) {
                 let ai = [av[0][i], av[1][i], av[2][i]];

@@ -155,30 +155,88 @@ impl<M: ToLanes> Kernel for Run<'_, M> {
     }
 }
 
-/// The same queries one at a time through the scalar methods.
-fn scalar<M: BxDFMethods>(models: &[M], queries: &[Query], width: usize) -> Vec<Bits> {
+/// The same queries one at a time through `one_query`, each with the mode
+/// and flags of its chunk's first query (`width` queries a chunk).
+fn one_by_one<M>(
+    models: &[M],
+    queries: &[Query],
+    width: usize,
+    one_query: impl Fn(&M, &Query, TransportMode, BxDFReflTransFlags) -> Bits,
+) -> Vec<Bits> {
     models
         .iter()
         .zip(queries)
         .enumerate()
         .map(|(k, (m, q))| {
             let head = &queries[k - k % width];
-            let (mode, flags) = (head.mode, head.flags);
-            bits_of(
-                m.f(q.wo, q.wi, mode),
-                m.sample_f(q.wo, q.uc, q.u, mode, flags),
-                m.pdf(q.wo, q.wi, mode, flags),
-            )
+            one_query(m, q, head.mode, head.flags)
         })
         .collect()
 }
 
-fn check<M: ToLanes + BxDFMethods>(name: &str, models: &[M], queries: &[Query]) {
+fn compare<M: ToLanes>(
+    name: &str,
+    models: &[M],
+    queries: &[Query],
+    one_query: impl Fn(&M, &Query, TransportMode, BxDFReflTransFlags) -> Bits + Copy,
+) {
     for level in SimdLevel::available() {
         let got = dispatch(level, Run { models, queries });
-        let want = scalar(models, queries, level.lanes());
+        let want = one_by_one(models, queries, level.lanes(), one_query);
         for (k, (g, w)) in got.iter().zip(&want).enumerate() {
             assert_eq!(g, w, "{name}, {level:?}, query {k}");
+        }
+    }
+}
+
+/// Every width against the model's scalar methods (which run the lane
+/// form at width one).
+fn check<M: ToLanes + BxDFMethods>(name: &str, models: &[M], queries: &[Query]) {
+    compare(name, models, queries, |m, q, mode, flags| {
+        bits_of(
+            m.f(q.wo, q.wi, mode),
+            m.sample_f(q.wo, q.uc, q.u, mode, flags),
+            m.pdf(q.wo, q.wi, mode, flags),
+        )
+    });
+}
+
+/// Every width against the lane form at width one (for a model whose
+/// scalar methods are plain scalar code).
+fn check_width_one<M: ToLanes>(name: &str, models: &[M], queries: &[Query]) {
+    compare(name, models, queries, |m, q, mode, flags| {
+        let one = m.one();
+        bits_of(
+            f1(&one, q.wo, q.wi, mode),
+            sample_f1(&one, q.wo, q.uc, q.u, mode, flags),
+            pdf1(&one, q.wo, q.wi, mode, flags),
+        )
+    });
+}
+
+/// The diffuse model's plain scalar methods and its lane form agree: the
+/// same values, directions within the lane sine and cosine's rounding.
+#[test]
+fn diffuse_scalar_code_agrees_with_its_lane_form() {
+    let mut rng = Rng::new(79, 0);
+    let n = 4000;
+    let q = queries(n, &mut rng);
+    for q in &q {
+        let m = diffuse(&mut rng);
+        let one = m.one();
+        assert_eq!(m.f(q.wo, q.wi, q.mode), f1(&one, q.wo, q.wi, q.mode));
+        assert_eq!(
+            m.pdf(q.wo, q.wi, q.mode, q.flags),
+            pdf1(&one, q.wo, q.wi, q.mode, q.flags)
+        );
+        let a = m.sample_f(q.wo, q.uc, q.u, q.mode, q.flags);
+        let b = sample_f1(&one, q.wo, q.uc, q.u, q.mode, q.flags);
+        assert_eq!(a.is_some(), b.is_some());
+        if let (Some(a), Some(b)) = (a, b) {
+            assert_eq!(a.f, b.f);
+            assert_eq!(a.flags, b.flags);
+            assert!((a.wi - b.wi).length() < 1e-6, "{:?} {:?}", a.wi, b.wi);
+            assert!((a.pdf - b.pdf).abs() <= 1e-6 * a.pdf.max(1.0));
         }
     }
 }
@@ -193,7 +251,7 @@ fn every_width_gives_the_scalar_bits() {
     let c: Vec<_> = (0..n).map(|_| conductor(&mut rng)).collect();
     check("conductor", &c, &q);
     let r: Vec<_> = (0..n).map(|_| diffuse(&mut rng)).collect();
-    check("diffuse", &r, &q);
+    check_width_one("diffuse", &r, &q);
     // Coated models: layered sampling is always unrestricted.
     let q: Vec<Query> = q
         .into_iter()
