@@ -454,7 +454,7 @@ impl EmbreeAccel {
         t_max: Float,
         hit: &mut dyn FnMut(u32, &Ray, Float) -> Option<Float>,
     ) -> Option<(u32, Float)> {
-        if !(t_max > 0.0) || self.bounds.is_empty() {
+        if t_max.is_nan() || t_max <= 0.0 || self.bounds.is_empty() {
             return None;
         }
         let mut q = self.query(ray, t_max, HitFn::Closest(hit));
@@ -473,7 +473,7 @@ impl EmbreeAccel {
         t_max: Float,
         hit: &mut dyn FnMut(u32, &Ray, Float) -> bool,
     ) -> bool {
-        if !(t_max > 0.0) || self.bounds.is_empty() {
+        if t_max.is_nan() || t_max <= 0.0 || self.bounds.is_empty() {
             return false;
         }
         let mut q = self.query(ray, t_max, HitFn::Any(hit));
