@@ -187,7 +187,9 @@ impl Accelerator {
 
     /// [`Accelerator::build`] with at most about `threads` build threads
     /// (the BVH builds in parallel; its result does not depend on
-    /// `threads`).
+    /// `threads`). Embree builds with its device's own thread pool, whatever
+    /// `threads`, and holds every entry as user geometry here (see
+    /// [`Accelerator::build_from_triangles`] for its triangles).
     pub fn build_with_threads(
         prim_bounds: &[Bounds3f],
         params: &AccelParams,
