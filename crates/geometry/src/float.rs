@@ -43,7 +43,8 @@ pub fn next_float_up(v: f32) -> f32 {
     // −0 becomes +0 (and every other value stays as it is).
     let v = if v == 0.0 { 0.0 } else { v };
     let bits = v.to_bits();
-    let bits = std::hint::select_unpredictable(v >= 0.0, bits + 1, bits.wrapping_sub(1));
+    let bits =
+        std::hint::select_unpredictable(v >= 0.0, bits.wrapping_add(1), bits.wrapping_sub(1));
     f32::from_bits(bits)
 }
 
@@ -55,7 +56,7 @@ pub fn next_float_down(v: f32) -> f32 {
     }
     let v = if v == 0.0 { -0.0 } else { v };
     let bits = v.to_bits();
-    let bits = std::hint::select_unpredictable(v > 0.0, bits.wrapping_sub(1), bits + 1);
+    let bits = std::hint::select_unpredictable(v > 0.0, bits.wrapping_sub(1), bits.wrapping_add(1));
     f32::from_bits(bits)
 }
 

@@ -2,15 +2,15 @@
 //! `embree`; needs the system's `libembree3`, e.g. Debian's
 //! `libembree-dev`).
 //!
-//! The `embree` crate (0.3, for Embree 3) supplies the C declarations and
-//! the link to `embree3`; its safe wrappers fix neither the build thread
-//! count nor offer 8/16-wide packets, so this module calls `embree::sys`
-//! directly behind a small owner type. Embree intersects its own
+//! The `embree3` crate (0.4, for Embree 3.13) supplies the C declarations
+//! and the link to `embree3`; its safe wrappers neither fix the build
+//! thread count nor offer 8/16-wide packets, so this module calls
+//! `embree3::sys` directly behind a small owner type. Embree intersects its own
 //! triangles (its built-in triangle geometry, with its own SIMD triangle
 //! tests), so its figures include triangle tests just as rpbrt's include
 //! `intersect_triangle`.
 
-use embree::sys::*;
+use embree3::sys::*;
 use rpbrt_geometry::{Float, Point3f, Ray};
 use std::ffi::CString;
 use std::time::Instant;

@@ -20,6 +20,8 @@
 
 pub mod bvh;
 pub mod bvh4;
+#[cfg(feature = "embree")]
+pub mod embree;
 pub mod grid;
 pub mod kdtree;
 pub(crate) mod packet;
@@ -30,6 +32,8 @@ mod wide;
 
 pub use bvh::{Bvh, BvhNode};
 pub use bvh4::{Bvh4, Bvh4Node};
+#[cfg(feature = "embree")]
+pub use embree::{AccelError, EmbreeAccel};
 pub use grid::Grid;
 pub use kdtree::{KdNode, KdTree};
 pub use params::{
@@ -112,6 +116,10 @@ pub enum Accelerator {
     KdTree(KdTree),
     /// A uniform grid with mailboxing (pbrt-v2 `GridAccel`).
     Grid(Grid),
+    /// Embree 3's BVH (`Accelerator "embree"`, cargo feature `embree`):
+    /// Embree culls, the hit closure decides.
+    #[cfg(feature = "embree")]
+    Embree(EmbreeAccel),
 }
 
 impl Accelerator {
@@ -128,7 +136,43 @@ impl Accelerator {
     where
         F: Fn(u32) -> Bounds3f + Sync,
     {
+        Accelerator::build_from_triangles(n, bounds, |_| None, params)
+    }
+
+    /// [`Accelerator::build_from`], also told which entries are opaque
+    /// triangles that the hit closure tests exactly (`triangle(e)` gives
+    /// their vertices): Embree intersects those with its own triangles and
+    /// lets the closure refine each candidate; every other structure
+    /// ignores `triangle`. If Embree fails to build its scene, the default
+    /// BVH is built instead (the scene checks [`embree::available`] first
+    /// and warns there).
+    pub fn build_from_triangles<F, T>(
+        n: usize,
+        bounds: F,
+        triangle: T,
+        params: &AccelParams,
+    ) -> Accelerator
+    where
+        F: Fn(u32) -> Bounds3f + Sync,
+        T: Fn(u32) -> Option<[Point3f; 3]>,
+    {
         let threads = default_threads();
+        #[cfg(feature = "embree")]
+        if params.kind == AccelKind::Embree {
+            match EmbreeAccel::build(n, &bounds, triangle) {
+                Ok(a) => return Accelerator::Embree(a),
+                Err(_) => {
+                    return Accelerator::Bvh4(Bvh4::build_from(
+                        n,
+                        bounds,
+                        &BvhParams::default(),
+                        threads,
+                    ))
+                }
+            }
+        }
+        #[cfg(not(feature = "embree"))]
+        let _ = triangle;
         match params.kind {
             AccelKind::Bvh if params.bvh.width == 2 => {
                 Accelerator::Bvh(Bvh::build_from(n, bounds, &params.bvh, threads))
@@ -143,7 +187,9 @@ impl Accelerator {
 
     /// [`Accelerator::build`] with at most about `threads` build threads
     /// (the BVH builds in parallel; its result does not depend on
-    /// `threads`).
+    /// `threads`). Embree builds with its device's own thread pool, whatever
+    /// `threads`, and holds every entry as user geometry here (see
+    /// [`Accelerator::build_from_triangles`] for its triangles).
     pub fn build_with_threads(
         prim_bounds: &[Bounds3f],
         params: &AccelParams,
@@ -158,6 +204,17 @@ impl Accelerator {
             }
             AccelKind::KdTree => Accelerator::KdTree(KdTree::build(prim_bounds, &params.kdtree)),
             AccelKind::Grid => Accelerator::Grid(Grid::build(prim_bounds, &params.grid)),
+            #[cfg(feature = "embree")]
+            AccelKind::Embree => {
+                match EmbreeAccel::build(prim_bounds.len(), |e| prim_bounds[e as usize], |_| None) {
+                    Ok(a) => Accelerator::Embree(a),
+                    Err(_) => Accelerator::Bvh4(Bvh4::build_with_threads(
+                        prim_bounds,
+                        &BvhParams::default(),
+                        threads,
+                    )),
+                }
+            }
         }
     }
 }
@@ -170,6 +227,8 @@ impl Aggregate for Accelerator {
             Accelerator::Bvh4(a) => a.bounds(),
             Accelerator::KdTree(a) => a.bounds(),
             Accelerator::Grid(a) => a.bounds(),
+            #[cfg(feature = "embree")]
+            Accelerator::Embree(a) => a.bounds(),
         }
     }
     #[inline]
@@ -182,6 +241,11 @@ impl Aggregate for Accelerator {
             Accelerator::Bvh4(a) => a.intersect(ray, t_max, hit),
             Accelerator::KdTree(a) => a.intersect(ray, t_max, hit),
             Accelerator::Grid(a) => a.intersect(ray, t_max, hit),
+            #[cfg(feature = "embree")]
+            Accelerator::Embree(a) => {
+                let mut hit = hit;
+                a.intersect(ray, t_max, &mut hit)
+            }
         }
     }
     #[inline]
@@ -194,6 +258,11 @@ impl Aggregate for Accelerator {
             Accelerator::Bvh4(a) => a.intersect_p(ray, t_max, hit),
             Accelerator::KdTree(a) => a.intersect_p(ray, t_max, hit),
             Accelerator::Grid(a) => a.intersect_p(ray, t_max, hit),
+            #[cfg(feature = "embree")]
+            Accelerator::Embree(a) => {
+                let mut hit = hit;
+                a.intersect_p(ray, t_max, &mut hit)
+            }
         }
     }
     #[inline]
@@ -206,6 +275,11 @@ impl Aggregate for Accelerator {
             Accelerator::Bvh4(a) => a.intersect_slots(ray, t_max, hit),
             Accelerator::KdTree(a) => a.intersect_slots(ray, t_max, hit),
             Accelerator::Grid(a) => a.intersect_slots(ray, t_max, hit),
+            #[cfg(feature = "embree")]
+            Accelerator::Embree(a) => {
+                let mut hit = hit;
+                a.intersect(ray, t_max, &mut |p, r, t| hit(p, p, r, t))
+            }
         }
     }
     #[inline]
@@ -218,6 +292,11 @@ impl Aggregate for Accelerator {
             Accelerator::Bvh4(a) => a.intersect_p_slots(ray, t_max, hit),
             Accelerator::KdTree(a) => a.intersect_p_slots(ray, t_max, hit),
             Accelerator::Grid(a) => a.intersect_p_slots(ray, t_max, hit),
+            #[cfg(feature = "embree")]
+            Accelerator::Embree(a) => {
+                let mut hit = hit;
+                a.intersect_p(ray, t_max, &mut |p, r, t| hit(p, p, r, t))
+            }
         }
     }
     fn slot_entries(&self) -> Option<&[u32]> {
@@ -226,6 +305,8 @@ impl Aggregate for Accelerator {
             Accelerator::Bvh4(a) => a.slot_entries(),
             Accelerator::KdTree(a) => a.slot_entries(),
             Accelerator::Grid(a) => a.slot_entries(),
+            #[cfg(feature = "embree")]
+            Accelerator::Embree(_) => None,
         }
     }
     fn memory_bytes(&self) -> usize {
@@ -234,6 +315,8 @@ impl Aggregate for Accelerator {
             Accelerator::Bvh4(a) => a.memory_bytes(),
             Accelerator::KdTree(a) => a.memory_bytes(),
             Accelerator::Grid(a) => a.memory_bytes(),
+            #[cfg(feature = "embree")]
+            Accelerator::Embree(a) => a.memory_bytes(),
         }
     }
     fn primitive_count(&self) -> usize {
@@ -242,6 +325,8 @@ impl Aggregate for Accelerator {
             Accelerator::Bvh4(a) => a.primitive_count(),
             Accelerator::KdTree(a) => a.primitive_count(),
             Accelerator::Grid(a) => a.primitive_count(),
+            #[cfg(feature = "embree")]
+            Accelerator::Embree(a) => a.primitive_count(),
         }
     }
     fn skipped_primitives(&self) -> usize {
@@ -250,8 +335,17 @@ impl Aggregate for Accelerator {
             Accelerator::Bvh4(a) => a.skipped_primitives(),
             Accelerator::KdTree(a) => a.skipped_primitives(),
             Accelerator::Grid(a) => a.skipped_primitives(),
+            #[cfg(feature = "embree")]
+            Accelerator::Embree(a) => a.skipped_primitives(),
         }
     }
+}
+
+/// Why `Accelerator "embree"` falls back to the BVH in a build without the
+/// cargo feature `embree`.
+#[cfg(not(feature = "embree"))]
+pub fn params_no_embree() -> &'static str {
+    params::NO_EMBREE
 }
 
 /// True for bounds a structure can hold: finite and not empty (zero-size

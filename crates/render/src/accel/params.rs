@@ -24,6 +24,10 @@ pub enum AccelKind {
     KdTree,
     /// `"grid"` (pbrt-v1/v2's uniform grid).
     Grid,
+    /// `"embree"`: Embree 3's BVH (cargo feature `embree`; without it the
+    /// scene warns and uses the BVH). It takes no parameters.
+    #[cfg(feature = "embree")]
+    Embree,
 }
 
 /// How the BVH chooses its splits (pbrt-v4 `SplitMethod`).
@@ -144,9 +148,16 @@ fn float_of(key: &str, v: ParamValue) -> Result<Float, String> {
     }
 }
 
+/// Why [`AccelParams::new`] refuses `"embree"` in a build without the cargo
+/// feature `embree`.
+#[cfg(not(feature = "embree"))]
+pub const NO_EMBREE: &str = "this build has no Embree";
+
 impl AccelParams {
-    /// The accelerator names [`AccelParams::new`] accepts.
-    pub const NAMES: &'static [&'static str] = &["bvh", "grid", "kdtree"];
+    /// The accelerator names a scene may ask for. `"embree"` is among them
+    /// in every build: [`AccelParams::new`] refuses it without the cargo
+    /// feature `embree`, and the scene then warns and uses `"bvh"`.
+    pub const NAMES: &'static [&'static str] = &["bvh", "embree", "grid", "kdtree"];
 
     /// Defaults for the accelerator named `name` (`"bvh"`, `"kdtree"` or
     /// `"grid"`).
@@ -155,9 +166,13 @@ impl AccelParams {
             "bvh" => AccelKind::Bvh,
             "kdtree" => AccelKind::KdTree,
             "grid" => AccelKind::Grid,
+            #[cfg(feature = "embree")]
+            "embree" => AccelKind::Embree,
+            #[cfg(not(feature = "embree"))]
+            "embree" => return Err(NO_EMBREE.to_string()),
             _ => {
                 return Err(format!(
-                    "\"{name}\": unknown accelerator (expected \"bvh\", \"kdtree\" or \"grid\")"
+                    "\"{name}\": unknown accelerator (expected \"bvh\", \"kdtree\", \"grid\" or \"embree\")"
                 ))
             }
         };

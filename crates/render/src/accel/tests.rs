@@ -133,6 +133,13 @@ fn all_accels(bounds: &[Bounds3f]) -> Vec<(String, Accelerator)> {
     ));
     let p = AccelParams::parse("grid", [("maxvoxels", ParamValue::Int(4))]).unwrap();
     v.push(("grid coarse".into(), Accelerator::build(bounds, &p)));
+    // Embree over user geometry only (its triangles: see
+    // `embree_triangles_match_brute_force`).
+    #[cfg(feature = "embree")]
+    v.push((
+        "embree".into(),
+        Accelerator::build(bounds, &AccelParams::new("embree").unwrap()),
+    ));
     v
 }
 
@@ -767,5 +774,60 @@ fn accel_throughput() {
             a.memory_bytes() as f64 / n as f64,
             tests as f64 / 10000.0
         );
+    }
+}
+
+/// Embree's own triangles, each candidate refined by the closure: the
+/// nearest hit must still be brute force's, on small, mixed, degenerate
+/// and far-away triangles.
+#[cfg(feature = "embree")]
+#[test]
+fn embree_triangles_match_brute_force() {
+    let mut cases: Vec<(Vec<Tri>, Vec<(Ray, Float)>, usize)> = Vec::new();
+    cases.push((random_tris(1, 2000, 0.12), random_rays(2, 2500), 250));
+    let mut mixed = random_tris(3, 800, 0.03);
+    mixed.extend(random_tris(4, 25, 1.5));
+    // Degenerate: a repeated vertex, collinear, a needle.
+    for (k, t) in mixed.iter_mut().enumerate().take(60) {
+        match k % 3 {
+            0 => t[2] = t[1],
+            1 => t[2] = t[1] + (t[1] - t[0]),
+            _ => t[2] = t[1] + (t[0] - t[1]) * 1e-6,
+        }
+    }
+    cases.push((mixed, random_rays(5, 2000), 500));
+    let scale: Float = 1e9;
+    let s = |p: Point3f| Point3f::new(p.x * scale, p.y * scale, p.z * scale);
+    let far: Vec<Tri> = random_tris(13, 500, 0.1)
+        .into_iter()
+        .map(|t| t.map(s))
+        .collect();
+    let far_rays = random_rays(14, 1500)
+        .into_iter()
+        .map(|(r, t)| (Ray::new(s(r.o), r.d), t * scale))
+        .collect();
+    cases.push((far, far_rays, 40));
+    let params = AccelParams::new("embree").unwrap();
+    for (k, (tris, rays, min_hits)) in cases.iter().enumerate() {
+        let bounds: Vec<Bounds3f> = tris.iter().map(tri_bounds).collect();
+        let accel = Accelerator::build_from_triangles(
+            tris.len(),
+            |e| bounds[e as usize],
+            |e| Some(tris[e as usize]),
+            &params,
+        );
+        let Accelerator::Embree(e) = &accel else {
+            panic!("case {k}: no Embree scene");
+        };
+        assert!(e.triangle_count() > 0, "case {k}");
+        let hit = |p: u32, r: &Ray, t: Float| tri_hit(&tris[p as usize], r, t);
+        let hits = check_against_brute(
+            &format!("embree triangles {k}"),
+            &accel,
+            tris.len(),
+            rays,
+            hit,
+        );
+        assert!(hits >= *min_hits, "case {k}: only {hits} hits");
     }
 }

@@ -511,17 +511,6 @@ impl PrimitiveAggregate {
     ) -> Self {
         let entries = EntryMap::new(&prims);
         let n = entries.len;
-        let accel = Accelerator::build_from(
-            n,
-            |e| {
-                let (p, i) = entries.locate(e);
-                match &prims[p] {
-                    Primitive::Mesh(m) => m.triangle_bounds(i),
-                    prim => prim.bounds(),
-                }
-            },
-            params,
-        );
         // The vertices of entry `e` when it is an opaque, non-degenerate
         // triangle.
         let opaque_triangle = |e: u32| -> Option<[Point3f; 3]> {
@@ -541,6 +530,18 @@ impl PrimitiveAggregate {
             };
             triangle_is_nondegenerate(p0, p1, p2).then_some([p0, p1, p2])
         };
+        let accel = Accelerator::build_from_triangles(
+            n,
+            |e| {
+                let (p, i) = entries.locate(e);
+                match &prims[p] {
+                    Primitive::Mesh(m) => m.triangle_bounds(i),
+                    prim => prim.bounds(),
+                }
+            },
+            opaque_triangle,
+            params,
+        );
         // 40 bytes per entry: bounded so that huge scenes do not pay
         // gigabytes for it (they fall back to going through the mesh).
         let cached = n <= max_vertices;

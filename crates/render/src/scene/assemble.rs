@@ -112,6 +112,16 @@ pub(super) fn reader<'a>(
 
 /// Reads an `Accelerator` directive's parameters.
 fn accel_params(name: &str, ap: &ParamReader) -> Result<AccelParams, Diagnostic> {
+    if name == "embree" {
+        if let Err(why) = embree_available() {
+            ap.warn(format!("\"embree\": {why}; using \"bvh\""));
+            // Its parameters (it has none) are not worth a second warning.
+            for param in ap.dict().params() {
+                param.mark_used();
+            }
+            return Ok(AccelParams::default());
+        }
+    }
     let mut p = AccelParams::new(name)
         .map_err(|_| unknown_type("accelerator", name, AccelParams::NAMES, ap.loc()))?;
     for param in ap.dict().params() {
@@ -134,6 +144,19 @@ fn accel_params(name: &str, ap: &ParamReader) -> Result<AccelParams, Diagnostic>
         param.mark_used();
     }
     Ok(p)
+}
+
+/// Whether `Accelerator "embree"` can be honoured: the cargo feature
+/// `embree` is on and Embree's device could be made.
+#[cfg(feature = "embree")]
+fn embree_available() -> Result<(), String> {
+    crate::accel::embree::available().map_err(|e| e.to_string())
+}
+
+/// Whether `Accelerator "embree"` can be honoured: not in this build.
+#[cfg(not(feature = "embree"))]
+fn embree_available() -> Result<(), String> {
+    Err(crate::accel::params_no_embree().to_string())
 }
 
 /// Creates the named media (pbrt-v4 `BasicScene::CreateMedia`), each
@@ -384,7 +407,14 @@ pub fn create_scene(
         materials: &materials,
         medium_ids: &medium_ids,
     };
-    let default_accel = AccelParams::default();
+    // Object definitions and animated shapes get an aggregate of their
+    // own: under Embree, an Embree scene each (reached through the user
+    // geometry of the instance or animated primitive); otherwise the
+    // default BVH, whatever the scene's accelerator.
+    let default_accel = match AccelParams::new(&desc.accelerator.name) {
+        Ok(a) if desc.accelerator.name == "embree" && embree_available().is_ok() => a,
+        _ => AccelParams::default(),
+    };
     let mut prims: Vec<Primitive> = Vec::new();
     for s in &desc.shapes {
         create_primitives(&cx, s, &mut lights, p, &mut prims);

@@ -2,6 +2,7 @@
 //! [`super::assemble`] and [`super::materials`] do with whole directives
 //! (orders, references between entities, located errors, warnings).
 
+mod accel;
 mod budget;
 mod camera;
 mod materials;
