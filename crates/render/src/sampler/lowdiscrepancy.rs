@@ -43,6 +43,71 @@ const fn compute_primes() -> [u32; PRIME_TABLE_SIZE] {
 /// The first [`PRIME_TABLE_SIZE`] primes (2, 3, 5, ..., 7919).
 pub static PRIMES: [u32; PRIME_TABLE_SIZE] = compute_primes();
 
+/// `⌈2^64 / p⌉` for every prime `p` of [`PRIMES`]: the high 64 bits of its
+/// product with an integer below 2^32 are that integer divided by `p`,
+/// exactly (Lemire, Kaser and Kurz 2019, "Faster remainder by direct
+/// computation"), for a fraction of a division's cost.
+static DIV_MAGIC: [u64; PRIME_TABLE_SIZE] = {
+    let primes = compute_primes();
+    let mut out = [0u64; PRIME_TABLE_SIZE];
+    let mut i = 0;
+    while i < PRIME_TABLE_SIZE {
+        out[i] = u64::MAX / primes[i] as u64 + 1;
+        i += 1;
+    }
+    out
+};
+
+/// Exact division by one prime of the table.
+trait DivideByPrime: Copy {
+    fn base(self) -> u64;
+    fn div(self, x: u64) -> u64;
+}
+
+/// By multiplication with [`DIV_MAGIC`]: only for dividends below 2^32.
+#[derive(Clone, Copy)]
+struct MagicDivision(u64, u64);
+
+impl DivideByPrime for MagicDivision {
+    #[inline(always)]
+    fn base(self) -> u64 {
+        self.0
+    }
+    #[inline(always)]
+    fn div(self, x: u64) -> u64 {
+        ((self.1 as u128 * x as u128) >> 64) as u64
+    }
+}
+
+/// By the division instruction.
+#[derive(Clone, Copy)]
+struct PlainDivision(u64);
+
+impl DivideByPrime for PlainDivision {
+    #[inline(always)]
+    fn base(self) -> u64 {
+        self.0
+    }
+    #[inline(always)]
+    fn div(self, x: u64) -> u64 {
+        x / self.0
+    }
+}
+
+/// Calls `$f` with the fastest exact division of `$a` (and of its
+/// quotients, which are smaller) by `PRIMES[$base_index]`.
+macro_rules! with_division {
+    ($base_index:expr, $a:expr, $f:expr) => {{
+        let (base_index, a) = ($base_index, $a);
+        let base = PRIMES[base_index] as u64;
+        if a <= u32::MAX as u64 {
+            $f(MagicDivision(base, DIV_MAGIC[base_index]), a)
+        } else {
+            $f(PlainDivision(base), a)
+        }
+    }};
+}
+
 /// Number of Sobol' dimensions (pbrt-v4's `NSobolDimensions`).
 pub const N_SOBOL_DIMENSIONS: usize = 1024;
 /// Columns per Sobol' generator matrix (pbrt-v4's `SobolMatrixSize`):
@@ -252,6 +317,8 @@ pub fn hash_values(values: &[&dyn HashBytes]) -> u64 {
 pub struct DigitPermutation {
     base: u32,
     n_digits: usize,
+    /// `1/base` to the power `n_digits`, as the digit loop computes it.
+    inv_base_n: Float,
     permutations: Vec<u16>,
 }
 
@@ -259,7 +326,7 @@ impl DigitPermutation {
     /// Permutations for `base` (< 65536) chosen by `seed`.
     pub fn new(base: u32, seed: u32) -> Self {
         debug_assert!(base >= 2 && base < 65536);
-        let n_digits = digits_for_base(base);
+        let (n_digits, inv_base_n) = digits_for_base(base);
         let mut permutations = Vec::with_capacity(n_digits * base as usize);
         for digit_index in 0..n_digits {
             let dseed = hash_values(&[&(base as i32), &(digit_index as i32), &seed]);
@@ -270,6 +337,7 @@ impl DigitPermutation {
         DigitPermutation {
             base,
             n_digits,
+            inv_base_n,
             permutations,
         }
     }
@@ -282,8 +350,10 @@ impl DigitPermutation {
     }
 }
 
-/// Number of base-`base` digits that matter at `Float` precision.
-fn digits_for_base(base: u32) -> usize {
+/// Number of base-`base` digits that matter at `Float` precision (the
+/// iterations of pbrt-v4's `ScrambledRadicalInverse` loop), and `1/base`
+/// to that power as that loop computes it.
+fn digits_for_base(base: u32) -> (usize, Float) {
     let inv_base = 1.0 / base as Float;
     let mut inv_base_m: Float = 1.0;
     let mut n = 0;
@@ -291,7 +361,7 @@ fn digits_for_base(base: u32) -> usize {
         n += 1;
         inv_base_m *= inv_base;
     }
-    n
+    (n, inv_base_m)
 }
 
 /// Digit permutations for every prime base of the table (pbrt-v4's
@@ -308,13 +378,18 @@ pub fn compute_radical_inverse_permutations(seed: u32) -> Vec<DigitPermutation> 
 
 /// The radical inverse of `a` in the base `PRIMES[base_index]`.
 #[inline]
-pub fn radical_inverse(base_index: usize, mut a: u64) -> Float {
-    let base = PRIMES[base_index] as u64;
+pub fn radical_inverse(base_index: usize, a: u64) -> Float {
+    with_division!(base_index, a, radical_inverse_by)
+}
+
+#[inline(always)]
+fn radical_inverse_by(d: impl DivideByPrime, mut a: u64) -> Float {
+    let base = d.base();
     let inv_base = 1.0 / base as Float;
     let mut inv_base_n: Float = 1.0;
     let mut reversed: u64 = 0;
     while a != 0 {
-        let next = a / base;
+        let next = d.div(a);
         let digit = a - next * base;
         reversed = reversed * base + digit;
         inv_base_n *= inv_base;
@@ -336,9 +411,42 @@ pub fn inverse_radical_inverse(mut inverse: u64, base: u64, n_digits: u32) -> u6
     index
 }
 
-/// The radical inverse with each digit position's digits permuted.
+/// The radical inverse with each digit position's digits permuted:
+/// pbrt-v4's loop, with what it recomputes on every call taken from `perm`:
+/// the number of digits and the final power of `1/base` (the loop's own
+/// floating-point condition and product, computed once); and, for indices
+/// that fit in 32 bits, the division by the base as a multiplication
+/// (`DIV_MAGIC`).
+/// Every step is exact, so the values are pbrt-v4's.
 #[inline]
-pub fn scrambled_radical_inverse(base_index: usize, mut a: u64, perm: &DigitPermutation) -> Float {
+pub fn scrambled_radical_inverse(base_index: usize, a: u64, perm: &DigitPermutation) -> Float {
+    debug_assert_eq!(perm.base, PRIMES[base_index]);
+    let reversed = with_division!(base_index, a, |d, a| scrambled_digits(d, a, perm));
+    (perm.inv_base_n * reversed as Float).min(ONE_MINUS_EPSILON)
+}
+
+/// The permuted digits of `a`, reversed, as an integer.
+#[inline(always)]
+fn scrambled_digits(d: impl DivideByPrime, mut a: u64, perm: &DigitPermutation) -> u64 {
+    let base = d.base();
+    let mut reversed: u64 = 0;
+    for row in perm.permutations.chunks_exact(perm.base as usize) {
+        let next = d.div(a);
+        let digit = (a - next * base) as usize;
+        reversed = reversed * base + row[digit] as u64;
+        a = next;
+    }
+    reversed
+}
+
+/// pbrt-v4's `ScrambledRadicalInverse` as written there: the reference
+/// [`scrambled_radical_inverse`] is tested against.
+#[cfg(test)]
+pub(crate) fn scrambled_radical_inverse_reference(
+    base_index: usize,
+    mut a: u64,
+    perm: &DigitPermutation,
+) -> Float {
     let base = PRIMES[base_index] as u64;
     let inv_base = 1.0 / base as Float;
     let mut inv_base_m: Float = 1.0;

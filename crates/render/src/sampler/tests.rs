@@ -6,6 +6,7 @@ use super::lowdiscrepancy::radical_inverse;
 use super::pmj02bn::{pmj02bn_set, N_PMJ02BN_SAMPLES};
 use super::*;
 use crate::params::ParamReader;
+use rpbrt_geometry::float::ONE_MINUS_EPSILON;
 use rpbrt_parser::{Diagnostic, FileLoc, ParameterDictionary, ParsedParameter};
 
 /// The sampler, with the warnings creating it raised added to `warnings`.
@@ -671,4 +672,64 @@ fn stratified_sample_count_overflow_is_an_error() {
     ]);
     let s = create_sampler("stratified", &params, RES, None, None, &loc, &mut w).unwrap();
     assert_eq!(s.samples_per_pixel(), 46340 * 46340);
+}
+
+#[test]
+fn radical_inverses_are_pbrt_v4_loops_bit_for_bit() {
+    use super::lowdiscrepancy::{
+        scrambled_radical_inverse, scrambled_radical_inverse_reference, DigitPermutation, PRIMES,
+        PRIME_TABLE_SIZE,
+    };
+    let mut rng = crate::rng::Rng::new(7, 0);
+    let mut compared = 0;
+    // Every small base, then a spread of large ones up to the last.
+    let bases = (0..64)
+        .chain((64..PRIME_TABLE_SIZE).step_by(37))
+        .chain([PRIME_TABLE_SIZE - 1]);
+    for base_index in bases {
+        let perm = DigitPermutation::new(PRIMES[base_index], 0x5eed + base_index as u32);
+        let mut indices: Vec<u64> = vec![
+            0,
+            1,
+            PRIMES[base_index] as u64 - 1,
+            PRIMES[base_index] as u64,
+            u32::MAX as u64 - 1,
+            u32::MAX as u64,
+            u32::MAX as u64 + 1,
+            u64::MAX,
+            u64::MAX - 1,
+        ];
+        for _ in 0..200 {
+            let bits = rng.uniform_u32() % 64;
+            let a = rng.uniform_u64() >> bits;
+            indices.push(a);
+        }
+        for a in indices {
+            let got = scrambled_radical_inverse(base_index, a, &perm);
+            let want = scrambled_radical_inverse_reference(base_index, a, &perm);
+            assert_eq!(
+                got.to_bits(),
+                want.to_bits(),
+                "base {} index {a}",
+                PRIMES[base_index]
+            );
+            compared += 1;
+            // pbrt-v4's `RadicalInverse` (whose integer overflows, as
+            // pbrt-v4's wraps, past about 2^40 for large bases).
+            if a >= 1 << 40 {
+                continue;
+            }
+            let base = PRIMES[base_index] as u64;
+            let (mut rest, mut reversed, mut inv_base_n) = (a, 0u64, 1.0 as Float);
+            while rest != 0 {
+                reversed = reversed * base + rest % base;
+                inv_base_n *= 1.0 / base as Float;
+                rest /= base;
+            }
+            let want = (reversed as Float * inv_base_n).min(ONE_MINUS_EPSILON);
+            let got = radical_inverse(base_index, a);
+            assert_eq!(got.to_bits(), want.to_bits(), "base {base} index {a}");
+        }
+    }
+    assert!(compared > 10_000, "{compared}");
 }

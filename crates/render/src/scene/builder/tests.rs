@@ -458,7 +458,7 @@ fn located_errors() {
         ("Sampler \"rnd\"\nWorldBegin\n", "<string>:1:1:", "unknown sampler type"),
         ("PixelFilter \"lanczos\"\nWorldBegin\n", "<string>:1:1:", "unknown pixel filter type"),
         ("Integrator \"whited\"\nWorldBegin\n", "<string>:1:1:", "unknown integrator type"),
-        ("Accelerator \"octree\"\nWorldBegin\n", "<string>:1:1:", "unknown accelerator type; expected one of \"bvh\", \"grid\", \"kdtree\""),
+        ("Accelerator \"octree\"\nWorldBegin\n", "<string>:1:1:", "unknown accelerator type; expected one of \"bvh\", \"embree\", \"grid\", \"kdtree\""),
         ("Camera \"pinhole\"\nWorldBegin\n", "<string>:1:1:", "unknown camera type"),
         ("MakeNamedMedium \"m\" \"string type\" \"fog\"\nWorldBegin\n", "<string>:1:21:", "unknown medium type"),
         ("ColorSpace \"adobe\"\nWorldBegin\n", "<string>:1:1:", "\"adobe\": unknown color space type; expected one of \"aces2065-1\", \"dci-p3\", \"rec2020\", \"srgb\""),
