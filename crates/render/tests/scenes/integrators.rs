@@ -9,8 +9,8 @@ use rpbrt_render::scene::assemble::{create_scene, CreateOptions};
 use rpbrt_render::scene::{build_scene_from_str, BuildOptions};
 use std::path::PathBuf;
 
-mod common;
-use common::{assert_same_pixels, render_scene, render_with};
+use crate::common;
+use crate::common::{assert_same_pixels, render_scene, render_with};
 use rpbrt_render::simd::SimdLevel;
 
 fn out_path(tag: &str) -> PathBuf {

@@ -8,8 +8,7 @@ use rpbrt_render::scene::assemble::{create_scene, CreateOptions};
 use rpbrt_render::scene::{build_scene_from_str, BuildOptions};
 use std::path::PathBuf;
 
-mod common;
-use common::render_scene;
+use crate::common::render_scene;
 
 fn out_path(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("rpbrt-media-{}", std::process::id()));

@@ -5,7 +5,7 @@
 //! decide every hit, so the answers must be the same bit for bit.
 #![cfg(feature = "embree")]
 
-mod common;
+use crate::common;
 
 use rpbrt_geometry::{Float, Point3f, Ray, Vector3f};
 use rpbrt_render::accel::Accelerator;
@@ -182,21 +182,17 @@ fn random_rays(seed: u64, n: usize) -> Vec<(Ray, Float)> {
         .collect()
 }
 
-#[test]
-fn embree_finds_the_bvh_hits() {
-    let bvh = create(&scene_text("bvh"));
-    let embree = create(&scene_text("embree"));
+/// Casts `rays` through both scenes' aggregates: every closest hit (entry,
+/// `t` bit for bit, the interaction) and every shadow test must agree.
+/// Returns how many rays hit.
+fn assert_same_hits(bvh: &CreatedScene, embree: &CreatedScene, rays: &[(Ray, Float)]) -> usize {
     assert!(
         matches!(embree.scene.aggregate.accelerator(), Accelerator::Embree(_)),
         "the scene did not get Embree: {:?}",
         embree.warnings
     );
-    if let Accelerator::Embree(e) = embree.scene.aggregate.accelerator() {
-        assert!(e.triangle_count() > 1000, "{e:?}");
-    }
     let (a, b) = (&bvh.scene.aggregate, &embree.scene.aggregate);
     assert_eq!(a.entry_count(), b.entry_count());
-    let rays = random_rays(7, 60_000);
     let (mut hits, mut differing, mut shadow_differing, mut occluded) = (0, 0, 0, 0);
     for (k, (ray, t_max)) in rays.iter().enumerate() {
         let ra = a.intersect_record(ray, *t_max);
@@ -231,9 +227,46 @@ fn embree_finds_the_bvh_hits() {
          {differing} closest hits and {shadow_differing} shadow tests differ",
         rays.len()
     );
-    assert!(hits > rays.len() / 2, "test too weak: {hits} hits");
     assert_eq!(differing, 0);
     assert_eq!(shadow_differing, 0);
+    hits
+}
+
+#[test]
+fn embree_finds_the_bvh_hits() {
+    let bvh = create(&scene_text("bvh"));
+    let embree = create(&scene_text("embree"));
+    if let Accelerator::Embree(e) = embree.scene.aggregate.accelerator() {
+        assert!(e.triangle_count() > 1000, "{e:?}");
+    }
+    let rays = random_rays(7, 60_000);
+    let hits = assert_same_hits(&bvh, &embree, &rays);
+    assert!(hits > rays.len() / 2, "test too weak: {hits} hits");
+}
+
+/// A billion units from the origin, where Embree's single-precision
+/// culling is coarsest: random meshes (degenerate triangles among them)
+/// scaled by 1e9, and the rays with them.
+#[test]
+fn embree_finds_the_bvh_hits_far_away() {
+    const SCALE: Float = 1e9;
+    let text = |accel: &str| {
+        format!(
+            "Accelerator \"{accel}\"\nCamera \"perspective\"\nWorldBegin\nScale 1e9 1e9 1e9\n{}{}",
+            random_mesh(11, 800, 0.25),
+            random_mesh(12, 30, 2.0)
+        )
+    };
+    let (bvh, embree) = (create(&text("bvh")), create(&text("embree")));
+    let rays: Vec<(Ray, Float)> = random_rays(13, 20_000)
+        .into_iter()
+        .map(|(r, t)| {
+            let o = Point3f::new(r.o.x * SCALE, r.o.y * SCALE, r.o.z * SCALE);
+            (Ray::with_time(o, r.d, r.time, None), t * SCALE)
+        })
+        .collect();
+    let hits = assert_same_hits(&bvh, &embree, &rays);
+    assert!(hits > rays.len() / 4, "test too weak: {hits} hits");
 }
 
 #[test]
