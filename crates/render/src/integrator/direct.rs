@@ -8,7 +8,7 @@ use super::bsdf_stage::BsdfAnswers;
 use super::Scene;
 use crate::bxdf::BSDF;
 use crate::light::{Light, LightLiSample, LightSampleContext};
-use crate::lightsampler::{LightSampler, SampledLight};
+use crate::lightsampler::{LightChoice, LightSampler, SampledLight};
 use crate::shape::{sample_solid_angle_batch, SolidAngleCore, SolidAngleQuery};
 use crate::simd::SimdLevel;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
@@ -170,7 +170,7 @@ pub(crate) fn answer_light(
     req: &LightRequest,
     lambda: &SampledWavelengths,
 ) -> Option<LightAnswer> {
-    let sampled = choose_light(scene, light_sampler, req)?;
+    let sampled = unculled(scene, req, light_sampler.sample(&req.ctx, req.u))?;
     let light = &scene.lights[sampled.light as usize];
     answer_with(
         sampled,
@@ -178,14 +178,14 @@ pub(crate) fn answer_light(
     )
 }
 
-/// The light the light sampler chooses for `req`, unless it is culled.
+/// The light the light sampler chose for `req`, unless it is culled.
 #[inline(always)]
-fn choose_light(
+fn unculled(
     scene: &Scene,
-    light_sampler: &LightSampler,
     req: &LightRequest,
+    sampled: Option<SampledLight>,
 ) -> Option<SampledLight> {
-    let sampled = light_sampler.sample(&req.ctx, req.u)?;
+    let sampled = sampled?;
     (!light_culled(scene, sampled.light, req.ctx.p(), req.hemisphere)).then_some(sampled)
 }
 
@@ -206,6 +206,8 @@ fn answer_with(sampled: SampledLight, ls: Option<LightLiSample>) -> Option<Light
 /// The buffers of [`answer_lights`], kept from batch to batch.
 #[derive(Default)]
 pub(crate) struct LightBatch {
+    choices: Vec<LightChoice>,
+    chosen: Vec<Option<SampledLight>>,
     queries: Vec<SolidAngleQuery>,
     pending: Vec<(usize, SampledLight)>,
     cores: Vec<SolidAngleCore>,
@@ -213,8 +215,9 @@ pub(crate) struct LightBatch {
 
 /// [`answer_light`] of every request in `requests` (`lambda(k)` gives
 /// request `k`'s wavelengths), into `out` (cleared first): the same
-/// answers, with the triangle lights' solid-angle samples, the costly
-/// part, taken lane-parallel at `level`'s width.
+/// answers, with the light BVH's descent and the triangle lights'
+/// solid-angle samples, the costly parts, taken lane-parallel at
+/// `level`'s width.
 pub(crate) fn answer_lights<'w>(
     scene: &Scene,
     light_sampler: &LightSampler,
@@ -227,8 +230,22 @@ pub(crate) fn answer_lights<'w>(
     out.clear();
     batch.queries.clear();
     batch.pending.clear();
+    // Every request's light, chosen together where the sampler descends a
+    // BVH (lane-parallel).
+    batch.chosen.clear();
+    if let LightSampler::Bvh(bvh) = light_sampler {
+        batch.choices.clear();
+        batch
+            .choices
+            .extend(requests.iter().map(|r| LightChoice::new(&r.ctx, r.u)));
+        bvh.sample_batch(level, &batch.choices, &mut batch.chosen);
+    } else {
+        batch
+            .chosen
+            .extend(requests.iter().map(|r| light_sampler.sample(&r.ctx, r.u)));
+    }
     for (k, req) in requests.iter().enumerate() {
-        let Some(sampled) = choose_light(scene, light_sampler, req) else {
+        let Some(sampled) = unculled(scene, req, batch.chosen[k]) else {
             out.push(None);
             continue;
         };

@@ -5,11 +5,14 @@
 //! stored as a bit trail so that [`BvhLightSampler::pmf`] retraces exactly
 //! the choices [`BvhLightSampler::sample`] makes.
 
-use rpbrt_geometry::{safe_acos, Bounds3f, Float, Point3f, PI};
+use rpbrt_geometry::{safe_acos, Bounds3f, Float, Normal3f, Point3f, PI};
 
 use super::{SampledLight, ONE_MINUS_EPSILON};
-use crate::light::{importance2, Light, LightBounds, LightSampleContext, PreparedLightBounds};
+use crate::light::{
+    importance2, importance_lanes, Light, LightBounds, LightSampleContext, PreparedLightBounds,
+};
 use crate::select::select_f32;
+use crate::simd::{F32Lanes, Kernel, SimdLevel, MAX_LANES};
 
 /// Number of buckets per axis for the split heuristic.
 const N_BUCKETS: usize = 12;
@@ -191,6 +194,12 @@ impl BvhLightSampler {
 
     /// Chooses a light for `ctx` with `u` in [0, 1).
     pub fn sample(&self, ctx: &LightSampleContext, u: Float) -> Option<SampledLight> {
+        self.sample_at(ctx.p(), ctx.ns, u)
+    }
+
+    /// [`sample`](Self::sample) at point `p` with shading normal `n`.
+    #[inline]
+    fn sample_at(&self, p: Point3f, n: Normal3f, u: Float) -> Option<SampledLight> {
         let p_inf = self.p_infinite();
         if u < p_inf {
             let n = self.infinite_lights.len();
@@ -204,8 +213,6 @@ impl BvhLightSampler {
         if self.nodes.is_empty() {
             return None;
         }
-        let p = ctx.p();
-        let n = ctx.ns;
         let mut u = ((u - p_inf) / (1.0 - p_inf)).min(ONE_MINUS_EPSILON);
         let mut node_index = 0usize;
         let mut pmf = 1.0 - p_inf;
@@ -239,6 +246,32 @@ impl BvhLightSampler {
             u = select_f32(first, u / p0, (u - p0) / p1).min(ONE_MINUS_EPSILON);
             node_index = std::hint::select_unpredictable(first, node_index + 1, c1);
         }
+    }
+
+    /// [`sample`](Self::sample) of every query in `queries` (its point,
+    /// shading normal and sample), into `out` (cleared first), bit for
+    /// bit: the descent through the tree's interior nodes runs at
+    /// `level`'s width, each lane at its own node, the importance of both
+    /// children of every lane's node evaluated together
+    /// ([`importance_lanes`]). (One sample's descent is a chain of square
+    /// roots and divisions, each waiting on the last: lanes run the chains
+    /// of many side by side.)
+    pub fn sample_batch(
+        &self,
+        level: SimdLevel,
+        queries: &[LightChoice],
+        out: &mut Vec<Option<SampledLight>>,
+    ) {
+        out.clear();
+        out.resize(queries.len(), None);
+        crate::simd::dispatch(
+            level,
+            SampleBatch {
+                sampler: self,
+                queries,
+                out,
+            },
+        );
     }
 
     /// The probability that [`sample`](Self::sample) chooses `light` at
@@ -314,5 +347,130 @@ impl BvhLightSampler {
     /// Number of BVH nodes (for tests and statistics).
     pub fn node_count(&self) -> usize {
         self.nodes.len()
+    }
+}
+
+/// One query of [`BvhLightSampler::sample_batch`]: a reference point, its
+/// shading normal (zero in a medium) and the sample in [0, 1).
+#[derive(Clone, Copy, Debug)]
+pub struct LightChoice {
+    /// The reference point ([`LightSampleContext::p`]).
+    pub p: Point3f,
+    /// Its shading normal ([`LightSampleContext::ns`]).
+    pub n: Normal3f,
+    /// The sample.
+    pub u: Float,
+}
+
+impl LightChoice {
+    /// The query of `ctx` with sample `u`.
+    #[inline]
+    pub fn new(ctx: &LightSampleContext, u: Float) -> Self {
+        LightChoice {
+            p: ctx.p(),
+            n: ctx.ns,
+            u,
+        }
+    }
+}
+
+/// [`BvhLightSampler::sample_batch`] at one width.
+struct SampleBatch<'a> {
+    sampler: &'a BvhLightSampler,
+    queries: &'a [LightChoice],
+    out: &'a mut [Option<SampledLight>],
+}
+
+impl Kernel for SampleBatch<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: F32Lanes>(self) {
+        let s = self.sampler;
+        let p_inf = s.p_infinite();
+        for (queries, out) in self.queries.chunks(L::N).zip(self.out.chunks_mut(L::N)) {
+            // Lanes descending the tree: their node, remapped sample and
+            // probability so far. Infinite lights and a tree of one light
+            // take the single sample's path.
+            let mut node = [0usize; MAX_LANES];
+            let mut u = [0.0 as Float; MAX_LANES];
+            let mut pmf = [0.0 as Float; MAX_LANES];
+            let mut active = 0u32;
+            for (i, q) in queries.iter().enumerate() {
+                if q.u < p_inf || s.nodes.first().is_none_or(|root| root.is_leaf) {
+                    out[i] = s.sample_at(q.p, q.n, q.u);
+                } else {
+                    u[i] = ((q.u - p_inf) / (1.0 - p_inf)).min(ONE_MINUS_EPSILON);
+                    pmf[i] = 1.0 - p_inf;
+                    active |= 1 << i;
+                }
+            }
+            if active == 0 {
+                continue;
+            }
+            let coord = |f: &dyn Fn(&LightChoice) -> Float| {
+                let mut v = [0.0 as Float; MAX_LANES];
+                for (x, q) in v.iter_mut().zip(queries) {
+                    *x = f(q);
+                }
+                L::load(&v)
+            };
+            let p = [coord(&|q| q.p.x), coord(&|q| q.p.y), coord(&|q| q.p.z)];
+            let n = [coord(&|q| q.n.x), coord(&|q| q.n.y), coord(&|q| q.n.z)];
+            let empty = PreparedLightBounds::default();
+            while active != 0 {
+                // Every lane's node is interior: its two children.
+                let mut b0 = [&empty; MAX_LANES];
+                let mut b1 = [&empty; MAX_LANES];
+                let mut bits = active;
+                while bits != 0 {
+                    let i = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    let c1 = s.nodes[node[i]].child_or_light as usize;
+                    b0[i] = &s.nodes[node[i] + 1].bounds;
+                    b1[i] = &s.nodes[c1].bounds;
+                }
+                let ci0 = importance_lanes::<L>(&b0[..L::N], &p, &n);
+                let ci1 = importance_lanes::<L>(&b1[..L::N], &p, &n);
+                // The single sample's arithmetic, lane-wise.
+                let (uv, pmfv) = (L::load(&u), L::load(&pmf));
+                let sum = ci0.add(ci1);
+                let p0 = ci0.div(sum);
+                let first = uv.lt(p0);
+                let p1 = L::splat(1.0).sub(p0);
+                let pmfv = pmfv.mul(L::select(first, p0, ci1.div(sum)));
+                let uv = L::select(first, uv.div(p0), uv.sub(p0).div(p1))
+                    .min(L::splat(ONE_MINUS_EPSILON));
+                let zero = L::splat(0.0);
+                let dead = L::bits(L::and(ci0.eq(zero), ci1.eq(zero)));
+                let first = L::bits(first);
+                uv.store(&mut u);
+                pmfv.store(&mut pmf);
+                let mut bits = active;
+                while bits != 0 {
+                    let i = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    if dead & (1 << i) != 0 {
+                        out[i] = None;
+                        active &= !(1 << i);
+                        continue;
+                    }
+                    let cur = &s.nodes[node[i]];
+                    node[i] = if first & (1 << i) != 0 {
+                        node[i] + 1
+                    } else {
+                        cur.child_or_light as usize
+                    };
+                    let next = &s.nodes[node[i]];
+                    if next.is_leaf {
+                        out[i] = Some(SampledLight {
+                            light: next.child_or_light,
+                            p: pmf[i],
+                        });
+                        active &= !(1 << i);
+                    }
+                }
+            }
+        }
     }
 }

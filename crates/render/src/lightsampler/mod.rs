@@ -14,7 +14,7 @@ mod bvh;
 #[cfg(test)]
 mod tests;
 
-pub use bvh::BvhLightSampler;
+pub use bvh::{BvhLightSampler, LightChoice};
 
 /// The largest float below 1.
 pub(crate) const ONE_MINUS_EPSILON: Float = 1.0 - Float::EPSILON / 2.0;

@@ -215,3 +215,52 @@ fn unknown_sampler_lists_known_ones() {
     assert!(msg.contains("uniform") && msg.contains("power") && msg.contains("bvh"));
     let _ = RgbColorSpace::srgb();
 }
+
+/// The batched choice equals the single one bit for bit at every width
+/// the processor runs: random scenes (one light, a few, many, with and
+/// without infinite lights, one-sided disks that some points are behind),
+/// points with and without normals, batches of every length up to two
+/// widths.
+#[test]
+fn batched_bvh_choices_match_single_ones() {
+    use crate::simd::SimdLevel;
+    let mut rng = Rng::with_sequence(21);
+    let mut descended = 0;
+    for (n, inf) in [(1, 0), (2, 0), (3, 1), (17, 0), (64, 2), (300, 0)] {
+        let lights = scene(&mut rng, n, inf);
+        let LightSampler::Bvh(s) = create_light_sampler("bvh", &lights).unwrap() else {
+            panic!("not the BVH sampler");
+        };
+        for batch in 1..=33 {
+            let ctxs: Vec<LightSampleContext> = (0..batch).map(|_| random_ctx(&mut rng)).collect();
+            let queries: Vec<LightChoice> = ctxs
+                .iter()
+                .map(|c| LightChoice::new(c, rng.uniform_float()))
+                .collect();
+            let want: Vec<Option<SampledLight>> = ctxs
+                .iter()
+                .zip(&queries)
+                .map(|(c, q)| s.sample(c, q.u))
+                .collect();
+            for level in [SimdLevel::Scalar, SimdLevel::Sse4, SimdLevel::Avx2] {
+                if level > SimdLevel::detected() {
+                    continue;
+                }
+                let mut got = Vec::new();
+                s.sample_batch(level, &queries, &mut got);
+                let bits = |v: &[Option<SampledLight>]| -> Vec<Option<(u32, u32)>> {
+                    v.iter()
+                        .map(|o| o.map(|x| (x.light, x.p.to_bits())))
+                        .collect()
+                };
+                assert_eq!(
+                    bits(&got),
+                    bits(&want),
+                    "{n} lights, batch {batch}, {level:?}"
+                );
+            }
+            descended += want.iter().filter(|w| w.is_some_and(|x| x.p < 1.0)).count();
+        }
+    }
+    assert!(descended > 1500, "{descended}");
+}

@@ -22,6 +22,10 @@ pub use lanes::{F32x4, F32x8};
 
 use std::sync::OnceLock;
 
+/// The most lanes any width has (arrays that hold one value per lane are
+/// this long).
+pub const MAX_LANES: usize = 16;
+
 /// An instruction-set level kernels can run at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum SimdLevel {

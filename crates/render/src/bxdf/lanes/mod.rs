@@ -36,8 +36,7 @@ use crate::spectrum::{SampledSpectrum, N_SPECTRUM_SAMPLES};
 // not be inlined.
 const _: () = assert!(N_SPECTRUM_SAMPLES == 4);
 
-/// The most lanes any width has.
-pub(crate) const MAX_LANES: usize = 16;
+pub(crate) use crate::simd::MAX_LANES;
 
 /// Lane `i` of `x`.
 #[inline(always)]
