@@ -143,18 +143,6 @@ AttributeEnd
     s
 }
 
-fn create(text: &str) -> CreatedScene {
-    let (desc, _) = build_scene_from_str(text, &BuildOptions::default())
-        .unwrap_or_else(|d| panic!("{}", d.render()));
-    match create_scene(&desc, &CreateOptions::default()) {
-        Ok(c) => c,
-        Err(e) => panic!(
-            "{:?}",
-            e.iter().map(|d| d.message.clone()).collect::<Vec<_>>()
-        ),
-    }
-}
-
 /// Rays from around the scene: random directions, rays aimed at its
 /// middle, axis-parallel ones, finite and infinite `t_max`, times in
 /// `[0, 1]`.
@@ -234,8 +222,8 @@ fn assert_same_hits(bvh: &CreatedScene, embree: &CreatedScene, rays: &[(Ray, Flo
 
 #[test]
 fn embree_finds_the_bvh_hits() {
-    let bvh = create(&scene_text("bvh"));
-    let embree = create(&scene_text("embree"));
+    let bvh = common::created(&scene_text("bvh"));
+    let embree = common::created(&scene_text("embree"));
     if let Accelerator::Embree(e) = embree.scene.aggregate.accelerator() {
         assert!(e.triangle_count() > 1000, "{e:?}");
     }
@@ -257,7 +245,10 @@ fn embree_finds_the_bvh_hits_far_away() {
             random_mesh(12, 30, 2.0)
         )
     };
-    let (bvh, embree) = (create(&text("bvh")), create(&text("embree")));
+    let (bvh, embree) = (
+        common::created(&text("bvh")),
+        common::created(&text("embree")),
+    );
     let rays: Vec<(Ray, Float)> = random_rays(13, 20_000)
         .into_iter()
         .map(|(r, t)| {

@@ -27,8 +27,9 @@ pub fn render_with(text: &str, threads: usize, wavefront: bool) -> (Image, bool)
     (render_created(created, threads, wavefront, None), has)
 }
 
-/// The scene of `text`, created.
-fn created(text: &str) -> rpbrt_render::scene::assemble::CreatedScene {
+/// The scene of `text`, created (a panic with its diagnostics where it
+/// fails).
+pub fn created(text: &str) -> rpbrt_render::scene::assemble::CreatedScene {
     let (desc, _) = build_scene_from_str(text, &BuildOptions::default())
         .unwrap_or_else(|d| panic!("{}", d.render()));
     match create_scene(&desc, &CreateOptions::default()) {
