@@ -53,7 +53,7 @@ use obvhs::BvhBuildParams;
 use rpbrt_geometry::{
     cross, dot, Bounds3f, Float, Frame, Normal3f, Point2f, Point3f, Ray, Vector3f,
 };
-use rpbrt_render::accel::{AccelKind, AccelParams, Accelerator, Aggregate, ParamValue};
+use rpbrt_render::accel::{AccelKind, AccelParams, Accelerator, Aggregate, ParamValue, WideBvh};
 use rpbrt_render::rng::Rng;
 use rpbrt_render::sampling::sample_cosine_hemisphere;
 use rpbrt_render::scene::{build_scene_from_str, BuildOptions};
@@ -442,10 +442,46 @@ where
     (rays.len() as f64 / t0.elapsed().as_secs_f64() / 1e6, hits)
 }
 
+/// The packet figures of a wide BVH (see `bench_mesh`): the SIMD level and
+/// the camera and incoherent rays' Mrays/s in packets of its width.
+fn packet_figures<const W: usize>(
+    bvh: &WideBvh<W>,
+    slot_tris: &[Tri],
+    cam_set: &[Ray],
+    bounce_set: &[Ray],
+    threads: usize,
+) -> String {
+    let level = rpbrt_render::simd::level();
+    let w = level.lanes();
+    if w == 1 {
+        return String::new();
+    }
+    let packet = |g: &[Ray]| {
+        let trs: Vec<TriangleRay> = g.iter().map(TriangleRay::new).collect();
+        let mut t_max = [Float::INFINITY; 16];
+        let mut best = [None; 16];
+        bvh.intersect_packet(
+            level,
+            g,
+            &mut t_max[..g.len()],
+            &mut best[..g.len()],
+            |lane, s, _, _, t| hit_tri(slot_tris, &trs[lane], s, t),
+        );
+        best[..g.len()].iter().filter(|b| b.is_some()).count()
+    };
+    let (tw, th) = if w == 8 { (4, 2) } else { (2, 2) };
+    let (pc, _) = run_groups(&tiled(cam_set, tw, th), w, threads, packet);
+    let (pi, _) = run_groups(bounce_set, w, threads, packet);
+    format!(
+        " simd={} packet{w}_coherent_mrays_s={pc:.2} packet{w}_incoherent_mrays_s={pi:.2}",
+        level.name()
+    )
+}
+
 /// The rpbrt structures benchmarked: (name, parameters).
 ///
-/// `bvh` is the default BVH (4-wide), `bvh2` the binary one
-/// (`"integer width" 2`).
+/// `bvh` is the default BVH, `bvh2` the binary one (`"integer width" 2`),
+/// `bvh4` and `bvh8` the 4- and 8-wide ones.
 fn rpbrt_structures() -> Vec<(&'static str, AccelParams)> {
     let mut v = Vec::new();
     for name in AccelParams::NAMES {
@@ -457,8 +493,10 @@ fn rpbrt_structures() -> Vec<(&'static str, AccelParams)> {
             v.push((*name, p));
         }
         if *name == "bvh" {
-            if let Ok(p) = AccelParams::parse(name, [("width", ParamValue::Int(2))]) {
-                v.push(("bvh2", p));
+            for (w, wname) in [(2, "bvh2"), (4, "bvh4"), (8, "bvh8")] {
+                if let Ok(p) = AccelParams::parse(name, [("width", ParamValue::Int(w))]) {
+                    v.push((wname, p));
+                }
             }
         }
     }
@@ -544,36 +582,18 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
             } else {
                 ""
             };
-            // The 4-wide BVH's packet traversal at the processor's SIMD
+            // The wide BVHs' packet traversal at the processor's SIMD
             // width: camera rays in 4×2 (8 lanes) or 2×2 (4 lanes) pixel
             // tiles, and the incoherent rays in groups of the same size.
-            let mut extra = String::new();
-            if let Accelerator::Bvh4(bvh) = &a {
-                let level = rpbrt_render::simd::level();
-                let w = level.lanes();
-                if w > 1 {
-                    let packet = |g: &[Ray]| {
-                        let trs: Vec<TriangleRay> = g.iter().map(TriangleRay::new).collect();
-                        let mut t_max = [Float::INFINITY; 16];
-                        let mut best = [None; 16];
-                        bvh.intersect_packet(
-                            level,
-                            g,
-                            &mut t_max[..g.len()],
-                            &mut best[..g.len()],
-                            |lane, s, _, _, t| hit_tri(slot_tris, &trs[lane], s, t),
-                        );
-                        best[..g.len()].iter().filter(|b| b.is_some()).count()
-                    };
-                    let (tw, th) = if w == 8 { (4, 2) } else { (2, 2) };
-                    let (pc, _) = run_groups(&tiled(&cam_set, tw, th), w, threads, packet);
-                    let (pi, _) = run_groups(&bounce_set, w, threads, packet);
-                    extra = format!(
-                        " simd={} packet{w}_coherent_mrays_s={pc:.2} packet{w}_incoherent_mrays_s={pi:.2}",
-                        level.name()
-                    );
+            let extra = match &a {
+                Accelerator::Bvh4(bvh) => {
+                    packet_figures(bvh, slot_tris, &cam_set, &bounce_set, threads)
                 }
-            }
+                Accelerator::Bvh8(bvh) => {
+                    packet_figures(bvh, slot_tris, &cam_set, &bounce_set, threads)
+                }
+                _ => String::new(),
+            };
             print_result(
                 &mesh.name,
                 name,

@@ -19,7 +19,6 @@
 //! magnitude so that box extents are finite in `f32`.
 
 pub mod bvh;
-pub mod bvh4;
 #[cfg(feature = "embree")]
 pub mod embree;
 pub mod grid;
@@ -29,9 +28,9 @@ mod params;
 #[cfg(test)]
 mod tests;
 mod wide;
+pub mod widebvh;
 
 pub use bvh::{Bvh, BvhNode};
-pub use bvh4::{Bvh4, Bvh4Node};
 #[cfg(feature = "embree")]
 pub use embree::{AccelError, EmbreeAccel};
 pub use grid::Grid;
@@ -39,6 +38,7 @@ pub use kdtree::{KdNode, KdTree};
 pub use params::{
     AccelKind, AccelParams, BvhParams, GridParams, KdTreeParams, ParamValue, SplitMethod,
 };
+pub use widebvh::{Bvh4, Bvh4Node, Bvh8, Bvh8Node, WideBvh, WideNode};
 
 use rpbrt_geometry::{gamma, next_float_down, next_float_up, Bounds3f, Float, Point3f, Ray};
 
@@ -112,6 +112,9 @@ pub enum Accelerator {
     /// The same SAH tree collapsed to 4-wide nodes (`Accelerator "bvh"`,
     /// the default: the fastest in `benches/accel.rs`).
     Bvh4(Bvh4),
+    /// The same SAH tree collapsed to 8-wide nodes
+    /// (`Accelerator "bvh" "integer width" 8`).
+    Bvh8(Bvh8),
     /// An SAH kd-tree (pbrt-v3 `KdTreeAccel`).
     KdTree(KdTree),
     /// A uniform grid with mailboxing (pbrt-v2 `GridAccel`).
@@ -177,6 +180,9 @@ impl Accelerator {
             AccelKind::Bvh if params.bvh.width == 2 => {
                 Accelerator::Bvh(Bvh::build_from(n, bounds, &params.bvh, threads))
             }
+            AccelKind::Bvh if params.bvh.width == 8 => {
+                Accelerator::Bvh8(Bvh8::build_from(n, bounds, &params.bvh, threads))
+            }
             AccelKind::Bvh => Accelerator::Bvh4(Bvh4::build_from(n, bounds, &params.bvh, threads)),
             _ => {
                 let b: Vec<Bounds3f> = (0..n as u32).map(bounds).collect();
@@ -198,6 +204,9 @@ impl Accelerator {
         match params.kind {
             AccelKind::Bvh if params.bvh.width == 2 => {
                 Accelerator::Bvh(Bvh::build_with_threads(prim_bounds, &params.bvh, threads))
+            }
+            AccelKind::Bvh if params.bvh.width == 8 => {
+                Accelerator::Bvh8(Bvh8::build_with_threads(prim_bounds, &params.bvh, threads))
             }
             AccelKind::Bvh => {
                 Accelerator::Bvh4(Bvh4::build_with_threads(prim_bounds, &params.bvh, threads))
@@ -225,6 +234,7 @@ impl Aggregate for Accelerator {
         match self {
             Accelerator::Bvh(a) => a.bounds(),
             Accelerator::Bvh4(a) => a.bounds(),
+            Accelerator::Bvh8(a) => a.bounds(),
             Accelerator::KdTree(a) => a.bounds(),
             Accelerator::Grid(a) => a.bounds(),
             #[cfg(feature = "embree")]
@@ -239,6 +249,7 @@ impl Aggregate for Accelerator {
         match self {
             Accelerator::Bvh(a) => a.intersect(ray, t_max, hit),
             Accelerator::Bvh4(a) => a.intersect(ray, t_max, hit),
+            Accelerator::Bvh8(a) => a.intersect(ray, t_max, hit),
             Accelerator::KdTree(a) => a.intersect(ray, t_max, hit),
             Accelerator::Grid(a) => a.intersect(ray, t_max, hit),
             #[cfg(feature = "embree")]
@@ -256,6 +267,7 @@ impl Aggregate for Accelerator {
         match self {
             Accelerator::Bvh(a) => a.intersect_p(ray, t_max, hit),
             Accelerator::Bvh4(a) => a.intersect_p(ray, t_max, hit),
+            Accelerator::Bvh8(a) => a.intersect_p(ray, t_max, hit),
             Accelerator::KdTree(a) => a.intersect_p(ray, t_max, hit),
             Accelerator::Grid(a) => a.intersect_p(ray, t_max, hit),
             #[cfg(feature = "embree")]
@@ -273,6 +285,7 @@ impl Aggregate for Accelerator {
         match self {
             Accelerator::Bvh(a) => a.intersect_slots(ray, t_max, hit),
             Accelerator::Bvh4(a) => a.intersect_slots(ray, t_max, hit),
+            Accelerator::Bvh8(a) => a.intersect_slots(ray, t_max, hit),
             Accelerator::KdTree(a) => a.intersect_slots(ray, t_max, hit),
             Accelerator::Grid(a) => a.intersect_slots(ray, t_max, hit),
             #[cfg(feature = "embree")]
@@ -290,6 +303,7 @@ impl Aggregate for Accelerator {
         match self {
             Accelerator::Bvh(a) => a.intersect_p_slots(ray, t_max, hit),
             Accelerator::Bvh4(a) => a.intersect_p_slots(ray, t_max, hit),
+            Accelerator::Bvh8(a) => a.intersect_p_slots(ray, t_max, hit),
             Accelerator::KdTree(a) => a.intersect_p_slots(ray, t_max, hit),
             Accelerator::Grid(a) => a.intersect_p_slots(ray, t_max, hit),
             #[cfg(feature = "embree")]
@@ -303,6 +317,7 @@ impl Aggregate for Accelerator {
         match self {
             Accelerator::Bvh(a) => a.slot_entries(),
             Accelerator::Bvh4(a) => a.slot_entries(),
+            Accelerator::Bvh8(a) => a.slot_entries(),
             Accelerator::KdTree(a) => a.slot_entries(),
             Accelerator::Grid(a) => a.slot_entries(),
             #[cfg(feature = "embree")]
@@ -313,6 +328,7 @@ impl Aggregate for Accelerator {
         match self {
             Accelerator::Bvh(a) => a.memory_bytes(),
             Accelerator::Bvh4(a) => a.memory_bytes(),
+            Accelerator::Bvh8(a) => a.memory_bytes(),
             Accelerator::KdTree(a) => a.memory_bytes(),
             Accelerator::Grid(a) => a.memory_bytes(),
             #[cfg(feature = "embree")]
@@ -323,6 +339,7 @@ impl Aggregate for Accelerator {
         match self {
             Accelerator::Bvh(a) => a.primitive_count(),
             Accelerator::Bvh4(a) => a.primitive_count(),
+            Accelerator::Bvh8(a) => a.primitive_count(),
             Accelerator::KdTree(a) => a.primitive_count(),
             Accelerator::Grid(a) => a.primitive_count(),
             #[cfg(feature = "embree")]
@@ -333,6 +350,7 @@ impl Aggregate for Accelerator {
         match self {
             Accelerator::Bvh(a) => a.skipped_primitives(),
             Accelerator::Bvh4(a) => a.skipped_primitives(),
+            Accelerator::Bvh8(a) => a.skipped_primitives(),
             Accelerator::KdTree(a) => a.skipped_primitives(),
             Accelerator::Grid(a) => a.skipped_primitives(),
             #[cfg(feature = "embree")]

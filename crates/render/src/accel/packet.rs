@@ -1,11 +1,11 @@
-//! Packet traversal of the 4-wide BVH: up to [`MAX_PACKET`] rays walk the
+//! Packet traversal of the wide BVHs: up to [`MAX_PACKET`] rays walk the
 //! tree together, each node's boxes tested against all of them at once,
 //! one ray per SIMD lane (Wald, Slusallek and Benthin 2001, "Interactive
 //! rendering with coherent ray tracing"; Embree's `rtcIntersect8/16`).
 //! Written once over [`F32Lanes`] and run at the processor's width by
 //! [`crate::simd::dispatch`]; the scalar one-lane form is the reference.
 //!
-//! Each ray's box tests compute exactly what [`Bvh4`]'s single-ray test
+//! Each ray's box tests compute exactly what [`WideBvh`]'s single-ray test
 //! computes (the same planes, nudged origins and far-plane padding), so a
 //! ray enters the same boxes either way; its leaves are tested with the
 //! caller's closure as the single-ray traversal tests them. Only the order
@@ -15,8 +15,8 @@
 //! visited when any active ray enters it, and popped entries are culled
 //! per lane against each ray's closest hit so far.
 
-use super::bvh4::{closest_in_leaf, Bvh4, WIDTH};
 use super::far_pad;
+use super::widebvh::{closest_in_leaf, WideBvh};
 use crate::simd::{F32Lanes, Kernel};
 use rpbrt_geometry::{next_float_down, next_float_up, Float, Ray};
 use std::mem::MaybeUninit;
@@ -25,22 +25,22 @@ use std::mem::MaybeUninit;
 pub const MAX_PACKET: usize = 16;
 
 /// Entries the packet stack holds: as the single-ray traversal's.
-const PACKET_STACK: usize = 3 * super::bvh::STACK_SIZE + 1;
+const PACKET_STACK: usize = 7 * super::bvh::STACK_SIZE + 1;
 
 /// The closest hits of a packet of rays, as [`super::Aggregate::intersect_slots`]
 /// finds them for each ray alone: `hit(lane, slot, entry, ray, t_max)`
 /// tests entry `entry` (at slot `slot`) against ray `lane`; `t_max[lane]`
 /// starts as the ray's bound and ends as its closest hit's distance, and
 /// `best[lane]` receives the hit entry and distance.
-pub(crate) struct PacketClosest<'a, F> {
-    pub bvh: &'a Bvh4,
+pub(crate) struct PacketClosest<'a, const W: usize, F> {
+    pub bvh: &'a WideBvh<W>,
     pub rays: &'a [Ray],
     pub t_max: &'a mut [Float],
     pub best: &'a mut [Option<(u32, Float)>],
     pub hit: F,
 }
 
-impl<F> Kernel for PacketClosest<'_, F>
+impl<const W: usize, F> Kernel for PacketClosest<'_, W, F>
 where
     F: FnMut(usize, u32, u32, &Ray, Float) -> Option<Float>,
 {
@@ -54,7 +54,7 @@ where
         let mut first = 0;
         while first < n {
             let end = (first + L::N).min(n);
-            packet_closest::<L, F>(
+            packet_closest::<W, L, F>(
                 self.bvh,
                 &self.rays[first..end],
                 &mut self.t_max[first..end],
@@ -120,8 +120,8 @@ fn packet_rays<L: F32Lanes>(rays: &[Ray]) -> PacketRays<L> {
 }
 
 #[inline(always)]
-fn packet_closest<L: F32Lanes, F>(
-    bvh: &Bvh4,
+fn packet_closest<const W: usize, L: F32Lanes, F>(
+    bvh: &WideBvh<W>,
     rays: &[Ray],
     t_max: &mut [Float],
     best: &mut [Option<(u32, Float)>],
@@ -168,9 +168,9 @@ fn packet_closest<L: F32Lanes, F>(
     loop {
         let node = &nodes[cur as usize];
         let b = &node.bounds;
-        let mut t_near = [zero; WIDTH];
-        let mut hit_bits = [0u32; WIDTH];
-        for c in 0..WIDTH {
+        let mut t_near = [zero; W];
+        let mut hit_bits = [0u32; W];
+        for c in 0..W {
             let mut t0 = zero;
             let mut t1 = t_max_v;
             if let Some(oct) = &octant {
@@ -198,7 +198,7 @@ fn packet_closest<L: F32Lanes, F>(
             hit_bits[c] = L::bits(m);
             t_near[c] = L::select(m, t0, inf);
         }
-        let entered = (0..WIDTH).fold(0, |m, c| m | (((hit_bits[c] != 0) as u32) << c));
+        let entered = (0..W).fold(0, |m, c| m | (((hit_bits[c] != 0) as u32) << c));
         bvh.prefetch_children(node, entered);
         // Leaf children, in lane order, each against the rays that enter it.
         let mut leaves = node.leaf_lanes;
@@ -232,9 +232,9 @@ fn packet_closest<L: F32Lanes, F>(
         }
         // Interior children entered by some ray: ordered by their entry
         // distance for the first such ray, nearest visited next.
-        let mut inner = [(0u32, 0.0 as Float, zero); WIDTH];
+        let mut inner = [(0u32, 0.0 as Float, zero); W];
         let mut n_inner = 0;
-        for c in 0..WIDTH {
+        for c in 0..W {
             let bits = hit_bits[c];
             if bits == 0 || node.leaf_lanes & (1 << c) != 0 {
                 continue;
@@ -274,7 +274,7 @@ fn packet_closest<L: F32Lanes, F>(
     }
 }
 
-impl Bvh4 {
+impl<const W: usize> WideBvh<W> {
     /// The closest hits of up to [`MAX_PACKET`] rays traced as packets of
     /// `level`'s width (see the module documentation):
     /// `hit(lane, slot, entry, ray, t_max)` as for

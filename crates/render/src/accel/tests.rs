@@ -98,7 +98,7 @@ fn random_rays(seed: u64, n: usize) -> Vec<(Ray, Float)> {
 fn all_accels(bounds: &[Bounds3f]) -> Vec<(String, Accelerator)> {
     let mut v = Vec::new();
     for method in ["sah", "hlbvh", "middle", "equal"] {
-        for (maxp, width) in [(1, 4), (4, 4), (1, 2), (4, 2)] {
+        for (maxp, width) in [(1, 4), (4, 4), (1, 8), (4, 8), (1, 2), (4, 2)] {
             let p = AccelParams::parse(
                 "bvh",
                 [
@@ -200,37 +200,75 @@ where
         assert_eq!(any_slot, any, "{name}: ray {k}: intersect_p_slots");
         singles.push(got);
     }
-    // The 4-wide BVH's packet traversal, at every width this processor
-    // runs: 16 rays a call (two packets of 8, four of 4, or sixteen
-    // single lanes), each ray's hit at the single ray's distance.
-    if let Accelerator::Bvh4(bvh) = accel {
-        for level in crate::simd::SimdLevel::available() {
-            for (g, group) in rays.chunks(16).enumerate() {
-                let rs: Vec<Ray> = group.iter().map(|(r, _)| *r).collect();
-                let mut t_max: Vec<Float> = group.iter().map(|(_, t)| *t).collect();
-                let mut best = vec![None; rs.len()];
-                bvh.intersect_packet(level, &rs, &mut t_max, &mut best, |lane, s, p, r, t| {
-                    assert_eq!(entry_of_bvh4(bvh, s), p, "{name}: packet slot {s}");
-                    assert_eq!(*r, rs[lane]);
-                    hit(p, r, t)
-                });
-                for (lane, b) in best.iter().enumerate() {
-                    let k = 16 * g + lane;
-                    assert_eq!(
-                        b.map(|b| b.1),
-                        singles[k].map(|s| s.1),
-                        "{name}: {level:?} packet: ray {k} {:?}",
-                        rays[k]
-                    );
-                }
-            }
+    match accel {
+        Accelerator::Bvh4(bvh) => check_packets(name, bvh, rays, &singles, &hit),
+        Accelerator::Bvh8(bvh) => {
+            check_packets(name, bvh, rays, &singles, &hit);
+            check_levels(name, bvh, rays, &singles, &hit);
         }
+        _ => {}
     }
     n_hits
 }
 
-fn entry_of_bvh4(bvh: &Bvh4, slot: u32) -> u32 {
-    bvh.prim_indices()[slot as usize]
+/// The wide BVH's packet traversal, at every width this processor runs:
+/// 16 rays a call (two packets of 8, four of 4, or sixteen single lanes),
+/// each ray's hit at the single ray's distance.
+fn check_packets<const W: usize, H>(
+    name: &str,
+    bvh: &WideBvh<W>,
+    rays: &[(Ray, Float)],
+    singles: &[Option<(u32, Float)>],
+    hit: &H,
+) where
+    H: Fn(u32, &Ray, Float) -> Option<Float>,
+{
+    for level in crate::simd::SimdLevel::available() {
+        for (g, group) in rays.chunks(16).enumerate() {
+            let rs: Vec<Ray> = group.iter().map(|(r, _)| *r).collect();
+            let mut t_max: Vec<Float> = group.iter().map(|(_, t)| *t).collect();
+            let mut best = vec![None; rs.len()];
+            bvh.intersect_packet(level, &rs, &mut t_max, &mut best, |lane, s, p, r, t| {
+                assert_eq!(bvh.prim_indices()[s as usize], p, "{name}: packet slot {s}");
+                assert_eq!(*r, rs[lane]);
+                hit(p, r, t)
+            });
+            for (lane, b) in best.iter().enumerate() {
+                let k = 16 * g + lane;
+                assert_eq!(
+                    b.map(|b| b.1),
+                    singles[k].map(|s| s.1),
+                    "{name}: {level:?} packet: ray {k} {:?}",
+                    rays[k]
+                );
+            }
+        }
+    }
+}
+
+/// The wide BVH's single-ray traversals compiled for every level this
+/// processor runs: the same hits (primitive and distance) and occlusion.
+fn check_levels<const W: usize, H>(
+    name: &str,
+    bvh: &WideBvh<W>,
+    rays: &[(Ray, Float)],
+    singles: &[Option<(u32, Float)>],
+    hit: &H,
+) where
+    H: Fn(u32, &Ray, Float) -> Option<Float>,
+{
+    for level in crate::simd::SimdLevel::available() {
+        for (k, (ray, t_max)) in rays.iter().enumerate() {
+            let got = bvh.intersect_slots_at(level, ray, *t_max, |s, p, r, t| {
+                assert_eq!(bvh.prim_indices()[s as usize], p, "{name}: slot {s}");
+                hit(p, r, t)
+            });
+            assert_eq!(got, singles[k], "{name}: {level:?}: ray {k} {ray:?}");
+            let any =
+                bvh.intersect_p_slots_at(level, ray, *t_max, |_, p, r, t| hit(p, r, t).is_some());
+            assert_eq!(any, got.is_some(), "{name}: {level:?}: ray {k}: occlusion");
+        }
+    }
 }
 
 fn check_all<H>(bounds: &[Bounds3f], rays: &[(Ray, Float)], hit: H, min_hits: usize)
@@ -248,6 +286,7 @@ where
 fn node_sizes() {
     assert_eq!(std::mem::size_of::<BvhNode>(), 32);
     assert_eq!(std::mem::size_of::<Bvh4Node>(), 128);
+    assert_eq!(std::mem::size_of::<Bvh8Node>(), 256);
     assert_eq!(std::mem::size_of::<KdNode>(), 8);
 }
 
@@ -558,6 +597,9 @@ fn builds_are_deterministic() {
         let w1 = Bvh4::build_with_threads(&bounds, &p, 1);
         let w3 = Bvh4::build_with_threads(&bounds, &p, 3);
         assert!(w1.nodes() == w3.nodes() && w1.prim_indices() == w3.prim_indices());
+        let e1 = Bvh8::build_with_threads(&bounds, &p, 1);
+        let e3 = Bvh8::build_with_threads(&bounds, &p, 3);
+        assert!(e1.nodes() == e3.nodes() && e1.prim_indices() == w1.prim_indices());
         assert!(
             w1.prim_indices() == a.prim_indices(),
             "{method:?}: same leaves"
@@ -615,18 +657,8 @@ fn direct_wide_build_is_the_collapsed_binary_tree() {
                     max_prims_in_node: max_prims,
                     ..Default::default()
                 };
-                let want = Bvh4::from_binary(Bvh::build_with_threads(bounds, &p, 1));
-                for threads in [1, 2, 3, 8] {
-                    let got = Bvh4::build_with_threads(bounds, &p, threads);
-                    let what =
-                        format!("{name}, {method:?}, {max_prims} per leaf, {threads} threads");
-                    assert!(got.nodes() == want.nodes(), "{what}: nodes differ");
-                    assert!(got.prim_indices() == want.prim_indices(), "{what}");
-                    assert_eq!(got.bounds(), want.bounds(), "{what}");
-                    // The direct build reserves one node per primitive and
-                    // must never outgrow it (growing would copy the tree).
-                    assert!(got.nodes().len() <= bounds.len().max(1), "{what}");
-                }
+                check_direct_build::<4>(name, bounds, &p);
+                check_direct_build::<8>(name, bounds, &p);
             }
         }
     }
@@ -674,8 +706,31 @@ fn bvh_leaves_cover_every_primitive_once() {
     }
 }
 
+/// [`direct_wide_build_is_the_collapsed_binary_tree`] for one width.
+fn check_direct_build<const W: usize>(name: &str, bounds: &[Bounds3f], p: &BvhParams) {
+    let want = WideBvh::<W>::from_binary(Bvh::build_with_threads(bounds, p, 1));
+    for threads in [1, 2, 3, 8] {
+        let got = WideBvh::<W>::build_with_threads(bounds, p, threads);
+        let what = format!(
+            "{name}, {W} wide, {:?}, {} per leaf, {threads} threads",
+            p.split_method, p.max_prims_in_node
+        );
+        assert!(got.nodes() == want.nodes(), "{what}: nodes differ");
+        assert!(got.prim_indices() == want.prim_indices(), "{what}");
+        assert_eq!(got.bounds(), want.bounds(), "{what}");
+        // The direct build reserves one node per primitive and must never
+        // outgrow it (growing would copy the tree).
+        assert!(got.nodes().len() <= bounds.len().max(1), "{what}");
+    }
+}
+
 #[test]
-fn bvh4_collapse_keeps_leaves_and_bounds() {
+fn wide_collapse_keeps_leaves_and_bounds() {
+    check_collapse::<4>();
+    check_collapse::<8>();
+}
+
+fn check_collapse<const W: usize>() {
     let tris = random_tris(21, 5000, 0.05);
     let bounds: Vec<Bounds3f> = tris.iter().map(tri_bounds).collect();
     for maxp in [1, 4] {
@@ -683,7 +738,7 @@ fn bvh4_collapse_keeps_leaves_and_bounds() {
             max_prims_in_node: maxp,
             ..Default::default()
         };
-        let w = Bvh4::build(&bounds, &p);
+        let w = WideBvh::<W>::build(&bounds, &p);
         let mut seen = vec![0u32; bounds.len()];
         let mut n_children = 0;
         // Walk from the root, checking that every child box holds what is
@@ -691,7 +746,7 @@ fn bvh4_collapse_keeps_leaves_and_bounds() {
         let mut stack = vec![(0usize, w.bounds())];
         while let Some((i, outer)) = stack.pop() {
             let node = &w.nodes()[i];
-            for lane in 0..bvh4::WIDTH {
+            for lane in 0..W {
                 let b = node.child_bounds(lane);
                 if b.is_empty() {
                     continue;

@@ -1,16 +1,16 @@
-//! Building the 4-wide BVH straight from the primitives (pbrt-v4 section
-//! 7.3.2's top-down build, collapsed as `bvh4.rs` collapses it), without
+//! Building the wide BVHs straight from the primitives (pbrt-v4 section
+//! 7.3.2's top-down build, collapsed as `widebvh.rs` collapses it), without
 //! the binary tree in between.
 //!
-//! [`Bvh4::from_binary`] turns a binary node into a wide one by opening,
-//! while there are fewer than four children, the interior child of largest
+//! [`WideBvh::from_binary`] turns a binary node into a wide one by opening,
+//! while there are fewer than `W` children, the interior child of largest
 //! surface area, in place. Here the same children are found top down: a
 //! binary node is decided (leaf, or split and partitioned) when it becomes
 //! a child, and opening it decides its two sides. Every binary node is
 //! decided once, on its own primitives, exactly as the binary builder
 //! decides it (the same [`Builder::decide`]), so the wide tree, its node
 //! order (depth first, children in lane order) and the primitive order are
-//! those of `Bvh4::from_binary(Bvh::build(..))`, for every thread count.
+//! those of `WideBvh::from_binary(Bvh::build(..))`, for every thread count.
 //!
 //! Memory: the binary tree of 10 million triangles is about 500 MB, as
 //! much as the wide one; it is never made. The root's subtrees each get
@@ -19,9 +19,9 @@
 //! soon as it is built.
 
 use super::bvh::{prim_refs, Builder, Decision, PrimRef, SetBounds, PAR_MIN_PRIMS};
-use super::bvh4::{Bvh4, Bvh4Node, WIDTH};
 use super::params::BvhParams;
 use super::surface_area_f64;
+use super::widebvh::{WideBvh, WideNode};
 use rpbrt_geometry::Bounds3f;
 
 /// Below this many primitives the two sides of a split are decided on one
@@ -40,12 +40,12 @@ struct Kid {
 }
 
 /// The children of one wide node, in lane order.
-struct Kids {
-    items: [Kid; WIDTH],
+struct Kids<const W: usize> {
+    items: [Kid; W],
     len: usize,
 }
 
-impl Kids {
+impl<const W: usize> Kids<W> {
     fn as_slice(&self) -> &[Kid] {
         &self.items[..self.len]
     }
@@ -53,14 +53,19 @@ impl Kids {
 
 /// Builds the 4-wide BVH over the `n` primitives whose bounds `bounds`
 /// gives (see the module documentation).
-pub(super) fn build<F>(n: usize, bounds: F, params: &BvhParams, threads: usize) -> Bvh4
+pub(super) fn build<const W: usize, F>(
+    n: usize,
+    bounds: F,
+    params: &BvhParams,
+    threads: usize,
+) -> WideBvh<W>
 where
     F: Fn(u32) -> Bounds3f + Sync,
 {
     let mut prims = prim_refs(n, bounds);
     let n_skipped = n - prims.len();
     if prims.is_empty() {
-        return Bvh4::from_parts(Vec::new(), Vec::new(), Bounds3f::empty(), n, n_skipped);
+        return WideBvh::from_parts(Vec::new(), Vec::new(), Bounds3f::empty(), n, n_skipped);
     }
     let builder = Builder::new(params, threads);
     let set = SetBounds::of(&prims);
@@ -76,7 +81,7 @@ where
                 set,
                 decision: Decision::Leaf,
             };
-            let mut node = Bvh4Node::empty();
+            let mut node = WideNode::<W>::empty();
             set_lane(&mut node, 0, &root, 0);
             nodes.push(node);
             write_indices(&prims, &mut idx);
@@ -92,7 +97,7 @@ where
     // would allocate and copy the whole tree (the system allocator only
     // reallocates in place up to 16-byte alignment), while the reserved
     // tail was never written and holds no memory.
-    Bvh4::from_parts(nodes, idx, set.bounds, n, n_skipped)
+    WideBvh::from_parts(nodes, idx, set.bounds, n, n_skipped)
 }
 
 /// Nodes to reserve for the wide tree over `prims` primitives: an upper
@@ -115,7 +120,7 @@ fn write_indices(prims: &[PrimRef], idx: &mut [u32]) {
 
 /// Fills lane `lane` of `node` for `kid`, whose first primitive sits at
 /// `first` in the final order: its box, and for a leaf its primitives.
-fn set_lane(node: &mut Bvh4Node, lane: usize, kid: &Kid, first: u32) {
+fn set_lane<const W: usize>(node: &mut WideNode<W>, lane: usize, kid: &Kid, first: u32) {
     let b = &kid.set.bounds;
     for a in 0..3 {
         node.bounds[a][lane] = b.p_min[a];
@@ -132,11 +137,11 @@ fn set_lane(node: &mut Bvh4Node, lane: usize, kid: &Kid, first: u32) {
 /// Appends `sub` (a subtree built with child indices relative to its own
 /// start) to `out`, shifting its interior children's indices; returns the
 /// index of its root.
-fn append_relocated(out: &mut Vec<Bvh4Node>, sub: &[Bvh4Node]) -> u32 {
+fn append_relocated<const W: usize>(out: &mut Vec<WideNode<W>>, sub: &[WideNode<W>]) -> u32 {
     let base = out.len() as u32;
     out.extend(sub.iter().map(|n| {
         let mut n = *n;
-        for lane in 0..WIDTH {
+        for lane in 0..W {
             // Interior children point forward, so never at the root (0);
             // unused lanes hold 0.
             if n.count[lane] == 0 && n.child[lane] != 0 {
@@ -197,9 +202,9 @@ impl Builder {
 
     /// The children of the wide node whose binary root (at `depth`) over
     /// `prims` splits at `mid` into `sides`: the root's two sides, then,
-    /// while there are fewer than four, the interior child of largest
+    /// while there are fewer than `W`, the interior child of largest
     /// surface area (the first of equals) opened in place.
-    fn wide_kids(
+    fn wide_kids<const W: usize>(
         &self,
         prims: &mut [PrimRef],
         depth: usize,
@@ -207,13 +212,12 @@ impl Builder {
         sides: (SetBounds, SetBounds),
         buckets: &mut Vec<u8>,
         par: bool,
-    ) -> Kids {
+    ) -> Kids<W> {
         let (l, r) = self.decide_pair(prims, 0, mid, sides, depth + 1, buckets, par);
-        let mut kids = Kids {
-            items: [l, r, l, r],
-            len: 2,
-        };
-        while kids.len < WIDTH {
+        let mut items = [l; W];
+        items[1] = r;
+        let mut kids = Kids { items, len: 2 };
+        while kids.len < W {
             let mut best: Option<(usize, f64)> = None;
             for (i, k) in kids.as_slice().iter().enumerate() {
                 if let Decision::Split { .. } = k.decision {
@@ -246,13 +250,13 @@ impl Builder {
     /// own. `wide_depth` is the wide node's depth (subtrees near the root
     /// are built in parallel).
     #[allow(clippy::too_many_arguments)]
-    fn build_wide(
+    fn build_wide<const W: usize>(
         &self,
         prims: &mut [PrimRef],
         idx: &mut [u32],
         first: u32,
         kid: &Kid,
-        out: &mut Vec<Bvh4Node>,
+        out: &mut Vec<WideNode<W>>,
         buckets: &mut Vec<u8>,
         wide_depth: usize,
     ) -> Option<u32> {
@@ -260,9 +264,9 @@ impl Builder {
             return None;
         };
         let par = wide_depth < self.wide_par_depth() && prims.len() >= PAR_MIN_PRIMS;
-        let kids = self.wide_kids(prims, kid.depth, mid, sides, buckets, par);
+        let kids: Kids<W> = self.wide_kids(prims, kid.depth, mid, sides, buckets, par);
         let me = out.len();
-        let mut node = Bvh4Node::empty();
+        let mut node = WideNode::<W>::empty();
         for (lane, k) in kids.as_slice().iter().enumerate() {
             set_lane(&mut node, lane, k, first);
             if let Decision::Leaf = k.decision {
@@ -328,7 +332,7 @@ impl Builder {
     }
 
     /// How many levels of wide nodes build their subtrees in parallel:
-    /// about as many tasks as threads (four per level).
+    /// about as many tasks as threads (`W` per level).
     fn wide_par_depth(&self) -> usize {
         self.par_depth.div_ceil(2)
     }
@@ -338,15 +342,15 @@ impl Builder {
     /// of their own (taken from the end of `prims`, which shrinks), built
     /// (in parallel when the builder has threads) and freed, and its nodes
     /// are appended in lane order.
-    fn build_root(
+    fn build_root<const W: usize>(
         &self,
         mut prims: Vec<PrimRef>,
         idx: &mut [u32],
-        kids: &Kids,
+        kids: &Kids<W>,
         par: bool,
-    ) -> Vec<Bvh4Node> {
+    ) -> Vec<WideNode<W>> {
         let idx_len = idx.len();
-        let mut root = Bvh4Node::empty();
+        let mut root = WideNode::<W>::empty();
         for (lane, k) in kids.as_slice().iter().enumerate() {
             set_lane(&mut root, lane, k, 0);
             if let Decision::Leaf = k.decision {
@@ -407,7 +411,7 @@ impl Builder {
         // level: a finished subtree's nodes wait (held twice once copied)
         // only for those before it, and the later subtrees' references
         // are not yet joined by nodes of their own.
-        let window = (1usize << self.par_depth.saturating_sub(1)).clamp(1, WIDTH);
+        let window = (1usize << self.par_depth.saturating_sub(1)).clamp(1, W);
         std::thread::scope(|s| {
             let mut pending = parts.into_iter();
             let mut running = std::collections::VecDeque::new();

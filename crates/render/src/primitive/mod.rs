@@ -4,7 +4,7 @@
 //! acceleration structure over a set of primitives.
 
 use crate::accel::packet::MAX_PACKET;
-use crate::accel::{AccelParams, Accelerator, Aggregate};
+use crate::accel::{AccelParams, Accelerator, Aggregate, WideBvh};
 use crate::shape::triangle::{
     intersect_prepared_triangle, intersect_triangle, triangle_is_nondegenerate, TriangleFrame,
     TriangleOf, TriangleRay,
@@ -688,13 +688,26 @@ impl PrimitiveAggregate {
         level: SimdLevel,
         out: &mut [Option<HitRecord>],
     ) {
-        let n = rays.len();
-        let Accelerator::Bvh4(bvh) = &self.accel else {
-            for (o, r) in out.iter_mut().zip(rays) {
-                *o = self.intersect_record(r, Float::INFINITY);
+        match &self.accel {
+            Accelerator::Bvh4(bvh) => self.packet_records(bvh, rays, level, out),
+            Accelerator::Bvh8(bvh) => self.packet_records(bvh, rays, level, out),
+            _ => {
+                for (o, r) in out.iter_mut().zip(rays) {
+                    *o = self.intersect_record(r, Float::INFINITY);
+                }
             }
-            return;
-        };
+        }
+    }
+
+    /// [`PrimitiveAggregate::intersect_records_packet`] under a wide BVH.
+    fn packet_records<const W: usize>(
+        &self,
+        bvh: &WideBvh<W>,
+        rays: &[Ray],
+        level: SimdLevel,
+        out: &mut [Option<HitRecord>],
+    ) {
+        let n = rays.len();
         if level == SimdLevel::Scalar || n > MAX_PACKET {
             for (o, r) in out.iter_mut().zip(rays) {
                 *o = self.intersect_record(r, Float::INFINITY);

@@ -125,20 +125,23 @@ pub fn env_warning() -> Option<String> {
     }
 }
 
-/// Asks the processor to start loading the cache lines of `v` (up to 128
-/// bytes from its start), which the caller will read soon: a hint with no
-/// effect on results (none where the architecture has no such hint).
+/// Asks the processor to start loading the cache lines of `v` (at most
+/// four: 256 bytes from its start), which the caller will read soon: a
+/// hint with no effect on results (none where the architecture has no
+/// such hint).
 #[inline(always)]
 pub fn prefetch<T>(v: &T) {
     #[cfg(target_arch = "x86_64")]
     {
         let p = v as *const T as *const i8;
+        let lines = std::mem::size_of::<T>().div_ceil(64).min(4);
         // SAFETY: prefetching is a hint that never faults, whatever the
         // address; SSE is part of the x86-64 baseline.
         unsafe {
             use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
-            _mm_prefetch::<_MM_HINT_T0>(p);
-            _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64));
+            for i in 0..lines {
+                _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(64 * i));
+            }
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
