@@ -115,9 +115,7 @@ pub fn equirect_to_equal_area(latlong: &Image, resolution: i32) -> Result<Image,
         let y = 0.5 * gy as Float - 0.75;
         let p = wrap_equal_area_square_f(Point2f::new(x / n as Float, y / n as Float));
         let st = direction_to_equirect(equal_area_square_to_sphere(p));
-        for (c, o) in out.iter_mut().enumerate() {
-            *o = latlong.bilerp_channel(st, c, wrap);
-        }
+        latlong.bilerp_channels_into(st, wrap, out);
     };
     let mut data = vec![0.0f32; n * n * nc];
     data.par_chunks_mut(BAND * n * nc)

@@ -689,6 +689,33 @@ impl Image {
         bilerp4(dx, dy, v)
     }
 
+    /// Bilinear interpolation of the first `out.len()` channels at `p`
+    /// into `out`: each value as [`Image::bilerp_channel`] gives it, the
+    /// four texels found once for all channels.
+    #[inline]
+    pub fn bilerp_channels_into(&self, p: Point2f, wrap: WrapMode2D, out: &mut [f32]) {
+        let x = p.x * self.resolution.x as f32 - 0.5;
+        let y = p.y * self.resolution.y as f32 - 0.5;
+        let (xf, yf) = (x.floor(), y.floor());
+        let (dx, dy) = (x - xf, y - yf);
+        let (xi, yi) = (xf as i32, yf as i32);
+        let corner = |x: i32, y: i32| {
+            remap_pixel_coords(Point2i { x, y }, self.resolution, wrap)
+                .map(|q| self.pixel_offset(q))
+        };
+        let at = [
+            corner(xi, yi),
+            corner(xi + 1, yi),
+            corner(xi, yi + 1),
+            corner(xi + 1, yi + 1),
+        ];
+        let n = self.n_channels().min(out.len());
+        for (c, o) in out[..n].iter_mut().enumerate() {
+            let v = at.map(|a| a.map_or(0.0, |i| self.value_at(i + c)));
+            *o = bilerp4(dx, dy, v);
+        }
+    }
+
     /// Bilinear interpolation of all channels.
     pub fn bilerp(&self, p: Point2f, wrap: WrapMode2D) -> ImageChannelValues {
         let mut cv = ImageChannelValues::new(self.n_channels(), 0.0);

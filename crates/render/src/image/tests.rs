@@ -115,6 +115,28 @@ fn wrap_modes() {
     }
 }
 
+/// All channels at once give each channel's own bilinear value, for every
+/// wrap mode, inside and outside the image.
+#[test]
+fn bilerp_channels_into_matches_each_channel() {
+    let img = random_float_image(7, 5, &["R", "G", "B"], 3);
+    let mut rng = Rng::new(11, 0);
+    for wrap in [WrapMode::Clamp, WrapMode::Repeat, WrapMode::Black] {
+        let wrap = WrapMode2D::new(wrap, WrapMode::Clamp);
+        for _ in 0..500 {
+            let q = Point2f::new(
+                rng.uniform_float() * 1.6 - 0.3,
+                rng.uniform_float() * 1.6 - 0.3,
+            );
+            let mut all = [0.0f32; 3];
+            img.bilerp_channels_into(q, wrap, &mut all);
+            for (c, v) in all.iter().enumerate() {
+                assert_eq!(*v, img.bilerp_channel(q, c, wrap), "{wrap:?} {q:?} {c}");
+            }
+        }
+    }
+}
+
 #[test]
 fn bilerp_and_channels() {
     let img = Image::from_f32(

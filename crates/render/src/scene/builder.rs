@@ -60,6 +60,25 @@ pub struct SceneBuilder {
     medium_uses: Vec<(String, FileLoc)>,
     /// Messages waiting for [`ParserTarget::take_diagnostics`].
     pending: Vec<Diagnostic>,
+    /// pbrt-v3's redefined textures and named materials (see
+    /// [`SceneBuilder::redefine`]).
+    renames: [Renames; 2],
+}
+
+/// Which names [`Renames`] tracks.
+#[derive(Clone, Copy, Debug)]
+enum Redefinable {
+    Texture = 0,
+    Material = 1,
+}
+
+/// The names of one kind that a pbrt-v3 file defined more than once, each
+/// with the name its latest definition is stored under, and how many were
+/// renamed.
+#[derive(Clone, Debug, Default)]
+struct Renames {
+    current: HashMap<String, String>,
+    count: usize,
 }
 
 impl Default for SceneBuilder {
@@ -93,6 +112,7 @@ impl SceneBuilder {
             named_material_uses: Vec::new(),
             medium_uses: Vec::new(),
             pending: Vec::new(),
+            renames: Default::default(),
         }
     }
 
@@ -280,7 +300,92 @@ impl SceneBuilder {
             .extend(diags.into_iter().filter(|d| !unchanged || d.is_error()));
     }
 
+    /// A name defined again (`defined`: the name is taken). pbrt-v4 refuses
+    /// it; pbrt-v3 warns and the later definition wins for what follows,
+    /// while what was defined before keeps the earlier one. So in a file
+    /// read as pbrt-v3 the definition is stored as `<name>-renamed-<n>`
+    /// (the name `--upgrade` gives it) and later references to `name` are
+    /// renamed to it ([`SceneBuilder::renamed_refs`]). Returns the name to
+    /// store the definition under, or pbrt-v4's error `refusal`.
+    fn redefine(
+        &mut self,
+        kind: Redefinable,
+        name: &str,
+        defined: bool,
+        loc: &FileLoc,
+        refusal: String,
+    ) -> Result<String, Diagnostic> {
+        if !defined {
+            return Ok(name.to_string());
+        }
+        if self.scene.pbrt_v3.is_none() {
+            return Err(Diagnostic::error(loc.clone(), refusal));
+        }
+        let r = &mut self.renames[kind as usize];
+        let stored = format!("{name}-renamed-{}", r.count);
+        r.count += 1;
+        let what = match kind {
+            Redefinable::Texture => "texture",
+            Redefinable::Material => "named material",
+        };
+        self.pending.push(Diagnostic::warning(
+            loc.clone(),
+            format!(
+                "\"{name}\": {what} defined again; as in pbrt-v3, this definition is used from \
+                 here on (stored as \"{stored}\")"
+            ),
+        ));
+        Ok(stored)
+    }
+
+    /// Records that `name`'s latest definition is stored as `stored`.
+    fn note_definition(&mut self, kind: Redefinable, name: &str, stored: &str) {
+        if name != stored {
+            self.renames[kind as usize]
+                .current
+                .insert(name.to_string(), stored.to_string());
+        }
+    }
+
+    /// The name a reference to `name` resolves to: its latest definition's.
+    fn resolve(&self, kind: Redefinable, name: &str) -> String {
+        self.renames[kind as usize]
+            .current
+            .get(name)
+            .cloned()
+            .unwrap_or_else(|| name.to_string())
+    }
+
+    /// `params` with their texture references (and a `mix` material's
+    /// material names) renamed to the latest definitions of pbrt-v3's
+    /// redefined names. Textures share one namespace here, as under
+    /// `--upgrade`.
+    fn renamed_refs(&self, mut params: ParamList) -> ParamList {
+        if self.renames.iter().all(|r| r.current.is_empty()) {
+            return params;
+        }
+        for p in params.iter_mut() {
+            let kind = if p.ty == "texture" {
+                Redefinable::Texture
+            } else if p.ty == "string"
+                && matches!(
+                    p.name.as_str(),
+                    "namedmaterial1" | "namedmaterial2" | "materials"
+                )
+            {
+                Redefinable::Material
+            } else {
+                continue;
+            };
+            for s in p.strings.iter_mut() {
+                *s = self.resolve(kind, s);
+            }
+        }
+        params
+    }
+
     fn entity(&self, name: String, params: ParamList, loc: FileLoc) -> SceneEntity {
+        let params = self.renamed_refs(params);
         SceneEntity::new(
             name,
             ParameterDictionary::new(params),
@@ -296,6 +401,7 @@ impl SceneBuilder {
         inherited: &Arc<Vec<ParsedParameter>>,
         loc: FileLoc,
     ) -> SceneEntity {
+        let params = self.renamed_refs(params);
         let dict = ParameterDictionary::with_inherited(params, inherited.as_ref().clone());
         SceneEntity::new(name, dict, loc, self.state.color_space)
     }
@@ -781,21 +887,28 @@ impl ParserTarget for SceneBuilder {
             }
         };
         EntityKind::Texture.check(&u.name, &loc)?;
-        let names = match kind {
-            TextureKind::Float => &mut self.float_texture_names,
-            TextureKind::Spectrum => &mut self.spectrum_texture_names,
+        let defined = match kind {
+            TextureKind::Float => self.float_texture_names.contains(name),
+            TextureKind::Spectrum => self.spectrum_texture_names.contains(name),
         };
-        if !names.insert(name.to_string()) {
-            return Err(Diagnostic::error(
-                loc,
-                format!("redefining texture \"{name}\""),
-            ));
-        }
+        let stored = self.redefine(
+            Redefinable::Texture,
+            name,
+            defined,
+            &loc,
+            format!("redefining texture \"{name}\""),
+        )?;
         let attrs = self.state.texture_attributes.clone();
+        // Its own references still mean the earlier definitions.
         let base = self.entity_with(u.name, u.params, &attrs, loc);
         self.charge_entity::<TextureSceneEntity>(&base, "Texture")?;
+        match kind {
+            TextureKind::Float => self.float_texture_names.insert(stored.clone()),
+            TextureKind::Spectrum => self.spectrum_texture_names.insert(stored.clone()),
+        };
+        self.note_definition(Redefinable::Texture, name, &stored);
         let entity = TextureSceneEntity {
-            name: name.to_string(),
+            name: stored,
             kind,
             base,
             render_from_object: self.render_from_object(),
@@ -837,12 +950,13 @@ impl ParserTarget for SceneBuilder {
         let (ty, mut params) =
             self.upgraded(upgrade::upgrade_material_for_render, &ty, params, &loc);
         EntityKind::Material.check(&ty, &ty_loc)?;
-        if !self.named_material_names.insert(name.to_string()) {
-            return Err(Diagnostic::error(
-                loc,
-                format!("\"{name}\": named material redefined"),
-            ));
-        }
+        let stored = self.redefine(
+            Redefinable::Material,
+            name,
+            self.named_material_names.contains(name),
+            &loc,
+            format!("\"{name}\": named material redefined"),
+        )?;
         params.insert(
             0,
             ParsedParameter::with_strings("string", "type", ty_loc, vec![ty.clone()]),
@@ -850,7 +964,9 @@ impl ParserTarget for SceneBuilder {
         let attrs = self.state.material_attributes.clone();
         let entity = self.entity_with(ty, params, &attrs, loc);
         self.charge_entity::<(String, SceneEntity)>(&entity, "MakeNamedMaterial")?;
-        self.scene.named_materials.push((name.to_string(), entity));
+        self.named_material_names.insert(stored.clone());
+        self.note_definition(Redefinable::Material, name, &stored);
+        self.scene.named_materials.push((stored, entity));
         Ok(())
     }
 
@@ -858,8 +974,9 @@ impl ParserTarget for SceneBuilder {
         self.verify_world("NamedMaterial", &loc)?;
         let bytes = vec_element::<(String, FileLoc)>() + heap(name.len());
         self.charge(bytes, "NamedMaterial", &loc)?;
-        self.named_material_uses.push((name.to_string(), loc));
-        self.state.material = MaterialRef::Named(name.to_string());
+        let name = self.resolve(Redefinable::Material, name);
+        self.named_material_uses.push((name.clone(), loc));
+        self.state.material = MaterialRef::Named(name);
         Ok(())
     }
 

@@ -395,6 +395,49 @@ fn pbrt_v3_matte_becomes_diffuse() {
     assert!(diags.iter().all(|d| !d.is_error()));
 }
 
+/// pbrt-v3 warns about a texture or named material defined again and uses
+/// the later definition from there on; what was defined before keeps the
+/// earlier one (pbrt-v3 makes each when it reads it). pbrt-v4 refuses both
+/// (see `errors_are_located`).
+#[test]
+fn pbrt_v3_redefinitions_take_effect_from_there_on() {
+    let text = "WorldBegin\n\
+        Texture \"t\" \"color\" \"constant\" \"color value\" [0.1 0.1 0.1]\n\
+        Material \"matte\" \"texture Kd\" \"t\"\n\
+        Texture \"t\" \"color\" \"scale\" \"texture tex1\" \"t\" \"rgb tex2\" [2 2 2]\n\
+        Material \"matte\" \"texture Kd\" \"t\"\n\
+        MakeNamedMaterial \"m\" \"string type\" \"matte\"\n\
+        NamedMaterial \"m\"\n\
+        MakeNamedMaterial \"m\" \"string type\" \"mirror\"\n\
+        MakeNamedMaterial \"both\" \"string type\" \"mix\" \"string namedmaterial1\" \"m\" \"string namedmaterial2\" \"m\"\n\
+        NamedMaterial \"m\"\n\
+        Shape \"sphere\"\n";
+    let (s, diags) = build_scene_from_str(text, &BuildOptions::default()).expect("builds");
+    assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
+    let warned: Vec<String> = diags
+        .iter()
+        .filter(|d| d.severity == Severity::Warning && d.message.contains("defined again"))
+        .map(|d| d.to_string())
+        .collect();
+    assert_eq!(warned.len(), 2, "{warned:#?}");
+    assert!(warned[0].starts_with("<string>:4:1:"), "{warned:#?}");
+    let names: Vec<&str> = s.spectrum_textures.iter().map(|t| t.name.as_str()).collect();
+    assert_eq!(names, ["t", "t-renamed-0"]);
+    // The redefinition builds on the texture it replaces.
+    let tex1 = s.spectrum_textures[1].base.params.get_texture("tex");
+    assert_eq!(tex1.ok().flatten().as_deref(), Some("t"));
+    let kd = |i: usize| s.materials[i].params.get_texture("reflectance").ok().flatten();
+    assert_eq!(kd(1).as_deref(), Some("t"));
+    assert_eq!(kd(2).as_deref(), Some("t-renamed-0"));
+    let named: Vec<&str> = s.named_materials.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(named, ["m", "m-renamed-0", "both"]);
+    let mix = &s.named_materials[2].1.params;
+    assert_eq!(
+        mix.get_string_array("materials").ok(),
+        Some(vec!["m-renamed-0".to_string(), "m-renamed-0".to_string()])
+    );
+}
+
 #[test]
 fn pbrt_v3_only_constructs_mark_the_scene() {
     let first = |text: &str| build(text).pbrt_v3.map(|l| (l.line, l.column));
