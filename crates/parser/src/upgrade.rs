@@ -667,9 +667,49 @@ pub fn upgrade_texture(
     params: Vec<ParsedParameter>,
     loc: &FileLoc,
 ) -> (String, Upgraded) {
+    upgrade_texture_with(ty, class, params, loc, false)
+}
+
+/// [`upgrade_texture`] for rpbrt's renderer, which also renders what
+/// pbrt-v4 cannot express: a pbrt-v3 `"scale"` spectrum texture of two
+/// textures (or of a texture and a non-uniform colour) keeps the first as
+/// `"tex"` and the second as `"tex2"`, rpbrt's spectrum factor of the
+/// `"scale"` texture, so the product renders as pbrt-v3 drew it.
+pub fn upgrade_texture_for_render(
+    ty: &str,
+    class: &str,
+    params: Vec<ParsedParameter>,
+    loc: &FileLoc,
+) -> (String, Upgraded) {
+    upgrade_texture_with(ty, class, params, loc, true)
+}
+
+fn upgrade_texture_with(
+    ty: &str,
+    class: &str,
+    params: Vec<ParsedParameter>,
+    loc: &FileLoc,
+    render: bool,
+) -> (String, Upgraded) {
     let mut e = Edit::new(class, params, loc);
     let ty = if ty == "color" { "spectrum" } else { ty }.to_string();
-    if class == "scale" {
+    let uniform_rgb = |p: &ParsedParameter| {
+        p.canonical_type() == "rgb" && matches!(p.floats[..], [r, g, b] if r == g && g == b)
+    };
+    let is_factor = |p: &ParsedParameter| p.name == "tex1" || p.name == "tex2";
+    if class == "scale"
+        && ty != "float"
+        && render
+        && !e.params.iter().any(|p| is_factor(p) && uniform_rgb(p))
+    {
+        // No factor becomes a float scale: the first is the texture, the
+        // second (if any) rpbrt's spectrum factor.
+        let mut first = true;
+        for p in e.params.iter_mut().filter(|p| is_factor(p)) {
+            p.name = if first { "tex" } else { "tex2" }.into();
+            first = false;
+        }
+    } else if class == "scale" {
         if ty == "float" {
             e.rename("tex1", "tex");
             e.rename("tex2", "scale");

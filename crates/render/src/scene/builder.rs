@@ -873,7 +873,7 @@ impl ParserTarget for SceneBuilder {
         self.verify_world("Texture", &loc)?;
         self.note_pbrt_v3_params(&params);
         let before = fingerprint(&params);
-        let (new_ty, u) = upgrade::upgrade_texture(ty, texname, params, &loc);
+        let (new_ty, u) = upgrade::upgrade_texture_for_render(ty, texname, params, &loc);
         let unchanged = new_ty == ty && u.name == texname && before == fingerprint(&u.params);
         self.keep_upgrade_messages(unchanged, u.diagnostics);
         let kind = match new_ty.as_str() {

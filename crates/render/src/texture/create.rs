@@ -424,7 +424,14 @@ pub fn create_spectrum_texture(
     let tex = match def.class {
         "constant" => SpectrumTexture::Constant(constant("value", 1.0)?),
         "scale" => {
-            let tex = tp.spectrum_texture("tex", Spectrum::constant(1.0), ty)?;
+            let mut tex = tp.spectrum_texture("tex", Spectrum::constant(1.0), ty)?;
+            // rpbrt's spectrum factor (pbrt-v3's scale of two textures).
+            if let Some(tex2) = tp.spectrum_texture_opt("tex2", ty)? {
+                tex = Arc::new(SpectrumTexture::Product(SpectrumProductTexture {
+                    tex,
+                    tex2,
+                }));
+            }
             let scale = tp.float_texture("scale", 1.0)?;
             if let Some(c) = scale.constant_value() {
                 if c == 1.0 {

@@ -150,6 +150,8 @@ pub enum SpectrumTexture {
     Constant(Spectrum),
     /// `tex * scale`.
     Scaled(SpectrumScaledTexture),
+    /// `tex * tex2` (pbrt-v3's scale of two textures).
+    Product(SpectrumProductTexture),
     /// A blend of two textures by a float texture.
     Mix(SpectrumMixTexture),
     /// A blend of two textures by the normal's alignment with a direction.
@@ -185,6 +187,7 @@ impl SpectrumTexture {
         match self {
             SpectrumTexture::Constant(s) => s.sample(lambda),
             SpectrumTexture::Scaled(t) => t.evaluate(ctx, lambda),
+            SpectrumTexture::Product(t) => t.evaluate(ctx, lambda),
             SpectrumTexture::Mix(t) => t.evaluate(ctx, lambda),
             SpectrumTexture::DirectionMix(t) => t.evaluate(ctx, lambda),
             SpectrumTexture::Bilerp(t) => t.evaluate(ctx, lambda),

@@ -46,7 +46,33 @@ impl FloatScaledTexture {
     }
 }
 
-/// `tex * scale` for spectra (pbrt-v4 `SpectrumScaledTexture`).
+/// The product of two spectrum textures: rpbrt's `"tex2"` factor of a
+/// `"scale"` texture, which renders pbrt-v3's scale of two textures.
+#[derive(Clone, Debug)]
+pub struct SpectrumProductTexture {
+    /// The first factor.
+    pub tex: SpectrumTextureRef,
+    /// The second factor.
+    pub tex2: SpectrumTextureRef,
+}
+
+impl SpectrumProductTexture {
+    /// The product at a point; `tex2` is not evaluated where `tex` is 0.
+    #[inline]
+    pub fn evaluate(
+        &self,
+        ctx: &TextureEvalContext,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        let a = self.tex.evaluate(ctx, lambda);
+        if a.is_black() {
+            return a;
+        }
+        a * self.tex2.evaluate(ctx, lambda)
+    }
+}
+
+/// A spectrum texture times a float texture (pbrt-v4 `SpectrumScaledTexture`).
 #[derive(Clone, Debug)]
 pub struct SpectrumScaledTexture {
     /// The texture.

@@ -421,12 +421,22 @@ fn pbrt_v3_redefinitions_take_effect_from_there_on() {
         .collect();
     assert_eq!(warned.len(), 2, "{warned:#?}");
     assert!(warned[0].starts_with("<string>:4:1:"), "{warned:#?}");
-    let names: Vec<&str> = s.spectrum_textures.iter().map(|t| t.name.as_str()).collect();
+    let names: Vec<&str> = s
+        .spectrum_textures
+        .iter()
+        .map(|t| t.name.as_str())
+        .collect();
     assert_eq!(names, ["t", "t-renamed-0"]);
     // The redefinition builds on the texture it replaces.
     let tex1 = s.spectrum_textures[1].base.params.get_texture("tex");
     assert_eq!(tex1.ok().flatten().as_deref(), Some("t"));
-    let kd = |i: usize| s.materials[i].params.get_texture("reflectance").ok().flatten();
+    let kd = |i: usize| {
+        s.materials[i]
+            .params
+            .get_texture("reflectance")
+            .ok()
+            .flatten()
+    };
     assert_eq!(kd(1).as_deref(), Some("t"));
     assert_eq!(kd(2).as_deref(), Some("t-renamed-0"));
     let named: Vec<&str> = s.named_materials.iter().map(|(n, _)| n.as_str()).collect();

@@ -364,3 +364,28 @@ fn uv_ctx(u: Float, v: Float, d: Float) -> TextureEvalContext {
         ..Default::default()
     }
 }
+
+/// pbrt-v3's `"scale"` of two colour textures renders their product (rpbrt's
+/// `"tex2"` factor; pbrt-v4 cannot express it and `--upgrade` refuses it).
+#[test]
+fn pbrt_v3_scale_of_two_textures_is_their_product() {
+    let n = create_ok(
+        "Texture \"a\" \"color\" \"constant\" \"color value\" [0.5 0.25 1]\n\
+         Texture \"b\" \"color\" \"checkerboard\" \"color tex1\" [0.2 0.4 0.6] \"color tex2\" [1 0.5 0]\n\
+         Texture \"p\" \"color\" \"scale\" \"texture tex1\" \"a\" \"texture tex2\" \"b\"\n",
+    );
+    let tex = |name: &str| n.albedo.get(name).cloned().expect(name);
+    let (a, b, p) = (tex("a"), tex("b"), tex("p"));
+    assert!(matches!(&*p, SpectrumTexture::Product(_)), "{p:?}");
+    let lambda = SampledWavelengths::sample_visible(0.5);
+    let mut differs = false;
+    for (u, v) in [(0.1, 0.1), (0.6, 0.1), (0.1, 0.6), (0.7, 0.8)] {
+        let ctx = uv_ctx(u, v, 0.0);
+        let (va, vb) = (a.evaluate(&ctx, &lambda), b.evaluate(&ctx, &lambda));
+        let want = va * vb;
+        let got = p.evaluate(&ctx, &lambda);
+        assert_eq!(got.values, want.values, "({u}, {v})");
+        differs |= want.values != va.values;
+    }
+    assert!(differs, "the second factor changes nothing: test too weak");
+}
