@@ -170,6 +170,43 @@ impl Edit {
         }
     }
 
+    /// pbrt-v3's colour light `"scale"` (a spectrum there, multiplied into
+    /// the emission): folded channel by channel into the RGB emission
+    /// `emission`, or made the emission where the light gives none
+    /// (pbrt-v3's default emission is 1). False, changing nothing, when the
+    /// scale is not an RGB or the emission is a spectrum or blackbody,
+    /// which take no per-channel factor.
+    fn rgb_scale_into_emission(&mut self, emission: &str) -> bool {
+        let Some(s) = self
+            .get("scale", &["rgb"])
+            .and_then(|p| <[f32; 3]>::try_from(&p.floats[..]).ok())
+        else {
+            return false;
+        };
+        let Some(i) = self.index(emission, &SPECTRUM_TYPES) else {
+            let loc = self
+                .get("scale", &["rgb"])
+                .map_or(self.loc.clone(), |p| p.loc.clone());
+            self.remove_all("scale", &SPECTRUM_TYPES);
+            self.add_front(ParsedParameter::with_floats(
+                "rgb",
+                emission,
+                loc,
+                s.to_vec(),
+            ));
+            return true;
+        };
+        let p = &mut self.params[i];
+        if p.canonical_type() != "rgb" || p.floats.len() != 3 {
+            return false;
+        }
+        for (v, f) in p.floats.iter_mut().zip(s) {
+            *v *= f;
+        }
+        self.remove_all("scale", &SPECTRUM_TYPES);
+        true
+    }
+
     /// pbrt-v3 `blackbody [T scale]`: keep T and fold the scale.
     fn upgrade_blackbody(&mut self, name: &str, scale: &mut f32) {
         let mut errs = Vec::new();
@@ -416,7 +453,17 @@ pub fn upgrade_material_for_render(
 pub fn upgrade_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
     let mut e = Edit::new(name, params, loc);
     let mut scale = 1.0f32;
-    if !e.rgb_into_scale("scale", &mut scale) {
+    // A colour scale multiplies the emission, where that is an RGB (or
+    // absent) and no image is scaled with it.
+    let emission = match name {
+        "point" | "spot" | "goniometric" => Some("I"),
+        "distant" => Some("L"),
+        "infinite" | "exinfinite" if e.get("mapname", &["string"]).is_none() => Some("L"),
+        _ => None,
+    };
+    if !e.rgb_into_scale("scale", &mut scale)
+        && !emission.is_some_and(|em| e.rgb_scale_into_emission(em))
+    {
         let l = e.get("scale", &SPECTRUM_TYPES).map(|p| p.loc.clone());
         e.error(l.as_ref(), "in pbrt-v4 a light's \"scale\" is a \"float\"; a non-uniform spectrum cannot be converted".into());
         return e.finish();
@@ -486,7 +533,7 @@ fn warn_if_normalized(e: &mut Edit) {
 pub fn upgrade_area_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
     let mut e = Edit::new(name, params, loc);
     let mut scale = 1.0f32;
-    if !e.rgb_into_scale("scale", &mut scale) {
+    if !e.rgb_into_scale("scale", &mut scale) && !e.rgb_scale_into_emission("L") {
         let l = e.get("scale", &SPECTRUM_TYPES).map(|p| p.loc.clone());
         e.error(l.as_ref(), "in pbrt-v4 a light's \"scale\" is a \"float\"; a non-uniform spectrum cannot be converted".into());
         return e.finish();

@@ -357,3 +357,41 @@ ObjectInstance "never-defined"
     assert!(!plain.contains("renamed"), "{plain}");
     assert!(!d.iter().any(|m| m.to_string().contains("renaming")));
 }
+
+/// pbrt-v3's colour light `scale` multiplies an RGB emission channel by
+/// channel (or becomes the emission where the light has none); it cannot
+/// scale a blackbody or an environment map's texels, which stay errors.
+#[test]
+fn colour_light_scales_fold_into_rgb_emission() {
+    let (out, diags) = format(
+        "WorldBegin\n\
+         LightSource \"point\" \"color I\" [2 2 4] \"color scale\" [1 0.5 0.25]\n\
+         LightSource \"distant\" \"color scale\" [0.5 1 2]\n\
+         AttributeBegin\n\
+         AreaLightSource \"area\" \"color L\" [4 4 4] \"color scale\" [1 2 3]\n\
+         Shape \"sphere\"\n\
+         AttributeEnd\n",
+        true,
+    );
+    assert!(!diags.has_errors(), "{diags}");
+    for frag in [
+        "LightSource \"point\"\n    \"rgb I\" [ 2 1 1 ]\n",
+        "LightSource \"distant\"\n    \"rgb L\" [ 0.5 1 2 ]\n",
+        "AreaLightSource \"diffuse\"\n        \"rgb L\" [ 4 8 12 ]\n",
+    ] {
+        assert!(out.contains(frag), "missing {frag:?} in\n{out}");
+    }
+    assert!(!out.contains("scale"), "{out}");
+    for bad in [
+        "LightSource \"point\" \"blackbody I\" [5500] \"color scale\" [1 0.5 0.25]\n",
+        "LightSource \"infinite\" \"string mapname\" \"sky.exr\" \"color scale\" [1 0.5 0.25]\n",
+    ] {
+        let (_, diags) = format(&format!("WorldBegin\n{bad}"), true);
+        assert!(
+            diags
+                .iter()
+                .any(|d| d.is_error() && d.message.contains("non-uniform spectrum")),
+            "{bad}: {diags}"
+        );
+    }
+}

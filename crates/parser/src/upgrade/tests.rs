@@ -109,7 +109,23 @@ fn materials() {
 
 #[test]
 fn lights() {
+    // A colour scale becomes the RGB emission pbrt-v3 multiplied it into
+    // (1 by default); it cannot scale a blackbody.
     let u = upgrade_light("point", vec![f("rgb", "scale", &[1., 2., 3.])], &loc(1));
+    assert!(u.diagnostics.is_empty(), "{:?}", u.diagnostics);
+    assert_eq!(u.params.len(), 1);
+    assert_eq!(
+        (u.params[0].name.as_str(), &u.params[0].floats[..]),
+        ("I", &[1., 2., 3.][..])
+    );
+    let u = upgrade_light(
+        "point",
+        vec![
+            f("rgb", "scale", &[1., 2., 3.]),
+            f("blackbody", "I", &[3000.]),
+        ],
+        &loc(1),
+    );
     assert!(u.diagnostics[0].is_error());
     let u = upgrade_light(
         "spot",
