@@ -451,6 +451,26 @@ pub fn upgrade_material_for_render(
 
 /// Upgrades a `LightSource`.
 pub fn upgrade_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
+    upgrade_light_with(name, params, loc, false)
+}
+
+/// [`upgrade_light`] for rpbrt's renderer, which also renders what pbrt-v4
+/// cannot express: a pbrt-v3 `projection` light's non-uniform RGB `I` with
+/// its `mapname` stays `"rgb I"`, which rpbrt multiplies into the map.
+pub fn upgrade_light_for_render(
+    name: &str,
+    params: Vec<ParsedParameter>,
+    loc: &FileLoc,
+) -> Upgraded {
+    upgrade_light_with(name, params, loc, true)
+}
+
+fn upgrade_light_with(
+    name: &str,
+    params: Vec<ParsedParameter>,
+    loc: &FileLoc,
+    render: bool,
+) -> Upgraded {
     let mut e = Edit::new(name, params, loc);
     let mut scale = 1.0f32;
     // A colour scale multiplies the emission, where that is an RGB (or
@@ -484,7 +504,11 @@ pub fn upgrade_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) ->
         e.error(l.as_ref(), "a non-uniform \"L\" with \"mapname\" on an \"infinite\" light is not supported by pbrt-v4".into());
         return e.finish();
     }
-    if has_map && name == "projection" && !e.rgb_into_scale("I", &mut scale) {
+    if has_map
+        && name == "projection"
+        && !e.rgb_into_scale("I", &mut scale)
+        && !(render && e.get("I", &["rgb"]).is_some_and(|p| p.floats.len() == 3))
+    {
         let l = e.get("I", &SPECTRUM_TYPES).map(|p| p.loc.clone());
         e.error(
             l.as_ref(),

@@ -402,3 +402,22 @@ fn approximate_material_mappings_warn_exact_ones_do_not() {
     }
     assert!(!warns("mix", vec![]));
 }
+
+/// A pbrt-v3 `projection` light's non-uniform `I` with its map: pbrt-v4
+/// cannot express it (`--upgrade` refuses), rpbrt's renderer keeps the RGB
+/// `I` to multiply the map by.
+#[test]
+fn projection_colour_with_a_map() {
+    let params = || {
+        vec![
+            ParsedParameter::with_strings("string", "mapname", loc(1), vec!["m.exr".into()]),
+            f("color", "I", &[2., 1., 0.5]),
+        ]
+    };
+    let u = upgrade_light("projection", params(), &loc(1));
+    assert!(u.diagnostics.iter().any(|d| d.is_error()));
+    let u = upgrade_light_for_render("projection", params(), &loc(1));
+    assert!(u.diagnostics.is_empty(), "{:?}", u.diagnostics);
+    let i = u.params.iter().find(|p| p.name == "I").expect("keeps I");
+    assert_eq!(i.floats, vec![2., 1., 0.5]);
+}

@@ -119,6 +119,22 @@ fn rgb_image(
     Ok(image.select_channels(&desc))
 }
 
+/// A float copy of the RGB `image` with its channels multiplied by `f`.
+fn scaled_rgb(image: &Image, f: [Float; 3], loc: &FileLoc) -> Result<Image, Diagnostic> {
+    let res = image.resolution();
+    let clamp = WrapMode2D::new(WrapMode::Clamp, WrapMode::Clamp);
+    let mut data = Vec::with_capacity(res.x as usize * res.y as usize * 3);
+    for y in 0..res.y {
+        for x in 0..res.x {
+            for (c, k) in f.iter().enumerate() {
+                data.push(image.get_channel(Point2i::new(x, y), c, clamp) * k);
+            }
+        }
+    }
+    Image::from_f32(data, res, &["R", "G", "B"])
+        .map_err(|e| Diagnostic::error(loc.clone(), e.to_string()))
+}
+
 /// Which of pbrt-v3's meanings a `LightSource` directive takes.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct LightDialect {
@@ -289,10 +305,17 @@ pub fn create_light(
                 }
                 let floc = lp.param_loc("filename");
                 let (im, ics) = read_image(lp, &filename)?;
-                let image = rgb_image(&im, &filename, "projection", &floc)?;
+                let mut image = rgb_image(&im, &filename, "projection", &floc)?;
                 let res = image.resolution();
                 if res.x <= 0 || res.y <= 0 {
                     return Err(Diagnostic::error(floc, format!("{filename}: empty image")));
+                }
+                // pbrt-v3 multiplies its map by `I` (an RGB here: the
+                // upgrade folds a uniform one into `scale`).
+                if dialect.v3_file && lp.param_type("I") == Some("rgb") {
+                    if let Some(&[r, g, b]) = lp.rgbs("I")?.first() {
+                        image = scaled_rgb(&image, [r, g, b], &floc)?;
+                    }
                 }
                 let scale =
                     normalize_scale(scale, &ics.illuminant_spectrum(), "image colour space", loc)?;

@@ -848,3 +848,46 @@ fn pbrt_v3_goniometric_and_projection_lights_without_images() {
         );
     }
 }
+
+/// pbrt-v3 multiplies a `projection` light's map by its `I`: the RGB `I`
+/// the render upgrade keeps is folded into the map, channel by channel.
+#[test]
+fn pbrt_v3_projection_map_is_multiplied_by_i() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-light-proj-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("slide.pfm");
+    let values: Vec<f32> = (0..12).map(|k| 0.25 + k as f32 * 0.1).collect();
+    Image::from_f32(values.clone(), Point2i::new(2, 2), &["R", "G", "B"])
+        .unwrap()
+        .write(&path, &Default::default())
+        .unwrap();
+    let file = ParsedParameter::with_strings(
+        "string",
+        "filename",
+        ploc(),
+        vec![path.display().to_string()],
+    );
+    let i = [2.0, 1.0, 0.5];
+    let mut e = entity("projection", vec![file, floats("I", &i)]);
+    e.pbrt_v3 = true;
+    let (light, _) = create_light(&e, None, &CameraTransform::default()).expect("creates");
+    let Light::Projection(p) = &light else {
+        panic!("{light:?}")
+    };
+    let clamp =
+        crate::image::WrapMode2D::new(crate::image::WrapMode::Clamp, crate::image::WrapMode::Clamp);
+    let plain = Image::read(&path, None).expect("reads").image;
+    for y in 0..2 {
+        for x in 0..2 {
+            for (c, k) in i.iter().enumerate() {
+                let q = Point2i::new(x, y);
+                assert_eq!(
+                    p.image.get_channel(q, c, clamp),
+                    plain.get_channel(q, c, clamp) * k,
+                    "texel ({x}, {y}) channel {c}"
+                );
+            }
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -986,7 +986,7 @@ impl ParserTarget for SceneBuilder {
         let pbrt_v3 = params
             .iter()
             .any(|p| p.name == "mapname" && p.ty == "string");
-        let (name, params) = self.upgraded(upgrade::upgrade_light, name, params, &loc);
+        let (name, params) = self.upgraded(upgrade::upgrade_light_for_render, name, params, &loc);
         EntityKind::Light.check(&name, &loc)?;
         let attrs = self.state.light_attributes.clone();
         let base = self.entity_with(name, params, &attrs, loc);
