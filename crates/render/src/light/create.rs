@@ -119,6 +119,48 @@ fn rgb_image(
     Ok(image.select_channels(&desc))
 }
 
+/// pbrt-v3's goniometric map, a latitude–longitude image of any size
+/// (`(φ/2π, θ/π)` of the light-space direction with y and z swapped, the
+/// swap pbrt-v4 also makes), resampled to the equal-area square pbrt-v4's
+/// light reads: `2h` texels a side for a `2h × h` map (as an environment
+/// map converts), else about twice the map's texel count. pbrt-v4 averages
+/// R, G and B where pbrt-v3 kept the colour: a coloured map warns.
+fn v3_goniometric_map(
+    lp: &ParamReader,
+    im: &Image,
+    filename: &str,
+    loc: &FileLoc,
+) -> Result<Image, Diagnostic> {
+    let res = im.resolution();
+    let n = if res.x == 2 * res.y {
+        res.x
+    } else {
+        ((2.0 * res.x as f64 * res.y as f64).sqrt().ceil() as i32).max(1)
+    };
+    let bytes = n as u64 * n as u64 * im.n_channels() as u64 * 4;
+    lp.charge(bytes, "goniometric map")?;
+    if let Some(desc) = im.get_channel_desc(&["R", "G", "B"]) {
+        let clamp = WrapMode2D::new(WrapMode::Clamp, WrapMode::Clamp);
+        let coloured = (0..res.y).any(|y| {
+            (0..res.x).any(|x| {
+                let v = im.get_channels_desc(Point2i::new(x, y), &desc, clamp);
+                v[0] != v[1] || v[1] != v[2]
+            })
+        });
+        if coloured {
+            lp.warn_located(
+                loc.clone(),
+                format!(
+                    "{filename}: pbrt-v4's goniometric light uses the average of R, G and B; \
+                     pbrt-v3 kept this map's colour"
+                ),
+            );
+        }
+    }
+    equirect_to_equal_area(im, n)
+        .map_err(|e| Diagnostic::error(loc.clone(), format!("{filename}: {e}")))
+}
+
 /// A float copy of the RGB `image` with its channels multiplied by `f`.
 fn scaled_rgb(image: &Image, f: [Float; 3], loc: &FileLoc) -> Result<Image, Diagnostic> {
     let res = image.resolution();
@@ -243,6 +285,11 @@ pub fn create_light(
             }
             let floc = lp.param_loc("filename");
             let (im, _) = read_image(lp, &filename)?;
+            let im = if dialect.v3_file {
+                v3_goniometric_map(lp, &im, &filename, &floc)?
+            } else {
+                im
+            };
             let image = goniometric_image(&im, &filename, &floc)?;
             if power > 0.0 {
                 let res = image.resolution();

@@ -891,3 +891,63 @@ fn pbrt_v3_projection_map_is_multiplied_by_i() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// pbrt-v3 reads a goniometric map as a latitude–longitude image of any
+/// size, θ down the rows of the light-space direction with y and z
+/// swapped: a map lit only in its top rows shines along +y.
+#[test]
+fn pbrt_v3_goniometric_reads_any_latitude_longitude_map() {
+    let dir = std::env::temp_dir().join(format!("rpbrt-light-gonio-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("gonio.pfm");
+    // 64 × 16 (not 2:1): the top rows (θ < π/4) are 1, the rest 0.
+    let (w, h) = (64, 16);
+    let values: Vec<f32> = (0..w * h)
+        .map(|k| if k < w * h / 4 { 1.0 } else { 0.0 })
+        .collect();
+    Image::from_f32(values, Point2i::new(w, h), &["Y"])
+        .unwrap()
+        .write(&path, &Default::default())
+        .unwrap();
+    let file = ParsedParameter::with_strings(
+        "string",
+        "filename",
+        ploc(),
+        vec![path.display().to_string()],
+    );
+    let mut e = entity("goniometric", vec![file]);
+    e.pbrt_v3 = true;
+    let (light, warnings) = create_light(&e, None, &CameraTransform::default()).expect("creates");
+    assert!(warnings.is_empty(), "{warnings:?}");
+    let mut rng = Rng::with_sequence(5);
+    let l = lambda(&mut rng);
+    let li = |p: Point3f| {
+        let ctx = LightSampleContext::from_point(p);
+        light
+            .sample_li(&ctx, Point2f::new(0.5, 0.5), &l, false)
+            .map_or(0.0, |s| s.l.average())
+    };
+    let up = li(Point3f::new(0.0, 2.0, 0.0));
+    // Without a map pbrt-v3's goniometric light is a point light of the
+    // same intensity: the map's 1 along +y gives the same light.
+    let mut bare = entity("goniometric", vec![]);
+    bare.pbrt_v3 = true;
+    let (point, _) = create_light(&bare, None, &CameraTransform::default()).expect("creates");
+    let ctx = LightSampleContext::from_point(Point3f::new(0.0, 2.0, 0.0));
+    let want = point
+        .sample_li(&ctx, Point2f::new(0.5, 0.5), &l, false)
+        .map_or(0.0, |s| s.l.average());
+    assert!(
+        (up / want - 1.0).abs() < 0.02,
+        "{up} against the point light's {want}"
+    );
+    // (The resampling filter spreads a texel's worth of light at most.)
+    for p in [
+        Point3f::new(0.0, -2.0, 0.0),
+        Point3f::new(2.0, -0.5, 0.0),
+        Point3f::new(0.0, -0.5, 2.0),
+    ] {
+        assert!(li(p) < 1e-3 * up, "lit towards {p:?}: {} of {up}", li(p));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

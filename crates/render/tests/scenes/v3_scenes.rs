@@ -301,7 +301,9 @@ fn file_cases() -> Vec<Case> {
     vec![
         case("shape plymesh", ("", "Shape \"plymesh\" \"string filename\" \"mesh.ply\""), ("", "Shape \"plymesh\" \"string filename\" \"mesh.ply\"")),
         case("texture imagemap", ("", "Texture \"t\" \"color\" \"imagemap\" \"string filename\" \"img.pfm\" \"bool trilinear\" \"true\" \"float gamma\" 2.2\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\""), ("", "Texture \"t\" \"spectrum\" \"imagemap\" \"string encoding\" \"gamma 2.2\" \"string filter\" \"trilinear\" \"string filename\" \"img.pfm\"\nMaterial \"diffuse\" \"texture reflectance\" \"t\"\nShape \"sphere\"")),
-        case("light goniometric", ("", "LightSource \"goniometric\" \"color I\" [ 2 2 2 ] \"string mapname\" \"img.pfm\"\nTranslate 0 0 -2\nShape \"sphere\""), ("", "LightSource \"goniometric\" \"string filename\" \"img.pfm\" \"rgb I\" [ 2 2 2 ]\nTranslate 0 0 -2\nShape \"sphere\"")),
+        // pbrt-v3's goniometric map is a latitude–longitude image of any
+        // size, resampled on load (pbrt-v4's `filename` is equal-area).
+        native("light goniometric", ("", "LightSource \"goniometric\" \"color I\" [ 2 2 2 ] \"string mapname\" \"img.pfm\"\nTranslate 0 0 -2\nShape \"sphere\"")),
         case("light projection", ("", "AttributeBegin\nRotate 180 0 1 0\nLightSource \"projection\" \"string mapname\" \"img.pfm\" \"float fov\" 60\nAttributeEnd\nTranslate 0 0 -2\nShape \"sphere\""), ("", "AttributeBegin\nRotate 180 0 1 0\nLightSource \"projection\" \"string filename\" \"img.pfm\" \"float fov\" 60\nAttributeEnd\nTranslate 0 0 -2\nShape \"sphere\"")),
         // pbrt-v3's `mapname` is a latitude–longitude map, resampled to
         // pbrt-v4's equal-area square on load (not pbrt-v4's `filename`).
