@@ -849,24 +849,32 @@ fn pbrt_v3_goniometric_and_projection_lights_without_images() {
     }
 }
 
-/// pbrt-v3 multiplies a `projection` light's map by its `I`: the RGB `I`
-/// the render upgrade keeps is folded into the map, channel by channel.
-#[test]
-fn pbrt_v3_projection_map_is_multiplied_by_i() {
-    let dir = std::env::temp_dir().join(format!("rpbrt-light-proj-{}", std::process::id()));
+/// `image` written to a fresh temporary folder: the folder, the file and
+/// its `"string filename"` parameter.
+fn temp_image(
+    tag: &str,
+    image: &Image,
+) -> (std::path::PathBuf, std::path::PathBuf, ParsedParameter) {
+    let dir = std::env::temp_dir().join(format!("rpbrt-light-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("slide.pfm");
-    let values: Vec<f32> = (0..12).map(|k| 0.25 + k as f32 * 0.1).collect();
-    Image::from_f32(values.clone(), Point2i::new(2, 2), &["R", "G", "B"])
-        .unwrap()
-        .write(&path, &Default::default())
-        .unwrap();
+    let path = dir.join("map.pfm");
+    image.write(&path, &Default::default()).unwrap();
     let file = ParsedParameter::with_strings(
         "string",
         "filename",
         ploc(),
         vec![path.display().to_string()],
     );
+    (dir, path, file)
+}
+
+/// pbrt-v3 multiplies a `projection` light's map by its `I`: the RGB `I`
+/// the render upgrade keeps is folded into the map, channel by channel.
+#[test]
+fn pbrt_v3_projection_map_is_multiplied_by_i() {
+    let values: Vec<f32> = (0..12).map(|k| 0.25 + k as f32 * 0.1).collect();
+    let slide = Image::from_f32(values, Point2i::new(2, 2), &["R", "G", "B"]).unwrap();
+    let (dir, path, file) = temp_image("proj", &slide);
     let i = [2.0, 1.0, 0.5];
     let mut e = entity("projection", vec![file, floats("I", &i)]);
     e.pbrt_v3 = true;
@@ -897,24 +905,13 @@ fn pbrt_v3_projection_map_is_multiplied_by_i() {
 /// swapped: a map lit only in its top rows shines along +y.
 #[test]
 fn pbrt_v3_goniometric_reads_any_latitude_longitude_map() {
-    let dir = std::env::temp_dir().join(format!("rpbrt-light-gonio-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("gonio.pfm");
     // 64 × 16 (not 2:1): the top rows (θ < π/4) are 1, the rest 0.
     let (w, h) = (64, 16);
     let values: Vec<f32> = (0..w * h)
         .map(|k| if k < w * h / 4 { 1.0 } else { 0.0 })
         .collect();
-    Image::from_f32(values, Point2i::new(w, h), &["Y"])
-        .unwrap()
-        .write(&path, &Default::default())
-        .unwrap();
-    let file = ParsedParameter::with_strings(
-        "string",
-        "filename",
-        ploc(),
-        vec![path.display().to_string()],
-    );
+    let map = Image::from_f32(values, Point2i::new(w, h), &["Y"]).unwrap();
+    let (dir, _, file) = temp_image("gonio", &map);
     let mut e = entity("goniometric", vec![file]);
     e.pbrt_v3 = true;
     let (light, warnings) = create_light(&e, None, &CameraTransform::default()).expect("creates");
