@@ -321,18 +321,10 @@ impl FormattingTarget {
             return;
         }
         for p in params.iter_mut() {
-            let kind = if p.ty == "texture" {
-                Kind::Texture
-            } else if materials
-                && p.ty == "string"
-                && matches!(
-                    p.name.as_str(),
-                    "namedmaterial1" | "namedmaterial2" | "materials"
-                )
-            {
-                Kind::Material
-            } else {
-                continue;
+            let kind = match upgrade::reference_of(p) {
+                Some(upgrade::Reference::Texture) => Kind::Texture,
+                Some(upgrade::Reference::NamedMaterial) if materials => Kind::Material,
+                _ => continue,
             };
             for s in p.strings.iter_mut() {
                 *s = self.reference(kind, s);

@@ -427,6 +427,33 @@ pub fn upgrade_material(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc)
     e.finish()
 }
 
+/// What a parameter names when it refers to a definition that pbrt-v3
+/// lets a file make again (and `--upgrade` or the renderer renames).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reference {
+    /// A texture (a `texture` parameter).
+    Texture = 0,
+    /// A named material (a `mix` material's `namedmaterial1`,
+    /// `namedmaterial2` or `materials`).
+    NamedMaterial = 1,
+}
+
+/// The kind of definition whose names `p`'s values are, if any.
+pub fn reference_of(p: &ParsedParameter) -> Option<Reference> {
+    if p.ty == "texture" {
+        Some(Reference::Texture)
+    } else if p.ty == "string"
+        && matches!(
+            p.name.as_str(),
+            "namedmaterial1" | "namedmaterial2" | "materials"
+        )
+    {
+        Some(Reference::NamedMaterial)
+    } else {
+        None
+    }
+}
+
 /// The pbrt-v3 materials pbrt-v4 dropped that a renderer reading pbrt-v3
 /// files directly can still build (rpbrt does): `--upgrade` must map them
 /// to something pbrt-v4 reads, rendering need not.

@@ -16,7 +16,7 @@ use rpbrt_geometry::{
     AnimatedTransform, Point3f, SquareMatrix4, Transform, TransformError, Vector3f,
 };
 use rpbrt_parser::budget::{heap, vec_element};
-use rpbrt_parser::upgrade::{self, Upgraded};
+use rpbrt_parser::upgrade::{self, Reference, Upgraded};
 use rpbrt_parser::{Diagnostic, MemoryBudget};
 use rpbrt_parser::{
     DirectiveResult, FileLoc, ParamList, ParameterDictionary, ParsedParameter, ParserTarget,
@@ -63,13 +63,6 @@ pub struct SceneBuilder {
     /// pbrt-v3's redefined textures and named materials (see
     /// [`SceneBuilder::redefine`]).
     renames: [Renames; 2],
-}
-
-/// Which names [`Renames`] tracks.
-#[derive(Clone, Copy, Debug)]
-enum Redefinable {
-    Texture = 0,
-    Material = 1,
 }
 
 /// The names of one kind that a pbrt-v3 file defined more than once, each
@@ -309,7 +302,7 @@ impl SceneBuilder {
     /// store the definition under, or pbrt-v4's error `refusal`.
     fn redefine(
         &mut self,
-        kind: Redefinable,
+        kind: Reference,
         name: &str,
         defined: bool,
         loc: &FileLoc,
@@ -325,8 +318,8 @@ impl SceneBuilder {
         let stored = format!("{name}-renamed-{}", r.count);
         r.count += 1;
         let what = match kind {
-            Redefinable::Texture => "texture",
-            Redefinable::Material => "named material",
+            Reference::Texture => "texture",
+            Reference::NamedMaterial => "named material",
         };
         self.pending.push(Diagnostic::warning(
             loc.clone(),
@@ -339,7 +332,7 @@ impl SceneBuilder {
     }
 
     /// Records that `name`'s latest definition is stored as `stored`.
-    fn note_definition(&mut self, kind: Redefinable, name: &str, stored: &str) {
+    fn note_definition(&mut self, kind: Reference, name: &str, stored: &str) {
         if name != stored {
             self.renames[kind as usize]
                 .current
@@ -348,7 +341,7 @@ impl SceneBuilder {
     }
 
     /// The name a reference to `name` resolves to: its latest definition's.
-    fn resolve(&self, kind: Redefinable, name: &str) -> String {
+    fn resolve(&self, kind: Reference, name: &str) -> String {
         self.renames[kind as usize]
             .current
             .get(name)
@@ -365,16 +358,7 @@ impl SceneBuilder {
             return params;
         }
         for p in params.iter_mut() {
-            let kind = if p.ty == "texture" {
-                Redefinable::Texture
-            } else if p.ty == "string"
-                && matches!(
-                    p.name.as_str(),
-                    "namedmaterial1" | "namedmaterial2" | "materials"
-                )
-            {
-                Redefinable::Material
-            } else {
+            let Some(kind) = upgrade::reference_of(p) else {
                 continue;
             };
             for s in p.strings.iter_mut() {
@@ -892,7 +876,7 @@ impl ParserTarget for SceneBuilder {
             TextureKind::Spectrum => self.spectrum_texture_names.contains(name),
         };
         let stored = self.redefine(
-            Redefinable::Texture,
+            Reference::Texture,
             name,
             defined,
             &loc,
@@ -906,7 +890,7 @@ impl ParserTarget for SceneBuilder {
             TextureKind::Float => self.float_texture_names.insert(stored.clone()),
             TextureKind::Spectrum => self.spectrum_texture_names.insert(stored.clone()),
         };
-        self.note_definition(Redefinable::Texture, name, &stored);
+        self.note_definition(Reference::Texture, name, &stored);
         let entity = TextureSceneEntity {
             name: stored,
             kind,
@@ -951,7 +935,7 @@ impl ParserTarget for SceneBuilder {
             self.upgraded(upgrade::upgrade_material_for_render, &ty, params, &loc);
         EntityKind::Material.check(&ty, &ty_loc)?;
         let stored = self.redefine(
-            Redefinable::Material,
+            Reference::NamedMaterial,
             name,
             self.named_material_names.contains(name),
             &loc,
@@ -965,7 +949,7 @@ impl ParserTarget for SceneBuilder {
         let entity = self.entity_with(ty, params, &attrs, loc);
         self.charge_entity::<(String, SceneEntity)>(&entity, "MakeNamedMaterial")?;
         self.named_material_names.insert(stored.clone());
-        self.note_definition(Redefinable::Material, name, &stored);
+        self.note_definition(Reference::NamedMaterial, name, &stored);
         self.scene.named_materials.push((stored, entity));
         Ok(())
     }
@@ -974,7 +958,7 @@ impl ParserTarget for SceneBuilder {
         self.verify_world("NamedMaterial", &loc)?;
         let bytes = vec_element::<(String, FileLoc)>() + heap(name.len());
         self.charge(bytes, "NamedMaterial", &loc)?;
-        let name = self.resolve(Redefinable::Material, name);
+        let name = self.resolve(Reference::NamedMaterial, name);
         self.named_material_uses.push((name.clone(), loc));
         self.state.material = MaterialRef::Named(name);
         Ok(())
