@@ -44,7 +44,7 @@ use super::vertex::{Begin, VertexIntegrator};
 use super::Scene;
 use crate::film::{FilmTile, SplatBuffer, VisibleSurface};
 use crate::primitive::HitRecord;
-use crate::sampler::{Sampler, SamplerCursor};
+use crate::sampler::{FourDrawBatch, Sampler, SamplerCursor};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::bounds::Bounds2i;
 use rpbrt_geometry::float::Float;
@@ -193,12 +193,20 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let mut answers: Vec<Option<LightAnswer>> = Vec::with_capacity(LANES);
         let mut bsdf_batch = BsdfBatch::default();
         let mut bsdf_answers: Vec<BsdfAnswers> = Vec::with_capacity(LANES);
+        let mut starts: Vec<(usize, Point2i)> = Vec::with_capacity(LANES);
+        let mut cursors: Vec<SamplerCursor> = Vec::with_capacity(LANES);
+        let mut draw_batch = FourDrawBatch::default();
+        let mut draws: Vec<Option<[Float; 6]>> = Vec::with_capacity(LANES);
+        let mut shade: Vec<usize> = Vec::with_capacity(LANES);
+        let mut predrawn: Vec<Option<[Float; 6]>> = Vec::new();
         let mut started = 0;
         let level = opts.simd.unwrap_or_else(crate::simd::level);
         loop {
             // Refill the pool in the tile's sample order. Once
             // interrupted, no sample starts; those in flight finish.
-            while active.len() < LANES
+            starts.clear();
+            cursors.clear();
+            while active.len() + starts.len() < LANES
                 && started < total
                 && reorder.has_room(started)
                 && !opts.interrupted()
@@ -208,6 +216,14 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 let p_pixel = pixels[seq / per_pixel];
                 let index = samples.start + (seq % per_pixel) as i32;
                 sampler.start_pixel_sample(p_pixel, index, 0);
+                starts.push((seq, p_pixel));
+                cursors.push(sampler.cursor());
+            }
+            // The camera samples' draws, together.
+            sampler.four_draws_batch(level, &cursors, &mut draw_batch, &mut draws);
+            for (&(seq, p_pixel), (cursor, &d)) in starts.iter().zip(cursors.iter().zip(&draws)) {
+                sampler.set_cursor(cursor);
+                sampler.offer_four_draws(d);
                 let cs = CameraRaySample::take(scene, opts, p_pixel, sampler, differentials);
                 let Some((ray, camera_weight)) = cs.ray else {
                     let f = Finished {
@@ -270,9 +286,23 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             if scratch.len() < lanes.len() {
                 scratch.resize_with(lanes.len(), Default::default);
             }
+            // The vertices' four draws, together, for the paths that hit
+            // something (the others draw nothing; a vertex that draws
+            // otherwise, such as a specular one, ignores them).
+            shade.clear();
+            shade.extend(active.iter().filter(|&&i| hits[i].is_some()));
+            cursors.clear();
+            cursors.extend(shade.iter().map(|&i| lanes[i].cursor));
+            sampler.four_draws_batch(level, &cursors, &mut draw_batch, &mut draws);
+            predrawn.clear();
+            predrawn.resize(lanes.len(), None);
+            for (&i, &d) in shade.iter().zip(&draws) {
+                predrawn[i] = d;
+            }
             for &i in &active {
                 let lane = &mut lanes[i];
                 sampler.set_cursor(&lane.cursor);
+                sampler.offer_four_draws(predrawn[i]);
                 let begun = self.0.begin(
                     scene,
                     &mut lane.path,

@@ -6,6 +6,7 @@
 
 use std::sync::OnceLock;
 
+use crate::simd::{dispatch, F32Lanes, Kernel, SimdLevel, U32Lanes};
 use rpbrt_geometry::float::{Float, ONE_MINUS_EPSILON};
 use rpbrt_geometry::tuple::Point2i;
 
@@ -587,12 +588,19 @@ fn sobol_reversed_byte_tables() -> &'static [[[u32; 256]; 7]; 2] {
 /// reversal of the fast Owen scramble.
 #[inline(always)]
 pub fn sobol_sample_fast_owen_01(a: u64, dimension: usize, seed: u32) -> Float {
+    fast_owen_01(sobol_reversed_01(a, dimension), seed)
+}
+
+/// The Sobol' value of index `a` in dimension 0 or 1, bit-reversed: what
+/// [`sobol_sample_fast_owen_01`] scrambles.
+#[inline(always)]
+pub(crate) fn sobol_reversed_01(a: u64, dimension: usize) -> u32 {
     debug_assert!(dimension < 2 && a < (1u64 << SOBOL_MATRIX_SIZE));
     if dimension == 0 {
         // Sobol' dimension 0 is the van der Corput sequence: its generator
         // matrix reverses the low 32 bits of the index (and ignores the
         // rest), so its bit-reversed value is the index itself.
-        return fast_owen_01(a as u32, seed);
+        return a as u32;
     }
     let t = &sobol_reversed_byte_tables()[1];
     let mut v = t[0][(a & 0xff) as usize]
@@ -604,13 +612,58 @@ pub fn sobol_sample_fast_owen_01(a: u64, dimension: usize, seed: u32) -> Float {
             ^ t[5][((a >> 40) & 0xff) as usize]
             ^ t[6][((a >> 48) & 0xff) as usize];
     }
-    fast_owen_01(v, seed)
+    v
+}
+
+/// [`fast_owen_01`] of each `(v_reversed, seed)` pair, lane-parallel at
+/// `level`, into `out` (as long as the inputs): the same bits at every
+/// level.
+pub(crate) fn fast_owen_01_batch(level: SimdLevel, v: &[u32], seeds: &[u32], out: &mut [Float]) {
+    dispatch(level, FastOwenBatch { v, seeds, out });
+}
+
+/// [`fast_owen_01_batch`]'s kernel.
+struct FastOwenBatch<'a> {
+    v: &'a [u32],
+    seeds: &'a [u32],
+    out: &'a mut [Float],
+}
+
+impl Kernel for FastOwenBatch<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: F32Lanes>(self) {
+        let n = self.v.len().min(self.seeds.len()).min(self.out.len());
+        let mut i = 0;
+        while i + L::N <= n {
+            let (v, seed) = (L::U32::load(&self.v[i..]), L::U32::load(&self.seeds[i..]));
+            fast_owen_01_lanes::<L>(v, seed).store(&mut self.out[i..]);
+            i += L::N;
+        }
+        for j in i..n {
+            self.out[j] = fast_owen_01(self.v[j], self.seeds[j]);
+        }
+    }
+}
+
+/// [`fast_owen_01`] in lanes: the same operations, lane by lane.
+#[inline(always)]
+fn fast_owen_01_lanes<L: F32Lanes>(v: L::U32, seed: L::U32) -> L {
+    let c = <L::U32 as U32Lanes>::splat;
+    let mut v = v.xor(v.mul(c(0x3d20_adea)));
+    v = v.add(seed);
+    v = v.mul(seed.shr::<16>().or(c(1)));
+    v = v.xor(v.mul(c(0x0552_6c56)));
+    v = v.xor(v.mul(c(0x53a2_2864)));
+    L::from_u32(v.reverse_bits())
+        .mul(L::splat(f32::from_bits(0x2f80_0000)))
+        .min(L::splat(ONE_MINUS_EPSILON))
 }
 
 /// The fast Owen scramble of `v_reversed.reverse_bits()` as a float in
 /// [0, 1).
 #[inline(always)]
-fn fast_owen_01(v_reversed: u32, seed: u32) -> Float {
+pub(crate) fn fast_owen_01(v_reversed: u32, seed: u32) -> Float {
     let v = fast_owen_reversed(v_reversed, seed);
     (v as Float * f32::from_bits(0x2f80_0000)).min(ONE_MINUS_EPSILON)
 }

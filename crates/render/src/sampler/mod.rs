@@ -26,7 +26,7 @@ pub use halton::HaltonSampler;
 pub use independent::IndependentSampler;
 pub use lowdiscrepancy::RandomizeStrategy;
 pub use pmj02bn::Pmj02bnSampler;
-pub use sobol::{PaddedSobolSampler, SobolSampler, ZSobolSampler};
+pub use sobol::{FourDrawBatch, PaddedSobolSampler, SobolSampler, ZSobolSampler};
 pub use stratified::StratifiedSampler;
 
 /// Where sample values come from, for code that runs under both the
@@ -180,6 +180,36 @@ impl Sampler {
             let u_lens = s.get_2d();
             (u_lambda, u_pixel, u_time, u_lens)
         })
+    }
+
+    /// The four draws [`Sampler::get_vertex_samples`] (or
+    /// [`Sampler::get_camera_samples`]) would take at each of `cursors`,
+    /// computed together, lane-parallel at `level`, into `out`: `None`
+    /// where this sampler has no batched form for them (today: all but
+    /// Z-Sobol' with fast Owen scrambling and an even log2 spp). Offer one
+    /// to the draw with [`Sampler::offer_four_draws`].
+    pub fn four_draws_batch(
+        &mut self,
+        level: crate::simd::SimdLevel,
+        cursors: &[SamplerCursor],
+        batch: &mut FourDrawBatch,
+        out: &mut Vec<Option<[Float; 6]>>,
+    ) {
+        if let Sampler::ZSobol(s) = self {
+            return s.four_draws_batch(level, cursors, batch, out);
+        }
+        out.clear();
+        out.resize(cursors.len(), None);
+    }
+
+    /// Offers four draws from [`Sampler::four_draws_batch`], computed at
+    /// the current cursor, to the next four-draw call at that cursor
+    /// ([`Sampler::set_cursor`] withdraws them).
+    #[inline]
+    pub fn offer_four_draws(&mut self, draws: Option<[Float; 6]>) {
+        if let Sampler::ZSobol(s) = self {
+            s.offer_four_draws(draws);
+        }
     }
 
     /// The sample's position within its pixel, in [0,1)².

@@ -14,10 +14,11 @@ use rpbrt_geometry::float::{Float, ONE_MINUS_EPSILON};
 use rpbrt_geometry::tuple::{Point2f, Point2i};
 
 use super::lowdiscrepancy::{
-    encode_morton2, mix_bits, permutation_element, sobol_matrices, sobol_sample,
-    sobol_sample_fast_owen_01, BinaryScrambler, RandomizeStrategy, N_SOBOL_DIMENSIONS,
-    PERMUTATIONS_4, SOBOL_MATRIX_SIZE,
+    encode_morton2, fast_owen_01, fast_owen_01_batch, mix_bits, permutation_element,
+    sobol_matrices, sobol_reversed_01, sobol_sample, sobol_sample_fast_owen_01, BinaryScrambler,
+    RandomizeStrategy, N_SOBOL_DIMENSIONS, PERMUTATIONS_4, SOBOL_MATRIX_SIZE,
 };
+use crate::simd::SimdLevel;
 
 /// Largest supported log2 of the Sobol' sampler's pixel scale (so that
 /// `2 * log2_scale + log2(spp)` fits the 52 generator-matrix columns).
@@ -470,6 +471,16 @@ impl PixelDigitCache {
     }
 }
 
+/// Scratch space for [`ZSobolSampler::four_draws_batch`], kept between
+/// calls so that a batch allocates nothing.
+#[derive(Clone, Debug, Default)]
+pub struct FourDrawBatch {
+    v: Vec<u32>,
+    seeds: Vec<u32>,
+    values: Vec<Float>,
+    found: Vec<bool>,
+}
+
 /// The Morton-ordered ("Z") Sobol' sampler, pbrt-v4's default.
 #[derive(Clone, Debug)]
 pub struct ZSobolSampler {
@@ -480,6 +491,10 @@ pub struct ZSobolSampler {
     morton_index: u64,
     dimension: i32,
     cache: Box<PixelDigitCache>,
+    /// Four draws computed ahead ([`ZSobolSampler::four_draws_batch`]) for
+    /// the Morton index and dimension they were drawn at, which the next
+    /// [`ZSobolSampler::get_1d_2d_1d_2d`] at that position returns.
+    offered: Option<(u64, i32, [Float; 6])>,
 }
 
 impl ZSobolSampler {
@@ -512,6 +527,7 @@ impl ZSobolSampler {
                 low_perm: [0; ZSOBOL_CACHED_DIMENSIONS],
                 scramble_hash: std::array::from_fn(|d| mix_bits((d as i32 ^ seed) as i64 as u64)),
             }),
+            offered: None,
         }
     }
 
@@ -536,6 +552,14 @@ impl ZSobolSampler {
     pub fn set_cursor(&mut self, c: &super::SamplerCursor) {
         self.morton_index = c.a;
         self.dimension = c.dimension;
+        self.offered = None;
+    }
+
+    /// Offers `draws` (from [`ZSobolSampler::four_draws_batch`] at the
+    /// current cursor) to the next [`ZSobolSampler::get_1d_2d_1d_2d`].
+    #[inline]
+    pub fn offer_four_draws(&mut self, draws: Option<[Float; 6]>) {
+        self.offered = draws.map(|v| (self.morton_index, self.dimension, v));
     }
 
     /// Starts sample `index` of pixel `p` at `dimension`.
@@ -683,8 +707,26 @@ impl ZSobolSampler {
     /// overlaps.
     #[inline(never)]
     pub fn get_1d_2d_1d_2d(&mut self) -> (Float, Point2f, Float, Point2f) {
-        if let Some(draws) = self.four_cached_draws() {
-            return draws;
+        if let Some((m, d, v)) = self.offered.take() {
+            if m == self.morton_index && d == self.dimension {
+                self.dimension += 6;
+                return (
+                    v[0],
+                    Point2f::new(v[1], v[2]),
+                    v[3],
+                    Point2f::new(v[4], v[5]),
+                );
+            }
+        }
+        if let Some(inputs) = self.four_draw_inputs() {
+            self.dimension += 6;
+            let f = |k: usize| fast_owen_01(inputs[k].0, inputs[k].1);
+            return (
+                f(0),
+                Point2f::new(f(1), f(2)),
+                f(3),
+                Point2f::new(f(4), f(5)),
+            );
         }
         let a = self.draw_1d();
         let b = self.draw_2d();
@@ -693,14 +735,57 @@ impl ZSobolSampler {
         (a, b, c, d)
     }
 
-    /// [`ZSobolSampler::get_1d_2d_1d_2d`] for even log2 spp, fast Owen
-    /// scrambling and cached dimensions: the four draws' cache entries are
-    /// tested together (one branch instead of one each, since they miss
-    /// together: every fourth sample and on a new pixel), refreshed where
-    /// stale, and the draws computed from them. The same values as the
-    /// four single draws.
+    /// [`ZSobolSampler::get_1d_2d_1d_2d`]'s values at each of `cursors`
+    /// (its sampler's positions), into `out`: the bit-reversed Sobol'
+    /// values are found per cursor, then scrambled and made floats
+    /// together, lane-parallel at `level`. `None` where the four draws
+    /// take the general route (odd log2 spp, another randomization,
+    /// uncached dimensions); the draw then computes them itself. Leaves the
+    /// sampler's position as it was.
+    pub fn four_draws_batch(
+        &mut self,
+        level: SimdLevel,
+        cursors: &[super::SamplerCursor],
+        batch: &mut FourDrawBatch,
+        out: &mut Vec<Option<[Float; 6]>>,
+    ) {
+        let (morton, dimension) = (self.morton_index, self.dimension);
+        batch.v.clear();
+        batch.seeds.clear();
+        batch.found.clear();
+        for c in cursors {
+            self.morton_index = c.a;
+            self.dimension = c.dimension;
+            let inputs = self.four_draw_inputs();
+            if let Some(inputs) = inputs {
+                batch.v.extend(inputs.iter().map(|p| p.0));
+                batch.seeds.extend(inputs.iter().map(|p| p.1));
+            }
+            batch.found.push(inputs.is_some());
+        }
+        (self.morton_index, self.dimension) = (morton, dimension);
+        batch.values.clear();
+        batch.values.resize(batch.v.len(), 0.0);
+        fast_owen_01_batch(level, &batch.v, &batch.seeds, &mut batch.values);
+        out.clear();
+        let mut values = batch.values.chunks_exact(6);
+        out.extend(batch.found.iter().map(|&f| {
+            f.then(|| values.next())
+                .flatten()
+                .map(|v| std::array::from_fn(|k| v[k]))
+        }));
+    }
+
+    /// For [`ZSobolSampler::get_1d_2d_1d_2d`] at the current position,
+    /// when the log2 spp is even, the scrambling fast Owen and the
+    /// dimensions cached: the six values' bit-reversed Sobol' values and
+    /// scrambling seeds (each value is [`fast_owen_01`] of its pair). The
+    /// four draws' cache entries are tested together (one branch instead
+    /// of one each, since they miss together: every fourth sample and on a
+    /// new pixel) and refreshed where stale, so the values are those of
+    /// the four single draws. Does not advance the dimension.
     #[inline(always)]
-    fn four_cached_draws(&mut self) -> Option<(Float, Point2f, Float, Point2f)> {
+    fn four_draw_inputs(&mut self) -> Option<[(u32, u32); 6]> {
         let d = self.dimension as usize;
         let n_digits = self.n_base4_digits as usize;
         if self.log2_samples_per_pixel & 1 != 0
@@ -738,17 +823,16 @@ impl ZSobolSampler {
         let index =
             |dd: usize| c.low_upper[dd] | PERMUTATIONS_4[c.low_perm[dd] as usize][digit] as u64;
         let h = |dd: usize| c.scramble_hash[dd];
-        let one = |dd: usize| sobol_sample_fast_owen_01(index(dd), 0, h(dd + 1) as u32);
-        let two = |dd: usize| {
-            let (i, bits) = (index(dd), h(dd + 2));
-            Point2f::new(
-                sobol_sample_fast_owen_01(i, 0, bits as u32),
-                sobol_sample_fast_owen_01(i, 1, (bits >> 32) as u32),
-            )
-        };
-        let draws = (one(d), two(d + 1), one(d + 3), two(d + 4));
-        self.dimension += 6;
-        Some(draws)
+        let (i1, bits1) = (index(d + 1), h(d + 3));
+        let (i4, bits4) = (index(d + 4), h(d + 6));
+        Some([
+            (sobol_reversed_01(index(d), 0), h(d + 1) as u32),
+            (sobol_reversed_01(i1, 0), bits1 as u32),
+            (sobol_reversed_01(i1, 1), (bits1 >> 32) as u32),
+            (sobol_reversed_01(index(d + 3), 0), h(d + 4) as u32),
+            (sobol_reversed_01(i4, 0), bits4 as u32),
+            (sobol_reversed_01(i4, 1), (bits4 >> 32) as u32),
+        ])
     }
 
     #[inline(always)]
@@ -830,6 +914,76 @@ mod tests {
 
     /// The cached index equals the uncached computation for the widest
     /// indices the cache covers, and the uncached fallback beyond them.
+    /// The batched four draws, at cursors of interleaved pixels, samples
+    /// and dimensions (the wavefront's order), are the single draws'
+    /// values at every SIMD level; offered to the sampler they are what the
+    /// four-draw call returns, and an offer at another cursor is ignored.
+    #[test]
+    fn batched_four_draws_match_single_draws() {
+        use crate::sampler::SamplerCursor;
+        use RandomizeStrategy::*;
+        let mut rng = crate::rng::Rng::new(5, 9);
+        for (spp, rand) in [(64, FastOwen), (16, FastOwen), (32, FastOwen), (64, Owen)] {
+            let mut reference = ZSobolSampler::new(spp, Point2i::new(300, 200), rand, 7);
+            let cursors: Vec<SamplerCursor> = (0..333)
+                .map(|_| {
+                    let p = Point2i::new(
+                        (rng.uniform_u32() % 300) as i32,
+                        (rng.uniform_u32() % 200) as i32,
+                    );
+                    let i = (rng.uniform_u32() % spp as u32) as i32;
+                    let d = [0, 6, 13, 52, 57, 60][(rng.uniform_u32() % 6) as usize];
+                    reference.start_pixel_sample(p, i, d);
+                    reference.cursor()
+                })
+                .collect();
+            let want: Vec<[Float; 6]> = cursors
+                .iter()
+                .map(|c| {
+                    reference.set_cursor(c);
+                    let (a, b, c, d) = (
+                        reference.get_1d(),
+                        reference.get_2d(),
+                        reference.get_1d(),
+                        reference.get_2d(),
+                    );
+                    [a, b.x, b.y, c, d.x, d.y]
+                })
+                .collect();
+            for level in SimdLevel::available() {
+                let mut s = ZSobolSampler::new(spp, Point2i::new(300, 200), rand, 7);
+                let mut batch = FourDrawBatch::default();
+                let mut out = Vec::new();
+                s.four_draws_batch(level, &cursors, &mut batch, &mut out);
+                assert_eq!(out.len(), cursors.len());
+                for ((c, got), want) in cursors.iter().zip(&out).zip(&want) {
+                    match got {
+                        Some(v) => assert_eq!(v, want, "{level:?} spp {spp} {c:?}"),
+                        // Only the general route declines.
+                        Option::None => assert!(rand != FastOwen || spp == 32 || c.dimension >= 57),
+                    }
+                    s.set_cursor(c);
+                    s.offer_four_draws(*got);
+                    let (a, b, cc, d) = s.get_1d_2d_1d_2d();
+                    assert_eq!([a, b.x, b.y, cc, d.x, d.y], *want);
+                    assert_eq!(s.dimension, c.dimension + 6);
+                }
+                // An offer is withdrawn when the cursor moves, and not
+                // taken at another dimension.
+                s.set_cursor(&cursors[0]);
+                s.offer_four_draws(Some([0.5; 6]));
+                s.set_cursor(&cursors[1]);
+                let (a, ..) = s.get_1d_2d_1d_2d();
+                assert_eq!(a, want[1][0]);
+                s.set_cursor(&cursors[1]);
+                s.offer_four_draws(Some([0.5; 6]));
+                reference.set_cursor(&cursors[1]);
+                assert_eq!(s.get_1d(), reference.get_1d());
+                assert_eq!(s.get_1d_2d_1d_2d(), reference.get_1d_2d_1d_2d());
+            }
+        }
+    }
+
     #[test]
     fn cached_sample_index_matches_uncached_for_large_indices() {
         // 2^10 × 2^10 pixels at 2^20 samples: 20 digits, the most cached;

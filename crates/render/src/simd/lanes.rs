@@ -13,6 +13,10 @@ pub trait F32Lanes: Copy {
     const N: usize;
     /// A lane mask (one boolean per lane).
     type Mask: Copy;
+    /// `u32` lanes of the same width.
+    type U32: super::U32Lanes;
+    /// Lane-wise `u as f32` (rounded to nearest, ties to even).
+    fn from_u32(u: Self::U32) -> Self;
     /// Every lane `x`.
     fn splat(x: f32) -> Self;
     /// Lanes from the first `N` values of `s`.
@@ -88,6 +92,11 @@ pub struct Scalar1(pub f32);
 impl F32Lanes for Scalar1 {
     const N: usize = 1;
     type Mask = bool;
+    type U32 = super::U32x1;
+    #[inline(always)]
+    fn from_u32(u: super::U32x1) -> Self {
+        Scalar1(u.0 as f32)
+    }
     #[inline(always)]
     fn splat(x: f32) -> Self {
         Scalar1(x)
@@ -214,6 +223,7 @@ pub use x86::{F32x4, F32x8};
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::F32Lanes;
+    use crate::simd::{U32x4, U32x8};
     use std::arch::x86_64::*;
 
     /// Eight lanes in an AVX register. Only [`crate::simd::dispatch`]'s
@@ -233,6 +243,20 @@ mod x86 {
     impl F32Lanes for F32x8 {
         const N: usize = 8;
         type Mask = __m256;
+        type U32 = U32x8;
+        #[inline(always)]
+        fn from_u32(u: U32x8) -> Self {
+            // The high and low halves convert exactly (as signed values
+            // below 2^16); their sum, rounded once, is `u as f32`.
+            unsafe {
+                let hi = _mm256_cvtepi32_ps(_mm256_srli_epi32::<16>(u.0));
+                let lo = _mm256_cvtepi32_ps(_mm256_and_si256(u.0, _mm256_set1_epi32(0xffff)));
+                F32x8(_mm256_add_ps(
+                    _mm256_mul_ps(hi, _mm256_set1_ps(65536.0)),
+                    lo,
+                ))
+            }
+        }
         #[inline(always)]
         fn splat(x: f32) -> Self {
             unsafe { F32x8(_mm256_set1_ps(x)) }
@@ -388,6 +412,16 @@ mod x86 {
     impl F32Lanes for F32x4 {
         const N: usize = 4;
         type Mask = __m128;
+        type U32 = U32x4;
+        #[inline(always)]
+        fn from_u32(u: U32x4) -> Self {
+            // As F32x8's.
+            unsafe {
+                let hi = _mm_cvtepi32_ps(_mm_srli_epi32::<16>(u.0));
+                let lo = _mm_cvtepi32_ps(_mm_and_si128(u.0, _mm_set1_epi32(0xffff)));
+                F32x4(_mm_add_ps(_mm_mul_ps(hi, _mm_set1_ps(65536.0)), lo))
+            }
+        }
         #[inline(always)]
         fn splat(x: f32) -> Self {
             unsafe { F32x4(_mm_set1_ps(x)) }

@@ -3,7 +3,8 @@
 //! its backends apart).
 //!
 //! A kernel is written once, generic over [`F32Lanes`] (a few `f32` lanes
-//! and their operations), and [`dispatch`] runs it at the widest width the
+//! and their operations, with [`U32Lanes`] of the same width beside them
+//! for bit work), and [`dispatch`] runs it at the widest width the
 //! processor offers: AVX2 with FMA (8 lanes), SSE4.1 (4 lanes) or plain
 //! scalar code (1 lane), chosen once per process from
 //! `is_x86_feature_detected!`, or forced with `RPBRT_SIMD=scalar|sse4|avx2`
@@ -13,9 +14,13 @@
 //! kernel gives the same values at every width. AVX-512 is not built yet:
 //! processors that have it run the AVX2 kernels.
 
+mod ints;
 mod lanes;
 pub mod math;
 
+pub use ints::{U32Lanes, U32x1};
+#[cfg(target_arch = "x86_64")]
+pub use ints::{U32x4, U32x8};
 pub use lanes::{F32Lanes, Scalar1};
 #[cfg(target_arch = "x86_64")]
 pub use lanes::{F32x4, F32x8};

@@ -226,3 +226,84 @@ fn elementary_functions_are_accurate_and_the_same_at_every_width() {
         assert_eq!(got, reference, "{level:?}");
     }
 }
+
+/// Applies every integer lane operation (and the exact conversion to
+/// `f32`) to `a` and `b` at width `L`, lane by lane.
+struct IntOps<'a> {
+    a: &'a [u32],
+    b: &'a [u32],
+}
+
+impl Kernel for IntOps<'_> {
+    type Output = Vec<[u32; 9]>;
+    #[allow(clippy::needless_range_loop)]
+    #[inline(always)]
+    fn run<L: F32Lanes>(self) -> Vec<[u32; 9]> {
+        let mut out = Vec::new();
+        for (ca, cb) in self.a.chunks_exact(L::N).zip(self.b.chunks_exact(L::N)) {
+            let (a, b) = (L::U32::load(ca), L::U32::load(cb));
+            let mut vals = [[0u32; 16]; 9];
+            a.add(b).store(&mut vals[0]);
+            a.mul(b).store(&mut vals[1]);
+            a.xor(b).store(&mut vals[2]);
+            a.or(b).store(&mut vals[3]);
+            a.and(b).store(&mut vals[4]);
+            a.shr::<16>().store(&mut vals[5]);
+            a.shr::<3>().store(&mut vals[6]);
+            a.reverse_bits().store(&mut vals[7]);
+            let mut f = [0f32; 16];
+            L::from_u32(a).store(&mut f);
+            for (v, f) in vals[8].iter_mut().zip(f) {
+                *v = f.to_bits();
+            }
+            for i in 0..L::N {
+                out.push(std::array::from_fn(|k| vals[k][i]));
+            }
+        }
+        out
+    }
+}
+
+/// Every integer lane operation gives the wrapping `u32` operation's
+/// bits at every level, and `from_u32` is `as f32` (ties included).
+#[test]
+fn integer_lanes_match_scalar() {
+    let mut rng = Rng::new(41, 3);
+    let mut a: Vec<u32> = (0..4096).map(|_| rng.uniform_u32()).collect();
+    let b: Vec<u32> = (0..4096).map(|_| rng.uniform_u32()).collect();
+    // Values whose conversion to f32 is a tie or near one, and the ends.
+    let specials = [
+        0,
+        1,
+        u32::MAX,
+        0x0100_0001,
+        0x0100_0003,
+        0xffff_ff80,
+        0x8000_0080,
+    ];
+    a[..specials.len()].copy_from_slice(&specials);
+    for (i, x) in a.iter_mut().enumerate().skip(specials.len()).take(512) {
+        *x = (*x | 0x0100_0000) & !(0x7f << (i % 8));
+    }
+    let expect: Vec<[u32; 9]> = a
+        .iter()
+        .zip(&b)
+        .map(|(&a, &b)| {
+            [
+                a.wrapping_add(b),
+                a.wrapping_mul(b),
+                a ^ b,
+                a | b,
+                a & b,
+                a >> 16,
+                a >> 3,
+                a.reverse_bits(),
+                (a as f32).to_bits(),
+            ]
+        })
+        .collect();
+    for level in SimdLevel::available() {
+        let got = dispatch(level, IntOps { a: &a, b: &b });
+        assert_eq!(got, expect, "{level:?}");
+    }
+}

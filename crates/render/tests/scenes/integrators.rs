@@ -638,6 +638,8 @@ AttributeEnd
 fn wavefront_matches_scalar_bit_for_bit() {
     for (sampler, spp, integrator) in [
         ("zsobol", 8, "path"),
+        // An even log2 spp: Z-Sobol's batched four draws.
+        ("zsobol", 16, "path"),
         ("independent", 5, "path"),
         ("halton", 6, "path"),
         ("pmj02bn", 3, "path"),
