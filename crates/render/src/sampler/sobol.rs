@@ -479,6 +479,46 @@ pub struct FourDrawBatch {
     seeds: Vec<u32>,
     values: Vec<Float>,
     found: Vec<bool>,
+    order: Vec<u32>,
+    counts: Vec<u32>,
+}
+
+/// The positions of `cursors` grouped by dimension into `order`, in their
+/// own order within a dimension (a stable counting sort): the wavefront's
+/// cursors come in its sample order, which keeps a pixel's samples
+/// together and in order. A range of over 1024 dimensions falls back to a
+/// comparison sort by dimension and index.
+fn sort_by_dimension(
+    cursors: &[super::SamplerCursor],
+    counts: &mut Vec<u32>,
+    order: &mut Vec<u32>,
+) {
+    order.clear();
+    let (lo, hi) = cursors.iter().fold((i32::MAX, i32::MIN), |(lo, hi), c| {
+        (lo.min(c.dimension), hi.max(c.dimension))
+    });
+    if cursors.is_empty() || hi as i64 - lo as i64 >= 1024 {
+        order.extend(0..cursors.len() as u32);
+        order.sort_unstable_by_key(|&k| {
+            let c = &cursors[k as usize];
+            (c.dimension, c.a)
+        });
+        return;
+    }
+    counts.clear();
+    counts.resize((hi - lo) as usize + 2, 0);
+    for c in cursors {
+        counts[(c.dimension - lo) as usize + 1] += 1;
+    }
+    for i in 1..counts.len() {
+        counts[i] += counts[i - 1];
+    }
+    order.resize(cursors.len(), 0);
+    for (k, c) in cursors.iter().enumerate() {
+        let slot = &mut counts[(c.dimension - lo) as usize];
+        order[*slot as usize] = k as u32;
+        *slot += 1;
+    }
 }
 
 /// The Morton-ordered ("Z") Sobol' sampler, pbrt-v4's default.
@@ -750,30 +790,43 @@ impl ZSobolSampler {
         out: &mut Vec<Option<[Float; 6]>>,
     ) {
         let (morton, dimension) = (self.morton_index, self.dimension);
+        let n = cursors.len();
+        // Taken in order of dimension, then index, the draws meet their
+        // cache entries as a pixel's samples taken in order do (the paths
+        // in flight are at different depths, so in their own order each
+        // dimension's entries would change at almost every draw).
+        sort_by_dimension(cursors, &mut batch.counts, &mut batch.order);
         batch.v.clear();
+        batch.v.resize(6 * n, 0);
         batch.seeds.clear();
+        batch.seeds.resize(6 * n, 0);
         batch.found.clear();
-        for c in cursors {
+        batch.found.resize(n, false);
+        for &k in &batch.order {
+            let k = k as usize;
+            let c = &cursors[k];
             self.morton_index = c.a;
             self.dimension = c.dimension;
-            let inputs = self.four_draw_inputs();
-            if let Some(inputs) = inputs {
-                batch.v.extend(inputs.iter().map(|p| p.0));
-                batch.seeds.extend(inputs.iter().map(|p| p.1));
+            if let Some(inputs) = self.four_draw_inputs() {
+                for (j, (v, seed)) in inputs.into_iter().enumerate() {
+                    batch.v[6 * k + j] = v;
+                    batch.seeds[6 * k + j] = seed;
+                }
+                batch.found[k] = true;
             }
-            batch.found.push(inputs.is_some());
         }
         (self.morton_index, self.dimension) = (morton, dimension);
         batch.values.clear();
-        batch.values.resize(batch.v.len(), 0.0);
+        batch.values.resize(6 * n, 0.0);
         fast_owen_01_batch(level, &batch.v, &batch.seeds, &mut batch.values);
         out.clear();
-        let mut values = batch.values.chunks_exact(6);
-        out.extend(batch.found.iter().map(|&f| {
-            f.then(|| values.next())
-                .flatten()
-                .map(|v| std::array::from_fn(|k| v[k]))
-        }));
+        out.extend(
+            batch
+                .found
+                .iter()
+                .zip(batch.values.chunks_exact(6))
+                .map(|(&f, v)| f.then(|| std::array::from_fn(|j| v[j]))),
+        );
     }
 
     /// For [`ZSobolSampler::get_1d_2d_1d_2d`] at the current position,
@@ -925,7 +978,7 @@ mod tests {
         let mut rng = crate::rng::Rng::new(5, 9);
         for (spp, rand) in [(64, FastOwen), (16, FastOwen), (32, FastOwen), (64, Owen)] {
             let mut reference = ZSobolSampler::new(spp, Point2i::new(300, 200), rand, 7);
-            let cursors: Vec<SamplerCursor> = (0..333)
+            let mut cursors: Vec<SamplerCursor> = (0..333)
                 .map(|_| {
                     let p = Point2i::new(
                         (rng.uniform_u32() % 300) as i32,
@@ -937,6 +990,10 @@ mod tests {
                     reference.cursor()
                 })
                 .collect();
+            // One far dimension among the last few: the comparison sort's
+            // batch (all but it within the counting sort's range).
+            reference.start_pixel_sample(Point2i::new(3, 4), 1, 2000);
+            cursors.insert(300, reference.cursor());
             let want: Vec<[Float; 6]> = cursors
                 .iter()
                 .map(|c| {
@@ -954,7 +1011,10 @@ mod tests {
                 let mut s = ZSobolSampler::new(spp, Point2i::new(300, 200), rand, 7);
                 let mut batch = FourDrawBatch::default();
                 let mut out = Vec::new();
-                s.four_draws_batch(level, &cursors, &mut batch, &mut out);
+                s.four_draws_batch(level, &cursors[300..], &mut batch, &mut out);
+                let far = out.clone();
+                s.four_draws_batch(level, &cursors[..300], &mut batch, &mut out);
+                out.extend(far);
                 assert_eq!(out.len(), cursors.len());
                 for ((c, got), want) in cursors.iter().zip(&out).zip(&want) {
                     match got {
