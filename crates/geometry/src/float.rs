@@ -324,6 +324,37 @@ pub fn find_interval(size: usize, pred: impl Fn(usize) -> bool) -> usize {
     (base - 1).min(size - 2)
 }
 
+/// [`find_interval`] for many searches at once, interleaved: `out[k]`
+/// becomes `find_interval(size, |i| pred(k, i))` for every `k`.
+///
+/// Every search over a `size`-entry table takes the same number of
+/// halving steps whatever its outcome, so the searches advance in step,
+/// one probe of each per round: their loads are independent, and the
+/// processor overlaps them instead of waiting on each chain of dependent
+/// loads in turn (the gain of lane-parallel sampling without gathers).
+#[inline]
+pub fn find_intervals(size: usize, out: &mut [usize], pred: impl Fn(usize, usize) -> bool) {
+    if size < 2 {
+        out.fill(0);
+        return;
+    }
+    out.fill(1);
+    let mut len = size - 2;
+    while len > 1 {
+        let half = len / 2;
+        for (k, base) in out.iter_mut().enumerate() {
+            *base = std::hint::select_unpredictable(pred(k, *base + half - 1), *base + half, *base);
+        }
+        len -= half;
+    }
+    for (k, base) in out.iter_mut().enumerate() {
+        if len == 1 && pred(k, *base) {
+            *base += 1;
+        }
+        *base = (*base - 1).min(size - 2);
+    }
+}
+
 /// sin(x)/x, well-behaved at zero.
 #[inline]
 pub fn sin_x_over_x(x: Float) -> Float {
@@ -441,6 +472,25 @@ mod tests {
                     find_interval(size, pred),
                     reference(size, pred),
                     "{size} {u}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn interleaved_searches_match_single_ones() {
+        // Every size up to 70, each search of a batch with its own
+        // threshold (so the batch's searches end in different intervals).
+        for size in 0..70usize {
+            let t: Vec<usize> = (0..size).map(|i| (i * 7 + i / 3) / 5).collect();
+            let us: Vec<usize> = (0..(size * 2 + 2)).collect();
+            let mut out = vec![usize::MAX; us.len()];
+            find_intervals(size, &mut out, |k, i| t[i] <= us[k] / 2);
+            for (k, &o) in out.iter().enumerate() {
+                assert_eq!(
+                    o,
+                    find_interval(size, |i| t[i] <= us[k] / 2),
+                    "size {size}, k {k}"
                 );
             }
         }

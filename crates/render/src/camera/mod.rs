@@ -15,6 +15,7 @@
 //! raster x increasing is camera +x and raster y increasing is camera −y.
 
 mod create;
+mod lanes;
 mod projective;
 mod realistic;
 mod spherical;
@@ -32,6 +33,7 @@ use rpbrt_geometry::{
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 pub use create::{create_camera, read_lens_file, CAMERA_NAMES};
+pub use lanes::PinholeRays;
 pub use projective::{OrthographicCamera, PerspectiveCamera, ProjectiveTransforms};
 pub use realistic::{ApertureImage, LensElementInterface, RealisticCamera};
 pub use spherical::{SphericalCamera, SphericalMapping};

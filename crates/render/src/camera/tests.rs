@@ -881,3 +881,101 @@ fn aperture_image_from_a_file() {
     // can pass; some of those are vignetted.
     assert!(got > 0 && got <= 64 + 16, "{got}");
 }
+
+#[test]
+fn pinhole_lanes_match_single_rays() {
+    use crate::simd::SimdLevel;
+    let moved = Transform::translate(Vector3f::new(3.0, -1.5, 250.0))
+        * Transform::rotate(37.0, Vector3f::new(0.3, 1.0, -0.2))
+        * Transform::scale(1.0, 1.0, -1.0);
+    let ct = CameraTransform {
+        render_from_camera: AnimatedTransform::fixed(moved),
+        world_from_render: Transform::identity(),
+    };
+    let cases = [
+        (
+            vec![P::F("fov", &[39.0])],
+            ct.clone(),
+            FilmGeometry::new(37, 23),
+        ),
+        (
+            vec![
+                P::F("fov", &[90.0]),
+                P::F("screenwindow", &[-0.5, 1.5, -1.0, 0.25]),
+            ],
+            ct,
+            FilmGeometry::new(16, 64),
+        ),
+        (
+            vec![],
+            CameraTransform::default(),
+            FilmGeometry::new(256, 256),
+        ),
+    ];
+    let mut rng = Rng::new(11, 0);
+    for (params, ct, film) in cases {
+        let c = create_camera_with(&entity_with("perspective", &params, ct), &film, Some(2))
+            .unwrap()
+            .camera;
+        let lanes = c.pinhole_rays().expect("a pinhole camera has a lane form");
+        // Points over the film and its filter margin, a few off it.
+        let (w, h) = (
+            film.full_resolution.x as Float,
+            film.full_resolution.y as Float,
+        );
+        let mut p_film: Vec<Point2f> = (0..203)
+            .map(|_| {
+                Point2f::new(
+                    -2.0 + (w + 4.0) * rng.uniform_float(),
+                    -2.0 + (h + 4.0) * rng.uniform_float(),
+                )
+            })
+            .collect();
+        p_film.extend([
+            Point2f::new(0.0, 0.0),
+            Point2f::new(w, h),
+            Point2f::new(w / 2.0, h / 2.0),
+        ]);
+        let times: Vec<Float> = p_film.iter().map(|_| rng.uniform_float()).collect();
+        for level in SimdLevel::available() {
+            let mut out = vec![];
+            lanes.rays(level, &p_film, &times, &mut out);
+            assert_eq!(out.len(), p_film.len());
+            for ((p, &t), r) in p_film.iter().zip(&times).zip(&out) {
+                let mut s = sample(p.x, p.y);
+                s.time = t;
+                let mut e = c.generate_ray(&s).unwrap().ray;
+                e.time = t;
+                let bits = |r: &Ray| {
+                    [r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, r.time].map(Float::to_bits)
+                };
+                assert_eq!(bits(r), bits(&e), "{level:?} at {p:?}");
+                assert_eq!(r.medium, Some(2));
+            }
+        }
+    }
+    // Thin lenses, moving cameras and other projections have none.
+    let lens = make(
+        "perspective",
+        &[P::F("lensradius", &[0.1]), P::F("focaldistance", &[3.0])],
+        FilmGeometry::new(8, 8),
+    );
+    assert!(lens.pinhole_rays().is_none());
+    assert!(make("orthographic", &[], FilmGeometry::new(8, 8))
+        .pinhole_rays()
+        .is_none());
+    let moving = CameraTransform {
+        render_from_camera: AnimatedTransform::new(
+            Transform::identity(),
+            0.0,
+            Transform::translate(Vector3f::new(2.0, 0.0, 0.0)),
+            1.0,
+        ),
+        world_from_render: Transform::identity(),
+    };
+    let c = create_camera(
+        &entity_with("perspective", &[], moving),
+        &FilmGeometry::new(8, 8),
+    );
+    assert!(c.unwrap().pinhole_rays().is_none());
+}

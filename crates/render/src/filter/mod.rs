@@ -68,6 +68,23 @@ impl FilterSampler {
         let weight = if pdf > 0.0 { fv / pdf } else { 0.0 };
         FilterSample { p, weight }
     }
+
+    /// [`sample`](Self::sample) of every value of `us`, appended to `out`
+    /// (the table searches of a batch interleaved:
+    /// [`PiecewiseConstant2D::sample_many`]).
+    pub fn sample_many(&self, us: &[Point2f], out: &mut Vec<FilterSample>) {
+        const BATCH: usize = 64;
+        let mut found = [(Point2f::new(0.0, 0.0), 0.0, Point2i::new(0, 0)); BATCH];
+        for us in us.chunks(BATCH) {
+            let found = &mut found[..us.len()];
+            self.distrib.sample_many(us, found);
+            out.extend(found.iter().map(|&(p, pdf, cell)| {
+                let fv = self.f[cell.y as usize * self.nx + cell.x as usize];
+                let weight = if pdf > 0.0 { fv / pdf } else { 0.0 };
+                FilterSample { p, weight }
+            }));
+        }
+    }
 }
 
 /// The box filter.
@@ -450,5 +467,15 @@ impl Filter {
     #[inline]
     pub fn sample(&self, u: Point2f) -> FilterSample {
         dispatch!(self, f => f.sample(u))
+    }
+    /// [`sample`](Self::sample) of every value of `us`, appended to `out`:
+    /// the same samples, the tabulated filters' searches interleaved.
+    pub fn sample_many(&self, us: &[Point2f], out: &mut Vec<FilterSample>) {
+        match self {
+            Filter::Gaussian(f) => f.sampler.sample_many(us, out),
+            Filter::Mitchell(f) => f.sampler.sample_many(us, out),
+            Filter::LanczosSinc(f) => f.sampler.sample_many(us, out),
+            _ => out.extend(us.iter().map(|&u| self.sample(u))),
+        }
     }
 }

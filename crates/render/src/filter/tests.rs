@@ -140,6 +140,31 @@ fn analytic_samplers_stay_inside_and_have_unit_weight() {
 }
 
 #[test]
+fn batched_samples_match_single_ones() {
+    let mut rng = Rng::new(6, 0);
+    for f in all_filters() {
+        let us: Vec<Point2f> = (0..300)
+            .map(|_| Point2f::new(rng.uniform_float(), rng.uniform_float()))
+            .collect();
+        let mut out = vec![FilterSample {
+            p: Point2f::new(9.0, 9.0),
+            weight: 9.0,
+        }];
+        f.sample_many(&us, &mut out);
+        assert_eq!(out.len(), us.len() + 1, "{}", name(&f));
+        for (u, s) in us.iter().zip(&out[1..]) {
+            let e = f.sample(*u);
+            assert_eq!(
+                (s.p.x.to_bits(), s.p.y.to_bits(), s.weight.to_bits()),
+                (e.p.x.to_bits(), e.p.y.to_bits(), e.weight.to_bits()),
+                "{} at {u:?}",
+                name(&f)
+            );
+        }
+    }
+}
+
+#[test]
 fn erf_values() {
     assert!((erf(0.0)).abs() < 1e-15);
     assert!((erf(0.3) - 0.328_626_759_459_127_4).abs() < 1e-12);

@@ -31,6 +31,7 @@
 
 pub(crate) mod bdpt;
 mod bsdf_stage;
+mod camera_samples;
 mod create;
 mod direct;
 mod function;

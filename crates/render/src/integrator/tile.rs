@@ -10,12 +10,12 @@
 //! The loop is generic over the [`TileIntegrator`]: each integrator gets
 //! its own copy, with its per-sample work called directly.
 
+use super::camera_samples::CameraRaySample;
 use super::render::{
     snapshot, thread_pool, with_progress, write_film, write_partial, ProgressFn, RenderError,
     RenderOptions, RenderStats,
 };
 use super::Scene;
-use crate::camera::CameraSample;
 use crate::film::{
     splat_scale, FilmTile, OrderedSplats, PartialError, SplatBuffer, VisibleSurface,
 };
@@ -154,137 +154,6 @@ impl<I: RayIntegrator> TileIntegrator for RayTiles<'_, I> {
         cs.finish(scene, tile, |ray, lambda, visible| {
             self.0.li(scene, ray, lambda, sampler, visible)
         });
-    }
-}
-
-/// The film position of a camera sample in pixel `p_pixel` (the filter
-/// sampled with `u_pixel`) and the camera ray through it, with
-/// differentials scaled by `diff_scale` when `differentials` asks for
-/// them (pbrt-v4 `GetCameraSample` and the ray generation that follows).
-#[allow(clippy::too_many_arguments)]
-#[inline]
-pub(crate) fn camera_ray(
-    scene: &Scene,
-    opts: &RenderOptions,
-    p_pixel: Point2i,
-    u_pixel: Point2f,
-    time: Float,
-    p_lens: Point2f,
-    differentials: bool,
-    diff_scale: Float,
-) -> (CameraSample, Option<(RayDifferential, Float)>) {
-    let mut fs = scene.filter.sample(u_pixel);
-    if opts.disable_pixel_jitter {
-        fs.p = Point2f::new(0.0, 0.0);
-        fs.weight = 1.0;
-    }
-    let cs = CameraSample {
-        p_film: Point2f::new(
-            p_pixel.x as Float + fs.p.x + 0.5,
-            p_pixel.y as Float + fs.p.y + 0.5,
-        ),
-        p_lens,
-        time,
-        filter_weight: fs.weight,
-    };
-    let ray = if differentials {
-        scene.camera.generate_ray_differential(&cs).map(|mut cr| {
-            if !opts.disable_pixel_jitter {
-                cr.ray.scale_differentials(diff_scale);
-            }
-            (cr.ray, cr.weight)
-        })
-    } else {
-        // Nothing reads them: the same main ray without its offset rays.
-        scene
-            .camera
-            .generate_ray(&cs)
-            .map(|cr| (RayDifferential::new(cr.ray), cr.weight))
-    };
-    (cs, ray)
-}
-
-/// One camera sample through one pixel: its wavelengths, film position
-/// and camera ray (pbrt-v4 `RayIntegrator::EvaluatePixelSample`'s first
-/// half).
-pub(crate) struct CameraRaySample {
-    /// The pixel.
-    pub p_pixel: Point2i,
-    /// The sampled wavelengths.
-    pub lambda: SampledWavelengths,
-    /// The film position, time, lens sample and filter weight.
-    pub cs: CameraSample,
-    /// The camera ray and its weight (`None` when the camera makes none).
-    pub ray: Option<(RayDifferential, Float)>,
-}
-
-impl CameraRaySample {
-    /// Draws the camera sample's dimensions from `sampler` in pbrt-v4's
-    /// order and generates the ray.
-    #[inline]
-    pub(crate) fn take(
-        scene: &Scene,
-        opts: &RenderOptions,
-        p_pixel: Point2i,
-        sampler: &mut Sampler,
-        differentials: bool,
-    ) -> Self {
-        let (mut lu, u_pixel, time, p_lens) = sampler.get_camera_samples();
-        if opts.disable_wavelength_jitter {
-            lu = 0.5;
-        }
-        let lambda = scene.film.sample_wavelengths(lu);
-        let scale = (1.0 / (sampler.samples_per_pixel() as Float).sqrt()).max(0.125);
-        let (cs, ray) = camera_ray(
-            scene,
-            opts,
-            p_pixel,
-            u_pixel,
-            time,
-            p_lens,
-            differentials,
-            scale,
-        );
-        CameraRaySample {
-            p_pixel,
-            lambda,
-            cs,
-            ray,
-        }
-    }
-
-    /// Estimates the radiance along the ray with `li` and adds it to the
-    /// tile (zero when there is no ray; NaN and infinite estimates are
-    /// dropped, as pbrt-v4 does).
-    #[inline]
-    pub(crate) fn finish(
-        mut self,
-        scene: &Scene,
-        tile: &mut FilmTile,
-        li: impl FnOnce(
-            RayDifferential,
-            &mut SampledWavelengths,
-            Option<&mut VisibleSurface>,
-        ) -> SampledSpectrum,
-    ) {
-        let mut l = SampledSpectrum::new(0.0);
-        // Only G-buffer films record the first visible surface.
-        let mut visible: Option<VisibleSurface> = if scene.film.uses_visible_surface() {
-            Some(VisibleSurface::default())
-        } else {
-            None
-        };
-        if let Some((ray, weight)) = self.ray {
-            l = li(ray, &mut self.lambda, visible.as_mut()) * weight;
-        }
-        add_estimate(
-            tile,
-            self.p_pixel,
-            l,
-            &self.lambda,
-            visible.as_ref(),
-            self.cs.filter_weight,
-        );
     }
 }
 

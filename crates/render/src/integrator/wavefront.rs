@@ -37,9 +37,10 @@
 //! [`PrimitiveAggregate::intersect_records`]: crate::primitive::PrimitiveAggregate::intersect_records
 
 use super::bsdf_stage::{answer_bsdfs, BsdfAnswers, BsdfBatch, BsdfQuery};
+use super::camera_samples::{differential_scale, CameraBatch, CameraDraws, CameraRaySample};
 use super::direct::{answer_lights, LightAnswer, LightBatch, LightRequest};
 use super::render::RenderOptions;
-use super::tile::{add_estimate, CameraRaySample, RayIntegrator, RayTiles, TileIntegrator};
+use super::tile::{add_estimate, RayIntegrator, RayTiles, TileIntegrator};
 use super::vertex::{Begin, VertexIntegrator};
 use super::Scene;
 use crate::film::{FilmTile, SplatBuffer, VisibleSurface};
@@ -199,6 +200,10 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let mut draws: Vec<Option<[Float; 6]>> = Vec::with_capacity(LANES);
         let mut shade: Vec<usize> = Vec::with_capacity(LANES);
         let mut predrawn: Vec<Option<[Float; 6]>> = Vec::new();
+        let mut camera_batch = CameraBatch::new(scene);
+        let mut camera_draws: Vec<(Point2i, CameraDraws)> = Vec::with_capacity(LANES);
+        let mut camera_samples: Vec<CameraRaySample> = Vec::with_capacity(LANES);
+        let diff_scale = differential_scale(sampler.samples_per_pixel());
         let mut started = 0;
         let level = opts.simd.unwrap_or_else(crate::simd::level);
         loop {
@@ -219,12 +224,29 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 starts.push((seq, p_pixel));
                 cursors.push(sampler.cursor());
             }
-            // The camera samples' draws, together.
+            // The camera samples' draws, computed together and taken by
+            // each sample in turn (leaving each cursor past them), then
+            // their filter offsets, wavelengths and rays together.
             sampler.four_draws_batch(level, &cursors, &mut draw_batch, &mut draws);
-            for (&(seq, p_pixel), (cursor, &d)) in starts.iter().zip(cursors.iter().zip(&draws)) {
+            camera_draws.clear();
+            for ((&(_, p_pixel), cursor), &d) in starts.iter().zip(cursors.iter_mut()).zip(&draws) {
                 sampler.set_cursor(cursor);
                 sampler.offer_four_draws(d);
-                let cs = CameraRaySample::take(scene, opts, p_pixel, sampler, differentials);
+                camera_draws.push((p_pixel, CameraDraws::take(sampler)));
+                *cursor = sampler.cursor();
+            }
+            camera_batch.take(
+                scene,
+                opts,
+                level,
+                &camera_draws,
+                differentials,
+                diff_scale,
+                &mut camera_samples,
+            );
+            for ((&(seq, p_pixel), cursor), cs) in
+                starts.iter().zip(&cursors).zip(camera_samples.drain(..))
+            {
                 let Some((ray, camera_weight)) = cs.ray else {
                     let f = Finished {
                         p_pixel,
@@ -239,7 +261,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 let lane = Lane {
                     seq,
                     p_pixel,
-                    cursor: sampler.cursor(),
+                    cursor: *cursor,
                     lambda: cs.lambda,
                     path: self.0.start(ray),
                     camera_weight,

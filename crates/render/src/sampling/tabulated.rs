@@ -92,6 +92,12 @@ impl PiecewiseConstant1D {
     #[inline]
     pub fn sample(&self, u: Float) -> (Float, Float, usize) {
         let o = find_interval(self.cdf.len(), |i| self.cdf[i] <= u);
+        self.sample_in(o, u)
+    }
+
+    /// [`sample`](Self::sample) once the interval `o` holding `u` is found.
+    #[inline(always)]
+    fn sample_in(&self, o: usize, u: Float) -> (Float, Float, usize) {
         let mut du = u - self.cdf[o];
         let width = self.cdf[o + 1] - self.cdf[o];
         if width > 0.0 {
@@ -204,6 +210,38 @@ impl PiecewiseConstant2D {
         )
     }
 
+    /// [`sample`](Self::sample) of every value of `us`, into `out` (as
+    /// long): the same samples, found a batch at a time with interleaved
+    /// searches ([`find_intervals`]), the marginal's first and then each
+    /// sample's conditional.
+    pub fn sample_many(&self, us: &[Point2f], out: &mut [(Point2f, Float, Point2i)]) {
+        const BATCH: usize = 16;
+        let mut rows = [0usize; BATCH];
+        let mut cols = [0usize; BATCH];
+        for (us, out) in us.chunks(BATCH).zip(out.chunks_mut(BATCH)) {
+            let n = us.len();
+            let cdf = &self.marginal.cdf;
+            find_intervals(cdf.len(), &mut rows[..n], |k, i| cdf[i] <= us[k].y);
+            // Every conditional has the same size; each search's table is
+            // looked up once, not at every probe.
+            let size = self.conditional[0].cdf.len();
+            let mut cdfs: [&[Float]; BATCH] = [&[]; BATCH];
+            for (c, &row) in cdfs.iter_mut().zip(&rows[..n]) {
+                *c = &self.conditional[row].cdf;
+            }
+            find_intervals(size, &mut cols[..n], |k, i| cdfs[k][i] <= us[k].x);
+            for k in 0..n {
+                let (d1, pdf1, v) = self.marginal.sample_in(rows[k], us[k].y);
+                let (d0, pdf0, uo) = self.conditional[v].sample_in(cols[k], us[k].x);
+                out[k] = (
+                    Point2f::new(d0, d1),
+                    pdf0 * pdf1,
+                    Point2i::new(uo as i32, v as i32),
+                );
+            }
+        }
+    }
+
     /// The density at `p` (area measure).
     pub fn pdf(&self, p: Point2f) -> Float {
         let o = self.domain.offset(p);
@@ -306,5 +344,39 @@ mod tests {
         }
         let support = f.iter().filter(|v| **v != 0.0).count() as f64 * cell_area as f64;
         assert!((est / n as f64 - support).abs() < 0.02 * support);
+    }
+
+    #[test]
+    fn two_d_batched_samples_match_single_ones() {
+        // Tables with zero rows and cells, of sizes that make the
+        // interleaved searches take every number of rounds, and batches
+        // longer and shorter than the searches' chunk.
+        for (nu, nv) in [(1, 1), (7, 5), (48, 48), (3, 33)] {
+            let f: Vec<Float> = (0..nu * nv)
+                .map(|i| ((i * 37 % 11) as Float) * if i % 5 == 0 { 0.0 } else { 1.0 })
+                .collect();
+            let domain = Bounds2f::new(Point2f::new(-1.5, -1.5), Point2f::new(1.5, 1.5));
+            let d = PiecewiseConstant2D::new(&f, nu, nv, domain);
+            let mut r = Rng::new(9, 0);
+            for n in [0, 1, 5, 16, 17, 100] {
+                let mut us: Vec<Point2f> = (0..n)
+                    .map(|_| Point2f::new(r.uniform_float(), r.uniform_float()))
+                    .collect();
+                if n > 2 {
+                    us[0] = Point2f::new(0.0, 0.0);
+                    us[1] = Point2f::new(ONE_MINUS_EPSILON, ONE_MINUS_EPSILON);
+                }
+                let mut out = vec![(Point2f::new(0.0, 0.0), -1.0, Point2i::new(-1, -1)); n];
+                d.sample_many(&us, &mut out);
+                for (u, o) in us.iter().zip(&out) {
+                    let e = d.sample(*u);
+                    assert_eq!(
+                        (o.0.x.to_bits(), o.0.y.to_bits(), o.1.to_bits(), o.2),
+                        (e.0.x.to_bits(), e.0.y.to_bits(), e.1.to_bits(), e.2),
+                        "{nu}x{nv}, u {u:?}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -19,8 +19,9 @@ pub(crate) use connect::{connect_bdpt, transmittance, Connection};
 pub(crate) use vertex::Vertex;
 pub(crate) use walk::{generate_camera_subpath, generate_light_subpath, WalkOptions};
 
+use super::camera_samples::CameraRaySample;
 use super::render::{write_film, ProgressFn, RenderError, RenderOptions, RenderStats};
-use super::tile::{self, CameraRaySample, TileIntegrator};
+use super::tile::{self, TileIntegrator};
 use super::Scene;
 use crate::film::{
     Film, FilmCore, FilmParams, FilmTile, KindConfig, PixelSensor, RgbFilm, SplatBuffer,

@@ -19,8 +19,8 @@
 mod grid;
 mod photon;
 
+use super::camera_samples::camera_ray;
 use super::render::{with_progress, ProgressFn, RenderError, RenderOptions, RenderStats, Snapshot};
-use super::tile::camera_ray;
 use super::{sample_ld, skip_intersection, RayCounters, Scene, VertexOrigins};
 use crate::bxdf::{BxDFReflTransFlags, TransportMode, BSDF};
 use crate::image::{ColorEncoding, Image, ImageMetadata, PixelFormat};
