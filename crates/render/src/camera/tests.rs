@@ -432,9 +432,9 @@ fn time_sampling_lerps_the_shutter() {
         .any(|w| w.loc.as_ref().map(|l| l.line) == Some(11)));
 }
 
-#[test]
-fn animated_camera_moves_rays_with_time() {
-    let ct = CameraTransform {
+/// A camera transform that moves 2 units along x over the shutter [0, 1].
+fn moving_transform() -> CameraTransform {
+    CameraTransform {
         render_from_camera: AnimatedTransform::new(
             Transform::identity(),
             0.0,
@@ -442,7 +442,12 @@ fn animated_camera_moves_rays_with_time() {
             1.0,
         ),
         world_from_render: Transform::identity(),
-    };
+    }
+}
+
+#[test]
+fn animated_camera_moves_rays_with_time() {
+    let ct = moving_transform();
     let c = create_camera(
         &entity_with("perspective", &[], ct),
         &FilmGeometry::new(8, 8),
@@ -964,15 +969,7 @@ fn pinhole_lanes_match_single_rays() {
     assert!(make("orthographic", &[], FilmGeometry::new(8, 8))
         .pinhole_rays()
         .is_none());
-    let moving = CameraTransform {
-        render_from_camera: AnimatedTransform::new(
-            Transform::identity(),
-            0.0,
-            Transform::translate(Vector3f::new(2.0, 0.0, 0.0)),
-            1.0,
-        ),
-        world_from_render: Transform::identity(),
-    };
+    let moving = moving_transform();
     let c = create_camera(
         &entity_with("perspective", &[], moving),
         &FilmGeometry::new(8, 8),
