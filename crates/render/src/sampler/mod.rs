@@ -186,7 +186,7 @@ impl Sampler {
     /// [`Sampler::get_camera_samples`]) would take at each of `cursors`,
     /// computed together, lane-parallel at `level`, into `out`: `None`
     /// where this sampler has no batched form for them (today: all but
-    /// Z-Sobol' with fast Owen scrambling and an even log2 spp). Offer one
+    /// Z-Sobol' with fast Owen scrambling and at least 4 spp). Offer one
     /// to the draw with [`Sampler::offer_four_draws`].
     pub fn four_draws_batch(
         &mut self,

@@ -779,7 +779,7 @@ impl ZSobolSampler {
     /// (its sampler's positions), into `out`: the bit-reversed Sobol'
     /// values are found per cursor, then scrambled and made floats
     /// together, lane-parallel at `level`. `None` where the four draws
-    /// take the general route (odd log2 spp, another randomization,
+    /// take the general route (2 spp, another randomization,
     /// uncached dimensions); the draw then computes them itself. Leaves the
     /// sampler's position as it was.
     pub fn four_draws_batch(
@@ -830,30 +830,36 @@ impl ZSobolSampler {
     }
 
     /// For [`ZSobolSampler::get_1d_2d_1d_2d`] at the current position,
-    /// when the log2 spp is even, the scrambling fast Owen and the
-    /// dimensions cached: the six values' bit-reversed Sobol' values and
-    /// scrambling seeds (each value is [`fast_owen_01`] of its pair). The
-    /// four draws' cache entries are tested together (one branch instead
-    /// of one each, since they miss together: every fourth sample and on a
-    /// new pixel) and refreshed where stale, so the values are those of
-    /// the four single draws. Does not advance the dimension.
+    /// when the scrambling is fast Owen, the dimensions cached and the
+    /// lowest sample digit has a digit above it (at least 4 samples per
+    /// pixel, 8 for an odd log2): the six values' bit-reversed Sobol'
+    /// values and scrambling seeds (each value is [`fast_owen_01`] of its
+    /// pair). The four draws' cache entries are tested together (one
+    /// branch instead of one each, since they miss together: every fourth
+    /// sample and on a new pixel) and refreshed where stale, so the values
+    /// are those of the four single draws. Does not advance the dimension.
     #[inline(always)]
     fn four_draw_inputs(&mut self) -> Option<[(u32, u32); 6]> {
         let d = self.dimension as usize;
         let n_digits = self.n_base4_digits as usize;
-        if self.log2_samples_per_pixel & 1 != 0
-            || self.log2_samples_per_pixel == 0
+        if self.log2_samples_per_pixel == 0
             || self.randomize != RandomizeStrategy::FastOwen
             || d + 6 >= ZSOBOL_CACHED_DIMENSIONS
             || n_digits > ZSOBOL_CACHED_DIGITS
         {
             return None;
         }
-        // The lowest sample digit is digit 0 (even log2 spp, at least one
-        // sample digit); its key is everything above it.
-        let morton = self.morton_index;
-        let key = morton >> 2;
+        // The lowest sample digit is digit `odd` (at bit `odd`: below it,
+        // for an odd log2 spp, the last bit); its key is everything above
+        // it.
+        let odd = (self.log2_samples_per_pixel & 1) as usize;
         let split = self.split(n_digits);
+        if split <= odd {
+            return None;
+        }
+        let morton = self.morton_index;
+        let key = morton >> (odd + 2);
+        let dims = [d, d + 1, d + 3, d + 4];
         let c = &mut *self.cache;
         let all_cached = (c.low_key[d] == key)
             & (c.low_key[d + 1] == key)
@@ -862,27 +868,40 @@ impl ZSobolSampler {
         if !all_cached {
             // Refreshed here, as the single draws would (the same cache
             // entries), without their per-draw checks.
-            if split == 0 {
-                return None;
-            }
-            for dd in [d, d + 1, d + 3, d + 4] {
+            for dd in dims {
                 if c.low_key[dd] != key {
-                    c.refresh_low(morton, dd, split, n_digits, 0, Self::dim_mix(dd));
+                    c.refresh_low(morton, dd, split, n_digits, odd, Self::dim_mix(dd));
                 }
             }
         }
+        // The last bit's flips (odd log2 spp), cached as the single
+        // draws cache them, under the index bits above it.
+        let mut last = [0u64; 4];
+        if odd == 1 {
+            let higher = morton >> 1;
+            for (l, dd) in last.iter_mut().zip(dims) {
+                let (k, flip) = &mut c.last_bit[dd];
+                if *k != higher {
+                    *k = higher;
+                    *flip = (mix_bits(higher ^ Self::dim_mix(dd)) & 1) as u8;
+                }
+                *l = (morton & 1) ^ *flip as u64;
+            }
+        }
         let c = &*self.cache;
-        let digit = (morton & 3) as usize;
-        let index =
-            |dd: usize| c.low_upper[dd] | PERMUTATIONS_4[c.low_perm[dd] as usize][digit] as u64;
+        let digit = ((morton >> odd) & 3) as usize;
+        let index = |j: usize| {
+            let dd = dims[j];
+            c.low_upper[dd] | (PERMUTATIONS_4[c.low_perm[dd] as usize][digit] as u64) << odd | last[j]
+        };
         let h = |dd: usize| c.scramble_hash[dd];
-        let (i1, bits1) = (index(d + 1), h(d + 3));
-        let (i4, bits4) = (index(d + 4), h(d + 6));
+        let (i1, bits1) = (index(1), h(d + 3));
+        let (i4, bits4) = (index(3), h(d + 6));
         Some([
-            (sobol_reversed_01(index(d), 0), h(d + 1) as u32),
+            (sobol_reversed_01(index(0), 0), h(d + 1) as u32),
             (sobol_reversed_01(i1, 0), bits1 as u32),
             (sobol_reversed_01(i1, 1), (bits1 >> 32) as u32),
-            (sobol_reversed_01(index(d + 3), 0), h(d + 4) as u32),
+            (sobol_reversed_01(index(2), 0), h(d + 4) as u32),
             (sobol_reversed_01(i4, 0), bits4 as u32),
             (sobol_reversed_01(i4, 1), (bits4 >> 32) as u32),
         ])
@@ -938,6 +957,8 @@ mod tests {
             (64, FastOwen),
             (16, FastOwen),
             (32, FastOwen),
+            (8, FastOwen),
+            (128, FastOwen),
             (64, Owen),
             (4, None),
         ] {
@@ -976,7 +997,14 @@ mod tests {
         use crate::sampler::SamplerCursor;
         use RandomizeStrategy::*;
         let mut rng = crate::rng::Rng::new(5, 9);
-        for (spp, rand) in [(64, FastOwen), (16, FastOwen), (32, FastOwen), (64, Owen)] {
+        for (spp, rand) in [
+            (64, FastOwen),
+            (16, FastOwen),
+            (32, FastOwen),
+            (8, FastOwen),
+            (2, FastOwen),
+            (64, Owen),
+        ] {
             let mut reference = ZSobolSampler::new(spp, Point2i::new(300, 200), rand, 7);
             let mut cursors: Vec<SamplerCursor> = (0..333)
                 .map(|_| {
@@ -1020,7 +1048,7 @@ mod tests {
                     match got {
                         Some(v) => assert_eq!(v, want, "{level:?} spp {spp} {c:?}"),
                         // Only the general route declines.
-                        Option::None => assert!(rand != FastOwen || spp == 32 || c.dimension >= 57),
+                        Option::None => assert!(rand != FastOwen || spp == 2 || c.dimension >= 57),
                     }
                     s.set_cursor(c);
                     s.offer_four_draws(*got);
