@@ -892,7 +892,9 @@ impl ZSobolSampler {
         let digit = ((morton >> odd) & 3) as usize;
         let index = |j: usize| {
             let dd = dims[j];
-            c.low_upper[dd] | (PERMUTATIONS_4[c.low_perm[dd] as usize][digit] as u64) << odd | last[j]
+            c.low_upper[dd]
+                | (PERMUTATIONS_4[c.low_perm[dd] as usize][digit] as u64) << odd
+                | last[j]
         };
         let h = |dd: usize| c.scramble_hash[dd];
         let (i1, bits1) = (index(1), h(d + 3));
