@@ -162,8 +162,13 @@ impl VertexIntegrator for PathIntegrator {
         const DONE: Begin = Begin::Step(VertexStep::DONE);
         let light_sampler: &LightSampler = &scene.light_sampler;
         // Built in place and used by reference: the intersection and the
-        // BSDF are large.
-        scratch.hit = record.and_then(|h| scene.aggregate.interaction(&s.ray.ray, &h));
+        // BSDF are large. (Assigned straight from the call, so that the
+        // call writes into the scratch: through `Option::and_then` it was
+        // built on the stack and copied.)
+        scratch.hit = match record {
+            Some(h) => scene.aggregate.interaction(&s.ray.ray, &h),
+            None => None,
+        };
         let Some(hit) = scratch.hit.as_mut() else {
             // Escaped: infinite lights, weighted by MIS unless the last
             // bounce could not have been light-sampled.

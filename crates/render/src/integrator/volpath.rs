@@ -403,7 +403,12 @@ impl VertexIntegrator for VolPathIntegrator {
             s.r_u *= t_maj / t_maj[0];
             s.r_l *= t_maj / t_maj[0];
         }
-        scratch.hit = record.and_then(|h| scene.aggregate.interaction(&s.ray.ray, &h));
+        // Assigned straight from the call, which then writes into the
+        // scratch (see `PathIntegrator::begin`).
+        scratch.hit = match record {
+            Some(h) => scene.aggregate.interaction(&s.ray.ray, &h),
+            None => None,
+        };
         let Some(hit) = scratch.hit.as_mut() else {
             // Escaped: infinite lights.
             for &li in &scene.infinite_lights {
