@@ -455,6 +455,27 @@ impl PixelDigitCache {
         self.low_perm[d] = ZSobolSampler::digit_permutation(key, dim_mix) as u8;
     }
 
+    /// The index bits of the lowest sample digit (at bit `odd`, its
+    /// `digit`) and everything above it, for dimension `d`, from the
+    /// entries [`PixelDigitCache::refresh_low`] keeps.
+    #[inline(always)]
+    fn low_index(&self, d: usize, digit: usize, odd: usize) -> u64 {
+        self.low_upper[d] | (PERMUTATIONS_4[self.low_perm[d] as usize][digit] as u64) << odd
+    }
+
+    /// The permuted last bit of `morton` (odd log2 spp), for dimension `d`:
+    /// its flip cached under the index bits above it.
+    #[inline(always)]
+    fn last_bit(&mut self, morton: u64, d: usize, dim_mix: u64) -> u64 {
+        let higher = morton >> 1;
+        let (key, flip) = &mut self.last_bit[d];
+        if *key != higher {
+            *key = higher;
+            *flip = (mix_bits(higher ^ dim_mix) & 1) as u8;
+        }
+        (morton & 1) ^ *flip as u64
+    }
+
     /// Permuted digit `i` of `morton` in place (at bit `2i - odd`), for
     /// dimension `d`, from the cache when the digits above it are the ones
     /// it was last chosen for.
@@ -697,19 +718,12 @@ impl ZSobolSampler {
             if cache.low_key[d] != key {
                 cache.refresh_low(morton, d, split, n_digits, odd, dim_mix);
             }
-            let digit = ((morton >> shift) & 3) as usize;
-            cache.low_upper[d] | (PERMUTATIONS_4[cache.low_perm[d] as usize][digit] as u64) << shift
+            cache.low_index(d, ((morton >> shift) & 3) as usize, shift)
         } else {
             cache.pixel_digits(morton, d, split, n_digits, odd, dim_mix)
         };
         if odd == 1 {
-            let higher = morton >> 1;
-            let (key, flip) = &mut cache.last_bit[d];
-            if *key != higher {
-                *key = higher;
-                *flip = (mix_bits(higher ^ dim_mix) & 1) as u8;
-            }
-            index |= (morton & 1) ^ *flip as u64;
+            index |= cache.last_bit(morton, d, dim_mix);
         }
         index
     }
@@ -874,28 +888,16 @@ impl ZSobolSampler {
                 }
             }
         }
-        // The last bit's flips (odd log2 spp), cached as the single
-        // draws cache them, under the index bits above it.
+        // The last bits (odd log2 spp), from the single draws' cache.
         let mut last = [0u64; 4];
         if odd == 1 {
-            let higher = morton >> 1;
             for (l, dd) in last.iter_mut().zip(dims) {
-                let (k, flip) = &mut c.last_bit[dd];
-                if *k != higher {
-                    *k = higher;
-                    *flip = (mix_bits(higher ^ Self::dim_mix(dd)) & 1) as u8;
-                }
-                *l = (morton & 1) ^ *flip as u64;
+                *l = c.last_bit(morton, dd, Self::dim_mix(dd));
             }
         }
         let c = &*self.cache;
         let digit = ((morton >> odd) & 3) as usize;
-        let index = |j: usize| {
-            let dd = dims[j];
-            c.low_upper[dd]
-                | (PERMUTATIONS_4[c.low_perm[dd] as usize][digit] as u64) << odd
-                | last[j]
-        };
+        let index = |j: usize| c.low_index(dims[j], digit, odd) | last[j];
         let h = |dd: usize| c.scramble_hash[dd];
         let (i1, bits1) = (index(1), h(d + 3));
         let (i4, bits4) = (index(3), h(d + 6));
