@@ -36,6 +36,8 @@ impl ParserTarget for Count {
         material(n: &str, p: ParamList); make_named_material(n: &str, p: ParamList);
         named_material(n: &str); light_source(n: &str, p: ParamList); area_light_source(n: &str, p: ParamList);
         object_begin(n: &str); object_end(); object_instance(n: &str);
+        renderer(n: &str, p: ParamList); surface_integrator(n: &str, p: ParamList);
+        volume_integrator(n: &str, p: ParamList); volume(n: &str, p: ParamList);
     }
     fn shape(&mut self, _n: &str, p: ParamList, _loc: FileLoc) -> rpbrt_parser::DirectiveResult {
         self.values += p.iter().map(|p| p.value_count()).sum::<usize>();

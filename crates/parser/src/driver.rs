@@ -184,17 +184,21 @@ enum Directive {
     ObjectInstance,
     Option,
     PixelFilter,
+    Renderer,
     ReverseOrientation,
     Rotate,
     Sampler,
     Scale,
     Shape,
+    SurfaceIntegrator,
     Texture,
     Transform,
     TransformBegin,
     TransformEnd,
     TransformTimes,
     Translate,
+    Volume,
+    VolumeIntegrator,
     WorldBegin,
     WorldEnd,
 }
@@ -228,17 +232,21 @@ const DIRECTIVES: &[(&str, Directive)] = &[
     ("ObjectInstance", Directive::ObjectInstance),
     ("Option", Directive::Option),
     ("PixelFilter", Directive::PixelFilter),
+    ("Renderer", Directive::Renderer),
     ("ReverseOrientation", Directive::ReverseOrientation),
     ("Rotate", Directive::Rotate),
     ("Sampler", Directive::Sampler),
     ("Scale", Directive::Scale),
     ("Shape", Directive::Shape),
+    ("SurfaceIntegrator", Directive::SurfaceIntegrator),
     ("Texture", Directive::Texture),
     ("Transform", Directive::Transform),
     ("TransformBegin", Directive::TransformBegin),
     ("TransformEnd", Directive::TransformEnd),
     ("TransformTimes", Directive::TransformTimes),
     ("Translate", Directive::Translate),
+    ("Volume", Directive::Volume),
+    ("VolumeIntegrator", Directive::VolumeIntegrator),
     ("WorldBegin", Directive::WorldBegin),
     ("WorldEnd", Directive::WorldEnd),
 ];
@@ -1071,7 +1079,11 @@ impl<'a> Run<'a> {
             | D::MakeNamedMaterial
             | D::LightSource
             | D::AreaLightSource
-            | D::Shape => {
+            | D::Shape
+            | D::Renderer
+            | D::SurfaceIntegrator
+            | D::VolumeIntegrator
+            | D::Volume => {
                 let n = self.quoted("a name", &l)?;
                 let p = self.params()?;
                 let t = self.sink();
@@ -1088,6 +1100,10 @@ impl<'a> Run<'a> {
                     D::MakeNamedMaterial => t.make_named_material(&n, p, loc),
                     D::LightSource => t.light_source(&n, p, loc),
                     D::AreaLightSource => t.area_light_source(&n, p, loc),
+                    D::Renderer => t.renderer(&n, p, loc),
+                    D::SurfaceIntegrator => t.surface_integrator(&n, p, loc),
+                    D::VolumeIntegrator => t.volume_integrator(&n, p, loc),
+                    D::Volume => t.volume(&n, p, loc),
                     _ => t.shape(&n, p, loc),
                 }
             }

@@ -35,6 +35,7 @@ use crate::loc::FileLoc;
 use crate::params::{canonical_type, ParsedParameter};
 use crate::target::{DirectiveResult, IncludeKind, ParamList, ParserTarget};
 use crate::tokenizer::escape_string;
+use crate::upgrade::legacy::{Given, LegacyTransport, Target};
 use crate::upgrade::{self, Upgraded};
 
 /// Prints directives as canonical pbrt-v4 text into a string.
@@ -48,6 +49,9 @@ pub struct FormattingTarget {
     /// `--upgrade`'s current name of each texture, named material and
     /// object instance.
     renames: [Renames; 3],
+    /// `--upgrade`: a pbrt-v1/v2 file's `Renderer`, `SurfaceIntegrator`
+    /// and `VolumeIntegrator`, written as one `Integrator` at `WorldBegin`.
+    legacy: LegacyTransport,
 }
 
 /// Which kind of named thing a [`Renames`] table holds.
@@ -363,6 +367,31 @@ impl FormattingTarget {
     }
 }
 
+impl FormattingTarget {
+    /// `Renderer`, `SurfaceIntegrator` or `VolumeIntegrator`: printed as
+    /// they are, or under `--upgrade` kept for the one `Integrator`
+    /// [`FormattingTarget::world_begin`] writes.
+    fn legacy_transport(
+        &mut self,
+        directive: &str,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        if !self.upgrade {
+            self.named(directive, name, &params);
+            return Ok(());
+        }
+        let given = Some(Given::new(name, params, loc));
+        match directive {
+            "Renderer" => self.legacy.renderer = given,
+            "SurfaceIntegrator" => self.legacy.surface = given,
+            _ => self.legacy.volume = given,
+        }
+        Ok(())
+    }
+}
+
 fn identity(name: &str, mut params: ParamList, _: &FileLoc) -> Upgraded {
     upgrade::upgrade_param_types(&mut params);
     Upgraded {
@@ -465,7 +494,43 @@ impl ParserTarget for FormattingTarget {
         self.simple("Sampler", name, params, &loc, upgrade::upgrade_sampler)
     }
     fn accelerator(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
-        self.simple("Accelerator", name, params, &loc, identity)
+        self.simple(
+            "Accelerator",
+            name,
+            params,
+            &loc,
+            upgrade::upgrade_accelerator,
+        )
+    }
+    fn renderer(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.legacy_transport("Renderer", name, params, loc)
+    }
+    fn surface_integrator(
+        &mut self,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        self.legacy_transport("SurfaceIntegrator", name, params, loc)
+    }
+    fn volume_integrator(
+        &mut self,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        self.legacy_transport("VolumeIntegrator", name, params, loc)
+    }
+    fn volume(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        if self.upgrade {
+            self.diags.push(Diagnostic::error(
+                loc,
+                format!("pbrt-v4 has no \"Volume\" regions: --upgrade cannot write this \"{name}\" region (give it a bounding shape with a MediumInterface)"),
+            ));
+        } else {
+            self.named("Volume", name, &params);
+        }
+        Ok(())
     }
     fn integrator(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
         self.simple(
@@ -522,7 +587,12 @@ impl ParserTarget for FormattingTarget {
         self.line(&format!("Option {} {value}", Self::quoted(name)));
         Ok(())
     }
-    fn world_begin(&mut self, _loc: FileLoc) -> DirectiveResult {
+    fn world_begin(&mut self, loc: FileLoc) -> DirectiveResult {
+        if !self.legacy.is_empty() {
+            let u = std::mem::take(&mut self.legacy).integrator(false, Target::PbrtV4, &loc);
+            let (n, p) = self.take(u);
+            self.named("Integrator", &n, &p);
+        }
         self.out.push('\n');
         self.line("WorldBegin");
         self.out.push('\n');

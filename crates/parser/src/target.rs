@@ -82,6 +82,24 @@ pub trait ParserTarget {
     fn integrator(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult;
     /// `Camera "name" params`
     fn camera(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult;
+    /// `Renderer "name" params` (pbrt-v2; pbrt-v1 had none): how the image
+    /// is made, `sampler` (the default), `metropolis` or a tool.
+    fn renderer(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult;
+    /// `SurfaceIntegrator "name" params` (pbrt-v1 and pbrt-v2): light
+    /// transport at surfaces.
+    fn surface_integrator(
+        &mut self,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult;
+    /// `VolumeIntegrator "name" params` (pbrt-v1 and pbrt-v2): light
+    /// transport in `Volume` regions.
+    fn volume_integrator(&mut self, name: &str, params: ParamList, loc: FileLoc)
+        -> DirectiveResult;
+    /// `Volume "name" params` (pbrt-v1 and pbrt-v2, in the world block): a
+    /// participating-medium region with no bounding surface.
+    fn volume(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult;
     /// `MakeNamedMedium "name" params`
     fn make_named_medium(&mut self, name: &str, params: ParamList, loc: FileLoc)
         -> DirectiveResult;

@@ -374,6 +374,19 @@ pub fn upgrade_material(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc)
             }
             e.rename("Kd", "reflectance");
         }
+        // pbrt-v1/v2: a glossy Blinn lobe over a mirror, each with a
+        // Fresnel term made from a colour; the nearest pbrt-v4 model is a
+        // rough conductor of the glossy lobe's colour.
+        "shinymetal" => {
+            e.name = "conductor".into();
+            e.rename("Ks", "reflectance");
+            e.remove_all("Kr", &SPECTRUM_TYPES);
+            e.remove_all("Kr", &["texture"]);
+            e.warn(
+                None,
+                "pbrt-v2's \"shinymetal\" is approximated by a rough \"conductor\" of its \"Ks\" colour: its mirror lobe (\"Kr\") and Blinn distribution are lost".into(),
+            );
+        }
         "fourier" => e.warn(
             None,
             "the \"fourier\" material is not supported by pbrt-v4 (see \"measured\")".into(),
@@ -457,7 +470,7 @@ pub fn reference_of(p: &ParsedParameter) -> Option<Reference> {
 /// The pbrt-v3 materials pbrt-v4 dropped that a renderer reading pbrt-v3
 /// files directly can still build (rpbrt does): `--upgrade` must map them
 /// to something pbrt-v4 reads, rendering need not.
-pub const NATIVE_V3_MATERIALS: &[&str] = &["disney", "fourier"];
+pub const NATIVE_V3_MATERIALS: &[&str] = &["disney", "fourier", "shinymetal"];
 
 /// [`upgrade_material`] for a renderer that implements
 /// [`NATIVE_V3_MATERIALS`]: those keep their name and parameters (only the
@@ -505,7 +518,9 @@ fn upgrade_light_with(
     let emission = match name {
         "point" | "spot" | "goniometric" => Some("I"),
         "distant" => Some("L"),
-        "infinite" | "exinfinite" if e.get("mapname", &["string"]).is_none() => Some("L"),
+        "infinite" | "exinfinite" | "infinitesample" if e.get("mapname", &["string"]).is_none() => {
+            Some("L")
+        }
         _ => None,
     };
     if !e.rgb_into_scale("scale", &mut scale)
@@ -521,12 +536,13 @@ fn upgrade_light_with(
     for n in ["samples", "nsamples"] {
         e.remove_all(n, &["integer", "float"]);
     }
-    // pbrt-v3 accepted "exinfinite" as another name of "infinite".
-    if name == "exinfinite" {
+    // pbrt-v3 accepted "exinfinite" as another name of "infinite", and
+    // pbrt-v1 had "infinitesample" (the same light, sampled by its map).
+    if name == "exinfinite" || name == "infinitesample" {
         e.name = "infinite".into();
     }
     let has_map = e.get("mapname", &["string"]).is_some();
-    if has_map && name == "infinite" && !e.rgb_into_scale("L", &mut scale) {
+    if has_map && e.name == "infinite" && !e.rgb_into_scale("L", &mut scale) {
         let l = e.get("L", &SPECTRUM_TYPES).map(|p| p.loc.clone());
         e.error(l.as_ref(), "a non-uniform \"L\" with \"mapname\" on an \"infinite\" light is not supported by pbrt-v4".into());
         return e.finish();
@@ -627,6 +643,11 @@ pub fn upgrade_film(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> 
     }
     if name == "image" {
         e.name = "rgb".into();
+        // pbrt-v1/v2's on-screen display, alpha premultiplication and
+        // partial writes: none changes the image.
+        e.remove_all("display", &["bool"]);
+        e.remove_all("premultiplyalpha", &["bool"]);
+        e.remove_all("writefrequency", &["integer"]);
     }
     e.finish()
 }
@@ -640,7 +661,37 @@ pub fn upgrade_sampler(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) 
         "lowdiscrepancy" | "02sequence" => e.name = "paddedsobol".into(),
         "maxmindist" => e.name = "pmj02bn".into(),
         "random" => e.name = "independent".into(),
+        // pbrt-v1/v2's best-candidate patterns were blue noise, as
+        // pbrt-v4's pmj02bn's are.
+        "bestcandidate" => e.name = "pmj02bn".into(),
+        // pbrt-v2's adaptive sampler took between `minsamples` and
+        // `maxsamples` per pixel, more where the first ones disagreed:
+        // every pixel takes `maxsamples` (same image, less noise).
+        "adaptive" => {
+            e.name = "paddedsobol".into();
+            let max = e
+                .remove("maxsamples", &["integer"])
+                .and_then(|p| p.ints.first().copied())
+                .unwrap_or(32);
+            e.remove_all("minsamples", &["integer"]);
+            e.remove_all("method", &["string"]);
+            e.remove_all("pixelsamples", &["integer"]);
+            let mut p = ParsedParameter::new("integer", "pixelsamples", e.loc.clone());
+            p.ints = vec![max];
+            e.add_front(p);
+        }
         _ => {}
+    }
+    e.finish()
+}
+
+/// Upgrades an `Accelerator`: pbrt-v1/v2's uniform `grid` (pbrt-v4 has
+/// none; the accelerator changes only the speed) becomes a `bvh`.
+pub fn upgrade_accelerator(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
+    let mut e = Edit::new(name, params, loc);
+    if name == "grid" {
+        e.name = "bvh".into();
+        e.remove_all("refineimmediately", &["bool"]);
     }
     e.finish()
 }
@@ -680,6 +731,26 @@ pub fn upgrade_integrator(name: &str, params: Vec<ParsedParameter>, loc: &FileLo
     e.finish()
 }
 
+/// [`upgrade_integrator`] for rpbrt's renderer, which also has pbrt-v3's
+/// `whitted`: `directlighting` (direct lighting at each hit, specular
+/// chains to `maxdepth`) is the same light transport as `whitted` and
+/// renders as it, where `--upgrade` can only approximate it with `path`.
+pub fn upgrade_integrator_for_render(
+    name: &str,
+    params: Vec<ParsedParameter>,
+    loc: &FileLoc,
+) -> Upgraded {
+    if name == "directlighting" {
+        let mut e = legacy::surface_integrator(
+            &legacy::Given::new(name, params, loc.clone()),
+            legacy::Target::Render,
+        );
+        e.remove_all("rrthreshold", &["float"]);
+        return e.finish();
+    }
+    upgrade_integrator(name, params, loc)
+}
+
 /// Upgrades a `Camera` (`environment` → `spherical`, equirectangular).
 pub fn upgrade_camera(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -> Upgraded {
     let mut e = Edit::new(name, params, loc);
@@ -690,6 +761,29 @@ pub fn upgrade_camera(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) -
     }
     if name == "realistic" {
         e.remove_all("simpleweighting", &["bool"]);
+    }
+    // pbrt-v2's half field of view, used where no "fov" is given.
+    if let Some(p) = e.remove("halffov", &["float"]) {
+        match p.floats[..] {
+            [h] if h > 0.0 && e.get("fov", &["float"]).is_none() => {
+                let fov = e.float("fov", &[2.0 * h]);
+                e.add_front(fov);
+            }
+            _ => {}
+        }
+    }
+    // pbrt-v1's clipping planes (default 1e-3 and 1e30): pbrt-v4 clips
+    // nothing, which changes the image only where they cut the scene.
+    for (plane, default) in [("hither", 1e-3), ("yon", 1e30)] {
+        if let Some(p) = e.remove(plane, &["float"]) {
+            if p.floats.first().is_some_and(|&v| v != default) {
+                let l = p.loc.clone();
+                e.warn(
+                    Some(&l),
+                    format!("pbrt-v1's clipping plane \"{plane}\" is ignored: pbrt-v4 cameras clip nothing"),
+                );
+            }
+        }
     }
     e.finish()
 }
@@ -1012,6 +1106,7 @@ fn upgrade_heightfield(e: &mut Edit) {
     ));
 }
 
+pub mod legacy;
 mod nurbs;
 
 #[cfg(test)]

@@ -52,6 +52,10 @@ pub(crate) enum WithParams {
     LightSource,
     AreaLightSource,
     Shape,
+    Renderer,
+    SurfaceIntegrator,
+    VolumeIntegrator,
+    Volume,
 }
 
 /// One recorded call.
@@ -114,6 +118,10 @@ impl Recorded {
                 WithParams::LightSource => t.light_source(&n, p, l),
                 WithParams::AreaLightSource => t.area_light_source(&n, p, l),
                 WithParams::Shape => t.shape(&n, p, l),
+                WithParams::Renderer => t.renderer(&n, p, l),
+                WithParams::SurfaceIntegrator => t.surface_integrator(&n, p, l),
+                WithParams::VolumeIntegrator => t.volume_integrator(&n, p, l),
+                WithParams::Volume => t.volume(&n, p, l),
             },
             Recorded::Translate(d, l) => t.translate(d, l),
             Recorded::Scale(s, l) => t.scale(s, l),
@@ -230,6 +238,28 @@ impl ParserTarget for Recorder {
     }
     fn integrator(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
         self.params(WithParams::Integrator, name, params, loc)
+    }
+    fn renderer(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.params(WithParams::Renderer, name, params, loc)
+    }
+    fn surface_integrator(
+        &mut self,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        self.params(WithParams::SurfaceIntegrator, name, params, loc)
+    }
+    fn volume_integrator(
+        &mut self,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        self.params(WithParams::VolumeIntegrator, name, params, loc)
+    }
+    fn volume(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.params(WithParams::Volume, name, params, loc)
     }
     fn camera(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
         self.params(WithParams::Camera, name, params, loc)

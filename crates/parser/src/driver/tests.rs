@@ -90,6 +90,18 @@ impl ParserTarget for Rec {
     fn integrator(&mut self, n: &str, p: ParamList, loc: FileLoc) -> DirectiveResult {
         self.with_params(format!("Integrator {n}"), p, &loc)
     }
+    fn renderer(&mut self, n: &str, p: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.with_params(format!("Renderer {n}"), p, &loc)
+    }
+    fn surface_integrator(&mut self, n: &str, p: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.with_params(format!("SurfaceIntegrator {n}"), p, &loc)
+    }
+    fn volume_integrator(&mut self, n: &str, p: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.with_params(format!("VolumeIntegrator {n}"), p, &loc)
+    }
+    fn volume(&mut self, n: &str, p: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.with_params(format!("Volume {n}"), p, &loc)
+    }
     fn camera(&mut self, n: &str, p: ParamList, loc: FileLoc) -> DirectiveResult {
         self.with_params(format!("Camera {n}"), p, &loc)
     }

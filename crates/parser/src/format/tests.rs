@@ -395,3 +395,71 @@ fn colour_light_scales_fold_into_rgb_emission() {
         );
     }
 }
+
+const V2_SCENE: &str = r#"Film "image" "string filename" "v2.exr" "integer xresolution" 64
+Sampler "bestcandidate" "integer pixelsamples" 8
+Accelerator "grid" "bool refineimmediately" "true"
+Renderer "sampler"
+VolumeIntegrator "single" "float stepsize" 0.1
+SurfaceIntegrator "directlighting" "integer maxdepth" 3 "string strategy" "one"
+WorldBegin
+Volume "homogeneous" "color sigma_a" [0.1 0.1 0.1] "point p0" [0 0 0] "point p1" [1 1 1]
+Shape "sphere"
+WorldEnd
+"#;
+
+#[test]
+fn formats_pbrt_v2_directives_as_they_are() {
+    let (out, diags) = format(V2_SCENE, false);
+    assert!(!diags.has_errors(), "{diags}");
+    for frag in [
+        "Renderer \"sampler\"\n",
+        "VolumeIntegrator \"single\"\n    \"float stepsize\" [ 0.1 ]\n",
+        "SurfaceIntegrator \"directlighting\"\n    \"integer maxdepth\" [ 3 ]\n",
+        "Volume \"homogeneous\"\n    \"color sigma_a\" [ 0.1 0.1 0.1 ]\n",
+    ] {
+        assert!(out.contains(frag), "missing {frag:?} in\n{out}");
+    }
+    let (again, _) = format(&out, false);
+    assert_eq!(out, again);
+}
+
+#[test]
+fn upgrades_pbrt_v2_transport_to_one_integrator() {
+    let (out, diags) = format(V2_SCENE, true);
+    for frag in [
+        "Sampler \"pmj02bn\"\n    \"integer pixelsamples\" [ 8 ]\n",
+        "Accelerator \"bvh\"\n",
+        "Integrator \"path\"\n    \"integer maxdepth\" [ 1 ]\n\nWorldBegin",
+    ] {
+        assert!(out.contains(frag), "missing {frag:?} in\n{out}");
+    }
+    assert!(!out.contains("Renderer") && !out.contains("SurfaceIntegrator"));
+    assert!(!out.contains("refineimmediately") && !out.contains("Volume"));
+    // The region cannot be written: a located error.
+    let msgs: Vec<String> = diags.iter().map(|d| d.to_string()).collect();
+    assert!(
+        msgs.iter()
+            .any(|m| m.contains(":8:1: error:") && m.contains("no \"Volume\" regions")),
+        "{msgs:?}"
+    );
+    // Metropolis becomes mlt with pbrt-v2's defaults spelled out.
+    let (out, diags) = format(
+        "Renderer \"metropolis\" \"integer samplesperpixel\" 64 \"bool bidirectional\" \"false\"\nWorldBegin\n",
+        true,
+    );
+    assert!(!diags.has_errors(), "{diags}");
+    assert!(
+        out.contains("Integrator \"mlt\"\n    \"integer maxdepth\" [ 7 ]\n    \"integer mutationsperpixel\" [ 64 ]\n    \"float largestepprobability\" [ 0.25 ]\n"),
+        "{out}"
+    );
+    assert!(!out.contains("bidirectional"), "{out}");
+    // A renderer that makes no image is a located error.
+    let (_, diags) = format("Renderer \"createprobes\"\nWorldBegin\n", true);
+    let msgs: Vec<String> = diags.iter().map(|d| d.to_string()).collect();
+    assert!(
+        msgs.iter()
+            .any(|m| m.contains(":1:1: error:") && m.contains("makes no image")),
+        "{msgs:?}"
+    );
+}

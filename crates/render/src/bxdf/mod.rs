@@ -26,6 +26,7 @@ mod layered;
 pub mod measured;
 mod microfacet;
 mod scattering;
+mod shinymetal;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
@@ -45,6 +46,7 @@ pub use scattering::{
     fr_complex, fr_complex_spectrum, fr_dielectric, fresnel_moment1, fresnel_moment2,
     henyey_greenstein, reflect, refract, sample_henyey_greenstein, Complex,
 };
+pub use shinymetal::ShinyMetalBxDF;
 
 /// Whether light (radiance) or importance is being transported; BxDFs that
 /// refract scale differently in the two cases.
@@ -327,6 +329,8 @@ pub enum BxDF {
     Disney(DisneyBxDF),
     /// pbrt-v3's tabulated Fourier BSDF.
     Fourier(FourierBxDF),
+    /// pbrt-v1/v2's `shinymetal`.
+    ShinyMetal(ShinyMetalBxDF),
 }
 
 macro_rules! dispatch {
@@ -344,6 +348,7 @@ macro_rules! dispatch {
             BxDF::Measured($b) => $e,
             BxDF::Disney($b) => $e,
             BxDF::Fourier($b) => $e,
+            BxDF::ShinyMetal($b) => $e,
         }
     };
 }
@@ -408,6 +413,7 @@ impl BxDF {
             BxDF::Measured(_) => "MeasuredBxDF",
             BxDF::Disney(_) => "DisneyBxDF",
             BxDF::Fourier(_) => "FourierBSDF",
+            BxDF::ShinyMetal(_) => "ShinyMetalBSDF",
         }
     }
 

@@ -35,6 +35,7 @@ pub const MATERIAL_NAMES: &[&str] = &[
     "interface",
     "measured",
     "mix",
+    "shinymetal",
     "subsurface",
     "thindielectric",
 ];
@@ -279,6 +280,12 @@ pub fn create_material(
             }))
         }
         "mix" => create_mix(tp, visible)?,
+        "shinymetal" => Material::ShinyMetal(Box::new(ShinyMetalMaterial {
+            ks: tp.spectrum_texture("Ks", Spectrum::constant(1.0), albedo)?,
+            kr: tp.spectrum_texture("Kr", Spectrum::constant(1.0), albedo)?,
+            roughness: tp.float_texture("roughness", 0.1)?,
+            perturbation: perturbation(tp, cache)?,
+        })),
         "subsurface" => create_subsurface(tp, cache)?,
         "measured" => {
             let file = tp.string("filename", "")?;

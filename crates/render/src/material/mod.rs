@@ -35,6 +35,7 @@ mod fourier;
 mod hair;
 mod measured;
 mod mix;
+mod shinymetal;
 mod subsurface;
 #[cfg(test)]
 mod tests;
@@ -51,6 +52,7 @@ pub use fourier::FourierMaterial;
 pub use hair::{HairAbsorption, HairMaterial};
 pub use measured::MeasuredMaterial;
 pub use mix::MixMaterial;
+pub use shinymetal::ShinyMetalMaterial;
 pub use subsurface::{SubsurfaceCoefficients, SubsurfaceMaterial};
 
 /// The longest chain of `mix` materials [`MaterialSet::resolve`] follows.
@@ -201,6 +203,8 @@ pub enum Material {
     Disney(Box<DisneyMaterial>),
     /// pbrt-v3's tabulated Fourier BSDF.
     Fourier(Box<FourierMaterial>),
+    /// pbrt-v1/v2's `shinymetal`.
+    ShinyMetal(Box<ShinyMetalMaterial>),
 }
 
 impl Material {
@@ -228,6 +232,7 @@ impl Material {
             Material::Measured(m) => Some(m.get_bxdf(ctx, lambda)),
             Material::Disney(m) => Some(m.get_bxdf(ctx, lambda)),
             Material::Fourier(m) => Some(m.get_bxdf(ctx, lambda)),
+            Material::ShinyMetal(m) => Some(m.get_bxdf(ctx, lambda)),
         }
     }
 
@@ -246,6 +251,7 @@ impl Material {
             Material::Measured(m) => Some(&m.perturbation),
             Material::Disney(m) => Some(&m.perturbation),
             Material::Fourier(m) => Some(&m.perturbation),
+            Material::ShinyMetal(m) => Some(&m.perturbation),
             Material::Hair(_) | Material::Mix(_) | Material::Interface => None,
         }
     }
@@ -284,6 +290,7 @@ impl Material {
             Material::Measured(_) => "measured",
             Material::Disney(_) => "disney",
             Material::Fourier(_) => "fourier",
+            Material::ShinyMetal(_) => "shinymetal",
         }
     }
 }

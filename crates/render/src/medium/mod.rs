@@ -7,7 +7,8 @@
 //! The files: `phase`, the phase function; `majorant`, majorant segments,
 //! the majorant grid and its DDA walk; `sampled_grid`, trilinearly
 //! interpolated sample grids; one file per medium type (`homogeneous`,
-//! `grid`, `rgbgrid`, `cloud`), each with its creation; `create`,
+//! `grid`, `rgbgrid`, `cloud`, and pbrt-v1/v2's `Volume` regions in
+//! `region`), each with its creation; `create`,
 //! creation from `MakeNamedMedium` and the parameter checks the media
 //! share.
 
@@ -22,6 +23,7 @@ pub mod measured;
 pub mod nanovdb;
 mod nanovdb_medium;
 mod phase;
+mod region;
 mod rgbgrid;
 mod sampled_grid;
 #[cfg(test)]
@@ -38,6 +40,7 @@ pub use nanovdb_medium::{NanoVdbMedium, NanoVdbTemperature};
 pub use phase::{
     henyey_greenstein, sample_henyey_greenstein, HGPhaseFunction, PhaseFunctionSample,
 };
+pub use region::{create_region, RegionMedium, VolumeRegion, REGION_NAMES};
 pub use rgbgrid::{RgbEmissionGrid, RgbGridMedium, RgbGridMediumParts, RGB_GRID_MAJORANT_RES};
 pub use sampled_grid::{GridValue, Interpolant, SampledGrid};
 
@@ -94,6 +97,8 @@ pub enum Medium {
     RgbGrid(Box<RgbGridMedium>),
     /// `cloud`.
     Cloud(Box<CloudMedium>),
+    /// pbrt-v1/v2's `Volume` regions, all of a scene's together.
+    Region(Box<RegionMedium>),
 }
 
 impl Medium {
@@ -106,6 +111,7 @@ impl Medium {
             Medium::UniformGrid(m) => m.is_emissive(),
             Medium::RgbGrid(m) => m.is_emissive(),
             Medium::Cloud(_) => false,
+            Medium::Region(m) => m.is_emissive(),
         }
     }
 
@@ -118,6 +124,7 @@ impl Medium {
             Medium::UniformGrid(m) => m.sample_point(p, lambda),
             Medium::RgbGrid(m) => m.sample_point(p, lambda),
             Medium::Cloud(m) => m.sample_point(p, lambda),
+            Medium::Region(m) => m.sample_point(p, lambda),
         }
     }
 
@@ -136,6 +143,7 @@ impl Medium {
             Medium::UniformGrid(m) => m.sample_ray(&ray, t_max, lambda).collect(),
             Medium::RgbGrid(m) => m.sample_ray(&ray, t_max, lambda).collect(),
             Medium::Cloud(m) => m.sample_ray(&ray, t_max, lambda).collect(),
+            Medium::Region(m) => m.sample_ray(&ray, t_max, lambda).collect(),
         }
     }
 }
@@ -190,6 +198,7 @@ pub fn sample_t_maj(
         Medium::UniformGrid(m) => sample_t_maj_in(&**m, ray, t_max, u, rng, lambda, callback),
         Medium::RgbGrid(m) => sample_t_maj_in(&**m, ray, t_max, u, rng, lambda, callback),
         Medium::Cloud(m) => sample_t_maj_in(&**m, ray, t_max, u, rng, lambda, callback),
+        Medium::Region(m) => sample_t_maj_in(&**m, ray, t_max, u, rng, lambda, callback),
     }
 }
 

@@ -24,7 +24,7 @@ use crate::integrator::{
 use crate::light::{create_light, Light, LightCull, LightDialect, LightType};
 use crate::lightsampler::create_light_sampler;
 use crate::material::MaterialSet;
-use crate::medium::{create_medium, Medium};
+use crate::medium::{create_medium, create_region, Medium, RegionMedium};
 use crate::params::{unknown_type, ParamReader};
 use crate::primitive::{AnimatedPrimitive, Primitive, PrimitiveAggregate, TransformedPrimitive};
 use crate::sampler::{create_sampler, Sampler};
@@ -190,6 +190,39 @@ fn create_media(desc: &SceneDescription, p: &mut Problems) -> (Vec<Medium>, Hash
     (media, ids)
 }
 
+/// Creates a pbrt-v1/v2 scene's `Volume` regions as one medium, appended
+/// to `media`; returns its id (`None` without regions).
+fn create_regions(
+    desc: &SceneDescription,
+    p: &mut Problems,
+    media: &mut Vec<Medium>,
+) -> Option<u32> {
+    let mut regions = Vec::new();
+    for v in &desc.volume_regions {
+        let Some(r) = p.take(reader(&v.base, &desc.budget)) else {
+            continue;
+        };
+        let region = r
+            .charge(v.base.params.memory_bytes() as u64, "this region's data")
+            .and_then(|()| {
+                create_region(
+                    &v.base.name,
+                    &r,
+                    &v.render_from_region,
+                    desc.regions_scatter,
+                )
+            });
+        if let Some(region) = p.finish(r, region) {
+            regions.push(region);
+        }
+    }
+    if regions.is_empty() {
+        return None;
+    }
+    media.push(Medium::Region(Box::new(RegionMedium::new(regions))));
+    Some(media.len() as u32 - 1)
+}
+
 /// pbrt-v3's `path` integrator traced BSSRDFs, which pbrt-v4's leaves to
 /// `volpath`: in a pbrt-v3 scene with subsurface scattering, `path` is
 /// rendered by `volpath` with the same parameters (the same image in
@@ -289,8 +322,11 @@ pub fn create_scene(
     let p = &mut problems;
 
     // Participating media, by name.
-    let (media, medium_ids) = create_media(desc, p);
-    let medium_of = |name: &str| medium_ids.get(name).copied();
+    let (mut media, medium_ids) = create_media(desc, p);
+    // pbrt-v1/v2's regions are seen wherever a ray is (surfaces do not
+    // change a ray's medium without a MediumInterface).
+    let regions = create_regions(desc, p, &mut media);
+    let medium_of = |name: &str| medium_ids.get(name).copied().or(regions);
 
     // Filter, film, camera, sampler.
     let filter = p.take(reader(&desc.filter, &desc.budget)).and_then(|r| {

@@ -16,6 +16,7 @@ use rpbrt_geometry::{
     AnimatedTransform, Point3f, SquareMatrix4, Transform, TransformError, Vector3f,
 };
 use rpbrt_parser::budget::{heap, vec_element};
+use rpbrt_parser::upgrade::legacy::{Given, LegacyTransport, Target};
 use rpbrt_parser::upgrade::{self, Reference, Upgraded};
 use rpbrt_parser::{Diagnostic, MemoryBudget};
 use rpbrt_parser::{
@@ -63,6 +64,9 @@ pub struct SceneBuilder {
     /// pbrt-v3's redefined textures and named materials (see
     /// [`SceneBuilder::redefine`]).
     renames: [Renames; 2],
+    /// A pbrt-v1/v2 file's `Renderer`, `SurfaceIntegrator` and
+    /// `VolumeIntegrator`, made into one integrator once all files are read.
+    legacy: LegacyTransport,
 }
 
 /// The names of one kind that a pbrt-v3 file defined more than once, each
@@ -106,6 +110,7 @@ impl SceneBuilder {
             medium_uses: Vec::new(),
             pending: Vec::new(),
             renames: Default::default(),
+            legacy: LegacyTransport::default(),
         }
     }
 
@@ -245,6 +250,134 @@ impl SceneBuilder {
         if unset(&self.scene.integrator) {
             self.scene.integrator = entity("path", vec![int("maxdepth", 5)]);
         }
+    }
+
+    /// In a pbrt-v1/v2 scene, the rendering options the file left out take
+    /// pbrt-v2's defaults (pbrt-v2 `core/api.cpp`'s `RenderOptions` and
+    /// the creators' parameter defaults): a 640 × 480 film, a box filter
+    /// of radius 0.5 and the `lowdiscrepancy` sampler (→ `paddedsobol`)
+    /// with 4 samples; its `Renderer`, `SurfaceIntegrator` (default
+    /// `directlighting`) and `VolumeIntegrator` become the integrator
+    /// unless the file also gave an `Integrator`.
+    fn use_pbrt_v2_defaults(&mut self, v2: &FileLoc) {
+        let unset = |e: &SceneEntity| e.loc == default_loc();
+        let int = |name: &str, v: i32| {
+            let mut p = ParsedParameter::new("integer", name, default_loc());
+            p.ints = vec![v];
+            p
+        };
+        let entity = |name: &str, params: Vec<ParsedParameter>| {
+            SceneEntity::new(
+                name,
+                ParameterDictionary::new(params),
+                default_loc(),
+                "srgb",
+            )
+        };
+        // pbrt-v2's creators' defaults, where the directive was given
+        // without them.
+        let missing =
+            |e: &SceneEntity, name: &str| !e.params.params().iter().any(|p| p.name == name);
+        let mut film_extra = Vec::new();
+        for (name, v) in [("xresolution", 640), ("yresolution", 480)] {
+            if missing(&self.scene.film, name) {
+                film_extra.push(int(name, v));
+            }
+        }
+        let mut sampler_extra = Vec::new();
+        if self.scene.sampler.name == "stratified" {
+            for name in ["xsamples", "ysamples"] {
+                if missing(&self.scene.sampler, name) {
+                    sampler_extra.push(int(name, 2));
+                }
+            }
+        } else if missing(&self.scene.sampler, "pixelsamples") {
+            sampler_extra.push(int("pixelsamples", 4));
+        }
+        for (e, extra) in [
+            (&mut self.scene.film, film_extra),
+            (&mut self.scene.sampler, sampler_extra),
+        ] {
+            if !extra.is_empty() {
+                let mut params = std::mem::take(&mut e.params).into_params();
+                params.extend(extra);
+                e.params = ParameterDictionary::new(params);
+            }
+        }
+        if unset(&self.scene.filter) {
+            self.scene.filter = entity("box", Vec::new());
+        }
+        if unset(&self.scene.sampler) {
+            self.scene.sampler.name = "paddedsobol".into();
+        }
+        let legacy = std::mem::take(&mut self.legacy);
+        if !unset(&self.scene.integrator) {
+            if let Some(g) = [&legacy.renderer, &legacy.surface, &legacy.volume]
+                .into_iter()
+                .flatten()
+                .next()
+            {
+                self.pending.push(Diagnostic::warning(
+                    g.loc.clone(),
+                    format!(
+                        "ignored: the \"Integrator\" at {} chooses the light transport",
+                        self.scene.integrator.loc
+                    ),
+                ));
+            }
+            return;
+        }
+        // pbrt-v2's default volume integrator, `emission`, ignores
+        // scattering.
+        self.scene.regions_scatter = legacy.volume.as_ref().is_some_and(|v| v.name != "emission");
+        let volumes = !self.scene.volume_regions.is_empty();
+        let u = legacy.integrator(volumes, Target::Render, v2);
+        let failed = u.diagnostics.iter().any(Diagnostic::is_error);
+        self.pending.extend(u.diagnostics);
+        if failed {
+            return;
+        }
+        let loc = [&legacy.renderer, &legacy.surface]
+            .into_iter()
+            .flatten()
+            .next()
+            .map_or_else(default_loc, |g| g.loc.clone());
+        self.scene.integrator = self.entity(u.name, u.params, loc);
+    }
+
+    /// pbrt-v2 put a point light at `from` added to where the
+    /// transformation takes the origin (its light-to-world was
+    /// `Translate(from) · CTM`); pbrt-v3 and pbrt-v4 transform `from`
+    /// itself. `from` is replaced by the point the transformation takes
+    /// to pbrt-v2's position.
+    fn v2_point_from(&self, params: &mut ParamList) {
+        let ctm = self.state.ctm[0];
+        if let Some(p) = params
+            .iter_mut()
+            .rev()
+            .find(|p| p.name == "from" && p.ty == "point3" && p.floats.len() == 3)
+        {
+            let from = Vector3f::new(p.floats[0], p.floats[1], p.floats[2]);
+            let world = ctm.apply_point(Point3f::new(0.0, 0.0, 0.0)) + from;
+            let q = ctm.inverse().apply_point(world);
+            p.floats = vec![q.x, q.y, q.z];
+        }
+    }
+
+    /// Notes a material type only pbrt-v1/v2 had.
+    fn note_v2_material(&mut self, ty: &str, loc: &FileLoc) {
+        if ty == "shinymetal" {
+            self.note_pbrt_v2(loc);
+        }
+    }
+
+    /// Remembers `loc` if it is the scene's first pbrt-v1/v2-only
+    /// construct (which also makes the scene a pbrt-v3 one).
+    fn note_pbrt_v2(&mut self, loc: &FileLoc) {
+        if self.scene.pbrt_v2.is_none() {
+            self.scene.pbrt_v2 = Some(loc.clone());
+        }
+        self.note_pbrt_v3(loc);
     }
 
     // ---- entities ---------------------------------------------------------
@@ -640,7 +773,7 @@ impl ParserTarget for SceneBuilder {
         self.scene.accelerator = self.option_entity(
             "Accelerator",
             EntityKind::Accelerator,
-            None,
+            Some(upgrade::upgrade_accelerator),
             name,
             params,
             loc,
@@ -649,7 +782,7 @@ impl ParserTarget for SceneBuilder {
     }
 
     fn integrator(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
-        let f = upgrade::upgrade_integrator;
+        let f = upgrade::upgrade_integrator_for_render;
         self.scene.integrator = self.option_entity(
             "Integrator",
             EntityKind::Integrator,
@@ -658,6 +791,61 @@ impl ParserTarget for SceneBuilder {
             params,
             loc,
         )?;
+        Ok(())
+    }
+
+    fn renderer(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.verify_options("Renderer", &loc)?;
+        self.note_pbrt_v2(&loc);
+        self.note_pbrt_v3_params(&params);
+        self.legacy.renderer = Some(Given::new(name, params, loc));
+        Ok(())
+    }
+
+    fn surface_integrator(
+        &mut self,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        self.verify_options("SurfaceIntegrator", &loc)?;
+        self.note_pbrt_v2(&loc);
+        self.note_pbrt_v3_params(&params);
+        self.legacy.surface = Some(Given::new(name, params, loc));
+        Ok(())
+    }
+
+    fn volume_integrator(
+        &mut self,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        self.verify_options("VolumeIntegrator", &loc)?;
+        self.note_pbrt_v2(&loc);
+        self.note_pbrt_v3_params(&params);
+        self.legacy.volume = Some(Given::new(name, params, loc));
+        Ok(())
+    }
+
+    fn volume(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
+        self.verify_world("Volume", &loc)?;
+        self.note_pbrt_v2(&loc);
+        self.note_pbrt_v3_params(&params);
+        let mut params = params;
+        upgrade::upgrade_param_types(&mut params);
+        let bytes = vec_element::<VolumeRegionEntity>()
+            + heap(name.len())
+            + params
+                .iter()
+                .map(ParsedParameter::memory_bytes)
+                .sum::<usize>();
+        self.charge(bytes, "Volume", &loc)?;
+        let base = self.entity(name.to_string(), params, loc);
+        self.scene.volume_regions.push(VolumeRegionEntity {
+            base,
+            render_from_region: self.render_from_object_at(0),
+        });
         Ok(())
     }
 
@@ -906,6 +1094,7 @@ impl ParserTarget for SceneBuilder {
 
     fn material(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
         self.verify_world("Material", &loc)?;
+        self.note_v2_material(name, &loc);
         let (name, params) =
             self.upgraded(upgrade::upgrade_material_for_render, name, params, &loc);
         EntityKind::Material.check(&name, &loc)?;
@@ -931,6 +1120,7 @@ impl ParserTarget for SceneBuilder {
                 format!("no parameter \"string type\" found for named material \"{name}\""),
             ));
         };
+        self.note_v2_material(&ty, &ty_loc);
         let (ty, mut params) =
             self.upgraded(upgrade::upgrade_material_for_render, &ty, params, &loc);
         EntityKind::Material.check(&ty, &ty_loc)?;
@@ -970,8 +1160,12 @@ impl ParserTarget for SceneBuilder {
         let pbrt_v3 = params
             .iter()
             .any(|p| p.name == "mapname" && p.ty == "string");
-        let (name, params) = self.upgraded(upgrade::upgrade_light_for_render, name, params, &loc);
+        let (name, mut params) =
+            self.upgraded(upgrade::upgrade_light_for_render, name, params, &loc);
         EntityKind::Light.check(&name, &loc)?;
+        if name == "point" && self.scene.pbrt_v2.is_some() {
+            self.v2_point_from(&mut params);
+        }
         let attrs = self.state.light_attributes.clone();
         let base = self.entity_with(name, params, &attrs, loc);
         self.charge_entity::<LightSceneEntity>(&base, "LightSource")?;
@@ -1157,7 +1351,9 @@ impl ParserTarget for SceneBuilder {
     }
 
     fn end_of_files(&mut self) -> DirectiveResult {
-        if self.scene.pbrt_v3.is_some() {
+        if let Some(v2) = self.scene.pbrt_v2.clone() {
+            self.use_pbrt_v2_defaults(&v2);
+        } else if self.scene.pbrt_v3.is_some() {
             self.use_pbrt_v3_defaults();
         }
         if self.block != Block::World {

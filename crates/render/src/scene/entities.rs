@@ -180,6 +180,15 @@ pub struct MediumSceneEntity {
     pub render_from_object: AnimatedTransform,
 }
 
+/// A pbrt-v1/v2 `Volume` directive: a density region seen by every ray.
+#[derive(Clone, Debug)]
+pub struct VolumeRegionEntity {
+    /// Type, parameters and location.
+    pub base: SceneEntity,
+    /// From region space to render space.
+    pub render_from_region: Transform,
+}
+
 /// An `ObjectBegin`/`ObjectEnd` block: shapes to be instanced.
 #[derive(Clone, Debug)]
 pub struct InstanceDefinitionSceneEntity {
@@ -272,6 +281,12 @@ pub struct SceneDescription {
     pub spectrum_textures: Vec<TextureSceneEntity>,
     /// Named media in definition order.
     pub media: Vec<MediumSceneEntity>,
+    /// pbrt-v1/v2 `Volume` regions in definition order: together one
+    /// medium, the camera's and the lights' unless they name another.
+    pub volume_regions: Vec<VolumeRegionEntity>,
+    /// Whether the regions scatter light (false under pbrt-v2's default
+    /// `emission` volume integrator: absorption and emission only).
+    pub regions_scatter: bool,
     /// Object definitions in order.
     pub instance_definitions: Vec<InstanceDefinitionSceneEntity>,
     /// Object instances in order.
@@ -287,6 +302,14 @@ pub struct SceneDescription {
     /// pbrt-v4 (a `goniometric` or `projection` light without an image),
     /// such a scene gets pbrt-v3's meaning.
     pub pbrt_v3: Option<FileLoc>,
+    /// Where the scene first used a construct only pbrt-v1 or pbrt-v2
+    /// accepts (`Renderer`, `SurfaceIntegrator`, `VolumeIntegrator`,
+    /// `Volume`), or `None`. Such a scene is also marked [`pbrt_v3`]
+    /// (pbrt-v3 reads everything else the way its predecessors did) and
+    /// takes pbrt-v2's defaults.
+    ///
+    /// [`pbrt_v3`]: SceneDescription::pbrt_v3
+    pub pbrt_v2: Option<FileLoc>,
     /// The memory budget the description is charged to; creating the
     /// render objects charges the same one.
     pub budget: MemoryBudget,
@@ -315,11 +338,14 @@ impl Default for SceneDescription {
             float_textures: Vec::new(),
             spectrum_textures: Vec::new(),
             media: Vec::new(),
+            volume_regions: Vec::new(),
+            regions_scatter: true,
             instance_definitions: Vec::new(),
             instances: Vec::new(),
             options: Vec::new(),
             diagnostics: Vec::new(),
             pbrt_v3: None,
+            pbrt_v2: None,
             budget: MemoryBudget::default(),
         }
     }

@@ -13,4 +13,5 @@ mod integrators;
 mod media;
 mod mutation_fuzz;
 mod observer;
+mod v2_scenes;
 mod v3_scenes;

@@ -217,7 +217,8 @@ fn cases() -> Vec<Case> {
         case("filter triangle", ("PixelFilter \"triangle\"", SPHERE), ("PixelFilter \"triangle\"", SPHERE)),
         // ---- integrators
         native("integrator whitted", ("Integrator \"whitted\" \"integer maxdepth\" 3", "Material \"mirror\"\nShape \"sphere\"")),
-        case("integrator directlighting", ("Integrator \"directlighting\" \"string strategy\" \"all\"", SPHERE), ("Integrator \"path\" \"integer maxdepth\" 1 \"string strategy\" \"all\"", SPHERE)),
+        // pbrt-v3's directlighting is the light transport of its whitted.
+        case("integrator directlighting", ("Integrator \"directlighting\" \"string strategy\" \"all\"", "Material \"mirror\"\nShape \"sphere\""), ("Integrator \"whitted\" \"integer maxdepth\" 5", "Material \"conductor\" \"float roughness\" 0 \"rgb reflectance\" [ 0.9 0.9 0.9 ]\nShape \"sphere\"")),
         case("integrator path", ("Integrator \"path\" \"integer maxdepth\" 3 \"float rrthreshold\" 0.5 \"string lightsamplestrategy\" \"spatial\"", SPHERE), ("Integrator \"path\" \"integer maxdepth\" 3 \"string lightsamplestrategy\" \"bvh\"", SPHERE)),
         case("integrator volpath", ("Integrator \"volpath\" \"integer maxdepth\" 3", SPHERE), ("Integrator \"volpath\" \"integer maxdepth\" 3", SPHERE)),
         case("integrator bdpt", ("Integrator \"bdpt\" \"integer maxdepth\" 3", SPHERE), ("Integrator \"bdpt\" \"integer maxdepth\" 3", SPHERE)),

@@ -579,7 +579,7 @@ Camera "perspective" "float fov" [ 40 ]
 Film "image" "integer xresolution" [ 64 ] "integer yresolution" [ 48 ] "string filename" "out.exr"
 Sampler "lowdiscrepancy" "integer pixelsamples" [ 16 ]
 PixelFilter "gaussian" "float xwidth" [ 2 ] "float ywidth" [ 2 ]
-Integrator "directlighting"
+Integrator "path" "float rrthreshold" [ 0.5 ]
 WorldBegin
 LightSource "point" "color I" [ 10 10 10 ] "point from" [ 0 4 0 ]
 AttributeBegin
@@ -736,4 +736,180 @@ fn imports_build_the_scene_a_one_thread_parse_builds() {
         "{e}"
     );
     let _ = std::fs::remove_dir_all(&d);
+}
+
+/// The integrator a pbrt-v1/v2 options block makes, with its integer
+/// parameters, and the build's messages.
+fn v2_integrator(opts: &str, world: &str) -> (String, Vec<(String, i32)>, Vec<String>) {
+    let text = format!("{opts}\nWorldBegin\n{world}\nShape \"sphere\"\n");
+    let (s, diags) = build_scene_from_str(&text, &BuildOptions::default())
+        .unwrap_or_else(|d| panic!("unexpected errors in:\n{text}\n{d}"));
+    let ints = s
+        .integrator
+        .params
+        .params()
+        .iter()
+        .filter(|p| p.ty == "integer")
+        .map(|p| (p.name.clone(), p.ints[0]))
+        .collect();
+    let msgs = diags.iter().map(|d| d.to_string()).collect();
+    (s.integrator.name.clone(), ints, msgs)
+}
+
+#[test]
+fn pbrt_v2_transport_becomes_one_integrator() {
+    let depth = |d: i32| vec![("maxdepth".to_string(), d)];
+    // The default surface integrator, directlighting (maxdepth 5), is
+    // rendered by pbrt-v3's whitted: the same light transport.
+    let (name, ints, msgs) = v2_integrator("Renderer \"sampler\"", "");
+    assert_eq!((name.as_str(), ints), ("whitted", depth(5)));
+    assert!(msgs.is_empty(), "{msgs:?}");
+    let (name, ints, _) = v2_integrator("SurfaceIntegrator \"path\" \"integer maxdepth\" 9", "");
+    assert_eq!((name.as_str(), ints), ("path", depth(9)));
+    let (name, ints, _) = v2_integrator("SurfaceIntegrator \"whitted\"", "");
+    assert_eq!((name.as_str(), ints), ("whitted", depth(5)));
+    // Approximations warn, located at their directive.
+    for (si, what) in [
+        ("photonmap", "photon mapping"),
+        ("irradiancecache", "irradiance caching"),
+        ("igi", "instant global illumination"),
+        ("glossyprt", "precomputed radiance transfer"),
+    ] {
+        let (name, _, msgs) =
+            v2_integrator(&format!("Film \"image\"\nSurfaceIntegrator \"{si}\""), "");
+        assert_eq!(name, "path", "{si}");
+        assert!(
+            msgs.iter()
+                .any(|m| m.starts_with("<string>:2:1: warning:") && m.contains(what)),
+            "{si}: {msgs:?}"
+        );
+    }
+    let (name, _, msgs) = v2_integrator("SurfaceIntegrator \"dipolesubsurface\"", "");
+    assert_eq!(name, "volpath");
+    assert!(msgs.iter().any(|m| m.contains("dipole")), "{msgs:?}");
+    // Metropolis is mlt.
+    let (name, ints, _) = v2_integrator(
+        "Renderer \"metropolis\" \"integer samplesperpixel\" 16 \"bool dodirectseparately\" \"false\"",
+        "",
+    );
+    assert_eq!(name, "mlt");
+    assert!(
+        ints.contains(&("mutationsperpixel".to_string(), 16)),
+        "{ints:?}"
+    );
+    assert!(ints.contains(&("maxdepth".to_string(), 7)), "{ints:?}");
+    // Regions: volpath, scattering only with a scattering volume
+    // integrator.
+    let region = "Volume \"homogeneous\" \"color sigma_s\" [ 1 1 1 ]";
+    let (name, _, _) = v2_integrator(
+        "SurfaceIntegrator \"path\"\nVolumeIntegrator \"single\"",
+        region,
+    );
+    assert_eq!(name, "volpath");
+    let s = build("SurfaceIntegrator \"path\"\nWorldBegin\nVolume \"homogeneous\"\n");
+    assert!(!s.regions_scatter && s.volume_regions.len() == 1);
+    let s = build("VolumeIntegrator \"single\"\nWorldBegin\nVolume \"exponential\"\n");
+    assert!(s.regions_scatter);
+    assert_eq!(s.integrator.name, "volpath");
+    // An Integrator line wins, with a warning at the pbrt-v2 one.
+    let (name, _, msgs) = v2_integrator("SurfaceIntegrator \"path\"\nIntegrator \"bdpt\"", "");
+    assert_eq!(name, "bdpt");
+    assert!(
+        msgs.iter()
+            .any(|m| m.starts_with("<string>:1:1: warning: ignored")),
+        "{msgs:?}"
+    );
+}
+
+#[test]
+fn pbrt_v2_defaults_and_refusals() {
+    let s = build(
+        "SurfaceIntegrator \"path\"\nFilm \"image\" \"string filename\" \"x.exr\"\nWorldBegin\n",
+    );
+    assert_eq!(s.film.name, "rgb");
+    assert_eq!(s.film.params.get_one_int("xresolution", 0).unwrap(), 640);
+    assert_eq!(s.film.params.get_one_int("yresolution", 0).unwrap(), 480);
+    assert_eq!(s.sampler.name, "paddedsobol");
+    assert_eq!(s.sampler.params.get_one_int("pixelsamples", 0).unwrap(), 4);
+    assert_eq!(s.filter.name, "box");
+    assert!(s.pbrt_v2.is_some() && s.pbrt_v3.is_some());
+    let s = build("SurfaceIntegrator \"path\"\nSampler \"stratified\"\nWorldBegin\n");
+    assert_eq!(s.sampler.params.get_one_int("xsamples", 0).unwrap(), 2);
+    let s = build("SurfaceIntegrator \"path\"\nSampler \"adaptive\" \"integer maxsamples\" 64\nAccelerator \"grid\"\nWorldBegin\n");
+    assert_eq!(s.sampler.name, "paddedsobol");
+    assert_eq!(s.sampler.params.get_one_int("pixelsamples", 0).unwrap(), 64);
+    assert_eq!(s.accelerator.name, "bvh");
+    // pbrt-v1's sampled environment light is pbrt-v4's infinite light.
+    let s = build("SurfaceIntegrator \"path\"\nWorldBegin\nLightSource \"infinitesample\" \"color L\" [ 1 1 1 ]\n");
+    assert_eq!(s.lights[0].base.name, "infinite");
+    // A pbrt-v2 material marks the file too.
+    let s = build("WorldBegin\nMaterial \"shinymetal\" \"color Ks\" [ 0.5 0.5 0.5 ]\n");
+    assert!(s.pbrt_v2.is_some());
+    assert_eq!(s.integrator.name, "whitted");
+    // Renderers that make no image, unknown types and misplaced
+    // directives are located errors.
+    for (text, at, what) in [
+        (
+            "Renderer \"createprobes\"\nWorldBegin\n",
+            "<string>:1:1:",
+            "makes no image",
+        ),
+        (
+            "Renderer \"aggregatetest\"\nWorldBegin\n",
+            "<string>:1:1:",
+            "makes no image",
+        ),
+        (
+            "Renderer \"fast\"\nWorldBegin\n",
+            "<string>:1:1:",
+            "unknown pbrt-v2 renderer",
+        ),
+        (
+            "SurfaceIntegrator \"foo\"\nWorldBegin\n",
+            "<string>:1:1:",
+            "unknown pbrt-v2 surface integrator",
+        ),
+        (
+            "VolumeIntegrator \"foo\"\nWorldBegin\nVolume \"homogeneous\"\n",
+            "<string>:1:1:",
+            "unknown pbrt-v2 volume integrator",
+        ),
+        (
+            "WorldBegin\nSurfaceIntegrator \"path\"\n",
+            "<string>:2:1:",
+            "SurfaceIntegrator",
+        ),
+        (
+            "Volume \"homogeneous\"\nWorldBegin\n",
+            "<string>:1:1:",
+            "Volume",
+        ),
+    ] {
+        assert_error(text, at, what);
+    }
+}
+
+#[test]
+fn pbrt_v2_point_light_adds_from_after_the_transformation() {
+    // pbrt-v2: Translate(from) · CTM puts the light at CTM(0) + from =
+    // (1, 0, 0) + (0, 0, 2); pbrt-v3 would put it at CTM(from).
+    let text = "SurfaceIntegrator \"path\"\nWorldBegin\nTranslate 1 0 0\nRotate 90 0 1 0\n\
+                LightSource \"point\" \"point from\" [ 0 0 2 ]\n";
+    let s = build(text);
+    let l = &s.lights[0];
+    let from = l.base.params.get_one_point3("from", [0.0; 3]).unwrap();
+    let p = l
+        .render_from_object
+        .start_transform
+        .apply_point(Point3f::new(from[0], from[1], from[2]));
+    assert!(close(p, 1.0, 0.0, 2.0), "{p:?}");
+    // The same text read as pbrt-v3.
+    let s = build(&text.replace("SurfaceIntegrator \"path\"\n", ""));
+    let l = &s.lights[0];
+    let from = l.base.params.get_one_point3("from", [0.0; 3]).unwrap();
+    let p = l
+        .render_from_object
+        .start_transform
+        .apply_point(Point3f::new(from[0], from[1], from[2]));
+    assert!(close(p, 3.0, 0.0, 0.0), "{p:?}");
 }
