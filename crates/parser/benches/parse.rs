@@ -38,6 +38,7 @@ impl ParserTarget for Count {
         object_begin(n: &str); object_end(); object_instance(n: &str);
         renderer(n: &str, p: ParamList); surface_integrator(n: &str, p: ParamList);
         volume_integrator(n: &str, p: ParamList); volume(n: &str, p: ParamList);
+        search_path(n: &str);
     }
     fn shape(&mut self, _n: &str, p: ParamList, _loc: FileLoc) -> rpbrt_parser::DirectiveResult {
         self.values += p.iter().map(|p| p.value_count()).sum::<usize>();

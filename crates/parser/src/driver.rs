@@ -189,6 +189,7 @@ enum Directive {
     Rotate,
     Sampler,
     Scale,
+    SearchPath,
     Shape,
     SurfaceIntegrator,
     Texture,
@@ -237,6 +238,7 @@ const DIRECTIVES: &[(&str, Directive)] = &[
     ("Rotate", Directive::Rotate),
     ("Sampler", Directive::Sampler),
     ("Scale", Directive::Scale),
+    ("SearchPath", Directive::SearchPath),
     ("Shape", Directive::Shape),
     ("SurfaceIntegrator", Directive::SurfaceIntegrator),
     ("Texture", Directive::Texture),
@@ -1042,6 +1044,10 @@ impl<'a> Run<'a> {
             D::CoordSysTransform => {
                 let n = self.quoted("a coordinate system name", &l)?;
                 self.sink().coord_sys_transform(&n, loc)
+            }
+            D::SearchPath => {
+                let n = self.quoted("a search path", &l)?;
+                self.sink().search_path(&n, loc)
             }
             D::ActiveTransform => {
                 let t = self.next_required("All, StartTime or EndTime", &l)?;

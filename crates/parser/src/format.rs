@@ -450,6 +450,13 @@ impl ParserTarget for FormattingTarget {
         self.line(&format!("CoordSysTransform {}", Self::quoted(name)));
         Ok(())
     }
+    fn search_path(&mut self, path: &str, _loc: FileLoc) -> DirectiveResult {
+        // Only pbrt-v1's plugin lookup read it: dropped by --upgrade.
+        if !self.upgrade {
+            self.line(&format!("SearchPath {}", Self::quoted(path)));
+        }
+        Ok(())
+    }
     fn active_transform_all(&mut self, _loc: FileLoc) -> DirectiveResult {
         self.line("ActiveTransform All");
         Ok(())

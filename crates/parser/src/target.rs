@@ -58,6 +58,9 @@ pub trait ParserTarget {
     fn coordinate_system(&mut self, name: &str, loc: FileLoc) -> DirectiveResult;
     /// `CoordSysTransform "name"`
     fn coord_sys_transform(&mut self, name: &str, loc: FileLoc) -> DirectiveResult;
+    /// `SearchPath "dirs"` (pbrt-v1, options block): where pbrt-v1 looked
+    /// for its plugins.
+    fn search_path(&mut self, path: &str, loc: FileLoc) -> DirectiveResult;
     /// `ActiveTransform All`
     fn active_transform_all(&mut self, loc: FileLoc) -> DirectiveResult;
     /// `ActiveTransform EndTime`

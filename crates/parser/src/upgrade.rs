@@ -387,6 +387,10 @@ pub fn upgrade_material(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc)
                 "pbrt-v2's \"shinymetal\" is approximated by a rough \"conductor\" of its \"Ks\" colour: its mirror lobe (\"Kr\") and Blinn distribution are lost".into(),
             );
         }
+        "bluepaint" | "brushedmetal" | "clay" | "felt" | "primer" | "skin" => e.error(
+            None,
+            format!("pbrt-v1's measured \"{name}\" material has no pbrt-v4 equivalent: --upgrade cannot write it (rpbrt renders it)"),
+        ),
         "fourier" => e.warn(
             None,
             "the \"fourier\" material is not supported by pbrt-v4 (see \"measured\")".into(),
@@ -470,7 +474,17 @@ pub fn reference_of(p: &ParsedParameter) -> Option<Reference> {
 /// The pbrt-v3 materials pbrt-v4 dropped that a renderer reading pbrt-v3
 /// files directly can still build (rpbrt does): `--upgrade` must map them
 /// to something pbrt-v4 reads, rendering need not.
-pub const NATIVE_V3_MATERIALS: &[&str] = &["disney", "fourier", "shinymetal"];
+pub const NATIVE_V3_MATERIALS: &[&str] = &[
+    "bluepaint",
+    "brushedmetal",
+    "clay",
+    "disney",
+    "felt",
+    "fourier",
+    "primer",
+    "shinymetal",
+    "skin",
+];
 
 /// [`upgrade_material`] for a renderer that implements
 /// [`NATIVE_V3_MATERIALS`]: those keep their name and parameters (only the
@@ -660,7 +674,22 @@ pub fn upgrade_sampler(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) 
     match name {
         "lowdiscrepancy" | "02sequence" => e.name = "paddedsobol".into(),
         "maxmindist" => e.name = "pmj02bn".into(),
-        "random" => e.name = "independent".into(),
+        "random" => {
+            e.name = "independent".into();
+            // pbrt-v1's random sampler took a grid's `xsamples` and
+            // `ysamples` (2 each) per pixel.
+            let x = e.remove("xsamples", &["integer"]);
+            let y = e.remove("ysamples", &["integer"]);
+            if x.is_some() || y.is_some() {
+                let n = |p: Option<ParsedParameter>| {
+                    p.and_then(|p| p.ints.first().copied()).unwrap_or(2)
+                };
+                let mut p = ParsedParameter::new("integer", "pixelsamples", e.loc.clone());
+                p.ints = vec![n(x).saturating_mul(n(y))];
+                e.remove_all("pixelsamples", &["integer"]);
+                e.add_front(p);
+            }
+        }
         // pbrt-v1/v2's best-candidate patterns were blue noise, as
         // pbrt-v4's pmj02bn's are.
         "bestcandidate" => e.name = "pmj02bn".into(),

@@ -30,6 +30,7 @@ pub(crate) enum Bare {
 pub(crate) enum OneName {
     CoordinateSystem,
     CoordSysTransform,
+    SearchPath,
     ColorSpace,
     NamedMaterial,
     ObjectBegin,
@@ -99,6 +100,7 @@ impl Recorded {
             Recorded::Name(k, n, l) => match k {
                 OneName::CoordinateSystem => t.coordinate_system(&n, l),
                 OneName::CoordSysTransform => t.coord_sys_transform(&n, l),
+                OneName::SearchPath => t.search_path(&n, l),
                 OneName::ColorSpace => t.color_space(&n, l),
                 OneName::NamedMaterial => t.named_material(&n, l),
                 OneName::ObjectBegin => t.object_begin(&n, l),
@@ -205,6 +207,9 @@ impl ParserTarget for Recorder {
     }
     fn coord_sys_transform(&mut self, name: &str, loc: FileLoc) -> DirectiveResult {
         self.name(OneName::CoordSysTransform, name, loc)
+    }
+    fn search_path(&mut self, path: &str, loc: FileLoc) -> DirectiveResult {
+        self.name(OneName::SearchPath, path, loc)
     }
     fn active_transform_all(&mut self, loc: FileLoc) -> DirectiveResult {
         self.bare(Bare::ActiveTransformAll, loc)

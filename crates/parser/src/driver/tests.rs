@@ -57,6 +57,9 @@ impl ParserTarget for Rec {
     fn coord_sys_transform(&mut self, n: &str, loc: FileLoc) -> DirectiveResult {
         self.push(format!("CoordSysTransform {n}"), &loc)
     }
+    fn search_path(&mut self, n: &str, loc: FileLoc) -> DirectiveResult {
+        self.push(format!("SearchPath {n}"), &loc)
+    }
     fn active_transform_all(&mut self, loc: FileLoc) -> DirectiveResult {
         self.push("ActiveTransform All".into(), &loc)
     }

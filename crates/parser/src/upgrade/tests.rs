@@ -421,3 +421,19 @@ fn projection_colour_with_a_map() {
     let i = u.params.iter().find(|p| p.name == "I").expect("keeps I");
     assert_eq!(i.floats, vec![2., 1., 0.5]);
 }
+
+#[test]
+fn pbrt_v1_random_sampler_takes_a_grid_of_samples() {
+    let loc = FileLoc::new(std::sync::Arc::from("f"), 1, 1);
+    let mut x = ParsedParameter::new("integer", "xsamples", loc.clone());
+    x.ints = vec![3];
+    let mut y = ParsedParameter::new("integer", "ysamples", loc.clone());
+    y.ints = vec![4];
+    let u = upgrade_sampler("random", vec![x, y], &loc);
+    assert_eq!(u.name, "independent");
+    assert_eq!(u.params.len(), 1);
+    assert_eq!(
+        (u.params[0].name.as_str(), u.params[0].ints[0]),
+        ("pixelsamples", 12)
+    );
+}

@@ -21,6 +21,7 @@ mod diffuse;
 mod disney;
 pub mod fourier;
 mod hair;
+mod lafortune;
 pub(crate) mod lanes;
 mod layered;
 pub mod measured;
@@ -39,6 +40,9 @@ pub use diffuse::{DiffuseBxDF, DiffuseTransmissionBxDF, NormalizedFresnelBxDF};
 pub use disney::{DisneyBxDF, DisneyParams};
 pub use fourier::{FourierBSDFTable, FourierBxDF, FourierError};
 pub use hair::HairBxDF;
+pub use lafortune::{
+    LafortuneBxDF, LafortuneFit, LafortuneLobe, LAFORTUNE_FITS, LAFORTUNE_MATERIALS,
+};
 pub use layered::{CoatedConductorBxDF, CoatedDiffuseBxDF, LayeredBxDF};
 pub use measured::{MeasuredBxDF, MeasuredBxDFData};
 pub use microfacet::TrowbridgeReitzDistribution;
@@ -331,6 +335,8 @@ pub enum BxDF {
     Fourier(FourierBxDF),
     /// pbrt-v1/v2's `shinymetal`.
     ShinyMetal(ShinyMetalBxDF),
+    /// pbrt-v1's measured Lafortune fits.
+    Lafortune(LafortuneBxDF),
 }
 
 macro_rules! dispatch {
@@ -349,6 +355,7 @@ macro_rules! dispatch {
             BxDF::Disney($b) => $e,
             BxDF::Fourier($b) => $e,
             BxDF::ShinyMetal($b) => $e,
+            BxDF::Lafortune($b) => $e,
         }
     };
 }
@@ -414,6 +421,7 @@ impl BxDF {
             BxDF::Disney(_) => "DisneyBxDF",
             BxDF::Fourier(_) => "FourierBSDF",
             BxDF::ShinyMetal(_) => "ShinyMetalBSDF",
+            BxDF::Lafortune(_) => "LafortuneBSDF",
         }
     }
 

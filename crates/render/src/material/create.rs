@@ -12,7 +12,7 @@ use rpbrt_parser::Diagnostic;
 
 use super::coated::LayerSettings;
 use super::*;
-use crate::bxdf::{FourierBSDFTable, MeasuredBxDFData};
+use crate::bxdf::{FourierBSDFTable, MeasuredBxDFData, LAFORTUNE_FITS};
 use crate::image::Image;
 use crate::params::unknown_type;
 use crate::spectrum::{
@@ -23,6 +23,9 @@ use crate::texture::{FloatTexture, SpectrumTexture, SpectrumTextureRef, TextureP
 /// The material types `Material` and `MakeNamedMaterial` accept, sorted
 /// (`""` and `"none"` also mean `interface`, as in pbrt-v4).
 pub const MATERIAL_NAMES: &[&str] = &[
+    "bluepaint",
+    "brushedmetal",
+    "clay",
     "coatedconductor",
     "coateddiffuse",
     "conductor",
@@ -30,12 +33,15 @@ pub const MATERIAL_NAMES: &[&str] = &[
     "diffuse",
     "diffusetransmission",
     "disney",
+    "felt",
     "fourier",
     "hair",
     "interface",
     "measured",
     "mix",
+    "primer",
     "shinymetal",
+    "skin",
     "subsurface",
     "thindielectric",
 ];
@@ -280,6 +286,16 @@ pub fn create_material(
             }))
         }
         "mix" => create_mix(tp, visible)?,
+        "bluepaint" | "brushedmetal" | "clay" | "felt" | "primer" | "skin" => {
+            let Some(fit) = LAFORTUNE_FITS.iter().find(|f| f.name == ty) else {
+                return Err(unknown_type("material", ty, MATERIAL_NAMES, tp.loc()));
+            };
+            Material::Lafortune(Box::new(LafortuneMaterial {
+                fit,
+                color_space: tp.color_space(),
+                perturbation: perturbation(tp, cache)?,
+            }))
+        }
         "shinymetal" => Material::ShinyMetal(Box::new(ShinyMetalMaterial {
             ks: tp.spectrum_texture("Ks", Spectrum::constant(1.0), albedo)?,
             kr: tp.spectrum_texture("Kr", Spectrum::constant(1.0), albedo)?,

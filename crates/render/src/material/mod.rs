@@ -33,6 +33,7 @@ mod diffuse;
 mod disney;
 mod fourier;
 mod hair;
+mod lafortune;
 mod measured;
 mod mix;
 mod shinymetal;
@@ -50,6 +51,7 @@ pub use diffuse::{DiffuseMaterial, DiffuseTransmissionMaterial};
 pub use disney::DisneyMaterial;
 pub use fourier::FourierMaterial;
 pub use hair::{HairAbsorption, HairMaterial};
+pub use lafortune::LafortuneMaterial;
 pub use measured::MeasuredMaterial;
 pub use mix::MixMaterial;
 pub use shinymetal::ShinyMetalMaterial;
@@ -205,6 +207,8 @@ pub enum Material {
     Fourier(Box<FourierMaterial>),
     /// pbrt-v1/v2's `shinymetal`.
     ShinyMetal(Box<ShinyMetalMaterial>),
+    /// pbrt-v1's measured Lafortune fits.
+    Lafortune(Box<LafortuneMaterial>),
 }
 
 impl Material {
@@ -233,6 +237,7 @@ impl Material {
             Material::Disney(m) => Some(m.get_bxdf(ctx, lambda)),
             Material::Fourier(m) => Some(m.get_bxdf(ctx, lambda)),
             Material::ShinyMetal(m) => Some(m.get_bxdf(ctx, lambda)),
+            Material::Lafortune(m) => Some(m.get_bxdf(ctx, lambda)),
         }
     }
 
@@ -252,6 +257,7 @@ impl Material {
             Material::Disney(m) => Some(&m.perturbation),
             Material::Fourier(m) => Some(&m.perturbation),
             Material::ShinyMetal(m) => Some(&m.perturbation),
+            Material::Lafortune(m) => Some(&m.perturbation),
             Material::Hair(_) | Material::Mix(_) | Material::Interface => None,
         }
     }
@@ -291,6 +297,7 @@ impl Material {
             Material::Disney(_) => "disney",
             Material::Fourier(_) => "fourier",
             Material::ShinyMetal(_) => "shinymetal",
+            Material::Lafortune(m) => m.fit.name,
         }
     }
 }

@@ -26,6 +26,7 @@ use rpbrt_parser::{
 use super::entities::*;
 use super::names::*;
 use super::state::*;
+use crate::bxdf::LAFORTUNE_MATERIALS;
 use crate::camera::{CameraTransform, RenderingCoordinateSystem};
 use crate::params::unknown_type;
 use crate::spectrum::RgbColorSpace;
@@ -67,6 +68,11 @@ pub struct SceneBuilder {
     /// A pbrt-v1/v2 file's `Renderer`, `SurfaceIntegrator` and
     /// `VolumeIntegrator`, made into one integrator once all files are read.
     legacy: LegacyTransport,
+    /// A `LookAt` came before `WorldBegin`.
+    options_look_at: bool,
+    /// The `Camera`'s world-from-camera transformations and times, and
+    /// whether a `LookAt` came before it (pbrt-v1's mirrors the view).
+    camera_placement: Option<([Transform; 2], [f32; 2], bool)>,
 }
 
 /// The names of one kind that a pbrt-v3 file defined more than once, each
@@ -111,6 +117,8 @@ impl SceneBuilder {
             pending: Vec::new(),
             renames: Default::default(),
             legacy: LegacyTransport::default(),
+            options_look_at: false,
+            camera_placement: None,
         }
     }
 
@@ -304,10 +312,12 @@ impl SceneBuilder {
                 e.params = ParameterDictionary::new(params);
             }
         }
-        if unset(&self.scene.filter) {
+        // (pbrt-v1's own defaults are already in place.)
+        let not_v1 = self.scene.pbrt_v1.is_none();
+        if not_v1 && unset(&self.scene.filter) {
             self.scene.filter = entity("box", Vec::new());
         }
-        if unset(&self.scene.sampler) {
+        if not_v1 && unset(&self.scene.sampler) {
             self.scene.sampler.name = "paddedsobol".into();
         }
         let legacy = std::mem::take(&mut self.legacy);
@@ -364,11 +374,85 @@ impl SceneBuilder {
         }
     }
 
-    /// Notes a material type only pbrt-v1/v2 had.
-    fn note_v2_material(&mut self, ty: &str, loc: &FileLoc) {
+    /// Notes a material type only pbrt-v1/v2 had, and gives a pbrt-v1
+    /// file's materials pbrt-v1's defaults where they differ from
+    /// pbrt-v2's (`Kd` 1 for `matte`, `plastic` and `uber`, `Ks` 1 for
+    /// `plastic` and `uber`, `Kr` 1 for `mirror`).
+    fn v1_v2_material(&mut self, ty: &str, params: &mut ParamList, loc: &FileLoc) {
         if ty == "shinymetal" {
             self.note_pbrt_v2(loc);
+        } else if LAFORTUNE_MATERIALS.contains(&ty) {
+            self.note_pbrt_v1(loc);
         }
+        if self.scene.pbrt_v1.is_none() {
+            return;
+        }
+        let ones: &[&str] = match ty {
+            "matte" => &["Kd"],
+            "plastic" | "uber" => &["Kd", "Ks"],
+            "mirror" => &["Kr"],
+            _ => &[],
+        };
+        for &name in ones {
+            if !params.iter().any(|p| p.name == name) {
+                params.push(ParsedParameter::with_floats(
+                    "rgb",
+                    name,
+                    loc.clone(),
+                    vec![1.0; 3],
+                ));
+            }
+        }
+    }
+
+    /// Remembers `loc` if it is the scene's first pbrt-v1-only construct
+    /// (which also makes the scene a pbrt-v2 one).
+    fn note_pbrt_v1(&mut self, loc: &FileLoc) {
+        if self.scene.pbrt_v1.is_none() {
+            self.scene.pbrt_v1 = Some(loc.clone());
+        }
+        self.note_pbrt_v2(loc);
+    }
+
+    /// pbrt-v1's defaults where pbrt-v2's differ: a `mitchell` filter, the
+    /// `bestcandidate` sampler (→ `pmj02bn`, 4 samples), the `kdtree` and
+    /// a `matte` default material of reflectance 1; and its `LookAt`,
+    /// whose camera frame was mirrored in x (pbrt-v2's README: add
+    /// `Scale -1 1 1` before it to get pbrt-v1's view).
+    fn use_pbrt_v1_defaults(&mut self) {
+        let unset = |e: &SceneEntity| e.loc == default_loc();
+        if unset(&self.scene.filter) {
+            self.scene.filter.name = "mitchell".into();
+        }
+        if unset(&self.scene.sampler) {
+            self.scene.sampler.name = "pmj02bn".into();
+        }
+        if unset(&self.scene.accelerator) {
+            self.scene.accelerator.name = "kdtree".into();
+        }
+        if let Some(m) = self.scene.materials.first_mut() {
+            if unset(m) && m.params.params().is_empty() {
+                let p =
+                    ParsedParameter::with_floats("rgb", "reflectance", default_loc(), vec![1.0; 3]);
+                m.params = ParameterDictionary::new(vec![p]);
+            }
+        }
+        let Some(([start, end], [t0, t1], true)) = self.camera_placement else {
+            return;
+        };
+        let mirror = Transform::scale(-1.0, 1.0, 1.0);
+        if self.scene.render_coord_sys == RenderingCoordinateSystem::Camera {
+            // Render space is camera space there: every shape is already
+            // placed in the unmirrored one.
+            self.pending.push(Diagnostic::warning(
+                self.scene.camera.base.loc.clone(),
+                "pbrt-v1's LookAt mirrored the view in x; not reproduced with --render-coord-sys camera",
+            ));
+            return;
+        }
+        let animated = AnimatedTransform::new(start * mirror, t0, end * mirror, t1);
+        self.scene.camera.camera_transform =
+            CameraTransform::new(&animated, self.scene.render_coord_sys);
     }
 
     /// Remembers `loc` if it is the scene's first pbrt-v1/v2-only
@@ -652,6 +736,7 @@ impl ParserTarget for SceneBuilder {
         )
         .map_err(|e| Self::transform_error(e, loc, "LookAt"))?;
         self.state.for_active(|c| *c * t);
+        self.options_look_at |= self.block == Block::Options;
         Ok(())
     }
 
@@ -794,6 +879,13 @@ impl ParserTarget for SceneBuilder {
         Ok(())
     }
 
+    fn search_path(&mut self, _path: &str, loc: FileLoc) -> DirectiveResult {
+        // Only pbrt-v1's plugin lookup read it; everything is built in.
+        self.verify_options("SearchPath", &loc)?;
+        self.note_pbrt_v1(&loc);
+        Ok(())
+    }
+
     fn renderer(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
         self.verify_options("Renderer", &loc)?;
         self.note_pbrt_v2(&loc);
@@ -873,6 +965,11 @@ impl ParserTarget for SceneBuilder {
             medium: self.state.outside_medium.clone(),
         };
         self.camera_defined = true;
+        self.camera_placement = Some((
+            world_from_camera,
+            [self.state.start_time, self.state.end_time],
+            self.options_look_at,
+        ));
         Ok(())
     }
 
@@ -1094,7 +1191,8 @@ impl ParserTarget for SceneBuilder {
 
     fn material(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
         self.verify_world("Material", &loc)?;
-        self.note_v2_material(name, &loc);
+        let mut params = params;
+        self.v1_v2_material(name, &mut params, &loc);
         let (name, params) =
             self.upgraded(upgrade::upgrade_material_for_render, name, params, &loc);
         EntityKind::Material.check(&name, &loc)?;
@@ -1120,7 +1218,7 @@ impl ParserTarget for SceneBuilder {
                 format!("no parameter \"string type\" found for named material \"{name}\""),
             ));
         };
-        self.note_v2_material(&ty, &ty_loc);
+        self.v1_v2_material(&ty, &mut params, &ty_loc);
         let (ty, mut params) =
             self.upgraded(upgrade::upgrade_material_for_render, &ty, params, &loc);
         EntityKind::Material.check(&ty, &ty_loc)?;
@@ -1156,6 +1254,9 @@ impl ParserTarget for SceneBuilder {
 
     fn light_source(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
         self.verify_world("LightSource", &loc)?;
+        if name == "infinitesample" {
+            self.note_pbrt_v1(&loc);
+        }
         // Only pbrt-v3 names an infinite light's image "mapname".
         let pbrt_v3 = params
             .iter()
@@ -1351,6 +1452,9 @@ impl ParserTarget for SceneBuilder {
     }
 
     fn end_of_files(&mut self) -> DirectiveResult {
+        if self.scene.pbrt_v1.is_some() {
+            self.use_pbrt_v1_defaults();
+        }
         if let Some(v2) = self.scene.pbrt_v2.clone() {
             self.use_pbrt_v2_defaults(&v2);
         } else if self.scene.pbrt_v3.is_some() {

@@ -310,6 +310,12 @@ pub struct SceneDescription {
     ///
     /// [`pbrt_v3`]: SceneDescription::pbrt_v3
     pub pbrt_v2: Option<FileLoc>,
+    /// Where the scene first used a construct only pbrt-v1 accepts
+    /// (`SearchPath`, its measured Lafortune materials, the
+    /// `infinitesample` light), or `None`; such a scene is also marked
+    /// [`pbrt_v2`](SceneDescription::pbrt_v2) and takes pbrt-v1's
+    /// defaults and camera.
+    pub pbrt_v1: Option<FileLoc>,
     /// The memory budget the description is charged to; creating the
     /// render objects charges the same one.
     pub budget: MemoryBudget,
@@ -346,6 +352,7 @@ impl Default for SceneDescription {
             diagnostics: Vec::new(),
             pbrt_v3: None,
             pbrt_v2: None,
+            pbrt_v1: None,
             budget: MemoryBudget::default(),
         }
     }

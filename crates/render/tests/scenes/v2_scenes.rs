@@ -207,3 +207,49 @@ fn shinymetal_mirror_reflects_its_kr_at_normal_incidence() {
     let im = render_scene(&text, 2);
     assert_close("shinymetal", mean(&im), 0.5, 0.02);
 }
+
+/// The mean of the left and right halves of a 16-pixel-wide image.
+fn halves(im: &Image) -> (f64, f64) {
+    let v = im.to_f32_vec();
+    let ch = v.len() / (16 * 16);
+    let (mut l, mut r) = (0.0, 0.0);
+    for (i, px) in v.chunks(ch).enumerate() {
+        let s: f64 = px.iter().map(|&x| x as f64).sum();
+        if i % 16 < 8 {
+            l += s;
+        } else {
+            r += s;
+        }
+    }
+    (l, r)
+}
+
+#[test]
+fn pbrt_v1_files_render_mirrored_with_their_materials() {
+    // An emitter at world +x: pbrt-v2 (and v3, v4) show it on the right,
+    // pbrt-v1's LookAt on the left. `SearchPath` and the measured `clay`
+    // each mark a pbrt-v1 file.
+    let scene = |tag: &str, first: &str, material: &str| {
+        format!(
+            "{first}\nLookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\" \"float fov\" 60\n\
+             Film \"image\" \"integer xresolution\" 16 \"integer yresolution\" 16 \"string filename\" \"{}\"\n\
+             Sampler \"bestcandidate\" \"integer pixelsamples\" 4\nWorldBegin\n\
+             AttributeBegin\nTranslate 2 0 5\nReverseOrientation\n\
+             AreaLightSource \"diffuse\" \"color L\" [ 1 1 1 ]\nShape \"disk\" \"float radius\" 1\nAttributeEnd\n\
+             AttributeBegin\nTranslate -2 0 5\nMaterial \"{material}\"\nShape \"sphere\" \"float radius\" 1\nAttributeEnd\n\
+             WorldEnd\n",
+            out(tag).display()
+        )
+    };
+    let (l1, r1) = halves(&render_scene(
+        &scene("v1-path", "SearchPath \"&\"", "matte"),
+        1,
+    ));
+    let (l2, r2) = halves(&render_scene(&scene("v1-clay", "", "clay"), 1));
+    let (l3, r3) = halves(&render_scene(
+        &scene("v2", "Renderer \"sampler\"", "matte"),
+        1,
+    ));
+    assert!(l1 > 4.0 * r1 && l2 > 4.0 * r2, "v1 {l1} {r1}, {l2} {r2}");
+    assert!(r3 > 4.0 * l3, "v2 {l3} {r3}");
+}

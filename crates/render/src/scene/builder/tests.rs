@@ -913,3 +913,44 @@ fn pbrt_v2_point_light_adds_from_after_the_transformation() {
         .apply_point(Point3f::new(from[0], from[1], from[2]));
     assert!(close(p, 3.0, 0.0, 0.0), "{p:?}");
 }
+
+#[test]
+fn pbrt_v1_defaults_materials_and_camera() {
+    let text = "SearchPath \"/usr/local/pbrt/lib:&\"\nLookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\"\n\
+                WorldBegin\nMaterial \"matte\"\nShape \"sphere\"\nMaterial \"clay\"\n";
+    let s = build_with(text, RenderingCoordinateSystem::CameraWorld);
+    assert!(s.pbrt_v1.is_some() && s.pbrt_v2.is_some() && s.pbrt_v3.is_some());
+    assert_eq!(s.filter.name, "mitchell");
+    assert_eq!(s.sampler.name, "pmj02bn");
+    assert_eq!(s.sampler.params.get_one_int("pixelsamples", 0).unwrap(), 4);
+    assert_eq!(s.accelerator.name, "kdtree");
+    assert_eq!(s.integrator.name, "whitted");
+    // pbrt-v1's matte defaults to Kd 1, and so does its default material.
+    let matte = &s.materials[1];
+    assert_eq!(matte.name, "diffuse");
+    assert_eq!(
+        matte.params.get_one_rgb("reflectance").unwrap(),
+        Some([1.0, 1.0, 1.0])
+    );
+    assert_eq!(
+        s.materials[0].params.get_one_rgb("reflectance").unwrap(),
+        Some([1.0, 1.0, 1.0])
+    );
+    assert_eq!(s.materials[2].name, "clay");
+    // pbrt-v1's LookAt mirrored the camera frame in x: camera +x looks
+    // toward world −x.
+    let rfc = s.camera.camera_transform.render_from_camera.start_transform;
+    let x = rfc.apply_vector(Vector3f::new(1.0, 0.0, 0.0));
+    assert!((x.x + 1.0).abs() < 1e-5, "{x:?}");
+    // Read as pbrt-v2 (no pbrt-v1 construct), the same camera is not
+    // mirrored.
+    let s = build("SurfaceIntegrator \"path\"\nLookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\"\nWorldBegin\n");
+    let rfc = s.camera.camera_transform.render_from_camera.start_transform;
+    let x = rfc.apply_vector(Vector3f::new(1.0, 0.0, 0.0));
+    assert!((x.x - 1.0).abs() < 1e-5, "{x:?}");
+    assert_error(
+        "WorldBegin\nSearchPath \"x\"\n",
+        "<string>:2:1:",
+        "SearchPath",
+    );
+}
