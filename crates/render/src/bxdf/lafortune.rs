@@ -242,12 +242,7 @@ impl BxDFMethods for LafortuneBxDF {
             return SampledSpectrum::new(0.0);
         }
         let [r, g, b] = self.rgb(wo, wi);
-        let s = RgbUnboundedSpectrum::new(self.cs, RGB::new(r, g, b));
-        let mut out = SampledSpectrum::new(0.0);
-        for (i, v) in out.values.iter_mut().enumerate() {
-            *v = s.evaluate(self.lambda.get(i));
-        }
-        out
+        RgbUnboundedSpectrum::new(self.cs, RGB::new(r, g, b)).sample(&self.lambda)
     }
 
     fn sample_f(

@@ -25,6 +25,7 @@ mod lafortune;
 pub(crate) mod lanes;
 mod layered;
 pub mod measured;
+mod merl;
 mod microfacet;
 mod scattering;
 mod shinymetal;
@@ -45,6 +46,7 @@ pub use lafortune::{
 };
 pub use layered::{CoatedConductorBxDF, CoatedDiffuseBxDF, LayeredBxDF};
 pub use measured::{MeasuredBxDF, MeasuredBxDFData};
+pub use merl::{MerlBxDF, MerlTable};
 pub use microfacet::TrowbridgeReitzDistribution;
 pub use scattering::{
     fr_complex, fr_complex_spectrum, fr_dielectric, fresnel_moment1, fresnel_moment2,
@@ -337,6 +339,8 @@ pub enum BxDF {
     ShinyMetal(ShinyMetalBxDF),
     /// pbrt-v1's measured Lafortune fits.
     Lafortune(LafortuneBxDF),
+    /// pbrt-v2's MERL tables.
+    Merl(MerlBxDF),
 }
 
 macro_rules! dispatch {
@@ -356,6 +360,7 @@ macro_rules! dispatch {
             BxDF::Fourier($b) => $e,
             BxDF::ShinyMetal($b) => $e,
             BxDF::Lafortune($b) => $e,
+            BxDF::Merl($b) => $e,
         }
     };
 }
@@ -422,6 +427,7 @@ impl BxDF {
             BxDF::Fourier(_) => "FourierBSDF",
             BxDF::ShinyMetal(_) => "ShinyMetalBSDF",
             BxDF::Lafortune(_) => "LafortuneBSDF",
+            BxDF::Merl(_) => "RegularHalfangleBRDF",
         }
     }
 

@@ -12,7 +12,7 @@ use rpbrt_parser::Diagnostic;
 
 use super::coated::LayerSettings;
 use super::*;
-use crate::bxdf::{FourierBSDFTable, MeasuredBxDFData, LAFORTUNE_FITS};
+use crate::bxdf::{FourierBSDFTable, MeasuredBxDFData, MerlTable, LAFORTUNE_FITS};
 use crate::image::Image;
 use crate::params::unknown_type;
 use crate::spectrum::{
@@ -45,6 +45,16 @@ pub const MATERIAL_NAMES: &[&str] = &[
     "subsurface",
     "thindielectric",
 ];
+
+/// Whether the file at `path` starts like a MERL table.
+fn is_merl_file(path: &std::path::Path) -> bool {
+    use std::io::Read;
+    let mut head = [0u8; 12];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok()
+        && MerlTable::looks_like(&head)
+}
 
 /// Image files already read as normal maps, by path (one load per file).
 pub type NormalMapCache = HashMap<PathBuf, Arc<Image>>;
@@ -313,6 +323,28 @@ pub fn create_material(
             }
             let loc = tp.param_loc("filename");
             let path = tp.resolve("filename", &file);
+            // pbrt-v2 read MERL tables (any suffix but .brdf) and its own
+            // irregular .brdf samples; pbrt-v4 reads RGL .bsdf files.
+            let ext = path
+                .extension()
+                .and_then(|e| e.to_str())
+                .map(str::to_ascii_lowercase);
+            if ext.as_deref() == Some("brdf") {
+                return Err(Diagnostic::error(
+                    loc,
+                    format!("{}: pbrt-v2's irregular \".brdf\" measured data is not supported yet (MERL tables and RGL .bsdf files are)", path.display()),
+                ));
+            }
+            if ext.as_deref() != Some("bsdf") && is_merl_file(&path) {
+                let table = MerlTable::cached(&path).map_err(|m| {
+                    Diagnostic::error(loc.clone(), format!("{}: {m}", path.display()))
+                })?;
+                return Ok(Material::Merl(Box::new(MerlMaterial {
+                    table,
+                    color_space: tp.color_space(),
+                    perturbation: perturbation(tp, cache)?,
+                })));
+            }
             let data =
                 MeasuredBxDFData::cached(&path).map_err(|m| Diagnostic::error(loc.clone(), m))?;
             Material::Measured(Box::new(MeasuredMaterial {

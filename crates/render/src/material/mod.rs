@@ -35,6 +35,7 @@ mod fourier;
 mod hair;
 mod lafortune;
 mod measured;
+mod merl;
 mod mix;
 mod shinymetal;
 mod subsurface;
@@ -53,6 +54,7 @@ pub use fourier::FourierMaterial;
 pub use hair::{HairAbsorption, HairMaterial};
 pub use lafortune::LafortuneMaterial;
 pub use measured::MeasuredMaterial;
+pub use merl::MerlMaterial;
 pub use mix::MixMaterial;
 pub use shinymetal::ShinyMetalMaterial;
 pub use subsurface::{SubsurfaceCoefficients, SubsurfaceMaterial};
@@ -209,6 +211,8 @@ pub enum Material {
     ShinyMetal(Box<ShinyMetalMaterial>),
     /// pbrt-v1's measured Lafortune fits.
     Lafortune(Box<LafortuneMaterial>),
+    /// pbrt-v2's `measured` with a MERL table.
+    Merl(Box<MerlMaterial>),
 }
 
 impl Material {
@@ -238,6 +242,7 @@ impl Material {
             Material::Fourier(m) => Some(m.get_bxdf(ctx, lambda)),
             Material::ShinyMetal(m) => Some(m.get_bxdf(ctx, lambda)),
             Material::Lafortune(m) => Some(m.get_bxdf(ctx, lambda)),
+            Material::Merl(m) => Some(m.get_bxdf(ctx, lambda)),
         }
     }
 
@@ -258,6 +263,7 @@ impl Material {
             Material::Fourier(m) => Some(&m.perturbation),
             Material::ShinyMetal(m) => Some(&m.perturbation),
             Material::Lafortune(m) => Some(&m.perturbation),
+            Material::Merl(m) => Some(&m.perturbation),
             Material::Hair(_) | Material::Mix(_) | Material::Interface => None,
         }
     }
@@ -298,6 +304,7 @@ impl Material {
             Material::Fourier(_) => "fourier",
             Material::ShinyMetal(_) => "shinymetal",
             Material::Lafortune(m) => m.fit.name,
+            Material::Merl(_) => "measured",
         }
     }
 }

@@ -366,6 +366,15 @@ impl RgbUnboundedSpectrum {
         self.scale * self.rsp.evaluate(lambda)
     }
 
+    /// The values at the sampled wavelengths.
+    pub fn sample(&self, lambda: &SampledWavelengths) -> SampledSpectrum {
+        let mut s = SampledSpectrum::new(0.0);
+        for (i, v) in s.values.iter_mut().enumerate() {
+            *v = self.evaluate(lambda.get(i));
+        }
+        s
+    }
+
     /// The largest value.
     pub fn max_value(&self) -> Float {
         self.scale * self.rsp.max_value()

@@ -253,3 +253,34 @@ fn pbrt_v1_files_render_mirrored_with_their_materials() {
     assert!(l1 > 4.0 * r1 && l2 > 4.0 * r2, "v1 {l1} {r1}, {l2} {r2}");
     assert!(r3 > 4.0 * l3, "v2 {l3} {r3}");
 }
+
+#[test]
+fn merl_table_of_a_lambertian_reflects_its_albedo() {
+    // A MERL table whose every entry is ρ/π once pbrt-v2's per-channel
+    // scales (1, 1.15, 1.66)/1500 are applied: a Lambertian of albedo ρ =
+    // 0.5. A sphere of it under a uniform environment of radiance 1
+    // reflects 0.5 everywhere.
+    let path = out("lambertian").with_extension("binary");
+    let mut b = Vec::with_capacity(12 + 24 * 90 * 90 * 180);
+    for d in [90i32, 90, 180] {
+        b.extend_from_slice(&d.to_le_bytes());
+    }
+    for scale in [1.0, 1.15, 1.66] {
+        let v: f64 = 0.5 / std::f64::consts::PI * 1500.0 / scale;
+        for _ in 0..90 * 90 * 180 {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    std::fs::write(&path, b).unwrap();
+    let text = format!(
+        "LookAt 0 0 -3  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 10\n\
+         Film \"image\" \"integer xresolution\" 16 \"integer yresolution\" 16 \"string filename\" \"{}\"\n\
+         Sampler \"lowdiscrepancy\" \"integer pixelsamples\" 16\nSurfaceIntegrator \"path\"\nWorldBegin\n\
+         LightSource \"infinite\" \"color L\" [ 1 1 1 ]\n\
+         Material \"measured\" \"string filename\" \"{}\"\nShape \"sphere\"\nWorldEnd\n",
+        out("merl").display(),
+        path.display()
+    );
+    let im = render_scene(&text, 2);
+    assert_close("merl", mean(&im), 0.5, 0.01);
+}
