@@ -35,7 +35,7 @@ use crate::loc::FileLoc;
 use crate::params::{canonical_type, ParsedParameter};
 use crate::target::{DirectiveResult, IncludeKind, ParamList, ParserTarget};
 use crate::tokenizer::escape_string;
-use crate::upgrade::legacy::{Given, LegacyTransport, Target};
+use crate::upgrade::legacy::{Given, LegacyTransport, Target, Transport};
 use crate::upgrade::{self, Upgraded};
 
 /// Prints directives as canonical pbrt-v4 text into a string.
@@ -373,20 +373,15 @@ impl FormattingTarget {
     /// [`FormattingTarget::world_begin`] writes.
     fn legacy_transport(
         &mut self,
-        directive: &str,
+        which: Transport,
         name: &str,
         params: ParamList,
         loc: FileLoc,
     ) -> DirectiveResult {
-        if !self.upgrade {
-            self.named(directive, name, &params);
-            return Ok(());
-        }
-        let given = Some(Given::new(name, params, loc));
-        match directive {
-            "Renderer" => self.legacy.renderer = given,
-            "SurfaceIntegrator" => self.legacy.surface = given,
-            _ => self.legacy.volume = given,
+        if self.upgrade {
+            self.legacy.set(which, Given::new(name, params, loc));
+        } else {
+            self.named(which.directive(), name, &params);
         }
         Ok(())
     }
@@ -510,7 +505,7 @@ impl ParserTarget for FormattingTarget {
         )
     }
     fn renderer(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
-        self.legacy_transport("Renderer", name, params, loc)
+        self.legacy_transport(Transport::Renderer, name, params, loc)
     }
     fn surface_integrator(
         &mut self,
@@ -518,7 +513,7 @@ impl ParserTarget for FormattingTarget {
         params: ParamList,
         loc: FileLoc,
     ) -> DirectiveResult {
-        self.legacy_transport("SurfaceIntegrator", name, params, loc)
+        self.legacy_transport(Transport::Surface, name, params, loc)
     }
     fn volume_integrator(
         &mut self,
@@ -526,7 +521,7 @@ impl ParserTarget for FormattingTarget {
         params: ParamList,
         loc: FileLoc,
     ) -> DirectiveResult {
-        self.legacy_transport("VolumeIntegrator", name, params, loc)
+        self.legacy_transport(Transport::Volume, name, params, loc)
     }
     fn volume(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
         if self.upgrade {

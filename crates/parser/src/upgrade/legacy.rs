@@ -49,6 +49,28 @@ pub struct LegacyTransport {
     pub volume: Option<Given>,
 }
 
+/// Which of the three directives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Transport {
+    /// `Renderer`.
+    Renderer,
+    /// `SurfaceIntegrator`.
+    Surface,
+    /// `VolumeIntegrator`.
+    Volume,
+}
+
+impl Transport {
+    /// The directive's name.
+    pub fn directive(self) -> &'static str {
+        match self {
+            Transport::Renderer => "Renderer",
+            Transport::Surface => "SurfaceIntegrator",
+            Transport::Volume => "VolumeIntegrator",
+        }
+    }
+}
+
 /// For whom the integrator is made.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Target {
@@ -90,6 +112,16 @@ const TOOLS: &[(&str, &str)] = &[
 ];
 
 impl LegacyTransport {
+    /// Records directive `which` (a later one replaces an earlier one).
+    pub fn set(&mut self, which: Transport, given: Given) {
+        let slot = match which {
+            Transport::Renderer => &mut self.renderer,
+            Transport::Surface => &mut self.surface,
+            Transport::Volume => &mut self.volume,
+        };
+        *slot = Some(given);
+    }
+
     /// Whether the file gave none of the three directives.
     pub fn is_empty(&self) -> bool {
         self.renderer.is_none() && self.surface.is_none() && self.volume.is_none()

@@ -276,3 +276,39 @@ impl BxDFMethods for NormalizedFresnelBxDF {
 
     fn regularize(&mut self) {}
 }
+
+/// A cosine-weighted direction on `wo`'s side, with `f` toward it: pbrt's
+/// default `BxDF::Sample_f` (up to pbrt-v3), which the old measured
+/// models keep.
+pub(crate) fn sample_cosine_reflection(
+    wo: Vector3f,
+    u: Point2f,
+    sample_flags: BxDFReflTransFlags,
+    flags: BxDFFlags,
+    f: impl Fn(Vector3f) -> SampledSpectrum,
+) -> Option<BSDFSample> {
+    if !sample_flags.contains(BxDFReflTransFlags::REFLECTION) {
+        return None;
+    }
+    let mut wi = sample_cosine_hemisphere(u);
+    if wo.z < 0.0 {
+        wi.z = -wi.z;
+    }
+    let pdf = cosine_hemisphere_pdf(abs_cos_theta(wi));
+    if pdf == 0.0 {
+        return None;
+    }
+    Some(BSDFSample::new(f(wi), wi, pdf, flags))
+}
+
+/// The density of [`sample_cosine_reflection`].
+pub(crate) fn cosine_reflection_pdf(
+    wo: Vector3f,
+    wi: Vector3f,
+    sample_flags: BxDFReflTransFlags,
+) -> Float {
+    if !sample_flags.contains(BxDFReflTransFlags::REFLECTION) || !same_hemisphere(wo, wi) {
+        return 0.0;
+    }
+    cosine_hemisphere_pdf(abs_cos_theta(wi))
+}

@@ -10,11 +10,11 @@
 //! version sampled it like any diffuse BxDF: cosine-weighted.
 
 use rpbrt_geometry::float::*;
+use rpbrt_geometry::same_hemisphere;
 use rpbrt_geometry::tuple::*;
-use rpbrt_geometry::{abs_cos_theta, same_hemisphere};
 
+use super::diffuse::{cosine_reflection_pdf, sample_cosine_reflection};
 use super::{BSDFSample, BxDFFlags, BxDFMethods, BxDFReflTransFlags, TransportMode};
-use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{
     RgbColorSpace, RgbUnboundedSpectrum, SampledSpectrum, SampledWavelengths, RGB,
 };
@@ -52,7 +52,9 @@ const fn grey(v: Float) -> [Float; 3] {
     [v, v, v]
 }
 
-/// pbrt-v1's six fits (its `materials/<name>.cpp`).
+/// pbrt-v1's six fits (its `materials/<name>.cpp`), the values as it
+/// wrote them.
+#[allow(clippy::excessive_precision)]
 pub const LAFORTUNE_FITS: [LafortuneFit; 6] = [
     LafortuneFit {
         name: "bluepaint",
@@ -253,18 +255,7 @@ impl BxDFMethods for LafortuneBxDF {
         mode: TransportMode,
         sample_flags: BxDFReflTransFlags,
     ) -> Option<BSDFSample> {
-        if !sample_flags.contains(BxDFReflTransFlags::REFLECTION) {
-            return None;
-        }
-        let mut wi = sample_cosine_hemisphere(u);
-        if wo.z < 0.0 {
-            wi.z = -wi.z;
-        }
-        let pdf = cosine_hemisphere_pdf(abs_cos_theta(wi));
-        if pdf == 0.0 {
-            return None;
-        }
-        Some(BSDFSample::new(self.f(wo, wi, mode), wi, pdf, self.flags()))
+        sample_cosine_reflection(wo, u, sample_flags, self.flags(), |wi| self.f(wo, wi, mode))
     }
 
     fn pdf(
@@ -274,10 +265,7 @@ impl BxDFMethods for LafortuneBxDF {
         _mode: TransportMode,
         sample_flags: BxDFReflTransFlags,
     ) -> Float {
-        if !sample_flags.contains(BxDFReflTransFlags::REFLECTION) || !same_hemisphere(wo, wi) {
-            return 0.0;
-        }
-        cosine_hemisphere_pdf(abs_cos_theta(wi))
+        cosine_reflection_pdf(wo, wi, sample_flags)
     }
 
     fn flags(&self) -> BxDFFlags {
@@ -306,7 +294,7 @@ mod tests {
         // Along the normal only the z terms count.
         let n = Vector3f::new(0.0, 0.0, 1.0);
         let rgb = b.rgb(n, n);
-        for c in 0..3 {
+        for (c, &got) in rgb.iter().enumerate() {
             let want = fit.diffuse[c] * INV_PI
                 + fit
                     .lobes
@@ -319,11 +307,7 @@ mod tests {
                         }
                     })
                     .sum::<Float>();
-            assert!(
-                (rgb[c] - want).abs() <= 1e-5 * want,
-                "{c}: {} {want}",
-                rgb[c]
-            );
+            assert!((got - want).abs() <= 1e-5 * want, "{c}: {got} {want}");
         }
         // The names table matches the fits.
         for (f, n) in LAFORTUNE_FITS.iter().zip(LAFORTUNE_MATERIALS) {

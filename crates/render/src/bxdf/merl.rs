@@ -17,10 +17,10 @@ use std::sync::{Mutex, OnceLock};
 
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;
-use rpbrt_geometry::{abs_cos_theta, same_hemisphere, spherical_phi, spherical_theta};
+use rpbrt_geometry::{same_hemisphere, spherical_phi, spherical_theta};
 
+use super::diffuse::{cosine_reflection_pdf, sample_cosine_reflection};
 use super::{BSDFSample, BxDFFlags, BxDFMethods, BxDFReflTransFlags, TransportMode};
-use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::spectrum::{
     RgbColorSpace, RgbUnboundedSpectrum, SampledSpectrum, SampledWavelengths, RGB,
 };
@@ -185,18 +185,7 @@ impl BxDFMethods for MerlBxDF {
         mode: TransportMode,
         sample_flags: BxDFReflTransFlags,
     ) -> Option<BSDFSample> {
-        if !sample_flags.contains(BxDFReflTransFlags::REFLECTION) {
-            return None;
-        }
-        let mut wi = sample_cosine_hemisphere(u);
-        if wo.z < 0.0 {
-            wi.z = -wi.z;
-        }
-        let pdf = cosine_hemisphere_pdf(abs_cos_theta(wi));
-        if pdf == 0.0 {
-            return None;
-        }
-        Some(BSDFSample::new(self.f(wo, wi, mode), wi, pdf, self.flags()))
+        sample_cosine_reflection(wo, u, sample_flags, self.flags(), |wi| self.f(wo, wi, mode))
     }
 
     fn pdf(
@@ -206,10 +195,7 @@ impl BxDFMethods for MerlBxDF {
         _mode: TransportMode,
         sample_flags: BxDFReflTransFlags,
     ) -> Float {
-        if !sample_flags.contains(BxDFReflTransFlags::REFLECTION) || !same_hemisphere(wo, wi) {
-            return 0.0;
-        }
-        cosine_hemisphere_pdf(abs_cos_theta(wi))
+        cosine_reflection_pdf(wo, wi, sample_flags)
     }
 
     fn flags(&self) -> BxDFFlags {

@@ -16,7 +16,7 @@ use rpbrt_geometry::{
     AnimatedTransform, Point3f, SquareMatrix4, Transform, TransformError, Vector3f,
 };
 use rpbrt_parser::budget::{heap, vec_element};
-use rpbrt_parser::upgrade::legacy::{Given, LegacyTransport, Target};
+use rpbrt_parser::upgrade::legacy::{Given, LegacyTransport, Target, Transport};
 use rpbrt_parser::upgrade::{self, Reference, Upgraded};
 use rpbrt_parser::{Diagnostic, MemoryBudget};
 use rpbrt_parser::{
@@ -82,6 +82,28 @@ pub struct SceneBuilder {
 struct Renames {
     current: HashMap<String, String>,
     count: usize,
+}
+
+/// Whether `e` is a default the file did not set.
+fn unset_entity(e: &SceneEntity) -> bool {
+    e.loc == default_loc()
+}
+
+/// An integer parameter standing for a default.
+fn default_int(name: &str, v: i32) -> ParsedParameter {
+    let mut p = ParsedParameter::new("integer", name, default_loc());
+    p.ints = vec![v];
+    p
+}
+
+/// An entity standing for a default.
+fn default_entity(name: &str, params: Vec<ParsedParameter>) -> SceneEntity {
+    SceneEntity::new(
+        name,
+        ParameterDictionary::new(params),
+        default_loc(),
+        "srgb",
+    )
 }
 
 impl Default for SceneBuilder {
@@ -235,20 +257,7 @@ impl SceneBuilder {
     /// (Both default to a 1280 × 720 film, a `bvh` and a perspective
     /// camera with a 90° field of view.)
     fn use_pbrt_v3_defaults(&mut self) {
-        let unset = |e: &SceneEntity| e.loc == default_loc();
-        let int = |name: &str, v: i32| {
-            let mut p = ParsedParameter::new("integer", name, default_loc());
-            p.ints = vec![v];
-            p
-        };
-        let entity = |name: &str, params: Vec<ParsedParameter>| {
-            SceneEntity::new(
-                name,
-                ParameterDictionary::new(params),
-                default_loc(),
-                "srgb",
-            )
-        };
+        let (unset, int, entity) = (unset_entity, default_int, default_entity);
         if unset(&self.scene.filter) {
             self.scene.filter = entity("box", Vec::new());
         }
@@ -268,20 +277,7 @@ impl SceneBuilder {
     /// `directlighting`) and `VolumeIntegrator` become the integrator
     /// unless the file also gave an `Integrator`.
     fn use_pbrt_v2_defaults(&mut self, v2: &FileLoc) {
-        let unset = |e: &SceneEntity| e.loc == default_loc();
-        let int = |name: &str, v: i32| {
-            let mut p = ParsedParameter::new("integer", name, default_loc());
-            p.ints = vec![v];
-            p
-        };
-        let entity = |name: &str, params: Vec<ParsedParameter>| {
-            SceneEntity::new(
-                name,
-                ParameterDictionary::new(params),
-                default_loc(),
-                "srgb",
-            )
-        };
+        let (unset, int, entity) = (unset_entity, default_int, default_entity);
         // pbrt-v2's creators' defaults, where the directive was given
         // without them.
         let missing =
@@ -405,6 +401,22 @@ impl SceneBuilder {
         }
     }
 
+    /// `Renderer`, `SurfaceIntegrator` or `VolumeIntegrator`: kept for
+    /// the one integrator made once all files are read.
+    fn legacy_transport(
+        &mut self,
+        which: Transport,
+        name: &str,
+        params: ParamList,
+        loc: FileLoc,
+    ) -> DirectiveResult {
+        self.verify_options(which.directive(), &loc)?;
+        self.note_pbrt_v2(&loc);
+        self.note_pbrt_v3_params(&params);
+        self.legacy.set(which, Given::new(name, params, loc));
+        Ok(())
+    }
+
     /// Remembers `loc` if it is the scene's first pbrt-v1-only construct
     /// (which also makes the scene a pbrt-v2 one).
     fn note_pbrt_v1(&mut self, loc: &FileLoc) {
@@ -420,7 +432,7 @@ impl SceneBuilder {
     /// whose camera frame was mirrored in x (pbrt-v2's README: add
     /// `Scale -1 1 1` before it to get pbrt-v1's view).
     fn use_pbrt_v1_defaults(&mut self) {
-        let unset = |e: &SceneEntity| e.loc == default_loc();
+        let unset = unset_entity;
         if unset(&self.scene.filter) {
             self.scene.filter.name = "mitchell".into();
         }
@@ -887,11 +899,7 @@ impl ParserTarget for SceneBuilder {
     }
 
     fn renderer(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
-        self.verify_options("Renderer", &loc)?;
-        self.note_pbrt_v2(&loc);
-        self.note_pbrt_v3_params(&params);
-        self.legacy.renderer = Some(Given::new(name, params, loc));
-        Ok(())
+        self.legacy_transport(Transport::Renderer, name, params, loc)
     }
 
     fn surface_integrator(
@@ -900,11 +908,7 @@ impl ParserTarget for SceneBuilder {
         params: ParamList,
         loc: FileLoc,
     ) -> DirectiveResult {
-        self.verify_options("SurfaceIntegrator", &loc)?;
-        self.note_pbrt_v2(&loc);
-        self.note_pbrt_v3_params(&params);
-        self.legacy.surface = Some(Given::new(name, params, loc));
-        Ok(())
+        self.legacy_transport(Transport::Surface, name, params, loc)
     }
 
     fn volume_integrator(
@@ -913,11 +917,7 @@ impl ParserTarget for SceneBuilder {
         params: ParamList,
         loc: FileLoc,
     ) -> DirectiveResult {
-        self.verify_options("VolumeIntegrator", &loc)?;
-        self.note_pbrt_v2(&loc);
-        self.note_pbrt_v3_params(&params);
-        self.legacy.volume = Some(Given::new(name, params, loc));
-        Ok(())
+        self.legacy_transport(Transport::Volume, name, params, loc)
     }
 
     fn volume(&mut self, name: &str, params: ParamList, loc: FileLoc) -> DirectiveResult {
