@@ -21,6 +21,7 @@ mod diffuse;
 mod disney;
 pub mod fourier;
 mod hair;
+mod irregular;
 mod lafortune;
 pub(crate) mod lanes;
 mod layered;
@@ -41,6 +42,7 @@ pub use diffuse::{DiffuseBxDF, DiffuseTransmissionBxDF, NormalizedFresnelBxDF};
 pub use disney::{DisneyBxDF, DisneyParams};
 pub use fourier::{FourierBSDFTable, FourierBxDF, FourierError};
 pub use hair::HairBxDF;
+pub use irregular::{IrregularBrdf, IrregularBxDF};
 pub use lafortune::{
     LafortuneBxDF, LafortuneFit, LafortuneLobe, LAFORTUNE_FITS, LAFORTUNE_MATERIALS,
 };
@@ -341,6 +343,8 @@ pub enum BxDF {
     Lafortune(LafortuneBxDF),
     /// pbrt-v2's MERL tables.
     Merl(MerlBxDF),
+    /// pbrt-v2's irregular `.brdf` measurements.
+    Irregular(IrregularBxDF),
 }
 
 macro_rules! dispatch {
@@ -361,6 +365,7 @@ macro_rules! dispatch {
             BxDF::ShinyMetal($b) => $e,
             BxDF::Lafortune($b) => $e,
             BxDF::Merl($b) => $e,
+            BxDF::Irregular($b) => $e,
         }
     };
 }
@@ -428,6 +433,7 @@ impl BxDF {
             BxDF::ShinyMetal(_) => "ShinyMetalBSDF",
             BxDF::Lafortune(_) => "LafortuneBSDF",
             BxDF::Merl(_) => "RegularHalfangleBRDF",
+            BxDF::Irregular(_) => "IrregIsotropicBRDF",
         }
     }
 

@@ -12,7 +12,7 @@ use rpbrt_parser::Diagnostic;
 
 use super::coated::LayerSettings;
 use super::*;
-use crate::bxdf::{FourierBSDFTable, MeasuredBxDFData, MerlTable, LAFORTUNE_FITS};
+use crate::bxdf::{FourierBSDFTable, IrregularBrdf, MeasuredBxDFData, MerlTable, LAFORTUNE_FITS};
 use crate::image::Image;
 use crate::params::unknown_type;
 use crate::spectrum::{
@@ -330,10 +330,13 @@ pub fn create_material(
                 .and_then(|e| e.to_str())
                 .map(str::to_ascii_lowercase);
             if ext.as_deref() == Some("brdf") {
-                return Err(Diagnostic::error(
-                    loc,
-                    format!("{}: pbrt-v2's irregular \".brdf\" measured data is not supported yet (MERL tables and RGL .bsdf files are)", path.display()),
-                ));
+                let data = IrregularBrdf::cached(&path).map_err(|m| {
+                    Diagnostic::error(loc.clone(), format!("{}: {m}", path.display()))
+                })?;
+                return Ok(Material::Irregular(Box::new(IrregularMaterial {
+                    data,
+                    perturbation: perturbation(tp, cache)?,
+                })));
             }
             if ext.as_deref() != Some("bsdf") && is_merl_file(&path) {
                 let table = MerlTable::cached(&path).map_err(|m| {

@@ -54,7 +54,7 @@ pub use fourier::FourierMaterial;
 pub use hair::{HairAbsorption, HairMaterial};
 pub use lafortune::LafortuneMaterial;
 pub use measured::MeasuredMaterial;
-pub use merl::MerlMaterial;
+pub use merl::{IrregularMaterial, MerlMaterial};
 pub use mix::MixMaterial;
 pub use shinymetal::ShinyMetalMaterial;
 pub use subsurface::{SubsurfaceCoefficients, SubsurfaceMaterial};
@@ -213,6 +213,8 @@ pub enum Material {
     Lafortune(Box<LafortuneMaterial>),
     /// pbrt-v2's `measured` with a MERL table.
     Merl(Box<MerlMaterial>),
+    /// pbrt-v2's `measured` with irregular `.brdf` measurements.
+    Irregular(Box<IrregularMaterial>),
 }
 
 impl Material {
@@ -243,6 +245,7 @@ impl Material {
             Material::ShinyMetal(m) => Some(m.get_bxdf(ctx, lambda)),
             Material::Lafortune(m) => Some(m.get_bxdf(ctx, lambda)),
             Material::Merl(m) => Some(m.get_bxdf(ctx, lambda)),
+            Material::Irregular(m) => Some(m.get_bxdf(ctx, lambda)),
         }
     }
 
@@ -264,6 +267,7 @@ impl Material {
             Material::ShinyMetal(m) => Some(&m.perturbation),
             Material::Lafortune(m) => Some(&m.perturbation),
             Material::Merl(m) => Some(&m.perturbation),
+            Material::Irregular(m) => Some(&m.perturbation),
             Material::Hair(_) | Material::Mix(_) | Material::Interface => None,
         }
     }
@@ -304,7 +308,7 @@ impl Material {
             Material::Fourier(_) => "fourier",
             Material::ShinyMetal(_) => "shinymetal",
             Material::Lafortune(m) => m.fit.name,
-            Material::Merl(_) => "measured",
+            Material::Merl(_) | Material::Irregular(_) => "measured",
         }
     }
 }

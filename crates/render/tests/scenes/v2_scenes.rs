@@ -284,3 +284,33 @@ fn merl_table_of_a_lambertian_reflects_its_albedo() {
     let im = render_scene(&text, 2);
     assert_close("merl", mean(&im), 0.5, 0.01);
 }
+
+#[test]
+fn irregular_measurements_of_a_lambertian_reflect_its_albedo() {
+    // pbrt-v2's irregular .brdf format: measurements of ρ/π (ρ = 0.5) at
+    // two wavelengths over a grid of angles, every lookup averages them
+    // to ρ/π: a sphere of it in a white furnace reflects 0.5.
+    let path = out("lambertian").with_extension("brdf");
+    let v = 0.5 / std::f64::consts::PI;
+    let mut text = String::from("2 400 700\n");
+    for i in 0..8 {
+        for o in 0..8 {
+            for p in 0..8 {
+                let (ti, to) = (0.1 + 0.2 * i as f64, 0.1 + 0.2 * o as f64);
+                text += &format!("{ti} {} {to} 0 {v} {v}\n", p as f64 * 0.45);
+            }
+        }
+    }
+    std::fs::write(&path, text).unwrap();
+    let scene = format!(
+        "LookAt 0 0 -3  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 10\n\
+         Film \"image\" \"integer xresolution\" 16 \"integer yresolution\" 16 \"string filename\" \"{}\"\n\
+         Sampler \"lowdiscrepancy\" \"integer pixelsamples\" 16\nSurfaceIntegrator \"path\"\nWorldBegin\n\
+         LightSource \"infinite\" \"color L\" [ 1 1 1 ]\n\
+         Material \"measured\" \"string filename\" \"{}\"\nShape \"sphere\"\nWorldEnd\n",
+        out("irregular").display(),
+        path.display()
+    );
+    let im = render_scene(&scene, 2);
+    assert_close("irregular", mean(&im), 0.5, 0.01);
+}
