@@ -30,6 +30,17 @@ pub fn decompose(m: &SquareMatrix4) -> Decomposition {
         mm.m[3][i] = 0.0;
     }
     mm.m[3][3] = 1.0;
+    if mm == SquareMatrix4::identity() {
+        // A translation (most animated shapes): what the iteration below
+        // finds, without its inverses (the identity is its own inverse,
+        // bit for bit).
+        let q = Quaternion::from_transform(&Transform::default()).normalize();
+        return Decomposition {
+            t,
+            r: q,
+            s: SquareMatrix4::identity(),
+        };
+    }
     let mut r = mm;
     for _ in 0..100 {
         let rit = match r.transpose().inverse() {
@@ -123,6 +134,12 @@ impl AnimatedTransform {
             return self.end_transform;
         }
         let dt = (time - self.start_time) / (self.end_time - self.start_time);
+        self.at_fraction(dt)
+    }
+
+    /// The decompositions' interpolation at `dt` of the keyframe interval
+    /// (0 at its start, 1 at its end).
+    fn at_fraction(&self, dt: Float) -> Transform {
         let trans = Vector3f::lerp(dt, self.d0.t, self.d1.t);
         let rotate = Quaternion::slerp(dt, self.d0.r, self.d1.r);
         let mut scale = SquareMatrix4::identity();
@@ -184,12 +201,34 @@ impl AnimatedTransform {
     /// within a piece of length `h` it stays within `L·h/2` of one of the
     /// piece's endpoint positions. The union of the padded endpoint boxes is
     /// therefore conservative, and tight as the pieces shrink.
+    ///
+    /// When the keyframes share their rotation (translation and scale
+    /// animated: the common case), every point moves along a straight
+    /// line, affine in time, so the boxes of the two ends bound the motion
+    /// (pbrt-v4 takes that union whenever its `hasRotation` is false).
     pub fn motion_bounds(&self, b: &Bounds3f) -> Bounds3f {
         if b.is_empty() {
             return *b;
         }
         if !self.actually_animated {
             return self.start_transform.apply_bounds(b);
+        }
+        if self.d0.r == self.d1.r {
+            // The keyframes themselves and the decompositions' ends (which
+            // the interpolation uses inside the interval and may differ
+            // from the keyframes in the last bits), padded for the
+            // rounding of the interpolation in between.
+            let r = self
+                .start_transform
+                .apply_bounds(b)
+                .union(&self.end_transform.apply_bounds(b))
+                .union(&self.at_fraction(0.0).apply_bounds(b))
+                .union(&self.at_fraction(1.0).apply_bounds(b));
+            let magnitude = [r.p_min, r.p_max]
+                .iter()
+                .flat_map(|p| [p.x.abs(), p.y.abs(), p.z.abs()])
+                .fold(0.0, Float::max);
+            return r.expand(1e-6 * ((b.p_max - b.p_min).length() + magnitude));
         }
         let delta = (self.end_time - self.start_time).max(Float::MIN_POSITIVE);
         let theta = self.d0.r.angle_between(self.d1.r) * 2.0;
@@ -277,6 +316,21 @@ mod tests {
         assert!(!AnimatedTransform::fixed(a).is_animated());
     }
 
+    /// A translation's decomposition skips the iteration; it must be what
+    /// the iteration gives.
+    #[test]
+    fn translation_decomposes_as_the_iteration_does() {
+        let m = *Transform::translate(Vector3f::new(1.5, -2.0, 7.25)).matrix();
+        let d = decompose(&m);
+        let rt = Transform::from_matrices(SquareMatrix4::identity(), SquareMatrix4::identity());
+        assert_eq!(d.r, Quaternion::from_transform(&rt).normalize());
+        let id = SquareMatrix4::identity();
+        assert_eq!(id.transpose().inverse(), Some(id));
+        assert_eq!(id.inverse().map(|ri| ri * id), Some(id));
+        assert_eq!(d.s, id);
+        assert_eq!(d.t, Vector3f::new(1.5, -2.0, 7.25));
+    }
+
     #[test]
     fn motion_bounds_contain_motion() {
         let a =
@@ -300,5 +354,40 @@ mod tests {
             sampled = sampled.union(&at.interpolate(i as Float / 1000.0).apply_bounds(&bx));
         }
         assert!(mb.diagonal().length() < sampled.diagonal().length() * 1.1);
+    }
+
+    /// Translation and scale animated, the rotation shared: the bounds of
+    /// the ends (padded by rounding only) hold every interpolated box.
+    #[test]
+    fn motion_bounds_of_straight_motion() {
+        let a =
+            Transform::translate(Vector3f::new(10.0, 1.0, -4.0)) * Transform::scale(2.0, 1.0, 1.0);
+        let b =
+            Transform::translate(Vector3f::new(10.5, -2.0, -4.0)) * Transform::scale(1.0, 2.0, 0.5);
+        let at = AnimatedTransform::new(a, 0.0, b, 1.0);
+        assert_eq!(at.d0.r, at.d1.r, "the straight-motion case");
+        let bx = Bounds3f::new(Point3f::new(-1.0, -0.5, -0.2), Point3f::new(1.0, 0.5, 2.0));
+        let mb = at.motion_bounds(&bx);
+        let ends = a.apply_bounds(&bx).union(&b.apply_bounds(&bx));
+        for i in 0..=1000 {
+            let xf = at.interpolate(i as Float / 1000.0);
+            for c in 0..8 {
+                assert!(mb.inside(xf.apply_point(bx.corner(c))), "t={i} c={c}");
+            }
+        }
+        assert!((mb.diagonal() - ends.diagonal()).length() < 1e-3);
+        // Pure translation, as a scene's `ActiveTransform` lines give it.
+        let a = Transform::translate(Vector3f::new(3.0, 4.0, 5.0));
+        let b = Transform::translate(Vector3f::new(3.25, 4.0, 4.5));
+        let at = AnimatedTransform::new(a, 0.0, b, 1.0);
+        let mb = at.motion_bounds(&bx);
+        for i in 0..=1000 {
+            let xf = at.interpolate(i as Float / 1000.0);
+            for c in 0..8 {
+                assert!(mb.inside(xf.apply_point(bx.corner(c))), "t={i} c={c}");
+            }
+        }
+        let ends = a.apply_bounds(&bx).union(&b.apply_bounds(&bx));
+        assert!((mb.diagonal() - ends.diagonal()).length() < 1e-4);
     }
 }

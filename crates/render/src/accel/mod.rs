@@ -509,9 +509,14 @@ impl RayPrecomp {
     }
 }
 
-/// The default number of build threads: the machine's parallelism.
+/// The default number of build threads: the machine's parallelism, asked
+/// once (on Linux the question reads cgroup files, and a scene of many
+/// animated shapes or object definitions builds an aggregate for each).
 pub(crate) fn default_threads() -> usize {
-    std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1)
+    static THREADS: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *THREADS.get_or_init(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    })
 }
