@@ -1,9 +1,12 @@
 //! The scale benchmark (issue 17, "Scale"): a 10-million-triangle binary PLY
 //! rendered at 64×64 with one sample per pixel, so that reading the mesh and
-//! building the BVH are nearly all the work.
+//! building the BVH are nearly all the work; and (`--scene motion`) 200,000
+//! spheres, each moving with its own `ActiveTransform StartTime`/`EndTime`
+//! translations, rendered at 128×128 with one sample per pixel.
 //!
 //!     cargo bench -p rpbrt --bench scale                  # generate, render, report
 //!     cargo bench -p rpbrt --bench scale -- --write-only  # just write the files
+//!     cargo bench -p rpbrt --bench scale -- --scene motion
 //!
 //! The mesh is a displaced grid of 2237×2237 vertices (9,999,392 triangles),
 //! binary little-endian, positions and triangle indices only (`float x y z`,
@@ -117,6 +120,54 @@ fn write_scene(dir: &Path, n: u32) -> std::io::Result<PathBuf> {
     Ok(scene)
 }
 
+/// Spheres in the motion scene.
+const MOTION_SPHERES: u32 = 200_000;
+
+/// Writes `motion.pbrt` into `dir`: [`MOTION_SPHERES`] small spheres at
+/// random places in a 40-unit cube (a fixed-seed xorshift, so the file is
+/// the same every time), each translated by its own start and end
+/// transforms, under a uniform sky.
+fn write_motion_scene(dir: &Path) -> std::io::Result<PathBuf> {
+    std::fs::create_dir_all(dir)?;
+    let scene = dir.join("motion.pbrt");
+    let mut w = BufWriter::with_capacity(1 << 20, File::create(&scene)?);
+    w.write_all(
+        b"LookAt 0 0 -60  0 0 0  0 1 0\n\
+          Camera \"perspective\" \"float fov\" 45 \"float shutteropen\" 0 \"float shutterclose\" 1\n\
+          Film \"rgb\" \"integer xresolution\" 128 \"integer yresolution\" 128\n\
+          \"string filename\" \"motion.exr\"\n\
+          Sampler \"independent\" \"integer pixelsamples\" 1\n\
+          WorldBegin\n\
+          LightSource \"infinite\" \"rgb L\" [1 1 1]\n\
+          Material \"diffuse\"\n",
+    )?;
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = |lo: f32, hi: f32| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        lo + (hi - lo) * ((state >> 40) as f32 / (1u64 << 24) as f32)
+    };
+    for _ in 0..MOTION_SPHERES {
+        let (x, y, z) = (
+            uniform(-20.0, 20.0),
+            uniform(-20.0, 20.0),
+            uniform(-20.0, 20.0),
+        );
+        let (dx, dy) = (uniform(-0.5, 0.5), uniform(-0.5, 0.5));
+        writeln!(
+            w,
+            "AttributeBegin\nActiveTransform StartTime\nTranslate {x:.4} {y:.4} {z:.4}\n\
+             ActiveTransform EndTime\nTranslate {:.4} {:.4} {z:.4}\nActiveTransform All\n\
+             Shape \"sphere\" \"float radius\" 0.1\nAttributeEnd",
+            x + dx,
+            y + dy
+        )?;
+    }
+    w.flush()?;
+    Ok(scene)
+}
+
 /// One timed run: (wall seconds, peak RSS in KiB if `/usr/bin/time` gave it).
 fn run_once(scene: &Path, threads: u32) -> Result<(f64, Option<u64>), String> {
     let rpbrt = env!("CARGO_BIN_EXE_rpbrt");
@@ -157,6 +208,7 @@ struct Args {
     runs: u32,
     threads: u32,
     write_only: bool,
+    motion: bool,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -166,6 +218,7 @@ fn parse_args() -> Result<Args, String> {
         runs: 3,
         threads: 2,
         write_only: false,
+        motion: false,
     };
     let mut it = std::env::args().skip(1);
     while let Some(arg) = it.next() {
@@ -180,6 +233,11 @@ fn parse_args() -> Result<Args, String> {
             "--runs" => a.runs = number("--runs", value("--runs")?)?,
             "--nthreads" => a.threads = number("--nthreads", value("--nthreads")?)?,
             "--write-only" => a.write_only = true,
+            "--scene" => match value("--scene")?.as_str() {
+                "triangles" => a.motion = false,
+                "motion" => a.motion = true,
+                other => return Err(format!("--scene {other:?}: triangles or motion")),
+            },
             // `cargo bench` passes this to every bench target.
             "--bench" => {}
             other => return Err(format!("unknown argument {other:?}")),
@@ -199,7 +257,12 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    let scene = match write_scene(&args.dir, args.n) {
+    let written = if args.motion {
+        write_motion_scene(&args.dir)
+    } else {
+        write_scene(&args.dir, args.n)
+    };
+    let scene = match written {
         Ok(s) => s,
         Err(e) => {
             eprintln!("scale: writing the scene in {}: {e}", args.dir.display());
@@ -227,11 +290,19 @@ fn main() -> ExitCode {
             }
         }
     }
+    let peak_gb = peak.map_or("n/a".into(), |k| format!("{:.2}", k as f64 * 1024.0 / 1e9));
+    if args.motion {
+        println!(
+            "RESULT scale motion spheres={MOTION_SPHERES} threads={} best_wall_s={best:.2} \
+             peak_rss_gb={peak_gb}",
+            args.threads
+        );
+        return ExitCode::SUCCESS;
+    }
     let tris = 2 * u64::from(args.n - 1) * u64::from(args.n - 1);
     println!(
         "RESULT scale triangles={tris} threads={} best_wall_s={best:.2} peak_rss_gb={}",
-        args.threads,
-        peak.map_or("n/a".into(), |k| format!("{:.2}", k as f64 * 1024.0 / 1e9))
+        args.threads, peak_gb
     );
     ExitCode::SUCCESS
 }
