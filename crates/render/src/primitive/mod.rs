@@ -221,10 +221,65 @@ pub struct TransformedPrimitive {
 /// Primitives whose transformation changes over the shutter interval.
 #[derive(Clone, Debug)]
 pub struct AnimatedPrimitive {
-    /// The animated aggregate, in its own space.
-    pub primitive: Arc<PrimitiveAggregate>,
+    /// What moves, in its own space.
+    pub primitive: Moving,
     /// From the primitive's space to rendering space, over time.
     pub render_from_primitive: AnimatedTransform,
+}
+
+/// What an [`AnimatedPrimitive`] moves: one shape (as pbrt-v4 wraps a
+/// single shape's primitive directly), or an aggregate over several (a
+/// mesh's triangles, an object definition's shapes).
+#[derive(Clone, Debug)]
+pub enum Moving {
+    /// A single shape: no aggregate of its own (a scene of many moving
+    /// spheres would otherwise hold a tree per sphere).
+    One(Primitive),
+    /// Several primitives, or a mesh, under their own aggregate.
+    Many(Arc<PrimitiveAggregate>),
+}
+
+impl Moving {
+    /// `prims` as one moving primitive, under `accel` when they need an
+    /// aggregate; `None` when there are none.
+    pub fn of(mut prims: Vec<Primitive>, accel: &AccelParams) -> Option<Moving> {
+        match prims.len() {
+            0 => None,
+            1 if matches!(prims[0], Primitive::Geometric(_)) => prims.pop().map(Moving::One),
+            _ => Some(Moving::Many(Arc::new(PrimitiveAggregate::new(
+                prims, accel,
+            )))),
+        }
+    }
+
+    /// Bounds in the primitive's own space.
+    fn bounds(&self) -> Bounds3f {
+        match self {
+            Moving::One(p) => p.bounds(),
+            Moving::Many(a) => a.bounds(),
+        }
+    }
+
+    fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
+        match self {
+            Moving::One(p) => p.intersect(ray, t_max),
+            Moving::Many(a) => a.intersect(ray, t_max),
+        }
+    }
+
+    fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
+        match self {
+            Moving::One(p) => p.intersect_p(ray, t_max),
+            Moving::Many(a) => a.intersect_p(ray, t_max),
+        }
+    }
+
+    fn for_each_material(&self, f: &mut impl FnMut(u32)) {
+        match self {
+            Moving::One(p) => p.for_each_material(f),
+            Moving::Many(a) => a.prims.iter().for_each(|q| q.for_each_material(f)),
+        }
+    }
 }
 
 fn transform_hit(
@@ -270,11 +325,7 @@ impl Primitive {
                 .prims
                 .iter()
                 .for_each(|q| q.for_each_material(f)),
-            Primitive::Animated(p) => p
-                .primitive
-                .prims
-                .iter()
-                .for_each(|q| q.for_each_material(f)),
+            Primitive::Animated(p) => p.primitive.for_each_material(f),
         }
     }
 

@@ -102,22 +102,74 @@ fn instances_match_direct_geometry() {
     assert!(hits > 500);
 }
 
-#[test]
-fn animated_primitive_follows_its_motion() {
+/// An aggregate holding one sphere moving along x from −2 to 2, held
+/// directly (`Moving::One`) or under an aggregate of its own.
+fn moving_sphere(own_aggregate: bool) -> PrimitiveAggregate {
     let start = Transform::translate(Vector3f::new(-2.0, 0.0, 0.0));
     let end = Transform::translate(Vector3f::new(2.0, 0.0, 0.0));
     let at = AnimatedTransform::new(start, 0.0, end, 1.0);
-    let inner = Arc::new(PrimitiveAggregate::new(
-        vec![sphere_prim(Transform::identity(), 0.5)],
-        &AccelParams::default(),
-    ));
-    let agg = PrimitiveAggregate::new(
+    let sphere = sphere_prim(Transform::identity(), 0.5);
+    let primitive = if own_aggregate {
+        Moving::Many(Arc::new(PrimitiveAggregate::new(
+            vec![sphere],
+            &AccelParams::default(),
+        )))
+    } else {
+        Moving::of(vec![sphere], &AccelParams::default()).expect("one primitive")
+    };
+    assert_eq!(matches!(primitive, Moving::One(_)), !own_aggregate);
+    PrimitiveAggregate::new(
         vec![Primitive::Animated(Box::new(AnimatedPrimitive {
-            primitive: inner,
+            primitive,
             render_from_primitive: at,
         }))],
         &AccelParams::default(),
-    );
+    )
+}
+
+/// A single moving shape is held without an aggregate of its own: the
+/// same hits, bit for bit, as under one (fixed-seed random rays at random
+/// times).
+#[test]
+fn single_moving_shape_hits_as_under_an_aggregate() {
+    let (one, many) = (moving_sphere(false), moving_sphere(true));
+    assert_eq!(one.bounds(), many.bounds());
+    let mut rng = Rng::new(11, 0);
+    let mut hits = 0;
+    for _ in 0..20000 {
+        let o = Point3f::new(
+            rng.uniform_float() * 6.0 - 3.0,
+            rng.uniform_float() * 2.0 - 1.0,
+            -5.0,
+        );
+        let d = Vector3f::new(
+            rng.uniform_float() * 0.4 - 0.2,
+            rng.uniform_float() * 0.4 - 0.2,
+            1.0,
+        );
+        let r = Ray::with_time(o, d, rng.uniform_float(), None);
+        let (a, b) = (
+            one.intersect(&r, Float::INFINITY),
+            many.intersect(&r, Float::INFINITY),
+        );
+        assert_eq!(a.is_some(), b.is_some());
+        if let (Some(a), Some(b)) = (a, b) {
+            assert_eq!(a.t_hit.to_bits(), b.t_hit.to_bits());
+            assert_eq!(a.si.p(), b.si.p());
+            assert_eq!(a.si.n, b.si.n);
+            hits += 1;
+        }
+        assert_eq!(
+            one.intersect_p(&r, Float::INFINITY),
+            many.intersect_p(&r, Float::INFINITY)
+        );
+    }
+    assert!(hits > 1000, "{hits}");
+}
+
+#[test]
+fn animated_primitive_follows_its_motion() {
+    let agg = moving_sphere(false);
     // The bounds cover the whole motion.
     let b = agg.bounds();
     assert!(b.p_min.x <= -2.5 && b.p_max.x >= 2.5);

@@ -26,7 +26,9 @@ use crate::lightsampler::create_light_sampler;
 use crate::material::MaterialSet;
 use crate::medium::{create_medium, create_region, Medium, RegionMedium};
 use crate::params::{unknown_type, ParamReader};
-use crate::primitive::{AnimatedPrimitive, Primitive, PrimitiveAggregate, TransformedPrimitive};
+use crate::primitive::{
+    AnimatedPrimitive, Moving, Primitive, PrimitiveAggregate, TransformedPrimitive,
+};
 use crate::sampler::{create_sampler, Sampler};
 use crate::texture::TextureOptions;
 
@@ -465,9 +467,9 @@ pub fn create_scene(
         }
         let mut inner = Vec::new();
         create_primitives(&cx, &at_origin(s), &mut lights, p, &mut inner);
-        if !inner.is_empty() {
+        if let Some(moving) = Moving::of(inner, &default_accel) {
             prims.push(Primitive::Animated(Box::new(AnimatedPrimitive {
-                primitive: Arc::new(PrimitiveAggregate::new(inner, &default_accel)),
+                primitive: moving,
                 render_from_primitive: s.render_from_object,
             })));
         }
@@ -489,9 +491,9 @@ pub fn create_scene(
         for s in &def.animated_shapes {
             let mut shapes = Vec::new();
             create_primitives(&cx, &at_origin(s), &mut lights, p, &mut shapes);
-            if !shapes.is_empty() {
+            if let Some(moving) = Moving::of(shapes, &default_accel) {
                 inner.push(Primitive::Animated(Box::new(AnimatedPrimitive {
-                    primitive: Arc::new(PrimitiveAggregate::new(shapes, &default_accel)),
+                    primitive: moving,
                     render_from_primitive: s.render_from_object,
                 })));
             }
@@ -524,7 +526,7 @@ pub fn create_scene(
                 render_from_primitive: *t,
             })),
             InstanceTransform::Animated(a) => Primitive::Animated(Box::new(AnimatedPrimitive {
-                primitive: def.clone(),
+                primitive: Moving::Many(def.clone()),
                 render_from_primitive: **a,
             })),
         });
