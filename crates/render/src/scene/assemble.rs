@@ -504,7 +504,7 @@ pub fn create_scene(
         );
     }
     for inst in &desc.instances {
-        let Some(def) = definitions.get(inst.name.as_str()) else {
+        let Some(def) = definitions.get(&*inst.name) else {
             p.errors.push(Diagnostic::error(
                 inst.loc.clone(),
                 format!("object \"{}\" is not defined", inst.name),

@@ -51,7 +51,7 @@ pub struct SceneBuilder {
     render_from_world: Transform,
     camera_defined: bool,
     active_definition: Option<InstanceDefinitionSceneEntity>,
-    instance_names: HashSet<String>,
+    instance_names: HashSet<Arc<str>>,
     named_material_names: HashSet<String>,
     medium_names: HashSet<String>,
     float_texture_names: HashSet<String>,
@@ -1383,7 +1383,7 @@ impl ParserTarget for SceneBuilder {
                 loc.clone(),
                 "ObjectBegin called inside of instance definition",
             ))
-        } else if !self.instance_names.insert(name.to_string()) {
+        } else if !self.instance_names.insert(Arc::from(name)) {
             Some(Diagnostic::error(
                 loc.clone(),
                 format!("\"{name}\": trying to redefine an object instance"),
@@ -1441,10 +1441,16 @@ impl ParserTarget for SceneBuilder {
         } else {
             InstanceTransform::Fixed(self.render_from_object_at(0) * world_from_render)
         };
-        let bytes = vec_element::<InstanceSceneEntity>() + heap(name.len());
+        // The object's name, shared with its definition (a million
+        // instances of one object hold one copy of its name, not a million).
+        let (name, name_bytes) = match self.instance_names.get(name) {
+            Some(shared) => (shared.clone(), 0),
+            None => (Arc::from(name), heap(name.len())),
+        };
+        let bytes = vec_element::<InstanceSceneEntity>() + name_bytes;
         self.charge(bytes, "ObjectInstance", &loc)?;
         self.scene.instances.push(InstanceSceneEntity {
-            name: name.to_string(),
+            name,
             loc,
             render_from_instance,
         });
@@ -1487,7 +1493,7 @@ impl ParserTarget for SceneBuilder {
             }
         }
         for inst in &self.scene.instances {
-            if !self.instance_names.contains(&inst.name) {
+            if !self.instance_names.contains(&*inst.name) {
                 self.pending.push(Diagnostic::error(
                     inst.loc.clone(),
                     format!("\"{}\": object instance not defined", inst.name),

@@ -214,8 +214,8 @@ pub enum InstanceTransform {
 /// An `ObjectInstance`.
 #[derive(Clone, Debug)]
 pub struct InstanceSceneEntity {
-    /// The instanced object's name.
-    pub name: String,
+    /// The instanced object's name (shared with its definition's).
+    pub name: Arc<str>,
     /// Where the directive was.
     pub loc: FileLoc,
     /// From instance space (the definition's render space) to render space.
