@@ -2,11 +2,15 @@
 //! rendered at 64×64 with one sample per pixel, so that reading the mesh and
 //! building the BVH are nearly all the work; and (`--scene motion`) 200,000
 //! spheres, each moving with its own `ActiveTransform StartTime`/`EndTime`
-//! translations, rendered at 128×128 with one sample per pixel.
+//! translations, rendered at 128×128 with one sample per pixel; and
+//! (`--scene instances`) 1,000,000 `ObjectInstance`s, each with its own
+//! `Translate` and `Rotate`, of one 19,602-triangle mesh (99 MB of text),
+//! rendered the same way.
 //!
 //!     cargo bench -p rpbrt --bench scale                  # generate, render, report
 //!     cargo bench -p rpbrt --bench scale -- --write-only  # just write the files
 //!     cargo bench -p rpbrt --bench scale -- --scene motion
+//!     cargo bench -p rpbrt --bench scale -- --scene instances
 //!
 //! The mesh is a displaced grid of 2237×2237 vertices (9,999,392 triangles),
 //! binary little-endian, positions and triangle indices only (`float x y z`,
@@ -168,6 +172,77 @@ fn write_motion_scene(dir: &Path) -> std::io::Result<PathBuf> {
     Ok(scene)
 }
 
+/// Instances in the instances scene, and vertices along each side of the
+/// instanced grid.
+const INSTANCES: u32 = 1_000_000;
+const INSTANCE_GRID: u32 = 100;
+
+/// Writes `instances.pbrt` into `dir`: a wavy 100×100-vertex grid (19,602
+/// triangles, inline) in an `ObjectBegin`, and [`INSTANCES`] instances of
+/// it at random places and turns in a 200-unit cube (a fixed-seed
+/// xorshift, so the file is the same every time), under a uniform sky.
+fn write_instances_scene(dir: &Path) -> std::io::Result<PathBuf> {
+    std::fs::create_dir_all(dir)?;
+    let scene = dir.join("instances.pbrt");
+    let mut w = BufWriter::with_capacity(1 << 20, File::create(&scene)?);
+    w.write_all(
+        b"LookAt 0 0 -300  0 0 0  0 1 0\n\
+          Camera \"perspective\" \"float fov\" 45\n\
+          Film \"rgb\" \"integer xresolution\" 128 \"integer yresolution\" 128\n\
+          \"string filename\" \"instances.exr\"\n\
+          Sampler \"independent\" \"integer pixelsamples\" 1\n\
+          WorldBegin\n\
+          LightSource \"infinite\" \"rgb L\" [1 1 1]\n\
+          Material \"diffuse\"\n\
+          ObjectBegin \"m\"\nShape \"trianglemesh\" \"point3 P\" [",
+    )?;
+    let n = INSTANCE_GRID;
+    for j in 0..n {
+        for i in 0..n {
+            let (x, y) = (i as f32 / (n - 1) as f32, j as f32 / (n - 1) as f32);
+            let z = 0.1 * (6.0 * x).sin() * (5.0 * y).cos();
+            write!(w, "{x:.4} {y:.4} {z:.4} ")?;
+        }
+    }
+    w.write_all(b"] \"integer indices\" [")?;
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let a = j * n + i;
+            write!(
+                w,
+                "{a} {} {} {a} {} {} ",
+                a + 1,
+                a + n + 1,
+                a + n + 1,
+                a + n
+            )?;
+        }
+    }
+    w.write_all(b"]\nObjectEnd\n")?;
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut uniform = |lo: f32, hi: f32| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        lo + (hi - lo) * ((state >> 40) as f32 / (1u64 << 24) as f32)
+    };
+    for _ in 0..INSTANCES {
+        let (x, y, z) = (
+            uniform(-100.0, 100.0),
+            uniform(-100.0, 100.0),
+            uniform(-100.0, 100.0),
+        );
+        let angle = uniform(0.0, 360.0);
+        writeln!(
+            w,
+            "AttributeBegin\nTranslate {x:.3} {y:.3} {z:.3}\nRotate {angle:.2} 0 1 0\n\
+             ObjectInstance \"m\"\nAttributeEnd"
+        )?;
+    }
+    w.flush()?;
+    Ok(scene)
+}
+
 /// One timed run: (wall seconds, peak RSS in KiB if `/usr/bin/time` gave it).
 fn run_once(scene: &Path, threads: u32) -> Result<(f64, Option<u64>), String> {
     let rpbrt = env!("CARGO_BIN_EXE_rpbrt");
@@ -208,7 +283,15 @@ struct Args {
     runs: u32,
     threads: u32,
     write_only: bool,
-    motion: bool,
+    scene: Scene,
+}
+
+/// Which generated scene the bench renders.
+#[derive(Clone, Copy, PartialEq)]
+enum Scene {
+    Triangles,
+    Motion,
+    Instances,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -218,7 +301,7 @@ fn parse_args() -> Result<Args, String> {
         runs: 3,
         threads: 2,
         write_only: false,
-        motion: false,
+        scene: Scene::Triangles,
     };
     let mut it = std::env::args().skip(1);
     while let Some(arg) = it.next() {
@@ -233,11 +316,16 @@ fn parse_args() -> Result<Args, String> {
             "--runs" => a.runs = number("--runs", value("--runs")?)?,
             "--nthreads" => a.threads = number("--nthreads", value("--nthreads")?)?,
             "--write-only" => a.write_only = true,
-            "--scene" => match value("--scene")?.as_str() {
-                "triangles" => a.motion = false,
-                "motion" => a.motion = true,
-                other => return Err(format!("--scene {other:?}: triangles or motion")),
-            },
+            "--scene" => {
+                a.scene = match value("--scene")?.as_str() {
+                    "triangles" => Scene::Triangles,
+                    "motion" => Scene::Motion,
+                    "instances" => Scene::Instances,
+                    other => {
+                        return Err(format!("--scene {other:?}: triangles, motion or instances"))
+                    }
+                }
+            }
             // `cargo bench` passes this to every bench target.
             "--bench" => {}
             other => return Err(format!("unknown argument {other:?}")),
@@ -257,10 +345,10 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    let written = if args.motion {
-        write_motion_scene(&args.dir)
-    } else {
-        write_scene(&args.dir, args.n)
+    let written = match args.scene {
+        Scene::Triangles => write_scene(&args.dir, args.n),
+        Scene::Motion => write_motion_scene(&args.dir),
+        Scene::Instances => write_instances_scene(&args.dir),
     };
     let scene = match written {
         Ok(s) => s,
@@ -291,18 +379,17 @@ fn main() -> ExitCode {
         }
     }
     let peak_gb = peak.map_or("n/a".into(), |k| format!("{:.2}", k as f64 * 1024.0 / 1e9));
-    if args.motion {
-        println!(
-            "RESULT scale motion spheres={MOTION_SPHERES} threads={} best_wall_s={best:.2} \
-             peak_rss_gb={peak_gb}",
-            args.threads
-        );
-        return ExitCode::SUCCESS;
-    }
-    let tris = 2 * u64::from(args.n - 1) * u64::from(args.n - 1);
+    let what = match args.scene {
+        Scene::Triangles => format!(
+            "triangles={}",
+            2 * u64::from(args.n - 1) * u64::from(args.n - 1)
+        ),
+        Scene::Motion => format!("motion spheres={MOTION_SPHERES}"),
+        Scene::Instances => format!("instances instances={INSTANCES}"),
+    };
     println!(
-        "RESULT scale triangles={tris} threads={} best_wall_s={best:.2} peak_rss_gb={}",
-        args.threads, peak_gb
+        "RESULT scale {what} threads={} best_wall_s={best:.2} peak_rss_gb={peak_gb}",
+        args.threads
     );
     ExitCode::SUCCESS
 }
