@@ -344,11 +344,9 @@ mod tests {
     fn translations_interpolate_as_the_composition_does() {
         let mut state = 0x6a09_e667_f3bc_c909u64;
         let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            let m = (state >> 40) as Float / (1u64 << 24) as Float - 0.5;
-            m * (2.0 as Float).powi((state % 24) as i32 - 8)
+            let r = crate::float::xorshift64(&mut state);
+            let m = (r >> 40) as Float / (1u64 << 24) as Float - 0.5;
+            m * (2.0 as Float).powi((r % 24) as i32 - 8)
         };
         for _ in 0..2000 {
             let a = Transform::translate(Vector3f::new(next(), next(), next()));
@@ -368,23 +366,14 @@ mod tests {
                     next().abs().fract()
                 };
                 let (f, g) = (at.at_fraction(dt), general.at_fraction(dt));
-                for (x, y) in f
-                    .matrix()
-                    .m
-                    .iter()
-                    .flatten()
-                    .zip(g.matrix().m.iter().flatten())
-                {
-                    assert_eq!(x.to_bits(), y.to_bits(), "dt {dt}: {f:?} against {g:?}");
-                }
-                for (x, y) in f
-                    .inverse_matrix()
-                    .m
-                    .iter()
-                    .flatten()
-                    .zip(g.inverse_matrix().m.iter().flatten())
-                {
-                    assert_eq!(x.to_bits(), y.to_bits(), "dt {dt}: inverses");
+                let pairs = [
+                    (f.matrix(), g.matrix()),
+                    (f.inverse_matrix(), g.inverse_matrix()),
+                ];
+                for (a, b) in pairs {
+                    for (x, y) in a.m.iter().flatten().zip(b.m.iter().flatten()) {
+                        assert_eq!(x.to_bits(), y.to_bits(), "dt {dt}: {f:?} against {g:?}");
+                    }
                 }
             }
         }

@@ -209,6 +209,16 @@ pub fn inner_product(a: &[Float], b: &[Float]) -> Float {
     sum.value()
 }
 
+/// A fixed-seed xorshift64 step, for tests that need many reproducible
+/// bit patterns: advances `state` and returns it.
+#[cfg(test)]
+pub(crate) fn xorshift64(state: &mut u64) -> u64 {
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    *state
+}
+
 /// Linear interpolation `(1 − t)·a + t·b`.
 #[inline]
 pub fn lerp(t: Float, a: Float, b: Float) -> Float {
@@ -419,12 +429,7 @@ mod tests {
         // Fixed seed; exponents across the float range, subnormal products
         // and overflowing ones included.
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = || xorshift64(&mut state);
         for _ in 0..200_000 {
             let r = next();
             // Half of them below 2 (tiny products), half anything

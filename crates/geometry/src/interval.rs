@@ -357,12 +357,7 @@ mod tests {
     #[test]
     fn sign_case_products_and_quotients_equal_all_four() {
         let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut next = || crate::float::xorshift64(&mut state);
         let specials = [
             0.0, -0.0, 1.0, -1.0, 1e-30, -1e-30, 3.5e20, -3.5e20, 0.1, -7.25,
         ];
