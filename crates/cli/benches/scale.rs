@@ -124,6 +124,41 @@ fn write_scene(dir: &Path, n: u32) -> std::io::Result<PathBuf> {
     Ok(scene)
 }
 
+/// Creates `dir/{stem}.pbrt` and writes the generated scenes' common start:
+/// a camera `distance` units from the origin down −z (with `camera_extra`
+/// parameters), a 128×128 film named `{stem}.exr`, one independent sample
+/// per pixel, a uniform white sky and a diffuse material.
+fn generated_scene(
+    dir: &Path,
+    stem: &str,
+    distance: u32,
+    camera_extra: &str,
+) -> std::io::Result<(PathBuf, BufWriter<File>)> {
+    std::fs::create_dir_all(dir)?;
+    let scene = dir.join(format!("{stem}.pbrt"));
+    let mut w = BufWriter::with_capacity(1 << 20, File::create(&scene)?);
+    write!(
+        w,
+        "LookAt 0 0 -{distance}  0 0 0  0 1 0\n\
+         Camera \"perspective\" \"float fov\" 45{camera_extra}\n\
+         Film \"rgb\" \"integer xresolution\" 128 \"integer yresolution\" 128\n\
+         \"string filename\" \"{stem}.exr\"\n\
+         Sampler \"independent\" \"integer pixelsamples\" 1\n\
+         WorldBegin\n\
+         LightSource \"infinite\" \"rgb L\" [1 1 1]\n\
+         Material \"diffuse\"\n"
+    )?;
+    Ok((scene, w))
+}
+
+/// A uniform value in [lo, hi) from a fixed-seed xorshift64 step of `state`.
+fn uniform(state: &mut u64, lo: f32, hi: f32) -> f32 {
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    lo + (hi - lo) * ((*state >> 40) as f32 / (1u64 << 24) as f32)
+}
+
 /// Spheres in the motion scene.
 const MOTION_SPHERES: u32 = 200_000;
 
@@ -132,26 +167,14 @@ const MOTION_SPHERES: u32 = 200_000;
 /// the same every time), each translated by its own start and end
 /// transforms, under a uniform sky.
 fn write_motion_scene(dir: &Path) -> std::io::Result<PathBuf> {
-    std::fs::create_dir_all(dir)?;
-    let scene = dir.join("motion.pbrt");
-    let mut w = BufWriter::with_capacity(1 << 20, File::create(&scene)?);
-    w.write_all(
-        b"LookAt 0 0 -60  0 0 0  0 1 0\n\
-          Camera \"perspective\" \"float fov\" 45 \"float shutteropen\" 0 \"float shutterclose\" 1\n\
-          Film \"rgb\" \"integer xresolution\" 128 \"integer yresolution\" 128\n\
-          \"string filename\" \"motion.exr\"\n\
-          Sampler \"independent\" \"integer pixelsamples\" 1\n\
-          WorldBegin\n\
-          LightSource \"infinite\" \"rgb L\" [1 1 1]\n\
-          Material \"diffuse\"\n",
+    let (scene, mut w) = generated_scene(
+        dir,
+        "motion",
+        60,
+        " \"float shutteropen\" 0 \"float shutterclose\" 1",
     )?;
     let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut uniform = |lo: f32, hi: f32| {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        lo + (hi - lo) * ((state >> 40) as f32 / (1u64 << 24) as f32)
-    };
+    let mut uniform = |lo, hi| uniform(&mut state, lo, hi);
     for _ in 0..MOTION_SPHERES {
         let (x, y, z) = (
             uniform(-20.0, 20.0),
@@ -182,20 +205,8 @@ const INSTANCE_GRID: u32 = 100;
 /// it at random places and turns in a 200-unit cube (a fixed-seed
 /// xorshift, so the file is the same every time), under a uniform sky.
 fn write_instances_scene(dir: &Path) -> std::io::Result<PathBuf> {
-    std::fs::create_dir_all(dir)?;
-    let scene = dir.join("instances.pbrt");
-    let mut w = BufWriter::with_capacity(1 << 20, File::create(&scene)?);
-    w.write_all(
-        b"LookAt 0 0 -300  0 0 0  0 1 0\n\
-          Camera \"perspective\" \"float fov\" 45\n\
-          Film \"rgb\" \"integer xresolution\" 128 \"integer yresolution\" 128\n\
-          \"string filename\" \"instances.exr\"\n\
-          Sampler \"independent\" \"integer pixelsamples\" 1\n\
-          WorldBegin\n\
-          LightSource \"infinite\" \"rgb L\" [1 1 1]\n\
-          Material \"diffuse\"\n\
-          ObjectBegin \"m\"\nShape \"trianglemesh\" \"point3 P\" [",
-    )?;
+    let (scene, mut w) = generated_scene(dir, "instances", 300, "")?;
+    w.write_all(b"ObjectBegin \"m\"\nShape \"trianglemesh\" \"point3 P\" [")?;
     let n = INSTANCE_GRID;
     for j in 0..n {
         for i in 0..n {
@@ -220,12 +231,7 @@ fn write_instances_scene(dir: &Path) -> std::io::Result<PathBuf> {
     }
     w.write_all(b"]\nObjectEnd\n")?;
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut uniform = |lo: f32, hi: f32| {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        lo + (hi - lo) * ((state >> 40) as f32 / (1u64 << 24) as f32)
-    };
+    let mut uniform = |lo, hi| uniform(&mut state, lo, hi);
     for _ in 0..INSTANCES {
         let (x, y, z) = (
             uniform(-100.0, 100.0),
