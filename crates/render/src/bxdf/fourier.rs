@@ -16,10 +16,9 @@
 //! before anything is allocated, so a truncated or corrupt file is a
 //! [`FourierError`], never a panic or an allocation sized by the header.
 
-use std::collections::HashMap;
+use super::{cached_file, FileCache};
 use std::fmt;
-use std::path::{Path, PathBuf};
-use std::sync::{Mutex, OnceLock};
+use std::path::Path;
 
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;
@@ -294,16 +293,8 @@ impl FourierBSDFTable {
 
     /// The table of `path`, read once per file for the whole run.
     pub fn cached(path: &Path) -> Result<&'static FourierBSDFTable, FourierError> {
-        static CACHE: OnceLock<Mutex<HashMap<PathBuf, &'static FourierBSDFTable>>> =
-            OnceLock::new();
-        let key = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
-        let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
-        if let Some(t) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
-            return Ok(t);
-        }
-        let table: &'static FourierBSDFTable = Box::leak(Box::new(Self::read(path)?));
-        let mut c = cache.lock().unwrap_or_else(|e| e.into_inner());
-        Ok(*c.entry(key).or_insert(table))
+        static CACHE: FileCache<FourierBSDFTable> = FileCache::new();
+        cached_file(&CACHE, path, Self::read)
     }
 
     /// Catmull–Rom offset and weights of a zenith cosine.

@@ -14,9 +14,8 @@
 //! turned them into RGB; rpbrt renders them spectrally). Sampling is
 //! cosine-weighted.
 
-use std::collections::HashMap;
-use std::path::{Path, PathBuf};
-use std::sync::{Mutex, OnceLock};
+use super::{cached_file, FileCache};
+use std::path::Path;
 
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;
@@ -118,16 +117,10 @@ impl IrregularBrdf {
 
     /// The measurements of the file at `path`, read once per run.
     pub fn cached(path: &Path) -> Result<&'static IrregularBrdf, String> {
-        static CACHE: OnceLock<Mutex<HashMap<PathBuf, &'static IrregularBrdf>>> = OnceLock::new();
-        let key = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
-        let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
-        if let Some(t) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
-            return Ok(t);
-        }
-        let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
-        let data: &'static IrregularBrdf = Box::leak(Box::new(Self::parse(&text)?));
-        let mut c = cache.lock().unwrap_or_else(|e| e.into_inner());
-        Ok(*c.entry(key).or_insert(data))
+        static CACHE: FileCache<IrregularBrdf> = FileCache::new();
+        cached_file(&CACHE, path, |p| {
+            Self::parse(&std::fs::read_to_string(p).map_err(|e| e.to_string())?)
+        })
     }
 
     /// Point `i`'s value at wavelength `lambda`.

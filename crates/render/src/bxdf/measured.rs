@@ -9,10 +9,9 @@
 //! `vndf` and, on the VNDF's sample space, the `luminance` used for
 //! importance sampling and the reflectance `spectra` at the `wavelengths`.
 
-use std::collections::HashMap;
+use super::{cached_file, FileCache};
 use std::fmt;
-use std::path::{Path, PathBuf};
-use std::sync::{Mutex, OnceLock};
+use std::path::Path;
 
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;
@@ -238,16 +237,8 @@ impl MeasuredBxDFData {
     /// allocator). The data are leaked on purpose: BxDFs are `Copy` and
     /// hold a plain reference. Failed reads are not cached.
     pub fn cached(path: &Path) -> Result<&'static MeasuredBxDFData, String> {
-        static CACHE: OnceLock<Mutex<HashMap<PathBuf, &'static MeasuredBxDFData>>> =
-            OnceLock::new();
-        let key = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
-        let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
-        if let Some(d) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
-            return Ok(d);
-        }
-        let data: &'static MeasuredBxDFData = Box::leak(Box::new(Self::read(path)?));
-        let mut c = cache.lock().unwrap_or_else(|e| e.into_inner());
-        Ok(*c.entry(key).or_insert(data))
+        static CACHE: FileCache<MeasuredBxDFData> = FileCache::new();
+        cached_file(&CACHE, path, Self::read)
     }
 }
 

@@ -11,9 +11,8 @@
 //! indexed by `√(θh / (π/2))`. Sampling is cosine-weighted, as pbrt-v2's
 //! default BxDF sampling was.
 
-use std::collections::HashMap;
-use std::path::{Path, PathBuf};
-use std::sync::{Mutex, OnceLock};
+use super::{cached_file, FileCache};
+use std::path::Path;
 
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::tuple::*;
@@ -73,16 +72,10 @@ impl MerlTable {
 
     /// The table of the file at `path`, read once per run and shared.
     pub fn cached(path: &Path) -> Result<&'static MerlTable, String> {
-        static CACHE: OnceLock<Mutex<HashMap<PathBuf, &'static MerlTable>>> = OnceLock::new();
-        let key = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
-        let cache = CACHE.get_or_init(|| Mutex::new(HashMap::new()));
-        if let Some(t) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
-            return Ok(t);
-        }
-        let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
-        let table: &'static MerlTable = Box::leak(Box::new(Self::parse(&bytes)?));
-        let mut c = cache.lock().unwrap_or_else(|e| e.into_inner());
-        Ok(*c.entry(key).or_insert(table))
+        static CACHE: FileCache<MerlTable> = FileCache::new();
+        cached_file(&CACHE, path, |p| {
+            Self::parse(&std::fs::read(p).map_err(|e| e.to_string())?)
+        })
     }
 
     /// pbrt-v2's `RegularHalfangleBRDF::f`: the RGB entry for the pair of

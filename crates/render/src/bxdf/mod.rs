@@ -35,6 +35,33 @@ mod tests;
 #[cfg(test)]
 mod tests_v3;
 
+/// A per-process cache of data read from files (measured BRDFs, Fourier
+/// tables), keyed by canonical path: each model's `cached` holds one as a
+/// `static` and reads through [`cached_file`].
+pub(crate) type FileCache<T> = std::sync::OnceLock<
+    std::sync::Mutex<std::collections::HashMap<std::path::PathBuf, &'static T>>,
+>;
+
+/// The data of the file at `path` from `cache`, made by `load` on first
+/// use and kept for the rest of the run. The data are leaked on purpose:
+/// BxDFs are `Copy` and hold a plain reference (pbrt-v4 keeps such data in
+/// the scene's allocator). Failed loads are not cached; two threads that
+/// load the same file at once keep the first.
+pub(crate) fn cached_file<T: Sync, E>(
+    cache: &'static FileCache<T>,
+    path: &std::path::Path,
+    load: impl FnOnce(&std::path::Path) -> Result<T, E>,
+) -> Result<&'static T, E> {
+    let key = path.canonicalize().unwrap_or_else(|_| path.to_path_buf());
+    let map = cache.get_or_init(Default::default);
+    if let Some(d) = map.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
+        return Ok(d);
+    }
+    let data: &'static T = Box::leak(Box::new(load(path)?));
+    let mut m = map.lock().unwrap_or_else(|e| e.into_inner());
+    Ok(*m.entry(key).or_insert(data))
+}
+
 pub use bsdf::BSDF;
 pub use conductor::ConductorBxDF;
 pub use dielectric::{DielectricBxDF, ThinDielectricBxDF};
