@@ -33,6 +33,7 @@ pub(crate) mod bdpt;
 mod bsdf_stage;
 mod camera_samples;
 mod create;
+mod diffuse_lanes;
 mod direct;
 mod function;
 mod lightpath;

@@ -3,7 +3,8 @@
 //! optional BSDF regularization.
 
 use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
-use super::direct::{light_request, light_shadow_query, LightAnswer, ShadowQuery};
+use super::diffuse_lanes::{DiffuseVertex, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut};
+use super::direct::{light_request, light_shadow_query, LightAnswer, LightRequest, ShadowQuery};
 use super::vertex::{li_by_vertices, Begin, VertexIntegrator, VertexStep};
 use super::{skip_intersection, RayIntegrator, Scene, VertexOrigins};
 use crate::bxdf::BSDF;
@@ -14,7 +15,7 @@ use crate::primitive::{HitRecord, PrimitiveIntersection};
 use crate::sampler::Sampler;
 use crate::sampling::power_heuristic;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use rpbrt_geometry::float::Float;
+use rpbrt_geometry::float::{Float, INV_PI};
 use rpbrt_geometry::ray::{Ray, RayDifferential};
 use rpbrt_geometry::tuple::*;
 
@@ -99,6 +100,8 @@ pub(crate) struct SurfaceScratch {
     u: Float,
     u2: Point2f,
     answers: BsdfAnswers,
+    /// A vertex the wavefront takes in lanes (`diffuse_lanes.rs`).
+    diffuse: DiffuseVertex,
 }
 
 impl VertexIntegrator for PathIntegrator {
@@ -274,16 +277,141 @@ impl VertexIntegrator for PathIntegrator {
             s.eta_scale *= bs.eta * bs.eta;
         }
         s.ray = RayDifferential::new(origins.spawn_ray(bs.wi));
-        let rr_beta = s.beta * s.eta_scale;
-        let m = rr_beta.max_component_value();
-        if m < 1.0 && s.depth > 1 {
-            let q = (1.0 - m).max(0.0);
-            if sampler.get_1d() < q {
-                return VertexStep { shadow, done: true };
-            }
-            s.beta /= 1.0 - q;
-        }
-        let done = s.beta.is_black();
-        VertexStep { shadow, done }
+        russian_roulette(s, sampler, shadow)
     }
+
+    #[inline(always)]
+    fn diffuse_hit(
+        &self,
+        scene: &Scene,
+        s: &PathState,
+        record: &HitRecord,
+        lambda: &SampledWavelengths,
+        gbuffer: bool,
+    ) -> Option<(SurfaceIn, SampledSpectrum)> {
+        // The vertices `begin` ends (the last one) or that draw or write
+        // more than a diffuse vertex does are left to it.
+        if s.depth >= self.max_depth || scene.force_diffuse || (gbuffer && s.depth == 0) {
+            return None;
+        }
+        let hit = scene.aggregate.triangle_hit(record)?;
+        if hit.area_light.is_some() {
+            return None;
+        }
+        let spectrum = scene.materials.constant_diffuse(hit.material?)?;
+        // `DiffuseMaterial::get_bxdf`; a black reflectance makes a BSDF
+        // without flags, which `begin` handles.
+        let r = spectrum.sample(lambda).clamp(0.0, 1.0);
+        if r.is_black() {
+            return None;
+        }
+        Some((SurfaceIn::new(&hit, s.ray.ray.d)?, r))
+    }
+
+    /// `begin`'s steps for a diffuse vertex: the depth, the sampler draws,
+    /// the light request (the surface kernel built the interaction and the
+    /// BSDF's frame).
+    #[inline(always)]
+    fn diffuse_begin(
+        &self,
+        s: &mut PathState,
+        scratch: &mut SurfaceScratch,
+        surface: &SurfaceOut,
+        r: SampledSpectrum,
+        sampler: &mut Sampler,
+    ) -> LightRequest {
+        s.depth += 1;
+        let (u_light, u_light_2d, _, u2) = sampler.get_vertex_samples();
+        let mut v = DiffuseVertex::new(surface, s.ray.ray.time, r, u2);
+        let ctx = v.light_context();
+        let z = v.frame.z;
+        scratch.hit = None;
+        scratch.bsdf = None;
+        scratch.diffuse = v;
+        LightRequest {
+            ctx,
+            u: u_light,
+            u_light: u_light_2d,
+            hemisphere: Some((z, dot(v.wo, z))),
+        }
+    }
+
+    #[inline(always)]
+    fn scatter_in(
+        s: &PathState,
+        scratch: &SurfaceScratch,
+        light: Option<&LightAnswer>,
+    ) -> ScatterIn {
+        ScatterIn::new(&scratch.diffuse, s.ray.ray.d, light)
+    }
+
+    /// `finish` for a diffuse vertex, given the BSDF's answers.
+    #[inline(always)]
+    fn diffuse_finish(
+        &self,
+        scene: &Scene,
+        s: &mut PathState,
+        scratch: &mut SurfaceScratch,
+        scatter: &ScatterOut,
+        light: Option<&LightAnswer>,
+        sampler: &mut Sampler,
+    ) -> VertexStep {
+        let v = &mut scratch.diffuse;
+        // `light_shadow_query`.
+        let shadow = light.and_then(|a| {
+            let f = scatter.f_light;
+            if f.is_black() {
+                return None;
+            }
+            let ls = &a.ls;
+            let (ray, t_max) = v.shadow_ray(ls.p_light, ls.n_light);
+            let p_l = a.p * ls.pdf;
+            let ld = if scene.lights[a.light as usize].light_type().is_delta() {
+                ls.l * f / p_l
+            } else {
+                let w_l = power_heuristic(1.0, p_l, 1.0, scatter.pdf_light);
+                ls.l * f * (w_l / p_l)
+            };
+            Some(ShadowQuery {
+                ray,
+                t_max,
+                ld: s.beta * ld,
+            })
+        });
+        s.prev_ctx = v.context();
+        let Some((wi, pdf, cos_over_pdf)) = scatter.sample else {
+            return VertexStep { shadow, done: true };
+        };
+        let f = v.r * INV_PI;
+        if f.is_black() {
+            return VertexStep { shadow, done: true };
+        }
+        s.beta *= f * cos_over_pdf;
+        s.p_b = pdf;
+        s.specular_bounce = false;
+        s.any_non_specular = true;
+        s.ray = RayDifferential::new(Ray::with_time(v.toward(wi), wi, v.time, None));
+        russian_roulette(s, sampler, shadow)
+    }
+}
+
+/// The end of a vertex: Russian roulette on the throughput (without the
+/// refraction scale), then the path ends where it is black.
+#[inline(always)]
+fn russian_roulette(
+    s: &mut PathState,
+    sampler: &mut Sampler,
+    shadow: Option<ShadowQuery>,
+) -> VertexStep {
+    let rr_beta = s.beta * s.eta_scale;
+    let m = rr_beta.max_component_value();
+    if m < 1.0 && s.depth > 1 {
+        let q = (1.0 - m).max(0.0);
+        if sampler.get_1d() < q {
+            return VertexStep { shadow, done: true };
+        }
+        s.beta /= 1.0 - q;
+    }
+    let done = s.beta.is_black();
+    VertexStep { shadow, done }
 }

@@ -7,6 +7,7 @@
 //! the same pixels.
 
 use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
+use super::diffuse_lanes::{ScatterIn, ScatterOut, SurfaceIn, SurfaceOut};
 use super::direct::{answer_light, LightAnswer, LightRequest, ShadowQuery};
 use super::Scene;
 use crate::film::VisibleSurface;
@@ -108,6 +109,59 @@ pub(crate) trait VertexIntegrator: Sync {
         scratch: &mut Self::Scratch,
         light: Option<&LightAnswer>,
     ) -> VertexStep;
+
+    /// The lane form of a diffuse vertex (`diffuse_lanes.rs`), for the
+    /// wavefront: for a hit `record` of the path in state `s` that the
+    /// lane form covers, the surface kernel's input and the reflectance
+    /// at `lambda`; `None` (the default) where the scalar vertex runs.
+    /// `gbuffer`: the film records the first visible surface.
+    fn diffuse_hit(
+        &self,
+        _scene: &Scene,
+        _s: &Self::State,
+        _record: &HitRecord,
+        _lambda: &SampledWavelengths,
+        _gbuffer: bool,
+    ) -> Option<(SurfaceIn, SampledSpectrum)> {
+        None
+    }
+
+    /// The first half of a vertex that [`VertexIntegrator::diffuse_hit`]
+    /// took, given its surface and reflectance: its light request.
+    fn diffuse_begin(
+        &self,
+        _s: &mut Self::State,
+        _scratch: &mut Self::Scratch,
+        _surface: &SurfaceOut,
+        _r: SampledSpectrum,
+        _sampler: &mut Sampler,
+    ) -> LightRequest {
+        unreachable!("diffuse_begin without diffuse_hit")
+    }
+
+    /// The scatter kernel's input for such a vertex, given the answer to
+    /// its light request.
+    fn scatter_in(
+        _s: &Self::State,
+        _scratch: &Self::Scratch,
+        _light: Option<&LightAnswer>,
+    ) -> ScatterIn {
+        unreachable!("scatter_in without diffuse_hit")
+    }
+
+    /// The second half of such a vertex, given the scatter kernel's
+    /// answers.
+    fn diffuse_finish(
+        &self,
+        _scene: &Scene,
+        _s: &mut Self::State,
+        _scratch: &mut Self::Scratch,
+        _scatter: &ScatterOut,
+        _light: Option<&LightAnswer>,
+        _sampler: &mut Sampler,
+    ) -> VertexStep {
+        unreachable!("diffuse_finish without diffuse_hit")
+    }
 }
 
 /// The scalar loop: the radiance along `ray`, each vertex's rays traced

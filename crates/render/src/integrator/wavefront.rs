@@ -38,6 +38,7 @@
 
 use super::bsdf_stage::{answer_bsdfs, BsdfAnswers, BsdfBatch, BsdfQuery};
 use super::camera_samples::{differential_scale, CameraBatch, CameraDraws, CameraRaySample};
+use super::diffuse_lanes::{scatters, surfaces, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut};
 use super::direct::{answer_lights, LightAnswer, LightBatch, LightRequest};
 use super::render::RenderOptions;
 use super::tile::{add_estimate, RayIntegrator, RayTiles, TileIntegrator};
@@ -86,6 +87,8 @@ struct Lane<S> {
     done: bool,
     /// The ray is the camera ray.
     camera: bool,
+    /// The vertex being shaded is a diffuse vertex taken in lanes.
+    diffuse: bool,
 }
 
 /// A finished sample waiting for its turn to be added to the tile.
@@ -200,6 +203,13 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let mut draws: Vec<Option<[Float; 6]>> = Vec::with_capacity(LANES);
         let mut shade: Vec<usize> = Vec::with_capacity(LANES);
         let mut predrawn: Vec<Option<[Float; 6]>> = Vec::new();
+        let mut diffuse: Vec<usize> = Vec::with_capacity(LANES);
+        let mut surface_in: Vec<SurfaceIn> = Vec::with_capacity(LANES);
+        let mut reflectances: Vec<SampledSpectrum> = Vec::with_capacity(LANES);
+        let mut surface_out: Vec<SurfaceOut> = Vec::with_capacity(LANES);
+        let mut diffuse_slot: Vec<usize> = Vec::new();
+        let mut scatter_in: Vec<ScatterIn> = Vec::with_capacity(LANES);
+        let mut scatter_out: Vec<ScatterOut> = Vec::with_capacity(LANES);
         let mut camera_batch = CameraBatch::new(scene);
         let mut camera_draws: Vec<(Point2i, CameraDraws)> = Vec::with_capacity(LANES);
         let mut camera_samples: Vec<CameraRaySample> = Vec::with_capacity(LANES);
@@ -269,6 +279,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     visible: gbuffer.then(VisibleSurface::default),
                     done: false,
                     camera: true,
+                    diffuse: false,
                 };
                 match free.pop() {
                     Some(slot) => {
@@ -321,19 +332,58 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             for (&i, &d) in shade.iter().zip(&draws) {
                 predrawn[i] = d;
             }
+            // The diffuse vertices' surfaces, lane-parallel (lanes the
+            // surface kernel leaves take the scalar vertex).
+            diffuse.clear();
+            surface_in.clear();
+            reflectances.clear();
+            for &i in &shade {
+                let lane = &lanes[i];
+                let Some(h) = &hits[i] else { continue };
+                if let Some((input, r)) =
+                    self.0
+                        .diffuse_hit(scene, &lane.path, h, &lane.lambda, gbuffer)
+                {
+                    diffuse.push(i);
+                    surface_in.push(input);
+                    reflectances.push(r);
+                }
+            }
+            surfaces(level, &surface_in, &mut surface_out);
+            diffuse_slot.resize(lanes.len(), 0);
+            for &i in &active {
+                lanes[i].diffuse = false;
+            }
+            for (k, &i) in diffuse.iter().enumerate() {
+                if surface_out[k].ok {
+                    lanes[i].diffuse = true;
+                    diffuse_slot[i] = k;
+                }
+            }
             for &i in &active {
                 let lane = &mut lanes[i];
                 sampler.set_cursor(&lane.cursor);
                 sampler.offer_four_draws(predrawn[i]);
-                let begun = self.0.begin(
-                    scene,
-                    &mut lane.path,
-                    hits[i],
-                    &mut lane.lambda,
-                    sampler,
-                    lane.visible.as_mut(),
-                    &mut scratch[i],
-                );
+                let begun = if lane.diffuse {
+                    let k = diffuse_slot[i];
+                    Begin::Light(self.0.diffuse_begin(
+                        &mut lane.path,
+                        &mut scratch[i],
+                        &surface_out[k],
+                        reflectances[k],
+                        sampler,
+                    ))
+                } else {
+                    self.0.begin(
+                        scene,
+                        &mut lane.path,
+                        hits[i],
+                        &mut lane.lambda,
+                        sampler,
+                        lane.visible.as_mut(),
+                        &mut scratch[i],
+                    )
+                };
                 lane.cursor = sampler.cursor();
                 lane.camera = false;
                 match begun {
@@ -375,19 +425,39 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 *I::bsdf_answers(&mut scratch[i]) = *a;
             }
 
+            // The diffuse vertices' BSDF values and samples, lane-parallel.
+            scatter_in.clear();
+            for (&i, a) in request_lanes.iter().zip(&answers) {
+                if lanes[i].diffuse {
+                    scatter_in.push(I::scatter_in(&lanes[i].path, &scratch[i], a.as_ref()));
+                }
+            }
+            scatters(level, &scatter_in, &mut scatter_out);
+
             // Shade, second half: the light samples' shadow queries and the
             // next rays.
+            let mut scattered = scatter_out.iter();
             for (&i, answer) in request_lanes.iter().zip(&answers) {
                 let lane = &mut lanes[i];
                 sampler.set_cursor(&lane.cursor);
-                let step = self.0.finish(
-                    scene,
-                    &mut lane.path,
-                    &mut lane.lambda,
-                    sampler,
-                    &mut scratch[i],
-                    answer.as_ref(),
-                );
+                let step = match lane.diffuse.then(|| scattered.next()).flatten() {
+                    Some(out) => self.0.diffuse_finish(
+                        scene,
+                        &mut lane.path,
+                        &mut scratch[i],
+                        out,
+                        answer.as_ref(),
+                        sampler,
+                    ),
+                    None => self.0.finish(
+                        scene,
+                        &mut lane.path,
+                        &mut lane.lambda,
+                        sampler,
+                        &mut scratch[i],
+                        answer.as_ref(),
+                    ),
+                };
                 lane.cursor = sampler.cursor();
                 lane.done = step.done;
                 if let Some(q) = step.shadow {

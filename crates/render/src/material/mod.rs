@@ -431,6 +431,22 @@ impl MaterialSet {
             .is_some_and(|(_, m)| m.has_subsurface_scattering())
     }
 
+    /// The reflectance of material `material` when it is a plain
+    /// `diffuse` material (no mix, no bump or normal map) of constant
+    /// reflectance: its BSDF at any point is a [`DiffuseBxDF`] of that
+    /// spectrum clamped to [0, 1], in the hit's shading frame (the
+    /// wavefront's lane-parallel diffuse vertex).
+    #[inline]
+    pub(crate) fn constant_diffuse(&self, material: u32) -> Option<&Spectrum> {
+        match self.materials.get(material as usize) {
+            Some(Material::Diffuse(m)) if !m.perturbation.is_some() => match &*m.reflectance {
+                crate::texture::SpectrumTexture::Constant(s) => Some(s),
+                _ => None,
+            },
+            _ => None,
+        }
+    }
+
     /// True when shading material `material` may read the hit's
     /// screen-space differentials: a texture that filters over its
     /// footprint, or bump or normal mapping. Only materials proven to read

@@ -441,6 +441,22 @@ pub struct HitRecord {
     kind: HitKind,
 }
 
+/// A hit on a triangle, before its interaction is built
+/// ([`PrimitiveAggregate::triangle_hit`]).
+#[derive(Debug)]
+pub(crate) struct TriangleHit<'a> {
+    /// The triangle.
+    pub tri: TriangleOf<&'a TriangleMesh>,
+    /// Its frame (what does not depend on the point hit).
+    pub frame: TriangleFrame,
+    /// The barycentrics of the hit.
+    pub b: [Float; 3],
+    /// The primitive's material (`None`: interface).
+    pub material: Option<u32>,
+    /// The primitive's area light.
+    pub area_light: Option<u32>,
+}
+
 /// How [`PrimitiveAggregate::interaction`] builds a hit's interaction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum HitKind {
@@ -810,6 +826,41 @@ impl PrimitiveAggregate {
             }
             HitKind::Other { t_max } => self.entry_intersect(hit.primitive, ray, t_max),
         }
+    }
+
+    /// What the interaction of a triangle hit is built from, for code that
+    /// builds it itself (the wavefront's lane-parallel vertices): the mesh,
+    /// the triangle, its frame, the barycentrics and the primitive's
+    /// material and area light. `None` for hits on other shapes.
+    #[inline]
+    pub(crate) fn triangle_hit(&self, hit: &HitRecord) -> Option<TriangleHit<'_>> {
+        let HitKind::Triangle(b0, b1, b2) = hit.kind else {
+            return None;
+        };
+        let frame = self.triangle_frames.get(hit.primitive as usize);
+        let (p, i) = self.entries.locate(hit.primitive);
+        let (tri, material, area_light) = match self.prims.get(p)? {
+            Primitive::Geometric(g) => match &g.shape {
+                Shape::Triangle(tri) => (
+                    TriangleOf {
+                        mesh: &*tri.mesh,
+                        tri_index: tri.tri_index,
+                    },
+                    g.material,
+                    g.area_light,
+                ),
+                _ => return None,
+            },
+            Primitive::Mesh(m) => (m.triangle(i), m.material, None),
+            _ => return None,
+        };
+        Some(TriangleHit {
+            frame: frame.copied().unwrap_or_else(|| tri.frame()),
+            tri,
+            b: [b0, b1, b2],
+            material,
+            area_light,
+        })
     }
 
     /// The interaction of a hit on the opaque triangle at entry `prim` at

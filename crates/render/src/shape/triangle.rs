@@ -185,7 +185,7 @@ impl TriangleMesh {
 
     /// The vertex indices of triangle `i`.
     #[inline(always)]
-    fn vertex_indices(&self, i: usize) -> [usize; 3] {
+    pub(crate) fn vertex_indices(&self, i: usize) -> [usize; 3] {
         [
             self.indices[3 * i] as usize,
             self.indices[3 * i + 1] as usize,

@@ -1,0 +1,551 @@
+//! The wavefront's diffuse vertex: the commonest path vertex of all, a
+//! hit on a triangle of a plain `diffuse` material with a constant
+//! reflectance, taken lane-parallel from the hit to the next ray, without
+//! building the general surface interaction and BSDF the scalar vertex
+//! builds (about 400 bytes a vertex, most of which this vertex never
+//! reads).
+//!
+//! Two kernels, each a fixed sequence of the IEEE operations the scalar
+//! code performs, so that every width gives the scalar vertex's bits:
+//!
+//! 1. [`surfaces`], after the closest hits: the hit point and its error
+//!    bound, ωo, the interpolated shading normal, the shading tangents
+//!    and the BSDF's frame (pbrt-v4's `Triangle::InteractionFromIntersection`
+//!    and `BSDF` constructor). What follows per lane (the point's
+//!    interval, the reflectance, the sampler draws and the light
+//!    request) runs the scalar code itself.
+//! 2. [`scatters`], after the light stage: the Lambertian BSDF's value and
+//!    density toward the light sample, and its cosine-weighted sample of
+//!    the next direction (pbrt-v4's `DiffuseBxDF` through `BSDF::f`,
+//!    `BSDF::PDF` and `BSDF::Sample_f`).
+//!
+//! Lanes where the scalar code takes a rare branch (a shading normal
+//! perpendicular to the tangent, derivatives rescaled) are flagged and
+//! take the scalar vertex instead.
+
+use super::direct::LightAnswer;
+use crate::bxdf::lanes::{gather_f, gather_s, MAX_LANES, S4};
+use crate::light::LightSampleContext;
+use crate::primitive::TriangleHit;
+use crate::simd::math::V3;
+use crate::simd::{dispatch, F32Lanes, Kernel, SimdLevel};
+use crate::spectrum::SampledSpectrum;
+use rpbrt_geometry::float::{gamma, Float, INV_PI, PI_OVER_4};
+use rpbrt_geometry::frame::Frame;
+use rpbrt_geometry::pointfi::Point3fi;
+use rpbrt_geometry::ray::{
+    offset_ray_origin, spawn_ray_from_origin_to_surface, Ray, SHADOW_EPSILON,
+};
+use rpbrt_geometry::tuple::*;
+
+/// What [`surfaces`] needs of one triangle hit.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct SurfaceIn {
+    /// The barycentrics.
+    b: [Float; 3],
+    /// The vertices.
+    p: [Point3f; 3],
+    /// The vertex normals (zero when the mesh has none).
+    n: [Normal3f; 3],
+    /// The mesh has vertex normals.
+    shading: bool,
+    /// The triangle's geometric normal and ∂p/∂u.
+    ng: Normal3f,
+    dpdu: Vector3f,
+    /// The ray's direction.
+    d: Vector3f,
+}
+
+impl SurfaceIn {
+    /// The input of a hit on `hit` by a ray of direction `d`; `None` for
+    /// meshes with shading tangents (left to the scalar vertex).
+    #[inline]
+    pub(crate) fn new(hit: &TriangleHit, d: Vector3f) -> Option<SurfaceIn> {
+        let mesh = hit.tri.mesh;
+        if mesh.s.is_some() {
+            return None;
+        }
+        let v = mesh.vertex_indices(hit.tri.tri_index as usize);
+        let p = [mesh.p[v[0]], mesh.p[v[1]], mesh.p[v[2]]];
+        let (n, shading) = match &mesh.n {
+            Some(nn) => ([nn[v[0]], nn[v[1]], nn[v[2]]], true),
+            None => ([Normal3f::default(); 3], false),
+        };
+        Some(SurfaceIn {
+            b: hit.b,
+            p,
+            n,
+            shading,
+            ng: hit.frame.n,
+            dpdu: hit.frame.dpdu,
+            d,
+        })
+    }
+}
+
+/// The surface at a hit, as the scalar interaction and BSDF have it.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct SurfaceOut {
+    /// The hit point and its error bound (before they become an interval).
+    pub p: Point3f,
+    pub p_error: Vector3f,
+    /// The geometric normal, on the shading normal's side.
+    pub n: Normal3f,
+    /// The shading normal.
+    pub ns: Normal3f,
+    /// ωo, normalized.
+    pub wo: Vector3f,
+    /// The BSDF frame's x and y axes (its z axis is `ns`).
+    pub x: Vector3f,
+    pub y: Vector3f,
+    /// False where the scalar code takes a branch this kernel does not:
+    /// the lane must take the scalar vertex.
+    pub ok: bool,
+}
+
+/// A diffuse vertex between its two halves: what the second half reads
+/// of the surface, the BSDF and the sampler draws.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct DiffuseVertex {
+    /// The hit point's interval and its midpoint and error bound.
+    pub pi: Point3fi,
+    p: Point3f,
+    p_error: Vector3f,
+    /// Geometric and shading normals.
+    pub n: Normal3f,
+    pub ns: Normal3f,
+    /// ωo (normalized).
+    pub wo: Vector3f,
+    /// The ray's time.
+    pub time: Float,
+    /// The BSDF's frame and reflectance.
+    pub frame: Frame,
+    pub r: SampledSpectrum,
+    /// The BSDF sample's draws.
+    pub u2: Point2f,
+    /// The offset origins computed so far (see `direct::VertexOrigins`).
+    sides: [Option<Point3f>; 2],
+}
+
+impl DiffuseVertex {
+    /// The vertex of surface `s` hit at `time`, with reflectance `r` and
+    /// the BSDF sample's 2-D draw `u2`.
+    #[inline]
+    pub(crate) fn new(s: &SurfaceOut, time: Float, r: SampledSpectrum, u2: Point2f) -> Self {
+        // As `SurfaceInteraction` holds it: an interval, read back as its
+        // midpoint and half-width.
+        let pi = Point3fi::from_value_and_error(s.p, s.p_error);
+        DiffuseVertex {
+            pi,
+            p: pi.midpoint(),
+            p_error: pi.error(),
+            n: s.n,
+            ns: s.ns,
+            wo: s.wo,
+            time,
+            frame: Frame {
+                x: s.x,
+                y: s.y,
+                z: Vector3f::from(s.ns),
+            },
+            r,
+            u2,
+            sides: [None, None],
+        }
+    }
+
+    /// The light-sampling context: the point offset toward ωo (the BSDF
+    /// only reflects), the normals.
+    #[inline]
+    pub(crate) fn light_context(&mut self) -> LightSampleContext {
+        LightSampleContext {
+            pi: Point3fi::from(self.toward(self.wo)),
+            n: self.n,
+            ns: self.ns,
+        }
+    }
+
+    /// The context of this vertex for the next vertex's MIS weights.
+    #[inline]
+    pub(crate) fn context(&self) -> LightSampleContext {
+        LightSampleContext {
+            pi: self.pi,
+            n: self.n,
+            ns: self.ns,
+        }
+    }
+
+    /// The ray origin offset off the surface toward `w`'s side (computed
+    /// once per side).
+    #[inline(always)]
+    pub(crate) fn toward(&mut self, w: Vector3f) -> Point3f {
+        let side = (dot(w, self.n) < 0.0) as usize;
+        match self.sides[side] {
+            Some(p) => p,
+            None => {
+                let p = offset_ray_origin(self.p, self.p_error, self.n, w);
+                self.sides[side] = Some(p);
+                p
+            }
+        }
+    }
+
+    /// The shadow ray toward a light sample's point `to_p` (normal `to_n`)
+    /// and its extent.
+    #[inline]
+    pub(crate) fn shadow_ray(&mut self, to_p: Point3fi, to_n: Normal3f) -> (Ray, Float) {
+        let p_to = to_p.midpoint();
+        let pf = self.toward(p_to - self.p);
+        let r = spawn_ray_from_origin_to_surface(pf, self.time, p_to, to_p.error(), to_n);
+        (r, 1.0 - SHADOW_EPSILON)
+    }
+}
+
+/// The components of a point, vector or normal.
+macro_rules! xyz {
+    ($v:expr) => {{
+        let v = $v;
+        [v.x, v.y, v.z]
+    }};
+}
+
+/// Lanes of a 3-vector per item.
+#[inline(always)]
+fn gather_v<L: F32Lanes>(n: usize, f: impl Fn(usize) -> [Float; 3]) -> V3<L> {
+    V3 {
+        x: gather_f(n, |i| f(i)[0]),
+        y: gather_f(n, |i| f(i)[1]),
+        z: gather_f(n, |i| f(i)[2]),
+    }
+}
+
+/// The lanes of `x`, stored.
+#[inline(always)]
+fn stored<L: F32Lanes>(x: L) -> [Float; MAX_LANES] {
+    let mut a = [0.0; MAX_LANES];
+    x.store(&mut a);
+    a
+}
+
+/// The lanes of a vector, stored: one array per component.
+struct Stored3([[Float; MAX_LANES]; 3]);
+
+impl Stored3 {
+    #[inline(always)]
+    fn new<L: F32Lanes>(v: V3<L>) -> Self {
+        Stored3([stored(v.x), stored(v.y), stored(v.z)])
+    }
+    #[inline(always)]
+    fn vector(&self, i: usize) -> Vector3f {
+        Vector3f::new(self.0[0][i], self.0[1][i], self.0[2][i])
+    }
+    #[inline(always)]
+    fn normal(&self, i: usize) -> Normal3f {
+        Normal3f::new(self.0[0][i], self.0[1][i], self.0[2][i])
+    }
+}
+
+/// Component-wise |v|.
+#[inline(always)]
+fn abs_v<L: F32Lanes>(v: V3<L>) -> V3<L> {
+    V3 {
+        x: v.x.abs(),
+        y: v.y.abs(),
+        z: v.z.abs(),
+    }
+}
+
+/// `if m { -v } else { v }` (a sign flip, as `face_forward`).
+#[inline(always)]
+fn flip_if<L: F32Lanes>(m: L::Mask, v: V3<L>) -> V3<L> {
+    let neg = V3 {
+        x: v.x.neg(),
+        y: v.y.neg(),
+        z: v.z.neg(),
+    };
+    V3::select(m, neg, v)
+}
+
+/// [`surfaces`] of at most one width's items.
+struct Surfaces<'a> {
+    items: &'a [SurfaceIn],
+    out: &'a mut [SurfaceOut],
+}
+
+impl Kernel for Surfaces<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: F32Lanes>(self) {
+        let it = self.items;
+        let n = it.len();
+        let s = L::splat;
+        let zero = s(0.0);
+        let b0: L = gather_f(n, |i| it[i].b[0]);
+        let b1: L = gather_f(n, |i| it[i].b[1]);
+        let b2: L = gather_f(n, |i| it[i].b[2]);
+        let p0 = gather_v::<L>(n, |i| xyz!(it[i].p[0]));
+        let p1 = gather_v::<L>(n, |i| xyz!(it[i].p[1]));
+        let p2 = gather_v::<L>(n, |i| xyz!(it[i].p[2]));
+        let ng = gather_v::<L>(n, |i| xyz!(it[i].ng));
+        let dpdu = gather_v::<L>(n, |i| xyz!(it[i].dpdu));
+        let d = gather_v::<L>(n, |i| xyz!(it[i].d));
+        let shading = L::from_bits(
+            it.iter()
+                .enumerate()
+                .fold(0, |m, (i, x)| m | ((x.shading as u32) << i)),
+        );
+
+        // The point, its error bound and ωo (`Triangle::interaction`).
+        let (pb0, pb1, pb2) = (p0.scale(b0), p1.scale(b1), p2.scale(b2));
+        let p = pb0.add(pb1).add(pb2);
+        let p_error = abs_v(pb0)
+            .add(abs_v(pb1))
+            .add(abs_v(pb2))
+            .scale(s(gamma(7)));
+        let (wo, wo_ok) = V3 {
+            x: d.x.neg(),
+            y: d.y.neg(),
+            z: d.z.neg(),
+        }
+        .try_normalize();
+        let wo = V3::select(
+            wo_ok,
+            wo,
+            V3 {
+                x: zero,
+                y: zero,
+                z: zero,
+            },
+        );
+
+        // The shading geometry of meshes with vertex normals: the
+        // interpolated normal (the geometric one where it vanishes), the
+        // tangent ∂p/∂u made perpendicular to it, and the geometric normal
+        // turned to its side.
+        let n0 = gather_v::<L>(n, |i| xyz!(it[i].n[0]));
+        let n1 = gather_v::<L>(n, |i| xyz!(it[i].n[1]));
+        let n2 = gather_v::<L>(n, |i| xyz!(it[i].n[2]));
+        let nsum = n0.scale(b0).add(n1.scale(b1)).add(n2.scale(b2));
+        let nonzero = nsum.dot(nsum).gt(zero);
+        let ns = V3::select(L::and(shading, nonzero), nsum.normalize(), ng);
+        let ts = ns.cross(dpdu);
+        let ts2 = ts.dot(ts);
+        let ss = ts.cross(ns);
+        let ss = V3::select(shading, ss, dpdu);
+        let n_out = V3::select(shading, flip_if::<L>(ng.dot(ns).lt(zero), ng), ng);
+        // Lanes with normals whose tangent cross product vanishes, or whose
+        // derivatives the interaction would rescale, go to the scalar code.
+        let big = s(1e16);
+        let rare = L::or(L::not(ts2.gt(zero)), L::or(ss.dot(ss).gt(big), ts2.gt(big)));
+        let ok = L::not(L::and(shading, rare));
+
+        // The BSDF frame: x along the shading tangent, z the shading
+        // normal (`Frame::from_xz`).
+        let x = ss.normalize();
+        let y = ns.cross(x);
+
+        let okb = L::bits(ok);
+        let (p, p_error) = (Stored3::new(p), Stored3::new(p_error));
+        let (n_out, ns, wo) = (Stored3::new(n_out), Stored3::new(ns), Stored3::new(wo));
+        let (x, y) = (Stored3::new(x), Stored3::new(y));
+        for (i, o) in self.out.iter_mut().enumerate().take(n) {
+            *o = SurfaceOut {
+                p: Point3f::from(p.vector(i)),
+                p_error: p_error.vector(i),
+                n: n_out.normal(i),
+                ns: ns.normal(i),
+                wo: wo.vector(i),
+                x: x.vector(i),
+                y: y.vector(i),
+                ok: (okb >> i) & 1 != 0,
+            };
+        }
+    }
+}
+
+/// The surfaces of `items` into `out` (cleared first), at `level`'s width.
+pub(crate) fn surfaces(level: SimdLevel, items: &[SurfaceIn], out: &mut Vec<SurfaceOut>) {
+    out.clear();
+    out.resize(items.len(), SurfaceOut::default());
+    let width = level.lanes().max(1);
+    for (items, out) in items.chunks(width).zip(out.chunks_mut(width)) {
+        dispatch(level, Surfaces { items, out });
+    }
+}
+
+/// What [`scatters`] needs of one vertex.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct ScatterIn {
+    /// The BSDF frame (z: the shading normal).
+    frame: Frame,
+    /// ωo (normalized) toward the light sample; the ray's direction, whose
+    /// negation is ωo for the BSDF sample (as the scalar vertex has them).
+    wo: Vector3f,
+    d: Vector3f,
+    /// The light sample's direction (any, without a light sample: its
+    /// answers are then not read).
+    wi: Vector3f,
+    /// The reflectance and the BSDF sample's draws.
+    r: SampledSpectrum,
+    u2: Point2f,
+}
+
+impl ScatterIn {
+    /// The input of vertex `v`, reached along direction `d`, given its
+    /// light sample.
+    #[inline]
+    pub(crate) fn new(v: &DiffuseVertex, d: Vector3f, light: Option<&LightAnswer>) -> Self {
+        ScatterIn {
+            frame: v.frame,
+            wo: v.wo,
+            d,
+            wi: light.map_or(Vector3f::default(), |a| a.ls.wi),
+            r: v.r,
+            u2: v.u2,
+        }
+    }
+}
+
+/// The BSDF's answers at one vertex.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct ScatterOut {
+    /// `bsdf.f(ωo, ωi) · |ωi · ns|` and `bsdf.pdf(ωo, ωi)` toward the
+    /// light sample.
+    pub f_light: SampledSpectrum,
+    pub pdf_light: Float,
+    /// The BSDF sample (`bsdf.sample_f`): its direction in rendering
+    /// space, its density, and `|ωi · ns| / pdf`; `None` where the scalar
+    /// method returns none.
+    pub sample: Option<(Vector3f, Float, Float)>,
+}
+
+/// `v` in the frame of axes `x`, `y`, `z` (`Frame::to_local`). (A function,
+/// not a closure: a closure would be compiled without the kernel's
+/// instruction set, its lane operations not inlined.)
+#[inline(always)]
+fn to_local<L: F32Lanes>(x: V3<L>, y: V3<L>, z: V3<L>, v: V3<L>) -> V3<L> {
+    V3 {
+        x: v.dot(x),
+        y: v.dot(y),
+        z: v.dot(z),
+    }
+}
+
+/// [`scatters`] of at most one width's items.
+struct Scatters<'a> {
+    items: &'a [ScatterIn],
+    out: &'a mut [ScatterOut],
+}
+
+impl Kernel for Scatters<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: F32Lanes>(self) {
+        let it = self.items;
+        let n = it.len();
+        let s = L::splat;
+        let zero = s(0.0);
+        let fx = gather_v::<L>(n, |i| xyz!(it[i].frame.x));
+        let fy = gather_v::<L>(n, |i| xyz!(it[i].frame.y));
+        let fz = gather_v::<L>(n, |i| xyz!(it[i].frame.z));
+        let r = gather_s::<L>(n, |i| it[i].r);
+        let f = S4([
+            r.0[0].mul(s(INV_PI)),
+            r.0[1].mul(s(INV_PI)),
+            r.0[2].mul(s(INV_PI)),
+            r.0[3].mul(s(INV_PI)),
+        ]);
+
+        // Toward the light: `BSDF::f` (zero for a grazing ωo or across
+        // hemispheres) times the cosine, and `BSDF::pdf`.
+        let wo = to_local(fx, fy, fz, gather_v::<L>(n, |i| xyz!(it[i].wo)));
+        let wi_r = gather_v::<L>(n, |i| xyz!(it[i].wi));
+        let wi = to_local(fx, fy, fz, wi_r);
+        let same = L::and(wo.z.mul(wi.z).gt(zero), L::not(wo.z.eq(zero)));
+        let cos = wi_r.dot(fz).abs();
+        let f_light = [
+            L::select(same, f.0[0], zero).mul(cos),
+            L::select(same, f.0[1], zero).mul(cos),
+            L::select(same, f.0[2], zero).mul(cos),
+            L::select(same, f.0[3], zero).mul(cos),
+        ];
+        let pdf_light = L::select(same, wi.z.abs().mul(s(INV_PI)), zero);
+
+        // The sample: a cosine-weighted direction on ωo's side (the
+        // concentric disk lifted to the hemisphere).
+        let d = gather_v::<L>(n, |i| xyz!(it[i].d));
+        let wo_s = to_local(
+            fx,
+            fy,
+            fz,
+            V3 {
+                x: d.x.neg(),
+                y: d.y.neg(),
+                z: d.z.neg(),
+            },
+        );
+        let ux: L = gather_f(n, |i| it[i].u2.x);
+        let uy: L = gather_f(n, |i| it[i].u2.y);
+        let ox = s(2.0).mul(ux).sub(s(1.0));
+        let oy = s(2.0).mul(uy).sub(s(1.0));
+        let center = L::and(ox.eq(zero), oy.eq(zero));
+        let x_major = ox.abs().gt(oy.abs());
+        let radius = L::select(x_major, ox, oy);
+        let phi = s(PI_OVER_4).mul(L::select(x_major, oy.div(ox), ox.div(oy)));
+        // The library's sine and cosine, as the scalar sample takes them.
+        let mut sin = [0.0f32; MAX_LANES];
+        let mut cos_phi = [0.0f32; MAX_LANES];
+        let mut phis = [0.0f32; MAX_LANES];
+        phi.store(&mut phis);
+        for i in 0..n {
+            (sin[i], cos_phi[i]) = phis[i].sin_cos();
+        }
+        let (sin, cos_phi) = (L::load(&sin), L::load(&cos_phi));
+        let cos_t = L::select(x_major, cos_phi, sin);
+        let sin_t = L::select(x_major, sin, cos_phi);
+        let dx = L::select(center, zero, radius.mul(cos_t));
+        let dy = L::select(center, zero, radius.mul(sin_t));
+        let z = s(1.0).sub(dx.mul(dx)).sub(dy.mul(dy)).max(zero).sqrt();
+        let z = L::select(wo_s.z.lt(zero), z.neg(), z);
+        let pdf = z.abs().mul(s(INV_PI));
+        let sampled = L::and(
+            L::not(wo_s.z.eq(zero)),
+            L::and(L::not(pdf.eq(zero)), L::not(z.eq(zero))),
+        );
+        // Back to rendering space (`Frame::from_local`).
+        let wi_s = fx.scale(dx).add(fy.scale(dy)).add(fz.scale(z));
+        let cos_over_pdf = wi_s.dot(fz).abs().div(pdf);
+
+        let sb = L::bits(sampled);
+        let f_light = [
+            stored(f_light[0]),
+            stored(f_light[1]),
+            stored(f_light[2]),
+            stored(f_light[3]),
+        ];
+        let (pdf_light, pdf, cos_over_pdf) = (stored(pdf_light), stored(pdf), stored(cos_over_pdf));
+        let wi_s = Stored3::new(wi_s);
+        for (i, o) in self.out.iter_mut().enumerate().take(n) {
+            *o = ScatterOut {
+                f_light: SampledSpectrum {
+                    values: [f_light[0][i], f_light[1][i], f_light[2][i], f_light[3][i]],
+                },
+                pdf_light: pdf_light[i],
+                sample: ((sb >> i) & 1 != 0).then(|| (wi_s.vector(i), pdf[i], cos_over_pdf[i])),
+            };
+        }
+    }
+}
+
+/// The BSDF answers of `items` into `out` (cleared first), at `level`'s
+/// width.
+pub(crate) fn scatters(level: SimdLevel, items: &[ScatterIn], out: &mut Vec<ScatterOut>) {
+    out.clear();
+    out.resize(items.len(), ScatterOut::default());
+    let width = level.lanes().max(1);
+    for (items, out) in items.chunks(width).zip(out.chunks_mut(width)) {
+        dispatch(level, Scatters { items, out });
+    }
+}
