@@ -556,7 +556,8 @@ fn whitted_direct_light_and_a_mirror() {
 }
 
 /// A scene with a bit of everything the path tracer's vertex meets:
-/// diffuse, conductor, dielectric and coated surfaces, a checkerboard
+/// diffuse (a mesh with vertex normals, one of them turned away, among
+/// them), conductor, dielectric and coated surfaces, a checkerboard
 /// texture (filtered with ray differentials) and a bump map, sphere,
 /// bilinear-patch and triangle emitters (the last sampled lane-parallel
 /// under `--wavefront`), spot and uniform infinite lights, a G-buffer
@@ -585,6 +586,12 @@ AttributeBegin
   Material "diffuse" "texture reflectance" "checks" "texture displacement" "bumps"
   Shape "trianglemesh" "point3 P" [ -4 0 -4  4 0 -4  4 0 4  -4 0 4 ]
       "point2 uv" [ 0 0 1 0 1 1 0 1 ] "integer indices" [ 0 1 2 0 2 3 ]
+AttributeEnd
+AttributeBegin
+  Material "diffuse" "rgb reflectance" [ 0.3 0.6 0.5 ]
+  Shape "trianglemesh" "point3 P" [ -3 0 2  -1 0 2.5  -2.2 1.4 2.2  -0.6 1.2 2 ]
+      "normal N" [ -0.3 0.2 1  0.1 0.3 -1  -0.2 -0.4 -1  0.5 0 -1 ]
+      "integer indices" [ 0 1 2  1 3 2 ]
 AttributeEnd
 AttributeBegin
   Translate -1.2 0.6 0
