@@ -10,8 +10,8 @@ use rpbrt_geometry::tuple::{Point2f, Point2i};
 
 use super::lowdiscrepancy::{
     compute_radical_inverse_permutations, inverse_radical_inverse, mix_bits,
-    owen_scrambled_radical_inverse, radical_inverse, scrambled_radical_inverse, DigitPermutation,
-    RandomizeStrategy, PRIME_TABLE_SIZE,
+    owen_scrambled_radical_inverse, radical_inverse, scrambled_radical_inverse,
+    scrambled_radical_inverses, DigitPermutation, RandomizeStrategy, PRIME_TABLE_SIZE,
 };
 
 /// Largest pixel tile the first two Halton dimensions are scaled over.
@@ -173,6 +173,58 @@ impl HaltonSampler {
         let d = self.dimension as usize;
         self.dimension += 2;
         Point2f::new(self.sample_dimension(d), self.sample_dimension(d + 1))
+    }
+
+    /// `N` consecutive dimensions from the current one, drawn together
+    /// ([`scrambled_radical_inverses`]) where that gives the values of
+    /// single draws: digit permutations, no dimension wrapping past the
+    /// prime table, an index below 2^32. Advances the dimension.
+    #[inline(always)]
+    fn draw_together<const N: usize>(&mut self) -> Option<[Float; N]> {
+        let d = self.dimension as usize;
+        if self.randomize != RandomizeStrategy::PermuteDigits
+            || d + N > PRIME_TABLE_SIZE
+            || self.halton_index > u32::MAX as u64
+        {
+            return None;
+        }
+        let perms = self.digit_permutations.as_ref()?;
+        self.dimension += N as i32;
+        Some(scrambled_radical_inverses::<N>(d, self.halton_index, perms))
+    }
+
+    /// A path vertex's draws: 1-D, 2-D, 1-D, 2-D (see
+    /// [`Sampler::get_vertex_samples`](super::Sampler::get_vertex_samples)).
+    #[inline]
+    pub fn get_1d_2d_1d_2d(&mut self) -> (Float, Point2f, Float, Point2f) {
+        if let Some(v) = self.draw_together::<6>() {
+            return (
+                v[0],
+                Point2f::new(v[1], v[2]),
+                v[3],
+                Point2f::new(v[4], v[5]),
+            );
+        }
+        let a = self.get_1d();
+        let b = self.get_2d();
+        let c = self.get_1d();
+        let d = self.get_2d();
+        (a, b, c, d)
+    }
+
+    /// A camera sample's draws: wavelengths (1-D), the position in the
+    /// pixel, time (1-D), lens (2-D) (see
+    /// [`Sampler::get_camera_samples`](super::Sampler::get_camera_samples)).
+    #[inline]
+    pub fn get_camera_samples(&mut self) -> (Float, Point2f, Float, Point2f) {
+        if let Some(v) = self.draw_together::<4>() {
+            return (v[0], self.get_pixel_2d(), v[1], Point2f::new(v[2], v[3]));
+        }
+        let a = self.get_1d();
+        let b = self.get_pixel_2d();
+        let c = self.get_1d();
+        let d = self.get_2d();
+        (a, b, c, d)
     }
 
     /// The position within the pixel: the first two (unrandomised)

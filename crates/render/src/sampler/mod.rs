@@ -153,8 +153,10 @@ impl Sampler {
     /// path in turn.
     #[inline]
     pub fn get_vertex_samples(&mut self) -> (Float, Point2f, Float, Point2f) {
-        if let Sampler::ZSobol(s) = self {
-            return s.get_1d_2d_1d_2d();
+        match self {
+            Sampler::ZSobol(s) => return s.get_1d_2d_1d_2d(),
+            Sampler::Halton(s) => return s.get_1d_2d_1d_2d(),
+            _ => {}
         }
         dispatch!(self, s => {
             let u_light = s.get_1d();
@@ -170,8 +172,10 @@ impl Sampler {
     /// position in the pixel, time (1-D), lens position (2-D).
     #[inline]
     pub fn get_camera_samples(&mut self) -> (Float, Point2f, Float, Point2f) {
-        if let Sampler::ZSobol(s) = self {
-            return s.get_1d_2d_1d_2d();
+        match self {
+            Sampler::ZSobol(s) => return s.get_1d_2d_1d_2d(),
+            Sampler::Halton(s) => return s.get_camera_samples(),
+            _ => {}
         }
         dispatch!(self, s => {
             let u_lambda = s.get_1d();

@@ -733,3 +733,71 @@ fn radical_inverses_are_pbrt_v4_loops_bit_for_bit() {
     }
     assert!(compared > 10_000, "{compared}");
 }
+
+/// The interleaved radical inverses of a path vertex's (six) and a camera
+/// sample's (four) consecutive dimensions are the single ones bit for bit,
+/// for every first dimension of the table and indices up to 2^32 − 1.
+#[test]
+fn interleaved_radical_inverses_match_single_ones() {
+    use super::lowdiscrepancy::{
+        compute_radical_inverse_permutations, scrambled_radical_inverse,
+        scrambled_radical_inverses, PRIME_TABLE_SIZE,
+    };
+    let perms = compute_radical_inverse_permutations(0x5eed);
+    let mut rng = crate::rng::Rng::new(11, 0);
+    let mut indices = vec![0u64, 1, 2, u32::MAX as u64 - 1, u32::MAX as u64];
+    indices.extend((0..40).map(|_| (rng.uniform_u32() >> (rng.uniform_u32() % 32)) as u64));
+    for first in 0..=PRIME_TABLE_SIZE - 6 {
+        for &a in &indices {
+            let six = scrambled_radical_inverses::<6>(first, a, &perms);
+            let four = scrambled_radical_inverses::<4>(first, a, &perms);
+            for (j, v) in six.iter().enumerate() {
+                let want = scrambled_radical_inverse(first + j, a, &perms[first + j]);
+                assert_eq!(
+                    v.to_bits(),
+                    want.to_bits(),
+                    "dimension {} index {a}",
+                    first + j
+                );
+                if j < 4 {
+                    assert_eq!(four[j].to_bits(), want.to_bits());
+                }
+            }
+        }
+    }
+}
+
+/// Halton's four-draw calls (a vertex's and a camera sample's) give the
+/// single draws' values and leave the same dimension, including where
+/// the dimensions wrap past the prime table and for every randomisation.
+#[test]
+fn halton_four_draws_match_single_draws() {
+    for rand in ["permutedigits", "none", "owen"] {
+        let mut s = make("halton", 64, 3, Some(rand));
+        for (p, index) in [(Point2i::new(5, 9), 0), (Point2i::new(40, 3), 63)] {
+            for dim in (2..60).chain(985..1000) {
+                let mut singles = s.clone();
+                s.start_pixel_sample(p, index, dim);
+                singles.start_pixel_sample(p, index, dim);
+                let (a, b, c, d) = s.get_vertex_samples();
+                let want = (
+                    singles.get_1d(),
+                    singles.get_2d(),
+                    singles.get_1d(),
+                    singles.get_2d(),
+                );
+                assert_eq!((a, b, c, d), want, "{rand} {dim}");
+                let (a, b, c, d) = s.get_camera_samples();
+                let want = (
+                    singles.get_1d(),
+                    singles.get_pixel_2d(),
+                    singles.get_1d(),
+                    singles.get_2d(),
+                );
+                assert_eq!((a, b, c, d), want, "{rand} {dim}");
+                assert_eq!(s.cursor(), singles.cursor());
+                assert!(s.get_1d() == singles.get_1d());
+            }
+        }
+    }
+}
