@@ -23,13 +23,15 @@
 //! perpendicular to the tangent, derivatives rescaled) are flagged and
 //! take the scalar vertex instead.
 
-use super::direct::LightAnswer;
+use super::direct::{LightAnswer, LightRequest};
+use super::Scene;
 use crate::bxdf::lanes::{gather_f, gather_s, MAX_LANES, S4};
 use crate::light::LightSampleContext;
-use crate::primitive::TriangleHit;
+use crate::primitive::{HitRecord, TriangleHit};
+use crate::sampler::Sampler;
 use crate::simd::math::V3;
 use crate::simd::{dispatch, F32Lanes, Kernel, SimdLevel};
-use crate::spectrum::SampledSpectrum;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::{gamma, Float, INV_PI, PI_OVER_4};
 use rpbrt_geometry::frame::Frame;
 use rpbrt_geometry::pointfi::Point3fi;
@@ -37,6 +39,32 @@ use rpbrt_geometry::ray::{
     offset_ray_origin, spawn_ray_from_origin_to_surface, Ray, SHADOW_EPSILON,
 };
 use rpbrt_geometry::tuple::*;
+
+/// The surface kernel's input and the reflectance at `lambda` of a hit
+/// `record` by a ray of direction `d`, when it is a diffuse vertex: a
+/// triangle without an area light, of a plain `diffuse` material of
+/// constant, not black, reflectance, in a mesh without shading tangents.
+/// `None`: the scalar vertex takes it.
+#[inline(always)]
+pub(crate) fn diffuse_surface(
+    scene: &Scene,
+    record: &HitRecord,
+    d: Vector3f,
+    lambda: &SampledWavelengths,
+) -> Option<(SurfaceIn, SampledSpectrum)> {
+    let hit = scene.aggregate.triangle_hit(record)?;
+    if hit.area_light.is_some() {
+        return None;
+    }
+    let spectrum = scene.materials.constant_diffuse(hit.material?)?;
+    // `DiffuseMaterial::get_bxdf`; a black reflectance makes a BSDF
+    // without flags, which the scalar vertex handles.
+    let r = spectrum.sample(lambda).clamp(0.0, 1.0);
+    if r.is_black() {
+        return None;
+    }
+    Some((SurfaceIn::new(&hit, d)?, r))
+}
 
 /// What [`surfaces`] needs of one triangle hit.
 #[derive(Clone, Copy, Debug, Default)]
@@ -128,10 +156,33 @@ pub(crate) struct DiffuseVertex {
 }
 
 impl DiffuseVertex {
+    /// The first half of a diffuse vertex (after the integrator has
+    /// counted it): the vertex of surface `s` hit at `time` with
+    /// reflectance `r`, its sampler draws taken, and its light request.
+    #[inline(always)]
+    pub(crate) fn begin(
+        s: &SurfaceOut,
+        time: Float,
+        r: SampledSpectrum,
+        sampler: &mut Sampler,
+    ) -> (DiffuseVertex, LightRequest) {
+        let (u_light, u_light_2d, _, u2) = sampler.get_vertex_samples();
+        let mut v = DiffuseVertex::new(s, time, r, u2);
+        let ctx = v.light_context();
+        let z = v.frame.z;
+        let req = LightRequest {
+            ctx,
+            u: u_light,
+            u_light: u_light_2d,
+            hemisphere: Some((z, dot(v.wo, z))),
+        };
+        (v, req)
+    }
+
     /// The vertex of surface `s` hit at `time`, with reflectance `r` and
     /// the BSDF sample's 2-D draw `u2`.
     #[inline]
-    pub(crate) fn new(s: &SurfaceOut, time: Float, r: SampledSpectrum, u2: Point2f) -> Self {
+    fn new(s: &SurfaceOut, time: Float, r: SampledSpectrum, u2: Point2f) -> Self {
         // As `SurfaceInteraction` holds it: an interval, read back as its
         // midpoint and half-width.
         let pi = Point3fi::from_value_and_error(s.p, s.p_error);
@@ -157,7 +208,7 @@ impl DiffuseVertex {
     /// The light-sampling context: the point offset toward ωo (the BSDF
     /// only reflects), the normals.
     #[inline]
-    pub(crate) fn light_context(&mut self) -> LightSampleContext {
+    fn light_context(&mut self) -> LightSampleContext {
         LightSampleContext {
             pi: Point3fi::from(self.toward(self.wo)),
             n: self.n,
@@ -188,6 +239,12 @@ impl DiffuseVertex {
                 p
             }
         }
+    }
+
+    /// The ray leaving the vertex toward `wi`.
+    #[inline]
+    pub(crate) fn spawn_ray(&mut self, wi: Vector3f) -> Ray {
+        Ray::with_time(self.toward(wi), wi, self.time, None)
     }
 
     /// The shadow ray toward a light sample's point `to_p` (normal `to_n`)

@@ -3,7 +3,9 @@
 //! optional BSDF regularization.
 
 use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
-use super::diffuse_lanes::{DiffuseVertex, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut};
+use super::diffuse_lanes::{
+    diffuse_surface, DiffuseVertex, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut,
+};
 use super::direct::{light_request, light_shadow_query, LightAnswer, LightRequest, ShadowQuery};
 use super::vertex::{li_by_vertices, Begin, VertexIntegrator, VertexStep};
 use super::{skip_intersection, RayIntegrator, Scene, VertexOrigins};
@@ -294,18 +296,7 @@ impl VertexIntegrator for PathIntegrator {
         if s.depth >= self.max_depth || scene.force_diffuse || (gbuffer && s.depth == 0) {
             return None;
         }
-        let hit = scene.aggregate.triangle_hit(record)?;
-        if hit.area_light.is_some() {
-            return None;
-        }
-        let spectrum = scene.materials.constant_diffuse(hit.material?)?;
-        // `DiffuseMaterial::get_bxdf`; a black reflectance makes a BSDF
-        // without flags, which `begin` handles.
-        let r = spectrum.sample(lambda).clamp(0.0, 1.0);
-        if r.is_black() {
-            return None;
-        }
-        Some((SurfaceIn::new(&hit, s.ray.ray.d)?, r))
+        diffuse_surface(scene, record, s.ray.ray.d, lambda)
     }
 
     /// `begin`'s steps for a diffuse vertex: the depth, the sampler draws,
@@ -321,19 +312,11 @@ impl VertexIntegrator for PathIntegrator {
         sampler: &mut Sampler,
     ) -> LightRequest {
         s.depth += 1;
-        let (u_light, u_light_2d, _, u2) = sampler.get_vertex_samples();
-        let mut v = DiffuseVertex::new(surface, s.ray.ray.time, r, u2);
-        let ctx = v.light_context();
-        let z = v.frame.z;
+        let (v, req) = DiffuseVertex::begin(surface, s.ray.ray.time, r, sampler);
         scratch.hit = None;
         scratch.bsdf = None;
         scratch.diffuse = v;
-        LightRequest {
-            ctx,
-            u: u_light,
-            u_light: u_light_2d,
-            hemisphere: Some((z, dot(v.wo, z))),
-        }
+        req
     }
 
     #[inline(always)]
@@ -390,7 +373,7 @@ impl VertexIntegrator for PathIntegrator {
         s.p_b = pdf;
         s.specular_bounce = false;
         s.any_non_specular = true;
-        s.ray = RayDifferential::new(Ray::with_time(v.toward(wi), wi, v.time, None));
+        s.ray = RayDifferential::new(v.spawn_ray(wi));
         russian_roulette(s, sampler, shadow)
     }
 }

@@ -5,8 +5,11 @@
 //! emission, and subsurface scattering through the materials' BSSRDFs.
 
 use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
+use super::diffuse_lanes::{
+    diffuse_surface, DiffuseVertex, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut,
+};
 use super::direct::ShadowQuery;
-use super::direct::{light_request, LightAnswer};
+use super::direct::{light_request, LightAnswer, LightRequest};
 use super::direct::{light_sample_culled, surface_light_context};
 use super::vertex::{li_by_vertices, Begin, VertexIntegrator, VertexStep};
 use super::volume::{
@@ -22,7 +25,7 @@ use crate::primitive::{HitRecord, MediumInterface, PrimitiveIntersection};
 use crate::rng::{mix_bits, Rng};
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
-use rpbrt_geometry::float::Float;
+use rpbrt_geometry::float::{Float, INV_PI};
 use rpbrt_geometry::interaction::SurfaceInteraction;
 use rpbrt_geometry::ray::{
     spawn_ray_from_origin_to_surface, MediumId, Ray, RayDifferential, SHADOW_EPSILON,
@@ -553,24 +556,142 @@ impl VertexIntegrator for VolPathIntegrator {
             }
         }
 
-        // Russian roulette.
-        if s.beta.is_black() {
+        russian_roulette(s, sampler, done.shadow)
+    }
+
+    #[inline(always)]
+    fn diffuse_hit(
+        &self,
+        scene: &Scene,
+        s: &VolPathState,
+        record: &HitRecord,
+        lambda: &SampledWavelengths,
+        gbuffer: bool,
+    ) -> Option<(SurfaceIn, SampledSpectrum)> {
+        // Only where `begin` asks for the light sample (no media, no
+        // interfaces: the ray's medium is none and stays none), and not
+        // where it ends the path or writes the visible surface.
+        if scene.has_volumes
+            || s.ray.ray.medium.is_some()
+            || s.depth >= self.max_depth
+            || scene.force_diffuse
+            || (gbuffer && s.depth == 0)
+        {
+            return None;
+        }
+        diffuse_surface(scene, record, s.ray.ray.d, lambda)
+    }
+
+    #[inline(always)]
+    fn diffuse_begin(
+        &self,
+        s: &mut VolPathState,
+        scratch: &mut VolPathScratch,
+        surface: &SurfaceOut,
+        r: SampledSpectrum,
+        sampler: &mut Sampler,
+    ) -> LightRequest {
+        s.depth += 1;
+        let (v, req) = DiffuseVertex::begin(surface, s.ray.ray.time, r, sampler);
+        scratch.hit = None;
+        scratch.bsdf = None;
+        scratch.diffuse = v;
+        req
+    }
+
+    #[inline(always)]
+    fn scatter_in(
+        _s: &VolPathState,
+        scratch: &VolPathScratch,
+        light: Option<&LightAnswer>,
+    ) -> ScatterIn {
+        // The BSDF sample leaves from ωo itself here (the path tracer
+        // negates the ray's direction).
+        ScatterIn::new(&scratch.diffuse, -scratch.diffuse.wo, light)
+    }
+
+    /// `finish` for a diffuse vertex, given the BSDF's answers.
+    #[inline(always)]
+    fn diffuse_finish(
+        &self,
+        scene: &Scene,
+        s: &mut VolPathState,
+        scratch: &mut VolPathScratch,
+        scatter: &ScatterOut,
+        light: Option<&LightAnswer>,
+        sampler: &mut Sampler,
+    ) -> VertexStep {
+        let v = &mut scratch.diffuse;
+        // `surface_shadow_query`.
+        let shadow = light.and_then(|a| {
+            let f_hat = scatter.f_light;
+            if f_hat.is_black() {
+                return None;
+            }
+            let ls = &a.ls;
+            let (ray, t_max) = v.shadow_ray(ls.p_light, ls.n_light);
+            let one = SampledSpectrum::new(1.0);
+            let ld = ld_value(
+                scene.lights[a.light as usize].light_type().is_delta(),
+                s.beta,
+                f_hat,
+                ls.l,
+                ShadowTransmittance {
+                    t_ray: one,
+                    r_u: one,
+                    r_l: one,
+                },
+                s.r_u,
+                a.p * ls.pdf,
+                scatter.pdf_light,
+            );
+            Some(ShadowQuery { ray, t_max, ld })
+        });
+        let done = VertexStep { shadow, done: true };
+        s.prev_ctx = v.context();
+        let Some((wi, pdf, cos_over_pdf)) = scatter.sample else {
+            return done;
+        };
+        let f = v.r * INV_PI;
+        if f.is_black() {
             return done;
         }
-        let rr_beta = s.beta * s.eta_scale / s.r_u.average();
-        let u_rr = sampler.get_1d();
-        let m = rr_beta.max_component_value();
-        if m < 1.0 && s.depth > 1 {
-            let q = (1.0 - m).max(0.0);
-            if u_rr < q {
-                return done;
-            }
-            s.beta /= 1.0 - q;
+        s.beta *= f * cos_over_pdf;
+        s.r_l = s.r_u / pdf;
+        s.specular_bounce = false;
+        s.any_non_specular = true;
+        // Without media the next ray's medium is none, as the hit's.
+        s.ray = RayDifferential::new(v.spawn_ray(wi));
+        russian_roulette(s, sampler, shadow)
+    }
+}
+
+/// The end of a surface vertex: Russian roulette on the throughput
+/// (without the refraction scale and the path's probability), after its
+/// draw; the path ends where the throughput is black.
+#[inline(always)]
+fn russian_roulette(
+    s: &mut VolPathState,
+    sampler: &mut Sampler,
+    shadow: Option<ShadowQuery>,
+) -> VertexStep {
+    let done = VertexStep { shadow, done: true };
+    if s.beta.is_black() {
+        return done;
+    }
+    let rr_beta = s.beta * s.eta_scale / s.r_u.average();
+    let u_rr = sampler.get_1d();
+    let m = rr_beta.max_component_value();
+    if m < 1.0 && s.depth > 1 {
+        let q = (1.0 - m).max(0.0);
+        if u_rr < q {
+            return done;
         }
-        VertexStep {
-            shadow: done.shadow,
-            done: false,
-        }
+        s.beta /= 1.0 - q;
+    }
+    VertexStep {
+        shadow: done.shadow,
+        done: false,
     }
 }
 
@@ -657,6 +778,8 @@ pub(crate) struct VolPathScratch {
     u2: Point2f,
     ray_medium: Option<MediumId>,
     answers: BsdfAnswers,
+    /// A vertex the wavefront takes in lanes (`diffuse_lanes.rs`).
+    diffuse: DiffuseVertex,
 }
 
 impl VolPathIntegrator {
