@@ -71,6 +71,17 @@ impl PinholeRays {
     }
 }
 
+/// `m[0] x + m[1] y + m[2] z`, summed in that order. (A function, not a
+/// closure: a closure is compiled without the kernel's instruction set,
+/// and its lane operations become calls.)
+#[inline(always)]
+fn row<L: F32Lanes>(m: &[Float], x: L, y: L, z: L) -> L {
+    L::splat(m[0])
+        .mul(x)
+        .add(L::splat(m[1]).mul(y))
+        .add(L::splat(m[2]).mul(z))
+}
+
 struct RaysKernel<'a> {
     cam: &'a PinholeRays,
     p_film: &'a [Point2f],
@@ -101,14 +112,12 @@ impl Kernel for RaysKernel<'_> {
             }
             let (x, y, z) = (L::load(&xs), L::load(&ys), s(0.0));
             // camera_from_raster.apply_point((x, y, 0)).
-            let row = |i: usize| {
-                s(m[i][0])
-                    .mul(x)
-                    .add(s(m[i][1]).mul(y))
-                    .add(s(m[i][2]).mul(z))
-                    .add(s(m[i][3]))
-            };
-            let (xp, yp, zp, wp) = (row(0), row(1), row(2), row(3));
+            let (xp, yp, zp, wp) = (
+                row(&m[0], x, y, z).add(s(m[0][3])),
+                row(&m[1], x, y, z).add(s(m[1][3])),
+                row(&m[2], x, y, z).add(s(m[2][3])),
+                row(&m[3], x, y, z).add(s(m[3][3])),
+            );
             let affine = wp.eq(s(1.0));
             let pc = [
                 L::select(affine, xp, xp.div(wp)),
@@ -124,12 +133,11 @@ impl Kernel for RaysKernel<'_> {
             let dc = [pc[0].div(len), pc[1].div(len), pc[2].div(len)];
             // render_from_camera.apply_ray: the direction's image, and the
             // origin pushed past its error bound along it.
-            let d: [L; 3] = std::array::from_fn(|i| {
-                s(r[i][0])
-                    .mul(dc[0])
-                    .add(s(r[i][1]).mul(dc[1]))
-                    .add(s(r[i][2]).mul(dc[2]))
-            });
+            let d = [
+                row(&r[0], dc[0], dc[1], dc[2]),
+                row(&r[1], dc[0], dc[1], dc[2]),
+                row(&r[2], dc[0], dc[1], dc[2]),
+            ];
             let len2 = d[0].mul(d[0]).add(d[1].mul(d[1])).add(d[2].mul(d[2]));
             let e = cam.origin_error;
             let dt = d[0]

@@ -87,7 +87,7 @@ pub(crate) struct SurfaceIn {
 impl SurfaceIn {
     /// The input of a hit on `hit` by a ray of direction `d`; `None` for
     /// meshes with shading tangents (left to the scalar vertex).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn new(hit: &TriangleHit, d: Vector3f) -> Option<SurfaceIn> {
         let mesh = hit.tri.mesh;
         if mesh.s.is_some() {
@@ -181,7 +181,7 @@ impl DiffuseVertex {
 
     /// The vertex of surface `s` hit at `time`, with reflectance `r` and
     /// the BSDF sample's 2-D draw `u2`.
-    #[inline]
+    #[inline(always)]
     fn new(s: &SurfaceOut, time: Float, r: SampledSpectrum, u2: Point2f) -> Self {
         // As `SurfaceInteraction` holds it: an interval, read back as its
         // midpoint and half-width.
@@ -207,7 +207,7 @@ impl DiffuseVertex {
 
     /// The light-sampling context: the point offset toward ωo (the BSDF
     /// only reflects), the normals.
-    #[inline]
+    #[inline(always)]
     fn light_context(&mut self) -> LightSampleContext {
         LightSampleContext {
             pi: Point3fi::from(self.toward(self.wo)),
@@ -217,7 +217,7 @@ impl DiffuseVertex {
     }
 
     /// The context of this vertex for the next vertex's MIS weights.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn context(&self) -> LightSampleContext {
         LightSampleContext {
             pi: self.pi,
@@ -242,14 +242,14 @@ impl DiffuseVertex {
     }
 
     /// The ray leaving the vertex toward `wi`.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn spawn_ray(&mut self, wi: Vector3f) -> Ray {
         Ray::with_time(self.toward(wi), wi, self.time, None)
     }
 
     /// The shadow ray toward a light sample's point `to_p` (normal `to_n`)
     /// and its extent.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn shadow_ray(&mut self, to_p: Point3fi, to_n: Normal3f) -> (Ray, Float) {
         let p_to = to_p.midpoint();
         let pf = self.toward(p_to - self.p);
@@ -451,7 +451,7 @@ pub(crate) struct ScatterIn {
 impl ScatterIn {
     /// The input of vertex `v`, reached along direction `d`, given its
     /// light sample.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn new(v: &DiffuseVertex, d: Vector3f, light: Option<&LightAnswer>) -> Self {
         ScatterIn {
             frame: v.frame,
