@@ -197,6 +197,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let mut answers: Vec<Option<LightAnswer>> = Vec::with_capacity(LANES);
         let mut bsdf_batch = BsdfBatch::default();
         let mut bsdf_answers: Vec<BsdfAnswers> = Vec::with_capacity(LANES);
+        let mut bsdf_lanes: Vec<usize> = Vec::with_capacity(LANES);
         let mut starts: Vec<(usize, Point2i)> = Vec::with_capacity(LANES);
         let mut cursors: Vec<SamplerCursor> = Vec::with_capacity(LANES);
         let mut draw_batch = FourDrawBatch::default();
@@ -412,17 +413,26 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 &mut answers,
             );
 
-            // BSDF: every vertex's BSDF queries, lane-parallel for the
-            // models with a lane form.
+            // BSDF: the other vertices' BSDF queries, lane-parallel for the
+            // models with a lane form. Only answers are written: a vertex's
+            // second half takes its answers, leaving none behind.
+            bsdf_lanes.clear();
             let bsdf_queries: Vec<Option<BsdfQuery>> = request_lanes
                 .iter()
                 .zip(&answers)
-                .map(|(&i, a)| I::bsdf_query(&lanes[i].path, &scratch[i], a.as_ref()))
+                .filter(|&(&i, _)| !lanes[i].diffuse)
+                .filter_map(|(&i, a)| {
+                    let q = I::bsdf_query(&lanes[i].path, &scratch[i], a.as_ref())?;
+                    bsdf_lanes.push(i);
+                    Some(Some(q))
+                })
                 .collect();
             answer_bsdfs(level, &bsdf_queries, &mut bsdf_batch, &mut bsdf_answers);
             drop(bsdf_queries);
-            for (&i, a) in request_lanes.iter().zip(&bsdf_answers) {
-                *I::bsdf_answers(&mut scratch[i]) = *a;
+            for (&i, a) in bsdf_lanes.iter().zip(&bsdf_answers) {
+                if a.light.is_some() || a.sample.is_some() {
+                    *I::bsdf_answers(&mut scratch[i]) = *a;
+                }
             }
 
             // The diffuse vertices' BSDF values and samples, lane-parallel.
