@@ -54,10 +54,8 @@ use rpbrt_geometry::ray::Ray;
 use rpbrt_geometry::tuple::*;
 use std::ops::Range;
 
-/// Paths in flight per thread. (With the diffuse vertex in lanes, 64 is
-/// 3–4% faster than 128 or 256 on the Cornell box and the water caustic,
-/// and as fast on the killeroo scene; below that the lane groups thin.)
-const LANES: usize = 64;
+/// Paths in flight per thread.
+const LANES: usize = 256;
 
 /// Finished samples the reorder buffer holds ahead of the oldest path
 /// still in flight (a power of two). A path can start only when its
