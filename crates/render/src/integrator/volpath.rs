@@ -628,23 +628,8 @@ impl VertexIntegrator for VolPathIntegrator {
             if f_hat.is_black() {
                 return None;
             }
-            let ls = &a.ls;
-            let (ray, t_max) = v.shadow_ray(ls.p_light, ls.n_light);
-            let one = SampledSpectrum::new(1.0);
-            let ld = ld_value(
-                scene.lights[a.light as usize].light_type().is_delta(),
-                s.beta,
-                f_hat,
-                ls.l,
-                ShadowTransmittance {
-                    t_ray: one,
-                    r_u: one,
-                    r_l: one,
-                },
-                s.r_u,
-                a.p * ls.pdf,
-                scatter.pdf_light,
-            );
+            let (ray, t_max) = v.shadow_ray(a.ls.p_light, a.ls.n_light);
+            let ld = unoccluded_ld(scene, a, s, f_hat, scatter.pdf_light);
             Some(ShadowQuery { ray, t_max, ld })
         });
         let done = VertexStep { shadow, done: true };
@@ -718,27 +703,40 @@ fn surface_shadow_query(
     let p_to = ls.p_light.midpoint();
     let pf = origins.toward(p_to - si.p());
     let ray = spawn_ray_from_origin_to_surface(pf, si.time, p_to, ls.p_light.error(), ls.n_light);
-    let light_pdf = a.p * ls.pdf;
+    let ld = unoccluded_ld(scene, a, s, f_hat, scatter_pdf);
+    Some(ShadowQuery {
+        ray,
+        t_max: 1.0 - SHADOW_EPSILON,
+        ld,
+    })
+}
+
+/// The contribution of light sample `a` at a surface vertex of a path in
+/// state `s` through a scene without media or interfaces, if nothing
+/// blocks it: [`ld_value`] with a transmittance of one.
+#[inline(always)]
+fn unoccluded_ld(
+    scene: &Scene,
+    a: &LightAnswer,
+    s: &VolPathState,
+    f_hat: SampledSpectrum,
+    scatter_pdf: Float,
+) -> SampledSpectrum {
     let one = SampledSpectrum::new(1.0);
-    let ld = ld_value(
+    ld_value(
         scene.lights[a.light as usize].light_type().is_delta(),
         s.beta,
         f_hat,
-        ls.l,
+        a.ls.l,
         ShadowTransmittance {
             t_ray: one,
             r_u: one,
             r_l: one,
         },
         s.r_u,
-        light_pdf,
+        a.p * a.ls.pdf,
         scatter_pdf,
-    );
-    Some(ShadowQuery {
-        ray,
-        t_max: 1.0 - SHADOW_EPSILON,
-        ld,
-    })
+    )
 }
 
 /// A light sample's contribution (pbrt-v4 `VolPathIntegrator::SampleLd`'s
