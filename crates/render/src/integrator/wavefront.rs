@@ -18,7 +18,10 @@
 //!    (delta tracking through media, emission, the BSDF, the sampler
 //!    draws) up to the vertex's light-sample request, and, after the
 //!    light stage, [`VertexIntegrator::finish`] (the BSDF toward the
-//!    light sample, the next ray);
+//!    light sample, the next ray). Diffuse vertices (`diffuse_lanes.rs`)
+//!    take both halves in lanes instead: their surfaces built together
+//!    before the first half, their BSDF's answers together before the
+//!    second;
 //! 3. **light**: the requests' lights chosen and sampled together
 //!    ([`answer_lights`]: triangle lights' solid-angle samples run
 //!    lane-parallel, at the SIMD level's width);
