@@ -317,6 +317,8 @@ fn render_command(opts: &args::Options) -> ExitCode {
             .map(|w| Arc::clone(w) as Arc<dyn rpbrt_render::integrator::RenderObserver>),
         wavefront,
         simd: None,
+        stage_times: (opts.stats && wavefront)
+            .then(|| Arc::new(rpbrt_render::integrator::StageTimes::new())),
     };
     let tev = match (&watch, &opts.display_server) {
         (Some(w), Some(address)) => {
@@ -407,6 +409,23 @@ fn render_command(opts: &args::Options) -> ExitCode {
             },
             rpbrt_render::simd::level().name()
         );
+        if let Some(times) = render_opts
+            .stage_times
+            .as_ref()
+            .filter(|_| integrator.has_wavefront())
+        {
+            let totals = times.totals();
+            let sum: f64 = totals.iter().map(|(_, t)| t.as_secs_f64()).sum();
+            diagln!("  Wavefront stages (thread time, all threads)");
+            for (name, t) in totals {
+                diagln!(
+                    "    {:<26} {:>8.3} s {:>5.1}%",
+                    name,
+                    t.as_secs_f64(),
+                    100.0 * t.as_secs_f64() / sum.max(1e-9)
+                );
+            }
+        }
         diagln!(
             "  Samples                    {:>10}  ({:.3} M/s)",
             stats.samples,

@@ -9,7 +9,7 @@ use super::Scene;
 use crate::bxdf::BSDF;
 use crate::light::{Light, LightLiSample, LightSampleContext};
 use crate::lightsampler::{LightChoice, LightSampler, SampledLight};
-use crate::shape::{sample_solid_angle_batch, SolidAngleCore, SolidAngleQuery};
+use crate::shape::{sample_solid_angle_points, SolidAnglePoint, SolidAngleQuery};
 use crate::simd::SimdLevel;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::Float;
@@ -210,7 +210,7 @@ pub(crate) struct LightBatch {
     chosen: Vec<Option<SampledLight>>,
     queries: Vec<SolidAngleQuery>,
     pending: Vec<(usize, SampledLight)>,
-    cores: Vec<SolidAngleCore>,
+    points: Vec<SolidAnglePoint>,
 }
 
 /// [`answer_light`] of every request in `requests` (`lambda(k)` gives
@@ -261,13 +261,13 @@ pub(crate) fn answer_lights<'w>(
         let ls = light.sample_li(&req.ctx, req.u_light, lambda(k), true);
         out.push(answer_with(sampled, ls));
     }
-    sample_solid_angle_batch(level, &batch.queries, &mut batch.cores);
-    for (&(k, sampled), &core) in batch.pending.iter().zip(&batch.cores) {
+    sample_solid_angle_points(level, &batch.queries, &mut batch.points);
+    for (&(k, sampled), point) in batch.pending.iter().zip(&batch.points) {
         let Light::DiffuseArea(area) = &scene.lights[sampled.light as usize] else {
             continue;
         };
         let req = &requests[k];
-        let ls = area.sample_li_from_core(&req.ctx, req.u_light, core, lambda(k));
+        let ls = area.sample_li_from_point(&req.ctx, req.u_light, point, lambda(k));
         out[k] = answer_with(sampled, ls);
     }
 }

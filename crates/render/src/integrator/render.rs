@@ -45,6 +45,9 @@ pub struct RenderOptions {
     /// process's ([`crate::simd::level`]). Tests set it to compare widths
     /// within one process.
     pub simd: Option<crate::simd::SimdLevel>,
+    /// Where the wavefront loop adds its time per stage (`--stats`);
+    /// `None`: it reads no clock.
+    pub stage_times: Option<Arc<super::StageTimes>>,
 }
 
 /// The image of a render in progress, as the film would write its R, G

@@ -30,6 +30,8 @@
 //!    interfaces `volpath` traces its shadow rays in the shade stage, by
 //!    ratio tracking, as its scalar loop does.)
 //!
+//! With `--stats` each thread times these stages ([`StageClock`]).
+//!
 //! Every path's arithmetic is the scalar loop's, its sampler
 //! dimensions drawn in the same order (each lane keeps a
 //! [`SamplerCursor`] into the thread's one sampler), and finished samples
@@ -44,6 +46,7 @@ use super::camera_samples::{differential_scale, CameraBatch, CameraDraws, Camera
 use super::diffuse_lanes::{scatters, surfaces, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut};
 use super::direct::{answer_lights, LightAnswer, LightBatch, LightRequest};
 use super::render::RenderOptions;
+use super::stages::{Stage, StageClock};
 use super::tile::{add_estimate, RayIntegrator, RayTiles, TileIntegrator};
 use super::vertex::{Begin, VertexIntegrator};
 use super::Scene;
@@ -223,7 +226,9 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let diff_scale = differential_scale(sampler.samples_per_pixel());
         let mut started = 0;
         let level = opts.simd.unwrap_or_else(crate::simd::level);
+        let mut clock = StageClock::new(opts.stage_times.as_deref());
         loop {
+            clock.enter(Stage::Camera);
             // Refill the pool in the tile's sample order. Once
             // interrupted, no sample starts; those in flight finish.
             starts.clear();
@@ -303,6 +308,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 break;
             }
 
+            clock.enter(Stage::Trace);
             // Trace: every path's closest hit, camera rays first (as
             // packets: they are consecutive samples of a few pixels).
             order.clear();
@@ -326,6 +332,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             if scratch.len() < lanes.len() {
                 scratch.resize_with(lanes.len(), Default::default);
             }
+            clock.enter(Stage::VertexDraws);
             // The vertices' four draws, together, for the paths that hit
             // something (the others draw nothing; a vertex that draws
             // otherwise, such as a specular one, ignores them).
@@ -339,6 +346,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             for (&i, &d) in shade.iter().zip(&draws) {
                 predrawn[i] = d;
             }
+            clock.enter(Stage::Surfaces);
             // The diffuse vertices' surfaces, lane-parallel (lanes the
             // surface kernel leaves take the scalar vertex).
             diffuse.clear();
@@ -367,6 +375,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     diffuse_slot[i] = k;
                 }
             }
+            clock.enter(Stage::Begin);
             for &i in &active {
                 let lane = &mut lanes[i];
                 sampler.set_cursor(&lane.cursor);
@@ -408,6 +417,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 }
             }
 
+            clock.enter(Stage::Lights);
             // Light: every request's light and its sample.
             answer_lights(
                 scene,
@@ -419,6 +429,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 &mut answers,
             );
 
+            clock.enter(Stage::Bsdfs);
             // BSDF: the other vertices' BSDF queries, lane-parallel for the
             // models with a lane form. Only answers are written: a vertex's
             // second half takes its answers, leaving none behind.
@@ -441,6 +452,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 }
             }
 
+            clock.enter(Stage::Scatters);
             // The diffuse vertices' BSDF values and samples, lane-parallel.
             scatter_in.clear();
             for (&i, a) in request_lanes.iter().zip(&answers) {
@@ -450,6 +462,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             }
             scatters(level, &scatter_in, &mut scatter_out);
 
+            clock.enter(Stage::Finish);
             // Shade, second half: the light samples' shadow queries and the
             // next rays.
             let mut scattered = scatter_out.iter();
@@ -482,6 +495,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 }
             }
 
+            clock.enter(Stage::Shadow);
             // Shadow: the light samples' visibility.
             scene.intersect_ps(&shadow_rays, &mut blocked);
             for (&(i, ld), &b) in shadow_lanes.iter().zip(&blocked) {
@@ -490,6 +504,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 }
             }
 
+            clock.enter(Stage::Retire);
             // Retire the paths that ended, freeing their slots.
             active.retain(|&i| {
                 let lane = &mut lanes[i];

@@ -14,7 +14,7 @@ use crate::rng::mix_bits;
 use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
 use crate::shape::{
     SampledTriangle, Shape, ShapeMethods, ShapeSample, ShapeSampleContext, SolidAngleCore,
-    SolidAngleQuery,
+    SolidAnglePoint, SolidAngleQuery,
 };
 use crate::spectrum::{RgbColorSpace, SampledSpectrum, SampledWavelengths, Spectrum};
 use crate::texture::{FloatTextureRef, TextureEvalContext};
@@ -150,7 +150,7 @@ impl DiffuseAreaLight {
 
     /// For a triangle light, the lane-parallel part of
     /// [`DiffuseAreaLight::sample_li`] as a query for
-    /// [`crate::shape::sample_solid_angle_batch`]; `None` for other shapes.
+    /// [`crate::shape::sample_solid_angle_points`]; `None` for other shapes.
     #[inline]
     pub(crate) fn triangle_query(
         &self,
@@ -174,6 +174,43 @@ impl DiffuseAreaLight {
         let t = self.sampled_triangle.as_ref()?;
         let ss = t.finish_sample(&Self::shape_ctx(ctx), u, core)?;
         self.li_sample_from(ctx, ss, lambda)
+    }
+
+    /// [`DiffuseAreaLight::sample_li`] of a triangle light given its
+    /// query's sampled point (the lane-parallel part): the same value.
+    #[inline]
+    pub(crate) fn sample_li_from_point(
+        &self,
+        ctx: &LightSampleContext,
+        u: Point2f,
+        s: &SolidAnglePoint,
+        lambda: &SampledWavelengths,
+    ) -> Option<LightLiSample> {
+        let t = self.sampled_triangle.as_ref()?;
+        let spectrum = match &self.emission {
+            AreaEmission::Spectrum(spectrum) if !s.core.by_area && self.alpha.is_none() => spectrum,
+            // A sample by area, or an emission that needs the point's uv.
+            _ => return self.sample_li_from_core(ctx, u, s.core, lambda),
+        };
+        if !s.core.ok || !s.toward {
+            return None;
+        }
+        // `l` toward −ωi, without an alpha texture.
+        let n = t.normal();
+        if !self.two_sided && dot(n, -s.wi) < 0.0 {
+            return None;
+        }
+        let le = spectrum.sample(lambda) * self.scale;
+        if le.is_black() {
+            return None;
+        }
+        Some(LightLiSample {
+            l: le,
+            wi: s.wi,
+            pdf: s.core.pdf,
+            p_light: s.pi,
+            n_light: n,
+        })
     }
 
     /// The light sample of the shape sample `ss`.

@@ -300,6 +300,30 @@ impl PreparedLightBounds {
         }
     }
 
+    /// The numbers [`importance_lanes`] reads, in its order.
+    #[inline(always)]
+    fn fields(&self) -> [Float; 16] {
+        let b = &self.bounds;
+        [
+            self.centroid.x,
+            self.centroid.y,
+            self.centroid.z,
+            self.half_diagonal,
+            b.w.x,
+            b.w.y,
+            b.w.z,
+            if b.two_sided { 1.0 } else { 0.0 },
+            self.sphere_center.x,
+            self.sphere_center.y,
+            self.sphere_center.z,
+            self.sphere_radius2,
+            self.sin_theta_o,
+            b.cos_theta_o,
+            b.cos_theta_e,
+            b.phi,
+        ]
+    }
+
     /// pbrt-v4's `LightBounds::Importance` (see [`LightBounds::importance`]).
     #[inline(always)]
     pub fn importance(&self, p: Point3f, n: Normal3f) -> Float {
@@ -440,71 +464,99 @@ pub(crate) fn importance_lanes<L: F32Lanes>(
 ) -> L {
     const MAX: usize = crate::simd::MAX_LANES;
     let empty = PreparedLightBounds::default();
-    let field = |f: &dyn Fn(&PreparedLightBounds) -> Float| -> L {
-        let mut v = [0.0 as Float; MAX];
-        for (i, x) in v.iter_mut().enumerate().take(L::N) {
-            *x = f(bounds.get(i).copied().unwrap_or(&empty));
+    // The bounds' fields, one row per field, gathered in one pass over
+    // the lanes (a plain loop: closures here become calls per lane).
+    let mut rows = [[0.0 as Float; MAX]; 16];
+    for i in 0..L::N {
+        let q = bounds.get(i).copied().unwrap_or(&empty);
+        for (row, f) in rows.iter_mut().zip(q.fields()) {
+            row[i] = f;
         }
-        L::load(&v)
-    };
-    let c = [
-        field(&|q| q.centroid.x),
-        field(&|q| q.centroid.y),
-        field(&|q| q.centroid.z),
-    ];
-    let half_diagonal = field(&|q| q.half_diagonal);
-    let w = [
-        field(&|q| q.bounds.w.x),
-        field(&|q| q.bounds.w.y),
-        field(&|q| q.bounds.w.z),
-    ];
-    let two_sided = field(&|q| if q.bounds.two_sided { 1.0 } else { 0.0 });
-    let sc = [
-        field(&|q| q.sphere_center.x),
-        field(&|q| q.sphere_center.y),
-        field(&|q| q.sphere_center.z),
-    ];
-    let r2 = field(&|q| q.sphere_radius2);
-    let sin_o = field(&|q| q.sin_theta_o);
-    let cos_o = field(&|q| q.bounds.cos_theta_o);
-    let cos_e = field(&|q| q.bounds.cos_theta_e);
-    let phi = field(&|q| q.bounds.phi);
+    }
+    let mut lanes = [L::splat(0.0); 16];
+    for (l, row) in lanes.iter_mut().zip(&rows) {
+        *l = L::load(row);
+    }
+    importance_of_fields(lanes, p, n)
+}
+
+/// [`importance_lanes`] where every lane has the same bounds `b`.
+#[inline(always)]
+pub(crate) fn importance_lanes_uniform<L: F32Lanes>(
+    b: &PreparedLightBounds,
+    p: &[L; 3],
+    n: &[L; 3],
+) -> L {
+    let mut lanes = [L::splat(0.0); 16];
+    for (l, f) in lanes.iter_mut().zip(b.fields()) {
+        *l = L::splat(f);
+    }
+    importance_of_fields(lanes, p, n)
+}
+
+/// The importance, lane-wise, of bounds given as their
+/// [`PreparedLightBounds::fields`].
+#[inline(always)]
+fn importance_of_fields<L: F32Lanes>(f: [L; 16], p: &[L; 3], n: &[L; 3]) -> L {
+    let [c0, c1, c2, half_diagonal, w0, w1, w2, two_sided, s0, s1, s2, r2, sin_o, cos_o, cos_e, phi] =
+        f;
+    let (c, w, sc) = ([c0, c1, c2], [w0, w1, w2], [s0, s1, s2]);
     let (zero, one) = (L::splat(0.0), L::splat(1.0));
-    let safe_sqrt1m = |c: L| one.sub(c.mul(c)).max(zero).sqrt();
-    let cos_sub = |sin_a: L, cos_a: L, sin_b: L, cos_b: L| {
-        let v = cos_a.mul(cos_b).add(sin_a.mul(sin_b));
-        L::select(cos_a.gt(cos_b), one, v)
-    };
-    let sin_sub = |sin_a: L, cos_a: L, sin_b: L, cos_b: L| {
-        let v = sin_a.mul(cos_b).sub(cos_a.mul(sin_b));
-        L::select(cos_a.gt(cos_b), zero, v)
-    };
-    let dot3 = |a: &[L; 3], b: &[L; 3]| a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]));
     let d = [p[0].sub(c[0]), p[1].sub(c[1]), p[2].sub(c[2])];
-    let len2 = dot3(&d, &d);
+    let len2 = dot3_l(&d, &d);
     let d2 = len2.max(half_diagonal);
     let l = len2.sqrt();
     let ok = L::and(l.gt(zero), l.lt(L::splat(Float::INFINITY)));
-    let wi = d.map(|x| L::select(ok, x.div(l), zero));
-    let cos_w = dot3(&w, &wi);
+    let wi = [
+        L::select(ok, d[0].div(l), zero),
+        L::select(ok, d[1].div(l), zero),
+        L::select(ok, d[2].div(l), zero),
+    ];
+    let cos_w = dot3_l(&w, &wi);
     let cos_w = L::select(two_sided.eq(one), cos_w.abs(), cos_w);
-    let sin_w = safe_sqrt1m(cos_w);
+    let sin_w = safe_sqrt1m_l(cos_w);
     let e = [p[0].sub(sc[0]), p[1].sub(sc[1]), p[2].sub(sc[2])];
-    let ds2 = dot3(&e, &e);
+    let ds2 = dot3_l(&e, &e);
     let root = one.sub(r2.div(ds2)).max(zero).sqrt();
     let cos_b = L::select(ds2.lt(r2), L::splat(-1.0), root);
-    let sin_b = safe_sqrt1m(cos_b);
-    let cos_x = cos_sub(sin_w, cos_w, sin_o, cos_o);
-    let sin_x = sin_sub(sin_w, cos_w, sin_o, cos_o);
-    let cos_p = cos_sub(sin_x, cos_x, sin_b, cos_b);
+    let sin_b = safe_sqrt1m_l(cos_b);
+    let cos_x = cos_sub_l(sin_w, cos_w, sin_o, cos_o);
+    let sin_x = sin_sub_l(sin_w, cos_w, sin_o, cos_o);
+    let cos_p = cos_sub_l(sin_x, cos_x, sin_b, cos_b);
     let imp = phi.mul(cos_p).div(d2);
     // At a point with a normal, the cosine at the receiver too.
     let no_n = L::and(L::and(n[0].eq(zero), n[1].eq(zero)), n[2].eq(zero));
-    let cos_i = dot3(&wi, n).abs();
-    let sin_i = safe_sqrt1m(cos_i);
-    let f = cos_sub(sin_i, cos_i, sin_b, cos_b);
+    let cos_i = dot3_l(&wi, n).abs();
+    let sin_i = safe_sqrt1m_l(cos_i);
+    let f = cos_sub_l(sin_i, cos_i, sin_b, cos_b);
     let imp = L::select(no_n, imp, imp.mul(f));
     L::select(cos_p.le(cos_e), zero, imp.max(zero))
+}
+
+/// `sqrt(max(0, 1 − c²))`, lane-wise.
+#[inline(always)]
+fn safe_sqrt1m_l<L: F32Lanes>(c: L) -> L {
+    L::splat(1.0).sub(c.mul(c)).max(L::splat(0.0)).sqrt()
+}
+
+/// [`cos_sub_clamped_sel`], lane-wise.
+#[inline(always)]
+fn cos_sub_l<L: F32Lanes>(sin_a: L, cos_a: L, sin_b: L, cos_b: L) -> L {
+    let v = cos_a.mul(cos_b).add(sin_a.mul(sin_b));
+    L::select(cos_a.gt(cos_b), L::splat(1.0), v)
+}
+
+/// [`sin_sub_clamped_sel`], lane-wise.
+#[inline(always)]
+fn sin_sub_l<L: F32Lanes>(sin_a: L, cos_a: L, sin_b: L, cos_b: L) -> L {
+    let v = sin_a.mul(cos_b).sub(cos_a.mul(sin_b));
+    L::select(cos_a.gt(cos_b), L::splat(0.0), v)
+}
+
+/// The dot product of two lane vectors, summed x, y, z in order.
+#[inline(always)]
+fn dot3_l<L: F32Lanes>(a: &[L; 3], b: &[L; 3]) -> L {
+    a[0].mul(b[0]).add(a[1].mul(b[1])).add(a[2].mul(b[2]))
 }
 
 /// [`cos_sub_clamped`] by selection.

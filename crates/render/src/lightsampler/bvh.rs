@@ -9,7 +9,8 @@ use rpbrt_geometry::{safe_acos, Bounds3f, Float, Normal3f, Point3f, PI};
 
 use super::{SampledLight, ONE_MINUS_EPSILON};
 use crate::light::{
-    importance2, importance_lanes, Light, LightBounds, LightSampleContext, PreparedLightBounds,
+    importance2, importance_lanes, importance_lanes_uniform, Light, LightBounds,
+    LightSampleContext, PreparedLightBounds,
 };
 use crate::select::select_f32;
 use crate::simd::{F32Lanes, Kernel, SimdLevel, MAX_LANES};
@@ -408,30 +409,52 @@ impl Kernel for SampleBatch<'_> {
             if active == 0 {
                 continue;
             }
-            let coord = |f: &dyn Fn(&LightChoice) -> Float| {
-                let mut v = [0.0 as Float; MAX_LANES];
-                for (x, q) in v.iter_mut().zip(queries) {
-                    *x = f(q);
+            let mut rows = [[0.0 as Float; MAX_LANES]; 6];
+            for (i, q) in queries.iter().enumerate() {
+                for (row, x) in rows
+                    .iter_mut()
+                    .zip([q.p.x, q.p.y, q.p.z, q.n.x, q.n.y, q.n.z])
+                {
+                    row[i] = x;
                 }
-                L::load(&v)
-            };
-            let p = [coord(&|q| q.p.x), coord(&|q| q.p.y), coord(&|q| q.p.z)];
-            let n = [coord(&|q| q.n.x), coord(&|q| q.n.y), coord(&|q| q.n.z)];
+            }
+            let p = [L::load(&rows[0]), L::load(&rows[1]), L::load(&rows[2])];
+            let n = [L::load(&rows[3]), L::load(&rows[4]), L::load(&rows[5])];
             let empty = PreparedLightBounds::default();
             while active != 0 {
                 // Every lane's node is interior: its two children.
-                let mut b0 = [&empty; MAX_LANES];
-                let mut b1 = [&empty; MAX_LANES];
+                // Lanes at one node (all of them at the root, most of
+                // them near it) read its children's bounds once.
+                let first = node[active.trailing_zeros() as usize];
+                let mut uniform = true;
                 let mut bits = active;
                 while bits != 0 {
                     let i = bits.trailing_zeros() as usize;
                     bits &= bits - 1;
-                    let c1 = s.nodes[node[i]].child_or_light as usize;
-                    b0[i] = &s.nodes[node[i] + 1].bounds;
-                    b1[i] = &s.nodes[c1].bounds;
+                    uniform &= node[i] == first;
                 }
-                let ci0 = importance_lanes::<L>(&b0[..L::N], &p, &n);
-                let ci1 = importance_lanes::<L>(&b1[..L::N], &p, &n);
+                let (ci0, ci1) = if uniform {
+                    let c1 = s.nodes[first].child_or_light as usize;
+                    (
+                        importance_lanes_uniform::<L>(&s.nodes[first + 1].bounds, &p, &n),
+                        importance_lanes_uniform::<L>(&s.nodes[c1].bounds, &p, &n),
+                    )
+                } else {
+                    let mut b0 = [&empty; MAX_LANES];
+                    let mut b1 = [&empty; MAX_LANES];
+                    let mut bits = active;
+                    while bits != 0 {
+                        let i = bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        let c1 = s.nodes[node[i]].child_or_light as usize;
+                        b0[i] = &s.nodes[node[i] + 1].bounds;
+                        b1[i] = &s.nodes[c1].bounds;
+                    }
+                    (
+                        importance_lanes::<L>(&b0[..L::N], &p, &n),
+                        importance_lanes::<L>(&b1[..L::N], &p, &n),
+                    )
+                };
                 // The single sample's arithmetic, lane-wise.
                 let (uv, pmfv) = (L::load(&u), L::load(&pmf));
                 let sum = ci0.add(ci1);

@@ -23,7 +23,9 @@ pub use disk::Disk;
 pub use hyperboloid::Hyperboloid;
 pub use paraboloid::Paraboloid;
 pub use sphere::Sphere;
-pub(crate) use triangle::{sample_solid_angle_batch, SolidAngleCore, SolidAngleQuery};
+pub(crate) use triangle::{
+    sample_solid_angle_points, SolidAngleCore, SolidAnglePoint, SolidAngleQuery,
+};
 pub use triangle::{SampledTriangle, Triangle, TriangleMesh};
 
 pub mod bilinear;

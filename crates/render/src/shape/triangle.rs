@@ -18,6 +18,7 @@ use crate::simd::math::{self, V3};
 use crate::simd::{dispatch, F32Lanes, Kernel, Scalar1, SimdLevel};
 use rpbrt_geometry::float::*;
 use rpbrt_geometry::interaction::{ShadingGeometry, SurfaceInteraction};
+use rpbrt_geometry::interval::Interval;
 use rpbrt_geometry::ray::Ray;
 use rpbrt_geometry::spherical::DirectionCone;
 use rpbrt_geometry::transform::Transform;
@@ -1006,7 +1007,7 @@ impl SampledTriangle {
     }
 
     /// [`SampledTriangle::sample`] in two steps, so that many samples'
-    /// lane-parallel parts run together ([`sample_solid_angle_batch`]):
+    /// lane-parallel parts run together ([`sample_solid_angle_points`]):
     /// the query of a sample ...
     #[inline]
     pub(crate) fn solid_angle_query(
@@ -1020,6 +1021,12 @@ impl SampledTriangle {
             ns: ctx.ns,
             u,
         }
+    }
+
+    /// The normal of every point on the triangle.
+    #[inline(always)]
+    pub(crate) fn normal(&self) -> Normal3f {
+        self.n
     }
 
     /// ... and the sample, given its query's core (the same value as
@@ -1112,7 +1119,7 @@ fn sample_area<T: TriangleGeometry>(t: &T, u: Point2f) -> Option<ShapeSample> {
 /// triangle subtends, warped by the cos θ approximation at the reference
 /// point; by area when the solid angle is too small or too large. The
 /// arithmetic is [`solid_angle_lanes`] at width one, the same that
-/// [`sample_solid_angle_batch`] runs on many samples at once.
+/// [`sample_solid_angle_points`] runs on many samples at once.
 #[inline(always)]
 fn sample_solid_angle<T: TriangleGeometry>(
     t: &T,
@@ -1125,7 +1132,8 @@ fn sample_solid_angle<T: TriangleGeometry>(
         ns: ctx.ns,
         u,
     };
-    let core = SolidAngleCore::of_lane(&solid_angle_lanes::<Scalar1>(&[q]), 0);
+    let mut core = SolidAngleCore::default();
+    SolidAngleCore::each_lane(&solid_angle_lanes::<Scalar1>(&[q]), 1, |c| core = c);
     finish_solid_angle(t, ctx, u, core)
 }
 
@@ -1174,22 +1182,32 @@ pub(crate) struct SolidAngleLanes<L: F32Lanes> {
     pdf: L,
     ok: L::Mask,
     by_area: L::Mask,
+    /// The queries' corners and reference points.
+    v: [V3<L>; 3],
+    p: V3<L>,
 }
 
 impl SolidAngleCore {
-    /// Lane `i` of `l`.
+    /// The first `n` lanes of `l`, in order, to `out`.
     #[inline(always)]
-    fn of_lane<L: F32Lanes>(l: &SolidAngleLanes<L>, i: usize) -> SolidAngleCore {
-        let get = |x: L| {
-            let mut a = [0.0; 16];
-            x.store(&mut a);
-            a[i]
-        };
-        SolidAngleCore {
-            b: [get(l.b[0]), get(l.b[1]), get(l.b[2])],
-            pdf: get(l.pdf),
-            ok: (L::bits(l.ok) >> i) & 1 != 0,
-            by_area: (L::bits(l.by_area) >> i) & 1 != 0,
+    fn each_lane<L: F32Lanes>(
+        l: &SolidAngleLanes<L>,
+        n: usize,
+        mut out: impl FnMut(SolidAngleCore),
+    ) {
+        let mut a = [[0.0; 16]; 4];
+        l.b[0].store(&mut a[0]);
+        l.b[1].store(&mut a[1]);
+        l.b[2].store(&mut a[2]);
+        l.pdf.store(&mut a[3]);
+        let (ok, by_area) = (L::bits(l.ok), L::bits(l.by_area));
+        for i in 0..n {
+            out(SolidAngleCore {
+                b: [a[0][i], a[1][i], a[2][i]],
+                pdf: a[3][i],
+                ok: (ok >> i) & 1 != 0,
+                by_area: (by_area >> i) & 1 != 0,
+            });
         }
     }
 }
@@ -1237,8 +1255,9 @@ fn solid_angle_lanes<L: F32Lanes>(q: &[SolidAngleQuery]) -> SolidAngleLanes<L> {
     // triangle uniformly.
     let zero = sp(0.0);
     let no_normal = L::and(L::and(ns.x.eq(zero), ns.y.eq(zero)), ns.z.eq(zero));
-    let w = |d: V3<L>| ns.dot(d).abs().max(sp(0.01));
-    let (w0, w1, w2) = (w(dirs[0]), w(dirs[1]), w(dirs[2]));
+    let w0 = ns.dot(dirs[0]).abs().max(sp(0.01));
+    let w1 = ns.dot(dirs[1]).abs().max(sp(0.01));
+    let w2 = ns.dot(dirs[2]).abs().max(sp(0.01));
     let weights = [w1, w1, w0, w2];
     let warped = sample_bilinear_lanes(u, weights);
     let warp_pdf = bilinear_pdf_lanes(warped, weights);
@@ -1256,6 +1275,8 @@ fn solid_angle_lanes<L: F32Lanes>(q: &[SolidAngleQuery]) -> SolidAngleLanes<L> {
         pdf: pdf.mul(tri.pdf),
         ok,
         by_area: L::not(in_range),
+        v,
+        p,
     }
 }
 
@@ -1282,7 +1303,6 @@ fn sample_bilinear_lanes<L: F32Lanes>(u: [L; 2], w: [L; 4]) -> [L; 2] {
 #[inline(always)]
 fn bilinear_pdf_lanes<L: F32Lanes>(p: [L; 2], w: [L; 4]) -> L {
     let (zero, one) = (L::splat(0.0), L::splat(1.0));
-    let inside = |x: L| L::and(x.ge(zero), x.le(one));
     let sum = w[0].add(w[1]).add(w[2]).add(w[3]);
     let (x, y) = (p[0], p[1]);
     let (nx, ny) = (one.sub(x), one.sub(y));
@@ -1294,39 +1314,103 @@ fn bilinear_pdf_lanes<L: F32Lanes>(p: [L; 2], w: [L; 4]) -> L {
         .add(x.mul(y).mul(w[3]));
     let pdf = L::splat(4.0).mul(f).div(sum);
     let pdf = L::select(sum.eq(zero), one, pdf);
-    L::select(L::and(inside(x), inside(y)), pdf, zero)
+    let inside = L::and(L::and(x.ge(zero), x.le(one)), L::and(y.ge(zero), y.le(one)));
+    L::select(inside, pdf, zero)
 }
 
-/// Runs [`solid_angle_lanes`] over every query.
-struct SolidAngleKernel<'a> {
+/// A solid-angle sample taken to its point in lanes: the core and, where
+/// the core has a sample by solid angle (`ok` and not `by_area`), the
+/// sampled point's interval ([`sample_at`]'s) and, when its density is
+/// positive and its midpoint is not the reference point (`toward`), the
+/// unit direction to that midpoint: what a triangle light's `sample_li`
+/// computes before its emission.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct SolidAnglePoint {
+    pub core: SolidAngleCore,
+    pub pi: Point3fi,
+    pub wi: Vector3f,
+    pub toward: bool,
+}
+
+/// Runs [`solid_angle_lanes`] and the sampled points over every query.
+struct SolidAnglePointKernel<'a> {
     queries: &'a [SolidAngleQuery],
-    out: &'a mut Vec<SolidAngleCore>,
+    out: &'a mut Vec<SolidAnglePoint>,
 }
 
-impl Kernel for SolidAngleKernel<'_> {
+impl Kernel for SolidAnglePointKernel<'_> {
     type Output = ();
     #[inline(always)]
     fn run<L: F32Lanes>(self) {
+        let zero = L::splat(0.0);
         for chunk in self.queries.chunks(L::N) {
             let l = solid_angle_lanes::<L>(chunk);
+            // `sample_at`: the point, its error bound and interval.
+            let [b0, b1, b2] = l.b;
+            let (pb0, pb1, pb2) = (l.v[0].scale(b0), l.v[1].scale(b1), l.v[2].scale(b2));
+            let p = pb0.add(pb1).add(pb2);
+            let g = L::splat(gamma(6));
+            let err = [
+                pb0.x.abs().add(pb1.x.abs()).add(pb2.x.abs()).mul(g),
+                pb0.y.abs().add(pb1.y.abs()).add(pb2.y.abs()).mul(g),
+                pb0.z.abs().add(pb1.z.abs()).add(pb2.z.abs()).mul(g),
+            ];
+            let (lx, hx) = math::interval_from_value_and_error(p.x, err[0]);
+            let (ly, hy) = math::interval_from_value_and_error(p.y, err[1]);
+            let (lz, hz) = math::interval_from_value_and_error(p.z, err[2]);
+            // `li_sample_from`: the direction from the reference point to
+            // the point's midpoint.
+            let two = L::splat(2.0);
+            let mid = V3 {
+                x: lx.add(hx).div(two),
+                y: ly.add(hy).div(two),
+                z: lz.add(hz).div(two),
+            };
+            let d = mid.sub(l.p);
+            let len2 = d.dot(d);
+            let wi = d.normalize();
+            let toward = L::bits(L::and(L::not(l.pdf.eq(zero)), L::not(len2.eq(zero))));
+            let mut a = [[0.0 as Float; 16]; 13];
+            for (row, x) in a
+                .iter_mut()
+                .zip([b0, b1, b2, l.pdf, lx, ly, lz, hx, hy, hz, wi.x, wi.y, wi.z])
+            {
+                x.store(row);
+            }
+            let (ok, by_area) = (L::bits(l.ok), L::bits(l.by_area));
             for i in 0..chunk.len() {
-                self.out.push(SolidAngleCore::of_lane(&l, i));
+                let interval = |lo: usize| Interval {
+                    low: a[lo][i],
+                    high: a[lo + 3][i],
+                };
+                self.out.push(SolidAnglePoint {
+                    core: SolidAngleCore {
+                        b: [a[0][i], a[1][i], a[2][i]],
+                        pdf: a[3][i],
+                        ok: (ok >> i) & 1 != 0,
+                        by_area: (by_area >> i) & 1 != 0,
+                    },
+                    pi: Point3fi::new(interval(4), interval(5), interval(6)),
+                    wi: Vector3f::new(a[10][i], a[11][i], a[12][i]),
+                    toward: (toward >> i) & 1 != 0,
+                });
             }
         }
     }
 }
 
-/// The cores of many solid-angle samples (of any triangles) at once, at
-/// `level`'s width, into `out` (cleared first): the same values
-/// [`Triangle`]'s and [`SampledTriangle`]'s `sample` compute one by one.
-pub(crate) fn sample_solid_angle_batch(
+/// The solid-angle samples of many queries (of any triangles) at once,
+/// taken on to their points ([`SolidAnglePoint`]), at `level`'s width,
+/// into `out` (cleared first): the same values [`Triangle`]'s and
+/// [`SampledTriangle`]'s `sample` compute one by one.
+pub(crate) fn sample_solid_angle_points(
     level: SimdLevel,
     queries: &[SolidAngleQuery],
-    out: &mut Vec<SolidAngleCore>,
+    out: &mut Vec<SolidAnglePoint>,
 ) {
     out.clear();
     out.reserve(queries.len());
-    dispatch(level, SolidAngleKernel { queries, out });
+    dispatch(level, SolidAnglePointKernel { queries, out });
 }
 
 #[cfg(test)]

@@ -72,6 +72,11 @@ pub trait F32Lanes: Copy {
     /// Lane-wise 2ⁿ for lanes holding an integer `n` in [−126, 127] (built
     /// from its exponent bits: exact).
     fn pow2i(n: Self) -> Self;
+    /// Lane-wise the float whose bit pattern is one more than `self`'s
+    /// where `up`, one less elsewhere (wrapping), as `f32::from_bits` of
+    /// `to_bits() ± 1`: the step of [`rpbrt_geometry::float::next_float_up`]
+    /// and `next_float_down`.
+    fn step_bits(self, up: Self::Mask) -> Self;
     /// Lane-wise `self > o`.
     #[inline(always)]
     fn gt(self, o: Self) -> Self::Mask {
@@ -214,6 +219,15 @@ impl F32Lanes for Scalar1 {
     #[inline(always)]
     fn pow2i(n: Self) -> Self {
         Scalar1(f32::from_bits(((n.0 as i32 + 127) as u32) << 23))
+    }
+    #[inline(always)]
+    fn step_bits(self, up: bool) -> Self {
+        let b = self.0.to_bits();
+        Scalar1(f32::from_bits(if up {
+            b.wrapping_add(1)
+        } else {
+            b.wrapping_sub(1)
+        }))
     }
 }
 
@@ -379,6 +393,22 @@ mod x86 {
             unsafe {
                 let e = _mm256_add_epi32(_mm256_cvttps_epi32(n.0), _mm256_set1_epi32(127));
                 F32x8(_mm256_castsi256_ps(_mm256_slli_epi32::<23>(e)))
+            }
+        }
+        #[inline(always)]
+        fn step_bits(self, up: __m256) -> Self {
+            unsafe {
+                // +1 where up (the mask's lanes are −1: subtract them),
+                // −1 elsewhere.
+                let b = _mm256_castps_si256(self.0);
+                let m = _mm256_castps_si256(up);
+                let plus = _mm256_sub_epi32(b, m);
+                let minus = _mm256_sub_epi32(b, _mm256_set1_epi32(1));
+                F32x8(_mm256_blendv_ps(
+                    _mm256_castsi256_ps(minus),
+                    _mm256_castsi256_ps(plus),
+                    up,
+                ))
             }
         }
     }
@@ -567,6 +597,21 @@ mod x86 {
             unsafe {
                 let e = _mm_add_epi32(_mm_cvttps_epi32(n.0), _mm_set1_epi32(127));
                 F32x4(_mm_castsi128_ps(_mm_slli_epi32::<23>(e)))
+            }
+        }
+        #[inline(always)]
+        fn step_bits(self, up: __m128) -> Self {
+            unsafe {
+                // As F32x8's.
+                let b = _mm_castps_si128(self.0);
+                let m = _mm_castps_si128(up);
+                let plus = _mm_sub_epi32(b, m);
+                let minus = _mm_sub_epi32(b, _mm_set1_epi32(1));
+                F32x4(_mm_blendv_ps(
+                    _mm_castsi128_ps(minus),
+                    _mm_castsi128_ps(plus),
+                    up,
+                ))
             }
         }
     }

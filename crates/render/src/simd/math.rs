@@ -180,6 +180,38 @@ pub fn safe_sqrt<L: F32Lanes>(x: L) -> L {
     x.max(L::splat(0.0)).sqrt()
 }
 
+/// [`rpbrt_geometry::float::next_float_up`] of each lane: the smallest
+/// float above it (+∞ stays, −0 is 0 first).
+#[inline(always)]
+pub fn next_float_up<L: F32Lanes>(v: L) -> L {
+    let zero = L::splat(0.0);
+    let w = L::select(v.eq(zero), zero, v);
+    let r = w.step_bits(w.ge(zero));
+    L::select(v.eq(L::splat(f32::INFINITY)), v, r)
+}
+
+/// [`rpbrt_geometry::float::next_float_down`] of each lane: the largest
+/// float below it (−∞ stays, 0 is −0 first).
+#[inline(always)]
+pub fn next_float_down<L: F32Lanes>(v: L) -> L {
+    let zero = L::splat(0.0);
+    let w = L::select(v.eq(zero), L::splat(-0.0), v);
+    let r = w.step_bits(L::not(w.gt(zero)));
+    L::select(v.eq(L::splat(f32::NEG_INFINITY)), v, r)
+}
+
+/// [`rpbrt_geometry::interval::Interval::from_value_and_error`] of each
+/// lane: its low and high ends (`v` itself where the error is 0). (A NaN
+/// end may differ from the scalar one in its sign and payload, which
+/// Rust leaves unspecified.)
+#[inline(always)]
+pub fn interval_from_value_and_error<L: F32Lanes>(v: L, err: L) -> (L, L) {
+    let exact = err.eq(L::splat(0.0));
+    let lo = next_float_down(v.sub(err));
+    let hi = next_float_up(v.add(err));
+    (L::select(exact, v, lo), L::select(exact, v, hi))
+}
+
 /// `(1 − t)·a + t·b`, as [`rpbrt_geometry::float::lerp`].
 #[inline(always)]
 pub fn lerp<L: F32Lanes>(t: L, a: L, b: L) -> L {

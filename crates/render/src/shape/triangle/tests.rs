@@ -846,18 +846,44 @@ fn batched_solid_angle_samples_match_single_ones() {
     let bits = |s: &Option<ShapeSample>| {
         s.map(|s| [s.p().x, s.p().y, s.p().z, s.pdf, s.uv.x, s.uv.y].map(f32::to_bits))
     };
-    let (mut by_area, mut sampled) = (0, 0);
+    let (mut by_area, mut sampled, mut toward) = (0, 0, 0);
     for level in crate::simd::SimdLevel::available() {
-        let mut cores = Vec::new();
-        sample_solid_angle_batch(level, &queries, &mut cores);
-        assert_eq!(cores.len(), cases.len());
-        for ((k, ctx, u), core) in cases.iter().zip(&cores) {
+        let mut points = Vec::new();
+        sample_solid_angle_points(level, &queries, &mut points);
+        assert_eq!(points.len(), cases.len());
+        for ((k, ctx, u), point) in cases.iter().zip(&points) {
             let single = tris[*k].sample(ctx, *u);
-            let batched = tris[*k].finish_sample(ctx, *u, *core);
+            let batched = tris[*k].finish_sample(ctx, *u, point.core);
             assert_eq!(bits(&single), bits(&batched), "{level:?}: {ctx:?} {u:?}");
-            by_area += core.by_area as usize;
+            by_area += point.core.by_area as usize;
             sampled += single.is_some() as usize;
+            // The point and the direction to it, as a light's sample
+            // finds them.
+            let Some(ss) = single.filter(|_| point.core.ok && !point.core.by_area) else {
+                continue;
+            };
+            let interval =
+                |i: rpbrt_geometry::interval::Interval| [i.low, i.high].map(f32::to_bits);
+            for (a, b) in [
+                (ss.pi.x, point.pi.x),
+                (ss.pi.y, point.pi.y),
+                (ss.pi.z, point.pi.z),
+            ] {
+                assert_eq!(interval(a), interval(b), "{level:?}: {ctx:?} {u:?}");
+            }
+            let d = ss.p() - ctx.p();
+            let expect_toward = !(ss.pdf == 0.0 || d.length_squared() == 0.0);
+            assert_eq!(point.toward, expect_toward);
+            if expect_toward {
+                let wi = d.normalize();
+                assert_eq!(
+                    [wi.x, wi.y, wi.z].map(f32::to_bits),
+                    [point.wi.x, point.wi.y, point.wi.z].map(f32::to_bits)
+                );
+                toward += 1;
+            }
         }
     }
+    assert!(toward > 0, "{toward}");
     assert!(by_area > 0 && sampled > by_area, "{by_area} {sampled}");
 }
