@@ -29,15 +29,14 @@ use crate::bxdf::lanes::{gather_f, gather_s, MAX_LANES, S4};
 use crate::light::LightSampleContext;
 use crate::primitive::{HitRecord, TriangleHit};
 use crate::sampler::Sampler;
-use crate::simd::math::V3;
+use crate::simd::math::{self, V3};
 use crate::simd::{dispatch, F32Lanes, Kernel, SimdLevel};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::{gamma, Float, INV_PI, PI_OVER_4};
 use rpbrt_geometry::frame::Frame;
+use rpbrt_geometry::interval::Interval;
 use rpbrt_geometry::pointfi::Point3fi;
-use rpbrt_geometry::ray::{
-    offset_ray_origin, spawn_ray_from_origin_to_surface, Ray, SHADOW_EPSILON,
-};
+use rpbrt_geometry::ray::{spawn_ray_from_origin_to_surface, Ray, SHADOW_EPSILON};
 use rpbrt_geometry::tuple::*;
 
 /// The surface kernel's input and the reflectance at `lambda` of a hit
@@ -114,9 +113,13 @@ impl SurfaceIn {
 /// The surface at a hit, as the scalar interaction and BSDF have it.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct SurfaceOut {
-    /// The hit point and its error bound (before they become an interval).
+    /// The hit point's interval, and its midpoint (what the interaction
+    /// reads as its point).
+    pub pi: Point3fi,
     pub p: Point3f,
-    pub p_error: Vector3f,
+    /// The ray origins offset off the surface (`offset_ray_origin`) to
+    /// the side of `n` and to the other side.
+    pub sides: [Point3f; 2],
     /// The geometric normal, on the shading normal's side.
     pub n: Normal3f,
     /// The shading normal.
@@ -135,10 +138,9 @@ pub(crate) struct SurfaceOut {
 /// of the surface, the BSDF and the sampler draws.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct DiffuseVertex {
-    /// The hit point's interval and its midpoint and error bound.
+    /// The hit point's interval and its midpoint.
     pub pi: Point3fi,
     p: Point3f,
-    p_error: Vector3f,
     /// Geometric and shading normals.
     pub n: Normal3f,
     pub ns: Normal3f,
@@ -151,8 +153,8 @@ pub(crate) struct DiffuseVertex {
     pub r: SampledSpectrum,
     /// The BSDF sample's draws.
     pub u2: Point2f,
-    /// The offset origins computed so far (see `direct::VertexOrigins`).
-    sides: [Option<Point3f>; 2],
+    /// The offset origins to the side of `n` and to the other side.
+    sides: [Point3f; 2],
 }
 
 impl DiffuseVertex {
@@ -167,7 +169,7 @@ impl DiffuseVertex {
         sampler: &mut Sampler,
     ) -> (DiffuseVertex, LightRequest) {
         let (u_light, u_light_2d, _, u2) = sampler.get_vertex_samples();
-        let mut v = DiffuseVertex::new(s, time, r, u2);
+        let v = DiffuseVertex::new(s, time, r, u2);
         let ctx = v.light_context();
         let z = v.frame.z;
         let req = LightRequest {
@@ -183,13 +185,9 @@ impl DiffuseVertex {
     /// the BSDF sample's 2-D draw `u2`.
     #[inline(always)]
     fn new(s: &SurfaceOut, time: Float, r: SampledSpectrum, u2: Point2f) -> Self {
-        // As `SurfaceInteraction` holds it: an interval, read back as its
-        // midpoint and half-width.
-        let pi = Point3fi::from_value_and_error(s.p, s.p_error);
         DiffuseVertex {
-            pi,
-            p: pi.midpoint(),
-            p_error: pi.error(),
+            pi: s.pi,
+            p: s.p,
             n: s.n,
             ns: s.ns,
             wo: s.wo,
@@ -201,14 +199,14 @@ impl DiffuseVertex {
             },
             r,
             u2,
-            sides: [None, None],
+            sides: s.sides,
         }
     }
 
     /// The light-sampling context: the point offset toward ωo (the BSDF
     /// only reflects), the normals.
     #[inline(always)]
-    fn light_context(&mut self) -> LightSampleContext {
+    fn light_context(&self) -> LightSampleContext {
         LightSampleContext {
             pi: Point3fi::from(self.toward(self.wo)),
             n: self.n,
@@ -226,31 +224,22 @@ impl DiffuseVertex {
         }
     }
 
-    /// The ray origin offset off the surface toward `w`'s side (computed
-    /// once per side).
+    /// The ray origin offset off the surface toward `w`'s side.
     #[inline(always)]
-    pub(crate) fn toward(&mut self, w: Vector3f) -> Point3f {
-        let side = (dot(w, self.n) < 0.0) as usize;
-        match self.sides[side] {
-            Some(p) => p,
-            None => {
-                let p = offset_ray_origin(self.p, self.p_error, self.n, w);
-                self.sides[side] = Some(p);
-                p
-            }
-        }
+    pub(crate) fn toward(&self, w: Vector3f) -> Point3f {
+        self.sides[(dot(w, self.n) < 0.0) as usize]
     }
 
     /// The ray leaving the vertex toward `wi`.
     #[inline(always)]
-    pub(crate) fn spawn_ray(&mut self, wi: Vector3f) -> Ray {
+    pub(crate) fn spawn_ray(&self, wi: Vector3f) -> Ray {
         Ray::with_time(self.toward(wi), wi, self.time, None)
     }
 
     /// The shadow ray toward a light sample's point `to_p` (normal `to_n`)
     /// and its extent.
     #[inline(always)]
-    pub(crate) fn shadow_ray(&mut self, to_p: Point3fi, to_n: Normal3f) -> (Ray, Float) {
+    pub(crate) fn shadow_ray(&self, to_p: Point3fi, to_n: Normal3f) -> (Ray, Float) {
         let p_to = to_p.midpoint();
         let pf = self.toward(p_to - self.p);
         let r = spawn_ray_from_origin_to_surface(pf, self.time, p_to, to_p.error(), to_n);
@@ -321,6 +310,25 @@ fn flip_if<L: F32Lanes>(m: L::Mask, v: V3<L>) -> V3<L> {
         z: v.z.neg(),
     };
     V3::select(m, neg, v)
+}
+
+/// Each component of `v` one float up where `o`'s is positive, one down
+/// where it is negative (the rounding of `offset_ray_origin`).
+#[inline(always)]
+fn round_off_v<L: F32Lanes>(v: V3<L>, o: V3<L>) -> V3<L> {
+    V3 {
+        x: round_off_l(v.x, o.x),
+        y: round_off_l(v.y, o.y),
+        z: round_off_l(v.z, o.z),
+    }
+}
+
+/// [`round_off_v`] of one component.
+#[inline(always)]
+fn round_off_l<L: F32Lanes>(v: L, o: L) -> L {
+    let zero = L::splat(0.0);
+    let down = L::select(o.lt(zero), math::next_float_down(v), v);
+    L::select(o.gt(zero), math::next_float_up(v), down)
 }
 
 /// [`surfaces`] of at most one width's items.
@@ -402,14 +410,71 @@ impl Kernel for Surfaces<'_> {
         let x = ss.normalize();
         let y = ns.cross(x);
 
+        // The point as the interaction holds it (an interval, read back as
+        // its midpoint and half-width) and the ray origins offset off the
+        // surface to either side (`offset_ray_origin`).
+        let (lx, hx) = math::interval_from_value_and_error(p.x, p_error.x);
+        let (ly, hy) = math::interval_from_value_and_error(p.y, p_error.y);
+        let (lz, hz) = math::interval_from_value_and_error(p.z, p_error.z);
+        let two = s(2.0);
+        let mid = V3 {
+            x: lx.add(hx).div(two),
+            y: ly.add(hy).div(two),
+            z: lz.add(hz).div(two),
+        };
+        let err = V3 {
+            x: hx.sub(lx).div(two),
+            y: hy.sub(ly).div(two),
+            z: hz.sub(lz).div(two),
+        };
+        let offset = n_out.scale(abs_v(n_out).dot(err));
+        let back = V3 {
+            x: offset.x.neg(),
+            y: offset.y.neg(),
+            z: offset.z.neg(),
+        };
+        let side0 = round_off_v(mid.add(offset), offset);
+        let side1 = round_off_v(mid.add(back), back);
+
         let okb = L::bits(ok);
-        let (p, p_error) = (Stored3::new(p), Stored3::new(p_error));
+        let (lo, hi) = (
+            Stored3::new(V3 {
+                x: lx,
+                y: ly,
+                z: lz,
+            }),
+            Stored3::new(V3 {
+                x: hx,
+                y: hy,
+                z: hz,
+            }),
+        );
+        let mid = Stored3::new(mid);
+        let (side0, side1) = (Stored3::new(side0), Stored3::new(side1));
         let (n_out, ns, wo) = (Stored3::new(n_out), Stored3::new(ns), Stored3::new(wo));
         let (x, y) = (Stored3::new(x), Stored3::new(y));
         for (i, o) in self.out.iter_mut().enumerate().take(n) {
+            let (l, h) = (lo.vector(i), hi.vector(i));
             *o = SurfaceOut {
-                p: Point3f::from(p.vector(i)),
-                p_error: p_error.vector(i),
+                pi: Point3fi::new(
+                    Interval {
+                        low: l.x,
+                        high: h.x,
+                    },
+                    Interval {
+                        low: l.y,
+                        high: h.y,
+                    },
+                    Interval {
+                        low: l.z,
+                        high: h.z,
+                    },
+                ),
+                p: Point3f::from(mid.vector(i)),
+                sides: [
+                    Point3f::from(side0.vector(i)),
+                    Point3f::from(side1.vector(i)),
+                ],
                 n: n_out.normal(i),
                 ns: ns.normal(i),
                 wo: wo.vector(i),
@@ -614,6 +679,7 @@ mod tests {
     use crate::rng::Rng;
     use crate::shape::triangle::TriangleOf;
     use crate::shape::TriangleMesh;
+    use rpbrt_geometry::ray::offset_ray_origin;
 
     fn vector(rng: &mut Rng, scale: Float) -> Vector3f {
         let mut c = || (2.0 * rng.uniform_float() - 1.0) * scale;
@@ -692,8 +758,20 @@ mod tests {
                 }
                 taken += 1;
                 let bits = |v: Vector3f| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
-                let pi = Point3fi::from_value_and_error(s.p, s.p_error);
-                assert_eq!(pi, si.pi, "{level:?} case {case}");
+                assert_eq!(s.pi, si.pi, "{level:?} case {case}");
+                let pbits = |p: Point3f| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
+                assert_eq!(pbits(s.p), pbits(si.p()));
+                for (k, w) in [Vector3f::from(si.n), -Vector3f::from(si.n)]
+                    .into_iter()
+                    .enumerate()
+                {
+                    let want = offset_ray_origin(si.p(), si.p_error(), si.n, w);
+                    assert_eq!(
+                        pbits(s.sides[k]),
+                        pbits(want),
+                        "{level:?} case {case} side {k}"
+                    );
+                }
                 assert_eq!(bits(Vector3f::from(s.n)), bits(Vector3f::from(si.n)));
                 assert_eq!(
                     bits(Vector3f::from(s.ns)),
