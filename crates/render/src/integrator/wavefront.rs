@@ -90,8 +90,6 @@ struct Lane<S> {
     camera_weight: Float,
     /// The filter's weight.
     filter_weight: Float,
-    /// The first visible surface (G-buffer films only).
-    visible: Option<VisibleSurface>,
     /// The path has ended (once its shadow ray is traced).
     done: bool,
     /// The ray is the camera ray.
@@ -105,21 +103,26 @@ struct Finished {
     p_pixel: Point2i,
     l: SampledSpectrum,
     lambda: SampledWavelengths,
-    visible: Option<VisibleSurface>,
     filter_weight: Float,
 }
 
 /// Finished samples, added to the tile in sequence order.
 struct ReorderBuffer {
     slots: Vec<Option<Finished>>,
+    /// Their first visible surfaces (G-buffer films only; otherwise
+    /// empty, so that the samples moved around stay small).
+    visible: Vec<Option<VisibleSurface>>,
     /// The next sample to add.
     next: usize,
 }
 
 impl ReorderBuffer {
-    fn new() -> Self {
+    fn new(gbuffer: bool) -> Self {
         ReorderBuffer {
             slots: (0..REORDER).map(|_| None).collect(),
+            visible: (0..if gbuffer { REORDER } else { 0 })
+                .map(|_| None)
+                .collect(),
             next: 0,
         }
     }
@@ -130,17 +133,31 @@ impl ReorderBuffer {
         seq < self.next + REORDER
     }
 
-    /// Files sample `seq` and adds every sample now in order to `tile`.
-    fn finish(&mut self, seq: usize, f: Finished, tile: &mut FilmTile) {
+    /// Files sample `seq` (and its visible surface) and adds every sample
+    /// now in order to `tile`.
+    fn finish(
+        &mut self,
+        seq: usize,
+        f: Finished,
+        visible: Option<VisibleSurface>,
+        tile: &mut FilmTile,
+    ) {
         debug_assert!(self.has_room(seq) && seq >= self.next);
         self.slots[seq % REORDER] = Some(f);
+        if let Some(slot) = self.visible.get_mut(seq % REORDER) {
+            *slot = visible;
+        }
         while let Some(f) = self.slots[self.next % REORDER].take() {
+            let visible = self
+                .visible
+                .get_mut(self.next % REORDER)
+                .and_then(Option::take);
             add_estimate(
                 tile,
                 f.p_pixel,
                 f.l,
                 &f.lambda,
-                f.visible.as_ref(),
+                visible.as_ref(),
                 f.filter_weight,
             );
             self.next += 1;
@@ -185,7 +202,9 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let per_pixel = (samples.end - samples.start).max(0) as usize;
         let total = pixels.len() * per_pixel;
         let gbuffer = scene.film.uses_visible_surface();
-        let mut reorder = ReorderBuffer::new();
+        let mut reorder = ReorderBuffer::new(gbuffer);
+        // The paths' first visible surfaces, by slot (G-buffer films only).
+        let mut visibles: Vec<VisibleSurface> = Vec::new();
         // The paths in flight stay in their slots from start to end (a
         // lane is a few hundred bytes: moving lanes around costs more
         // than indexing them).
@@ -274,10 +293,9 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                         p_pixel,
                         l: SampledSpectrum::new(0.0),
                         lambda: cs.lambda,
-                        visible: None,
                         filter_weight: cs.cs.filter_weight,
                     };
-                    reorder.finish(seq, f, tile);
+                    reorder.finish(seq, f, None, tile);
                     continue;
                 };
                 let lane = Lane {
@@ -288,20 +306,24 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     path: self.0.start(ray),
                     camera_weight,
                     filter_weight: cs.cs.filter_weight,
-                    visible: gbuffer.then(VisibleSurface::default),
                     done: false,
                     camera: true,
                     diffuse: false,
                 };
-                match free.pop() {
+                let slot = match free.pop() {
                     Some(slot) => {
                         lanes[slot] = lane;
-                        active.push(slot);
+                        slot
                     }
                     None => {
-                        active.push(lanes.len());
                         lanes.push(lane);
+                        lanes.len() - 1
                     }
+                };
+                active.push(slot);
+                if gbuffer {
+                    visibles.resize(lanes.len(), VisibleSurface::default());
+                    visibles[slot] = VisibleSurface::default();
                 }
             }
             if active.is_empty() {
@@ -396,7 +418,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                         hits[i],
                         &mut lane.lambda,
                         sampler,
-                        lane.visible.as_mut(),
+                        visibles.get_mut(i),
                         &mut scratch[i],
                     )
                 };
@@ -515,10 +537,10 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     p_pixel: lane.p_pixel,
                     l: *I::radiance(&mut lane.path) * lane.camera_weight,
                     lambda: lane.lambda,
-                    visible: lane.visible.take(),
                     filter_weight: lane.filter_weight,
                 };
-                reorder.finish(lane.seq, f, tile);
+                let visible = visibles.get_mut(i).map(std::mem::take);
+                reorder.finish(lane.seq, f, visible, tile);
                 free.push(i);
                 false
             });
