@@ -103,8 +103,8 @@ impl SurfaceIn {
             p,
             n,
             shading,
-            ng: hit.frame.n,
-            dpdu: hit.frame.dpdu,
+            ng: hit.ng,
+            dpdu: hit.dpdu,
             d,
         })
     }
@@ -741,7 +741,8 @@ mod tests {
             );
             let hit = TriangleHit {
                 tri,
-                frame,
+                ng: frame.n,
+                dpdu: frame.dpdu,
                 b: [b0, b1, b2],
                 material: None,
                 area_light: None,

@@ -17,7 +17,7 @@ use rpbrt_geometry::float::Float;
 use rpbrt_geometry::interaction::SurfaceInteraction;
 use rpbrt_geometry::ray::{MediumId, Ray};
 use rpbrt_geometry::transform::Transform;
-use rpbrt_geometry::tuple::Point3f;
+use rpbrt_geometry::tuple::{Normal3f, Point3f, Vector3f};
 use rpbrt_geometry::Bounds3f;
 use std::sync::Arc;
 
@@ -447,8 +447,10 @@ pub struct HitRecord {
 pub(crate) struct TriangleHit<'a> {
     /// The triangle.
     pub tri: TriangleOf<&'a TriangleMesh>,
-    /// Its frame (what does not depend on the point hit).
-    pub frame: TriangleFrame,
+    /// Its geometric normal and ∂p/∂u (of its frame: what does not depend
+    /// on the point hit).
+    pub ng: Normal3f,
+    pub dpdu: Vector3f,
     /// The barycentrics of the hit.
     pub b: [Float; 3],
     /// The primitive's material (`None`: interface).
@@ -854,8 +856,18 @@ impl PrimitiveAggregate {
             Primitive::Mesh(m) => (m.triangle(i), m.material, None),
             _ => return None,
         };
+        // Two fields of the cached frame, read in place (copying the whole
+        // frame through the stack stalls on store forwarding).
+        let (ng, dpdu) = match frame {
+            Some(f) => (f.n, f.dpdu),
+            None => {
+                let f = tri.frame();
+                (f.n, f.dpdu)
+            }
+        };
         Some(TriangleHit {
-            frame: frame.copied().unwrap_or_else(|| tri.frame()),
+            ng,
+            dpdu,
             tri,
             b: [b0, b1, b2],
             material,
