@@ -1201,6 +1201,8 @@ impl SolidAngleCore {
         l.b[2].store(&mut a[2]);
         l.pdf.store(&mut a[3]);
         let (ok, by_area) = (L::bits(l.ok), L::bits(l.by_area));
+        // Lane i of several stored rows: indexing reads best.
+        #[allow(clippy::needless_range_loop)]
         for i in 0..n {
             out(SolidAngleCore {
                 b: [a[0][i], a[1][i], a[2][i]],
@@ -1378,6 +1380,8 @@ impl Kernel for SolidAnglePointKernel<'_> {
                 x.store(row);
             }
             let (ok, by_area) = (L::bits(l.ok), L::bits(l.by_area));
+            // Lane i of several stored rows: indexing reads best.
+            #[allow(clippy::needless_range_loop)]
             for i in 0..chunk.len() {
                 let interval = |lo: usize| Interval {
                     low: a[lo][i],
