@@ -2,6 +2,23 @@ use super::math;
 use super::*;
 use crate::rng::Rng;
 
+/// Values that lane code gets wrong most easily: zeros of both signs,
+/// infinities, NaN, subnormals, the largest float.
+const AWKWARD: [f32; 12] = [
+    0.0,
+    -0.0,
+    1.0,
+    -1.0,
+    f32::INFINITY,
+    f32::NEG_INFINITY,
+    f32::NAN,
+    1e-40,
+    -1e-40,
+    f32::MAX,
+    3.5,
+    -2.25,
+];
+
 /// Applies every lane operation to `a` and `b` at width `L` and returns
 /// the results lane by lane, to compare with the scalar code's.
 struct AllOps<'a> {
@@ -50,20 +67,7 @@ impl Kernel for AllOps<'_> {
 /// on the awkward ones (zeros of both signs, infinities, NaN, subnormals).
 #[test]
 fn every_width_computes_what_scalar_code_computes() {
-    let special = [
-        0.0f32,
-        -0.0,
-        1.0,
-        -1.0,
-        f32::INFINITY,
-        f32::NEG_INFINITY,
-        f32::NAN,
-        1e-40,
-        -1e-40,
-        f32::MAX,
-        3.5,
-        -2.25,
-    ];
+    let special = AWKWARD;
     let mut rng = Rng::with_sequence(5);
     let mut a = Vec::new();
     let mut b = Vec::new();
@@ -337,21 +341,16 @@ fn next_floats_and_intervals_match_the_scalar_functions() {
             out
         }
     }
-    let special = [
-        0.0f32,
-        -0.0,
-        1.0,
-        -1.0,
-        f32::INFINITY,
-        f32::NEG_INFINITY,
-        f32::NAN,
-        f32::MIN_POSITIVE,
-        -f32::MIN_POSITIVE,
-        1e-45,
-        -1e-45,
-        f32::MAX,
-        f32::MIN,
-    ];
+    let special: Vec<f32> = AWKWARD
+        .into_iter()
+        .chain([
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            1e-45,
+            -1e-45,
+            f32::MIN,
+        ])
+        .collect();
     let mut rng = Rng::with_sequence(48);
     let mut v = Vec::new();
     let mut e = Vec::new();
