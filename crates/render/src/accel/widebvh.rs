@@ -153,6 +153,10 @@ struct WideRay {
     o_near: [Float; 3],
     o_far: [Float; 3],
     inv: [Float; 3],
+    /// `inv` times [`far_pad`]: the far distances' padding folded into
+    /// their factor (one rounding more, which the pad's `2γ₃` covers, so
+    /// the test stays conservative).
+    inv_far: [Float; 3],
 }
 
 impl WideRay {
@@ -166,10 +170,12 @@ impl WideRay {
             o_near: o,
             o_far: o,
             inv: [0.0; 3],
+            inv_far: [0.0; 3],
         };
         for a in 0..3 {
             let inv = 1.0 / d[a];
             w.inv[a] = inv;
+            w.inv_far[a] = inv * far_pad();
             // A negative direction (−0 included) enters through the max
             // plane. Selected, not branched on: the signs of a ray's
             // direction are as good as random. (Only integers: a select
@@ -197,16 +203,16 @@ impl WideRay {
     #[inline(always)]
     fn test<const W: usize>(&self, node: &WideNode<W>, t_max: Float) -> ([Float; W], u32) {
         let b = &node.bounds;
-        let pad = far_pad();
         let mut t0 = [0.0 as Float; W];
         let mut t1 = [t_max; W];
         for a in 0..3 {
             let nr = &b[self.near[a]];
             let fr = &b[self.far[a]];
-            let (on, of, inv) = (self.o_near[a], self.o_far[a], self.inv[a]);
+            let (on, of) = (self.o_near[a], self.o_far[a]);
+            let (inv, inv_far) = (self.inv[a], self.inv_far[a]);
             for i in 0..W {
                 t0[i] = fmax(t0[i], (nr[i] - on) * inv);
-                t1[i] = fmin(t1[i], (fr[i] - of) * inv * pad);
+                t1[i] = fmin(t1[i], (fr[i] - of) * inv_far);
             }
         }
         let mut mask = 0u32;
@@ -261,12 +267,13 @@ impl<const W: usize> WideBvh<W> {
     #[inline(always)]
     pub(super) fn prefetch_children(&self, node: &WideNode<W>, mask: u32) {
         let mut inner = mask & !node.leaf_lanes;
+        let base = self.nodes.as_ptr();
         while inner != 0 {
             let i = inner.trailing_zeros() as usize;
             inner &= inner - 1;
-            if let Some(n) = self.nodes.get(node.child[i] as usize) {
-                crate::simd::prefetch(n);
-            }
+            // An address, not a reference: a prefetch never faults, so the
+            // index needs no bounds check (the visit that follows has one).
+            crate::simd::prefetch_ptr(base.wrapping_add(node.child[i] as usize));
         }
     }
 
@@ -449,40 +456,7 @@ impl<const W: usize> WideBvh<W> {
                     &mut hit,
                 );
             }
-            let mut inner = mask & !node.leaf_lanes;
-            let mut next: Option<(u32, Float)> = None;
-            if inner != 0 && inner & (inner - 1) == 0 {
-                // One interior child hit (the common case): no ordering.
-                let i = inner.trailing_zeros() as usize;
-                if t0[i] <= t_max {
-                    next = Some((node.child[i], t0[i]));
-                }
-            } else if inner != 0 {
-                // Hit interior children sorted near to far (at most `W`:
-                // insertion sort); the nearest is visited next, the others
-                // pushed far to near.
-                let mut order = [(0usize, 0.0 as Float); W];
-                let mut n = 0;
-                while inner != 0 {
-                    let i = inner.trailing_zeros() as usize;
-                    inner &= inner - 1;
-                    let mut j = n;
-                    while j > 0 && order[j - 1].1 > t0[i] {
-                        order[j] = order[j - 1];
-                        j -= 1;
-                    }
-                    order[j] = (i, t0[i]);
-                    n += 1;
-                }
-                for &(i, tn) in order[..n].iter().rev() {
-                    if tn <= t_max {
-                        if let Some(prev) = next {
-                            stack.push(prev);
-                        }
-                        next = Some((node.child[i], tn));
-                    }
-                }
-            }
+            let next = nearest_child(node, mask & !node.leaf_lanes, &t0, t_max, &mut stack);
             match next {
                 Some((c, _)) => cur = c,
                 None => loop {
@@ -544,6 +518,68 @@ impl<const W: usize> WideBvh<W> {
             }
         }
     }
+}
+
+/// Of the interior children in `inner` (lanes of `node` whose boxes the
+/// ray entered at `t0`), those entered by `t_max`: the nearest is
+/// returned, to be visited next, and the others pushed far to near.
+#[inline(always)]
+fn nearest_child<const W: usize>(
+    node: &WideNode<W>,
+    mut inner: u32,
+    t0: &[Float; W],
+    t_max: Float,
+    stack: &mut Stack<(u32, Float)>,
+) -> Option<(u32, Float)> {
+    if inner == 0 {
+        return None;
+    }
+    if inner & (inner - 1) == 0 {
+        // One interior child hit (the common case): no ordering.
+        let i = inner.trailing_zeros() as usize;
+        return (t0[i] <= t_max).then(|| (node.child[i], t0[i]));
+    }
+    let i = inner.trailing_zeros() as usize;
+    let rest = inner & (inner - 1);
+    if rest & (rest - 1) == 0 {
+        // Two (the next most common): the nearer (the lower lane on a
+        // tie, as the sort below orders them) is visited next, the other
+        // pushed.
+        let j = rest.trailing_zeros() as usize;
+        let (a, b) = if t0[j] < t0[i] { (j, i) } else { (i, j) };
+        if t0[a] > t_max {
+            return None;
+        }
+        if t0[b] <= t_max {
+            stack.push((node.child[b], t0[b]));
+        }
+        return Some((node.child[a], t0[a]));
+    }
+    // Hit interior children sorted near to far (at most `W`: insertion
+    // sort).
+    let mut order = [(0usize, 0.0 as Float); W];
+    let mut n = 0;
+    while inner != 0 {
+        let i = inner.trailing_zeros() as usize;
+        inner &= inner - 1;
+        let mut j = n;
+        while j > 0 && order[j - 1].1 > t0[i] {
+            order[j] = order[j - 1];
+            j -= 1;
+        }
+        order[j] = (i, t0[i]);
+        n += 1;
+    }
+    let mut next = None;
+    for &(i, tn) in order[..n].iter().rev() {
+        if tn <= t_max {
+            if let Some(prev) = next {
+                stack.push(prev);
+            }
+            next = Some((node.child[i], tn));
+        }
+    }
+    next
 }
 
 impl<const W: usize> Aggregate for WideBvh<W> {

@@ -136,9 +136,17 @@ pub fn env_warning() -> Option<String> {
 /// such hint).
 #[inline(always)]
 pub fn prefetch<T>(v: &T) {
+    prefetch_ptr(v as *const T);
+}
+
+/// [`prefetch`] of the value at `v`, which need not be a valid address: a
+/// prefetch never faults (callers skip the bounds check a reference would
+/// need).
+#[inline(always)]
+pub fn prefetch_ptr<T>(v: *const T) {
     #[cfg(target_arch = "x86_64")]
     {
-        let p = v as *const T as *const i8;
+        let p = v as *const i8;
         let lines = std::mem::size_of::<T>().div_ceil(64).min(4);
         // SAFETY: prefetching is a hint that never faults, whatever the
         // address; SSE is part of the x86-64 baseline.
