@@ -8,8 +8,8 @@ independent sampler, max_depth 8 = pbrt maxdepth 7), in the same run.
     python3 bench/cbox_vs_mitsuba.py [--variants scalar_spectral,llvm_ad_spectral] [--threads 2]
 
 Prints one RESULT line with every variant's time and its ratio to rpbrt's,
-for each rpbrt design (--designs scalar,wavefront: the default loop and
---wavefront).
+for each rpbrt design (--designs scalar,wavefront: --no-wavefront and
+--wavefront; the default is the wavefront).
 Each Mitsuba variant is timed on its render call after a warm-up render (the
 LLVM variants JIT-compile there); rpbrt is timed as a whole process, the
 median of --repeat runs interleaved with Mitsuba's (the machine drifts).
@@ -37,7 +37,7 @@ ap.add_argument("--spp", type=int, default=64)
 ap.add_argument("--repeat", type=int, default=3)
 ap.add_argument("--rpbrt", default=os.path.join(root, "target", "release", "rpbrt"))
 ap.add_argument("--designs", default="scalar,wavefront",
-                help="rpbrt designs to time: scalar (the default loop), wavefront (--wavefront)")
+                help="rpbrt designs to time: scalar (--no-wavefront), wavefront (--wavefront)")
 args = ap.parse_args()
 
 if not os.path.exists(args.rpbrt):
@@ -46,7 +46,7 @@ if not os.path.exists(args.rpbrt):
 
 def time_rpbrt(design):
     out = os.path.join("/tmp", "rpbrt-cbox-bench.exr")
-    extra = ["--wavefront"] if design == "wavefront" else []
+    extra = ["--wavefront"] if design == "wavefront" else ["--no-wavefront"]
     t0 = time.perf_counter()
     subprocess.run([args.rpbrt, "--quiet", "--nthreads", str(args.threads), "--spp",
                     str(args.spp), "--outfile", out] + extra + [scene], check=True)

@@ -35,8 +35,9 @@ pub struct Options {
     pub stats: bool,
     /// `--write-partial-images`.
     pub write_partial_images: bool,
-    /// `--wavefront`: the wavefront path tracer.
-    pub wavefront: bool,
+    /// `--wavefront` (`Some(true)`) or `--no-wavefront` (`Some(false)`):
+    /// the design, where the command line chooses it.
+    pub wavefront: Option<bool>,
     /// `--disable-pixel-jitter`.
     pub disable_pixel_jitter: bool,
     /// `--disable-wavelength-jitter`.
@@ -100,6 +101,8 @@ Rendering options:
                                directive. Default: 3/4 of the machine's memory.
   --mse-reference-image <file> Compute the MSE against this image while rendering.
   --mse-reference-out <file>   Write the MSE per sample count to this file.
+  --no-wavefront               Render path and volpath scenes with the scalar loop (one
+                               path per thread at a time; same image).
   --nthreads <n>               Use n threads (default: all cores).
   --outfile <file>             Write the image here (overrides the Film's filename).
   --preview [<addr>]           Watch the render in a browser: serves a live view on
@@ -122,6 +125,7 @@ Rendering options:
                                `imgtool assemble` joins them.
   --wavefront                  Render path and volpath scenes with the wavefront path
                                tracer (many paths per thread at once; same image).
+                               The default for path, and for volpath without media.
   --write-partial-images       Write the image periodically while rendering.
 
 Scene file tools:
@@ -335,7 +339,8 @@ pub fn parse_args(args: &[String]) -> Result<Options, ArgError> {
             "quiet" => o.quiet = true,
             "stats" => o.stats = true,
             "writepartialimages" => o.write_partial_images = true,
-            "wavefront" => o.wavefront = true,
+            "wavefront" => o.wavefront = Some(true),
+            "nowavefront" => o.wavefront = Some(false),
             "disablepixeljitter" => o.disable_pixel_jitter = true,
             "disablewavelengthjitter" => o.disable_wavelength_jitter = true,
             "disabletexturefiltering" => o.disable_texture_filtering = true,

@@ -267,8 +267,14 @@ fn render_command(opts: &args::Options) -> ExitCode {
             diagln!("rpbrt: warning: {w}");
         }
     }
-    let wavefront = opts.wavefront || desc_flag(&desc, "wavefront");
-    if wavefront && !integrator.has_wavefront() && !opts.quiet {
+    // The command line's choice, else the scene file's `Option "bool
+    // wavefront"`, else the integrator's default for this scene.
+    let asked = opts.wavefront.or(match desc.option("wavefront") {
+        Some(OptionValue::Bool(b)) => Some(*b),
+        _ => None,
+    });
+    let wavefront = asked.unwrap_or_else(|| integrator.wavefront_by_default(&scene));
+    if asked == Some(true) && !integrator.has_wavefront() && !opts.quiet {
         diagln!(
             "rpbrt: warning: --wavefront: the \"{}\" integrator has no wavefront form yet; rendering it with the scalar loop",
             integrator.name(),

@@ -848,11 +848,11 @@ fn named_medium_type_is_not_an_unused_parameter() {
 /// minutes), in both designs, and the image so far is written.
 #[test]
 fn ctrl_c_is_honoured_between_samples_of_one_pixel() {
-    for design in [None, Some("--wavefront")] {
+    for design in ["--no-wavefront", "--wavefront"] {
         let out = std::env::temp_dir().join(format!(
-            "rpbrt-cli-{}-ctrlc-{}.exr",
+            "rpbrt-cli-{}-ctrlc{}.exr",
             std::process::id(),
-            design.is_some()
+            design
         ));
         let scene = temp_scene(
             "ctrlc.pbrt",
@@ -861,9 +861,7 @@ fn ctrl_c_is_honoured_between_samples_of_one_pixel() {
         let mut cmd = rpbrt();
         cmd.args(["--quiet", "--nthreads", "2", "--outfile"])
             .arg(&out);
-        if let Some(d) = design {
-            cmd.arg(d);
-        }
+        cmd.arg(design);
         let mut child = cmd.arg(&scene).spawn().unwrap();
         // Into the second wave: each pixel's remaining 2^31 - 2 samples.
         std::thread::sleep(std::time::Duration::from_millis(1500));
@@ -1086,4 +1084,74 @@ fn max_memory_flag_is_checked_and_listed() {
         e.contains("Memory budget") && e.contains("MiB of 512.0 MiB (--max-memory)"),
         "{e}"
     );
+}
+
+/// The design each render gets (`--stats` names it): the wavefront path
+/// tracer for `path` and for `volpath` without media, the scalar loop for
+/// `volpath` with media; `--wavefront` and `--no-wavefront` choose, and so
+/// does the scene's `Option "bool wavefront"`, which the command line
+/// overrides.
+#[test]
+fn the_design_defaults_to_the_wavefront_except_through_media() {
+    let head = "LookAt 0 0 -5  0 0 0  0 1 0\nCamera \"perspective\"\nSampler \"independent\" \"integer pixelsamples\" 1\nFilm \"rgb\" \"integer xresolution\" 4 \"integer yresolution\" 4\n";
+    let world = "WorldBegin\nLightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\nMaterial \"diffuse\"\nShape \"sphere\" \"float radius\" 1\n";
+    let fog = "AttributeBegin\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"fog\" \"\"\nMaterial \"interface\"\nTranslate 3 0 0\nShape \"sphere\" \"float radius\" 1\nAttributeEnd\n";
+    let cases: [(&str, &str, &str, &[&str], &str); 8] = [
+        ("path", "Integrator \"path\"\n", "", &[], "wavefront"),
+        (
+            "path-scalar",
+            "Integrator \"path\"\n",
+            "",
+            &["--no-wavefront"],
+            "scalar",
+        ),
+        ("volpath", "", "", &[], "wavefront"),
+        ("volpath-fog", "", fog, &[], "scalar"),
+        (
+            "volpath-fog-wavefront",
+            "",
+            fog,
+            &["--wavefront"],
+            "wavefront",
+        ),
+        (
+            "option-false",
+            "Option \"bool wavefront\" false\nIntegrator \"path\"\n",
+            "",
+            &[],
+            "scalar",
+        ),
+        (
+            "option-false-wavefront",
+            "Option \"bool wavefront\" false\nIntegrator \"path\"\n",
+            "",
+            &["--wavefront"],
+            "wavefront",
+        ),
+        ("bdpt", "Integrator \"bdpt\"\n", "", &[], "scalar"),
+    ];
+    for (name, integrator, media, flags, want) in cases {
+        let scene = temp_scene(
+            &format!("design-{name}.pbrt"),
+            &format!("{integrator}{head}{world}{media}"),
+        );
+        let out = rpbrt()
+            .args(["--quiet", "--stats", "--nthreads", "1", "--outfile"])
+            .arg(std::env::temp_dir().join(format!(
+                "rpbrt-cli-{}-design-{name}.exr",
+                std::process::id()
+            )))
+            .args(flags)
+            .arg(&scene)
+            .output()
+            .unwrap();
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{name}: {e}");
+        let design = e
+            .lines()
+            .find(|l| l.trim_start().starts_with("Design"))
+            .and_then(|l| l.split_whitespace().nth(1))
+            .unwrap_or("");
+        assert_eq!(design, want, "{name}: {e}");
+    }
 }
