@@ -167,7 +167,18 @@ impl DenselySampledSpectrum {
 pub struct PiecewiseLinearSpectrum {
     lambdas: Vec<Float>,
     values: Vec<Float>,
+    /// Where [`PiecewiseLinearSpectrum::evaluate`]'s search starts: entry
+    /// `k` counts the wavelengths at or below `index_base + k` nm, for
+    /// every whole nanometre from the first wavelength's floor to the
+    /// last's (empty when that span exceeds [`INDEX_MAX_NM`]).
+    index: Vec<u32>,
+    index_base: Float,
 }
+
+/// The widest span of wavelengths (nm) [`PiecewiseLinearSpectrum`] keeps a
+/// lookup table for (4 bytes a nanometre); wider ones are searched by
+/// bisection.
+const INDEX_MAX_NM: Float = 4096.0;
 
 impl PiecewiseLinearSpectrum {
     /// A spectrum from matching wavelength and value lists; the wavelengths
@@ -193,7 +204,30 @@ impl PiecewiseLinearSpectrum {
                 ));
             }
         }
-        Ok(PiecewiseLinearSpectrum { lambdas, values })
+        let (first, last) = (lambdas[0], lambdas[lambdas.len() - 1]);
+        let index_base = first.floor();
+        let index = if last - index_base <= INDEX_MAX_NM {
+            // One pass over both: the counts only grow.
+            let nm = (last.floor() - index_base) as usize + 1;
+            let mut j = 0;
+            (0..nm)
+                .map(|k| {
+                    let at = index_base + k as Float;
+                    while j < lambdas.len() && lambdas[j] <= at {
+                        j += 1;
+                    }
+                    j as u32
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        Ok(PiecewiseLinearSpectrum {
+            lambdas,
+            values,
+            index,
+            index_base,
+        })
     }
 
     /// A spectrum from interleaved `lambda, value` pairs, extended with
@@ -262,8 +296,7 @@ impl PiecewiseLinearSpectrum {
         }
         // The last sample at or below lambda, kept one short of the end.
         let i = self
-            .lambdas
-            .partition_point(|&l| l <= lambda)
+            .samples_at_or_below(lambda)
             .saturating_sub(1)
             .min(self.lambdas.len().saturating_sub(2));
         if self.lambdas.len() == 1 {
@@ -276,6 +309,30 @@ impl PiecewiseLinearSpectrum {
     /// The largest sample value.
     pub fn max_value(&self) -> Float {
         self.values.iter().copied().fold(0.0, Float::max)
+    }
+
+    /// How many sample wavelengths are at or below `lambda` (which lies
+    /// within them): `partition_point`'s answer, found from the lookup
+    /// table's entry for `lambda`'s nanometre and a step or two, not by
+    /// bisection (conductors evaluate two such spectra at four
+    /// wavelengths every vertex).
+    #[inline]
+    fn samples_at_or_below(&self, lambda: Float) -> usize {
+        let ls = &self.lambdas;
+        if self.index.is_empty() {
+            return ls.partition_point(|&l| l <= lambda);
+        }
+        // `lambda − index_base` may round up to the next whole number;
+        // the steps below correct the count either way.
+        let k = ((lambda - self.index_base) as usize).min(self.index.len() - 1);
+        let mut j = self.index[k] as usize;
+        while j > 0 && ls[j - 1] > lambda {
+            j -= 1;
+        }
+        while j < ls.len() && ls[j] <= lambda {
+            j += 1;
+        }
+        j
     }
 }
 

@@ -219,6 +219,84 @@ fn densely_sampled_matches_piecewise_linear() {
     }
 }
 
+/// The interpolation by bisection that the lookup table replaces.
+fn piecewise_by_bisection(s: &PiecewiseLinearSpectrum, lambda: Float) -> Float {
+    let (ls, vs) = (s.lambdas(), s.values());
+    if !(lambda >= ls[0] && lambda <= ls[ls.len() - 1]) {
+        return 0.0;
+    }
+    if ls.len() == 1 {
+        return vs[0];
+    }
+    let i = ls
+        .partition_point(|&l| l <= lambda)
+        .saturating_sub(1)
+        .min(ls.len() - 2);
+    let t = (lambda - ls[i]) / (ls[i + 1] - ls[i]);
+    (1.0 - t) * vs[i] + t * vs[i + 1]
+}
+
+/// `evaluate` through the whole-nanometre lookup table gives what bisection
+/// gives, bit for bit: at random wavelengths, at every sample wavelength
+/// and its neighbouring floats, at whole nanometres and their neighbours,
+/// for samples closer than a nanometre, wider apart, off the whole
+/// numbers, one sample only, a span too wide for the table, and a named
+/// metal.
+#[test]
+fn piecewise_linear_lookup_matches_bisection() {
+    let mut rng = Rng::with_sequence(11);
+    let mut spectra = Vec::new();
+    let dense: Vec<Float> = (0..1500).map(|i| 380.0 + 0.3 * i as Float).collect();
+    let dense_v: Vec<Float> = (0..1500).map(|i| ((i * 7919) % 101) as Float).collect();
+    spectra.push(PiecewiseLinearSpectrum::new(dense, dense_v).unwrap());
+    spectra.push(
+        PiecewiseLinearSpectrum::new(
+            vec![360.5, 400.25, 555.0, 830.75],
+            vec![1.0, 4.0, -2.0, 8.0],
+        )
+        .unwrap(),
+    );
+    spectra.push(PiecewiseLinearSpectrum::new(vec![500.0], vec![3.0]).unwrap());
+    spectra.push(
+        PiecewiseLinearSpectrum::new(vec![-10.0, 2.0, 9000.0, 1e6], vec![1.0, 2.0, 3.0, 4.0])
+            .unwrap(),
+    );
+    spectra.push(
+        PiecewiseLinearSpectrum::new(vec![1e9, 1e9 + 256.0, 1e9 + 2048.0], vec![1.0, 2.0, 3.0])
+            .unwrap(),
+    );
+    match named_spectrum("metal-Au-eta") {
+        Some(Spectrum::PiecewiseLinear(p)) => spectra.push((*p).clone()),
+        other => panic!("metal-Au-eta: {other:?}"),
+    }
+    for s in &spectra {
+        let ls = s.lambdas();
+        let (lo, hi) = (ls[0], ls[ls.len() - 1]);
+        let mut probes: Vec<Float> = Vec::new();
+        for &l in ls {
+            probes.extend([l, l.next_down(), l.next_up()]);
+        }
+        let mut w = lo.floor() - 2.0;
+        while w <= hi.floor() + 2.0 && probes.len() < 200_000 {
+            probes.extend([w, w.next_down(), w.next_up()]);
+            w += 1.0;
+        }
+        for _ in 0..20_000 {
+            let u = rng.uniform_float();
+            probes.push(lo - 1.0 + u * (hi - lo + 2.0));
+        }
+        probes.extend([Float::NAN, Float::INFINITY, Float::NEG_INFINITY]);
+        for &l in &probes {
+            let (got, want) = (s.evaluate(l), piecewise_by_bisection(s, l));
+            assert_eq!(
+                got.to_bits(),
+                want.to_bits(),
+                "{l} in {lo}..{hi}: {got} vs {want}"
+            );
+        }
+    }
+}
+
 #[test]
 fn piecewise_linear_rejects_bad_input() {
     assert!(PiecewiseLinearSpectrum::new(vec![400.0, 400.0], vec![1.0, 2.0]).is_err());
