@@ -96,7 +96,13 @@ impl MipValue for f32 {
         let im = &m.pyramid[level];
         let w = m.wrap2d();
         match im.n_channels() {
-            3 => (0..3).map(|c| im.bilerp_channel(st, c, w)).sum::<f32>() / 3.0,
+            3 => {
+                // The three channels' texels found once (the same values
+                // as three `bilerp_channel` calls).
+                let mut v = [0.0; 3];
+                im.bilerp_channels_into(st, w, &mut v);
+                v.iter().sum::<f32>() / 3.0
+            }
             4 => im.bilerp_channel(st, 3, w),
             _ => im.bilerp_channel(st, 0, w),
         }
@@ -131,11 +137,11 @@ impl MipValue for [f32; 3] {
         let im = &m.pyramid[level];
         let w = m.wrap2d();
         if im.n_channels() >= 3 {
-            [
-                im.bilerp_channel(st, 0, w),
-                im.bilerp_channel(st, 1, w),
-                im.bilerp_channel(st, 2, w),
-            ]
+            // The four texels found once for the three channels (the same
+            // values as three `bilerp_channel` calls).
+            let mut v = [0.0; 3];
+            im.bilerp_channels_into(st, w, &mut v);
+            v
         } else {
             let v = im.bilerp_channel(st, 0, w);
             [v; 3]

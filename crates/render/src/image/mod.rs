@@ -271,6 +271,23 @@ pub struct Image {
     data: PixelData,
 }
 
+/// Channel `c` of `out`, for each `c`, interpolated between the texels
+/// whose storage indices `at` holds (`None`: outside, black) with the
+/// weights of `dx`, `dy`; `get` reads a stored value.
+#[inline(always)]
+fn bilerp_texels(
+    at: [Option<usize>; 4],
+    dx: f32,
+    dy: f32,
+    out: &mut [f32],
+    get: impl Fn(usize) -> f32,
+) {
+    for (c, o) in out.iter_mut().enumerate() {
+        let v = at.map(|a| a.map_or(0.0, |i| get(i + c)));
+        *o = bilerp4(dx, dy, v);
+    }
+}
+
 /// pbrt-v4's `Bilerp` of four corner values.
 #[inline]
 pub(crate) fn bilerp4(dx: f32, dy: f32, v: [f32; 4]) -> f32 {
@@ -710,9 +727,13 @@ impl Image {
             corner(xi + 1, yi + 1),
         ];
         let n = self.n_channels().min(out.len());
-        for (c, o) in out[..n].iter_mut().enumerate() {
-            let v = at.map(|a| a.map_or(0.0, |i| self.value_at(i + c)));
-            *o = bilerp4(dx, dy, v);
+        // The storage type matched once for all twelve-odd reads (each
+        // read is `value_at`'s).
+        let out = &mut out[..n];
+        match &self.data {
+            PixelData::U256(v) => bilerp_texels(at, dx, dy, out, |i| self.encoding.to_linear(v[i])),
+            PixelData::Half(v) => bilerp_texels(at, dx, dy, out, |i| v[i].to_f32()),
+            PixelData::Float(v) => bilerp_texels(at, dx, dy, out, |i| v[i]),
         }
     }
 

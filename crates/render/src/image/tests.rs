@@ -116,13 +116,27 @@ fn wrap_modes() {
 }
 
 /// All channels at once give each channel's own bilinear value, for every
-/// wrap mode, inside and outside the image.
+/// storage format (8-bit sRGB, half, float) and wrap mode, inside and
+/// outside the image.
 #[test]
 fn bilerp_channels_into_matches_each_channel() {
-    let img = random_float_image(7, 5, &["R", "G", "B"], 3);
+    let float = random_float_image(7, 5, &["R", "G", "B"], 3);
+    let half = float.convert_to_format(PixelFormat::Half, ColorEncoding::Linear);
+    let u8_srgb = random_u8_image(7, 5, &["R", "G", "B"], 4);
     let mut rng = Rng::new(11, 0);
-    for wrap in [WrapMode::Clamp, WrapMode::Repeat, WrapMode::Black] {
-        let wrap = WrapMode2D::new(wrap, WrapMode::Clamp);
+    for (img, wrap) in [&float, &half, &u8_srgb].into_iter().flat_map(|img| {
+        [
+            WrapMode::Clamp,
+            WrapMode::Repeat,
+            WrapMode::Black,
+            WrapMode::OctahedralSphere,
+        ]
+        .map(|w| (img, w))
+    }) {
+        let wrap = match wrap {
+            WrapMode::OctahedralSphere => WrapMode2D::new(wrap, wrap),
+            w => WrapMode2D::new(w, WrapMode::Clamp),
+        };
         for _ in 0..500 {
             let q = Point2f::new(
                 rng.uniform_float() * 1.6 - 0.3,
@@ -131,7 +145,8 @@ fn bilerp_channels_into_matches_each_channel() {
             let mut all = [0.0f32; 3];
             img.bilerp_channels_into(q, wrap, &mut all);
             for (c, v) in all.iter().enumerate() {
-                assert_eq!(*v, img.bilerp_channel(q, c, wrap), "{wrap:?} {q:?} {c}");
+                let want = img.bilerp_channel(q, c, wrap);
+                assert_eq!(v.to_bits(), want.to_bits(), "{wrap:?} {q:?} {c}");
             }
         }
     }
