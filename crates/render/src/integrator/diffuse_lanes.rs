@@ -39,18 +39,20 @@ use rpbrt_geometry::pointfi::Point3fi;
 use rpbrt_geometry::ray::{spawn_ray_from_origin_to_surface, Ray, SHADOW_EPSILON};
 use rpbrt_geometry::tuple::*;
 
-/// The surface kernel's input and the reflectance at `lambda` of a hit
-/// `record` by a ray of direction `d`, when it is a diffuse vertex: a
-/// triangle without an area light, of a plain `diffuse` material of
-/// constant, not black, reflectance, in a mesh without shading tangents.
-/// `None`: the scalar vertex takes it.
+/// The reflectance at `lambda` of a hit `record` by a ray of direction
+/// `d`, when it is a diffuse vertex: a triangle without an area light, of
+/// a plain `diffuse` material of constant, not black, reflectance, in a
+/// mesh without shading tangents; the surface kernel's input is written
+/// to `out`. `None`: the scalar vertex takes it (`out` is then
+/// unspecified).
 #[inline(always)]
 pub(crate) fn diffuse_surface(
     scene: &Scene,
     record: &HitRecord,
     d: Vector3f,
     lambda: &SampledWavelengths,
-) -> Option<(SurfaceIn, SampledSpectrum)> {
+    out: &mut SurfaceIn,
+) -> Option<SampledSpectrum> {
     let hit = scene.aggregate.triangle_hit(record)?;
     if hit.area_light.is_some() {
         return None;
@@ -62,7 +64,7 @@ pub(crate) fn diffuse_surface(
     if r.is_black() {
         return None;
     }
-    Some((SurfaceIn::new(&hit, d)?, r))
+    out.fill(&hit, d).then_some(r)
 }
 
 /// What [`surfaces`] needs of one triangle hit.
@@ -84,29 +86,37 @@ pub(crate) struct SurfaceIn {
 }
 
 impl SurfaceIn {
-    /// The input of a hit on `hit` by a ray of direction `d`; `None` for
-    /// meshes with shading tangents (left to the scalar vertex).
+    /// Writes the input of a hit on `hit` by a ray of direction `d`;
+    /// false for meshes with shading tangents (left to the scalar vertex).
+    /// Field by field, in place: a whole input built on the stack and
+    /// copied would be written in 8- and 4-byte pieces and read back in
+    /// 16-byte ones, which stalls on store forwarding.
     #[inline(always)]
-    pub(crate) fn new(hit: &TriangleHit, d: Vector3f) -> Option<SurfaceIn> {
+    pub(crate) fn fill(&mut self, hit: &TriangleHit, d: Vector3f) -> bool {
         let mesh = hit.tri.mesh;
         if mesh.s.is_some() {
-            return None;
+            return false;
         }
         let v = mesh.vertex_indices(hit.tri.tri_index as usize);
-        let p = [mesh.p[v[0]], mesh.p[v[1]], mesh.p[v[2]]];
-        let (n, shading) = match &mesh.n {
-            Some(nn) => ([nn[v[0]], nn[v[1]], nn[v[2]]], true),
-            None => ([Normal3f::default(); 3], false),
-        };
-        Some(SurfaceIn {
-            b: hit.b,
-            p,
-            n,
-            shading,
-            ng: hit.ng,
-            dpdu: hit.dpdu,
-            d,
-        })
+        for k in 0..3 {
+            self.p[k] = mesh.p[v[k]];
+        }
+        match &mesh.n {
+            Some(nn) => {
+                for k in 0..3 {
+                    self.n[k] = nn[v[k]];
+                }
+                self.shading = true;
+            }
+            None => {
+                self.n = [Normal3f::default(); 3];
+                self.shading = false;
+            }
+        }
+        self.b = hit.b;
+        hit.frame_parts(&mut self.ng, &mut self.dpdu);
+        self.d = d;
+        true
     }
 }
 
@@ -159,69 +169,55 @@ pub(crate) struct DiffuseVertex {
 
 impl DiffuseVertex {
     /// The first half of a diffuse vertex (after the integrator has
-    /// counted it): the vertex of surface `s` hit at `time` with
-    /// reflectance `r`, its sampler draws taken, and its light request.
+    /// counted it): this vertex becomes the one of surface `s` hit at
+    /// `time` with reflectance `r`, its sampler draws taken; returns its
+    /// light request. (Written in place, field by field, for the reason
+    /// [`SurfaceIn::fill`] gives.)
     #[inline(always)]
     pub(crate) fn begin(
+        &mut self,
         s: &SurfaceOut,
         time: Float,
         r: SampledSpectrum,
         sampler: &mut Sampler,
-    ) -> (DiffuseVertex, LightRequest) {
+    ) -> LightRequest {
         let (u_light, u_light_2d, _, u2) = sampler.get_vertex_samples();
-        let v = DiffuseVertex::new(s, time, r, u2);
-        let ctx = v.light_context();
-        let z = v.frame.z;
-        let req = LightRequest {
-            ctx,
+        self.pi = s.pi;
+        self.p = s.p;
+        self.n = s.n;
+        self.ns = s.ns;
+        self.wo = s.wo;
+        self.time = time;
+        self.frame.x = s.x;
+        self.frame.y = s.y;
+        self.frame.z = Vector3f::from(s.ns);
+        self.r = r;
+        self.u2 = u2;
+        self.sides[0] = s.sides[0];
+        self.sides[1] = s.sides[1];
+        // The light-sampling context: the point offset toward ωo (the
+        // BSDF only reflects), the normals; read from `s`, not from the
+        // fields just written.
+        let z = Vector3f::from(s.ns);
+        LightRequest {
+            ctx: LightSampleContext {
+                pi: Point3fi::from(s.sides[(dot(s.wo, s.n) < 0.0) as usize]),
+                n: s.n,
+                ns: s.ns,
+            },
             u: u_light,
             u_light: u_light_2d,
-            hemisphere: Some((z, dot(v.wo, z))),
-        };
-        (v, req)
-    }
-
-    /// The vertex of surface `s` hit at `time`, with reflectance `r` and
-    /// the BSDF sample's 2-D draw `u2`.
-    #[inline(always)]
-    fn new(s: &SurfaceOut, time: Float, r: SampledSpectrum, u2: Point2f) -> Self {
-        DiffuseVertex {
-            pi: s.pi,
-            p: s.p,
-            n: s.n,
-            ns: s.ns,
-            wo: s.wo,
-            time,
-            frame: Frame {
-                x: s.x,
-                y: s.y,
-                z: Vector3f::from(s.ns),
-            },
-            r,
-            u2,
-            sides: s.sides,
-        }
-    }
-
-    /// The light-sampling context: the point offset toward ωo (the BSDF
-    /// only reflects), the normals.
-    #[inline(always)]
-    fn light_context(&self) -> LightSampleContext {
-        LightSampleContext {
-            pi: Point3fi::from(self.toward(self.wo)),
-            n: self.n,
-            ns: self.ns,
+            hemisphere: Some((z, dot(s.wo, z))),
         }
     }
 
     /// The context of this vertex for the next vertex's MIS weights.
     #[inline(always)]
-    pub(crate) fn context(&self) -> LightSampleContext {
-        LightSampleContext {
-            pi: self.pi,
-            n: self.n,
-            ns: self.ns,
-        }
+    pub(crate) fn write_context(&self, ctx: &mut LightSampleContext) {
+        // Field by field (see `SurfaceIn::fill`).
+        ctx.pi = self.pi;
+        ctx.n = self.n;
+        ctx.ns = self.ns;
     }
 
     /// The ray origin offset off the surface toward `w`'s side.
@@ -741,13 +737,13 @@ mod tests {
             );
             let hit = TriangleHit {
                 tri,
-                ng: frame.n,
-                dpdu: frame.dpdu,
+                frame: Some(&frame),
                 b: [b0, b1, b2],
                 material: None,
                 area_light: None,
             };
-            let input = SurfaceIn::new(&hit, d).expect("no shading tangents");
+            let mut input = SurfaceIn::default();
+            assert!(input.fill(&hit, d), "no shading tangents");
             let wi = vector(&mut rng, 1.0).normalize();
             let u2 = Point2f::new(rng.uniform_float(), rng.uniform_float());
             for level in SimdLevel::available() {

@@ -290,13 +290,14 @@ impl VertexIntegrator for PathIntegrator {
         record: &HitRecord,
         lambda: &SampledWavelengths,
         gbuffer: bool,
-    ) -> Option<(SurfaceIn, SampledSpectrum)> {
+        out: &mut SurfaceIn,
+    ) -> Option<SampledSpectrum> {
         // The vertices `begin` ends (the last one) or that draw or write
         // more than a diffuse vertex does are left to it.
         if s.depth >= self.max_depth || scene.force_diffuse || (gbuffer && s.depth == 0) {
             return None;
         }
-        diffuse_surface(scene, record, s.ray.ray.d, lambda)
+        diffuse_surface(scene, record, s.ray.ray.d, lambda, out)
     }
 
     /// `begin`'s steps for a diffuse vertex: the depth, the sampler draws,
@@ -312,11 +313,9 @@ impl VertexIntegrator for PathIntegrator {
         sampler: &mut Sampler,
     ) -> LightRequest {
         s.depth += 1;
-        let (v, req) = DiffuseVertex::begin(surface, s.ray.ray.time, r, sampler);
         scratch.hit = None;
         scratch.bsdf = None;
-        scratch.diffuse = v;
-        req
+        scratch.diffuse.begin(surface, s.ray.ray.time, r, sampler)
     }
 
     #[inline(always)]
@@ -361,7 +360,7 @@ impl VertexIntegrator for PathIntegrator {
                 ld: s.beta * ld,
             })
         });
-        s.prev_ctx = v.context();
+        v.write_context(&mut s.prev_ctx);
         let Some((wi, pdf, cos_over_pdf)) = scatter.sample else {
             return VertexStep { shadow, done: true };
         };

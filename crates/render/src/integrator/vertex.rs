@@ -112,9 +112,9 @@ pub(crate) trait VertexIntegrator: Sync {
 
     /// The lane form of a diffuse vertex (`diffuse_lanes.rs`), for the
     /// wavefront: for a hit `record` of the path in state `s` that the
-    /// lane form covers, the surface kernel's input and the reflectance
-    /// at `lambda`; `None` (the default) where the scalar vertex runs.
-    /// `gbuffer`: the film records the first visible surface.
+    /// lane form covers, the reflectance at `lambda`, the surface kernel's
+    /// input written to `out`; `None` (the default) where the scalar
+    /// vertex runs. `gbuffer`: the film records the first visible surface.
     fn diffuse_hit(
         &self,
         _scene: &Scene,
@@ -122,7 +122,8 @@ pub(crate) trait VertexIntegrator: Sync {
         _record: &HitRecord,
         _lambda: &SampledWavelengths,
         _gbuffer: bool,
-    ) -> Option<(SurfaceIn, SampledSpectrum)> {
+        _out: &mut SurfaceIn,
+    ) -> Option<SampledSpectrum> {
         None
     }
 

@@ -567,7 +567,8 @@ impl VertexIntegrator for VolPathIntegrator {
         record: &HitRecord,
         lambda: &SampledWavelengths,
         gbuffer: bool,
-    ) -> Option<(SurfaceIn, SampledSpectrum)> {
+        out: &mut SurfaceIn,
+    ) -> Option<SampledSpectrum> {
         // Only where `begin` asks for the light sample (no media, no
         // interfaces: the ray's medium is none and stays none), and not
         // where it ends the path or writes the visible surface.
@@ -579,7 +580,7 @@ impl VertexIntegrator for VolPathIntegrator {
         {
             return None;
         }
-        diffuse_surface(scene, record, s.ray.ray.d, lambda)
+        diffuse_surface(scene, record, s.ray.ray.d, lambda, out)
     }
 
     #[inline(always)]
@@ -592,11 +593,9 @@ impl VertexIntegrator for VolPathIntegrator {
         sampler: &mut Sampler,
     ) -> LightRequest {
         s.depth += 1;
-        let (v, req) = DiffuseVertex::begin(surface, s.ray.ray.time, r, sampler);
         scratch.hit = None;
         scratch.bsdf = None;
-        scratch.diffuse = v;
-        req
+        scratch.diffuse.begin(surface, s.ray.ray.time, r, sampler)
     }
 
     #[inline(always)]
@@ -633,7 +632,7 @@ impl VertexIntegrator for VolPathIntegrator {
             Some(ShadowQuery { ray, t_max, ld })
         });
         let done = VertexStep { shadow, done: true };
-        s.prev_ctx = v.context();
+        v.write_context(&mut s.prev_ctx);
         let Some((wi, pdf, cos_over_pdf)) = scatter.sample else {
             return done;
         };

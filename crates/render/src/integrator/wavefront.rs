@@ -232,6 +232,9 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let mut draws: Vec<Option<[Float; 6]>> = Vec::with_capacity(LANES);
         let mut shade: Vec<usize> = Vec::with_capacity(LANES);
         let mut predrawn: Vec<Option<[Float; 6]>> = Vec::new();
+        // The 1-D draw after them (the second half's Russian roulette).
+        let mut next_draws: Vec<Option<Float>> = Vec::with_capacity(LANES);
+        let mut predrawn_next: Vec<Option<Float>> = Vec::new();
         let mut diffuse: Vec<usize> = Vec::with_capacity(LANES);
         let mut surface_in: Vec<SurfaceIn> = Vec::with_capacity(LANES);
         let mut reflectances: Vec<SampledSpectrum> = Vec::with_capacity(LANES);
@@ -268,7 +271,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             // The camera samples' draws, computed together and taken by
             // each sample in turn (leaving each cursor past them), then
             // their filter offsets, wavelengths and rays together.
-            sampler.four_draws_batch(level, &cursors, &mut draw_batch, &mut draws);
+            sampler.four_draws_batch(level, &cursors, &mut draw_batch, &mut draws, None);
             camera_draws.clear();
             for ((&(_, p_pixel), cursor), &d) in starts.iter().zip(cursors.iter_mut()).zip(&draws) {
                 sampler.set_cursor(cursor);
@@ -357,16 +360,27 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             clock.enter(Stage::VertexDraws);
             // The vertices' four draws, together, for the paths that hit
             // something (the others draw nothing; a vertex that draws
-            // otherwise, such as a specular one, ignores them).
+            // otherwise, such as a specular one, ignores them), and the
+            // 1-D draw after them, which the second half's Russian
+            // roulette takes where it draws there.
             shade.clear();
             shade.extend(active.iter().filter(|&&i| hits[i].is_some()));
             cursors.clear();
             cursors.extend(shade.iter().map(|&i| lanes[i].cursor));
-            sampler.four_draws_batch(level, &cursors, &mut draw_batch, &mut draws);
+            sampler.four_draws_batch(
+                level,
+                &cursors,
+                &mut draw_batch,
+                &mut draws,
+                Some(&mut next_draws),
+            );
             predrawn.clear();
             predrawn.resize(lanes.len(), None);
-            for (&i, &d) in shade.iter().zip(&draws) {
+            predrawn_next.clear();
+            predrawn_next.resize(lanes.len(), None);
+            for ((&i, &d), &n) in shade.iter().zip(&draws).zip(&next_draws) {
                 predrawn[i] = d;
+                predrawn_next[i] = n;
             }
             clock.enter(Stage::Surfaces);
             // The diffuse vertices' surfaces, lane-parallel (lanes the
@@ -377,15 +391,22 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             for &i in &shade {
                 let lane = &lanes[i];
                 let Some(h) = &hits[i] else { continue };
-                if let Some((input, r)) =
+                // Written in place (see `SurfaceIn::fill`); a slot not
+                // taken is written over by the next.
+                let k = diffuse.len();
+                if surface_in.len() == k {
+                    surface_in.push(SurfaceIn::default());
+                }
+                let out = &mut surface_in[k];
+                if let Some(r) =
                     self.0
-                        .diffuse_hit(scene, &lane.path, h, &lane.lambda, gbuffer)
+                        .diffuse_hit(scene, &lane.path, h, &lane.lambda, gbuffer, out)
                 {
                     diffuse.push(i);
-                    surface_in.push(input);
                     reflectances.push(r);
                 }
             }
+            surface_in.truncate(diffuse.len());
             surfaces(level, &surface_in, &mut surface_out);
             diffuse_slot.resize(lanes.len(), 0);
             for &i in &active {
@@ -491,6 +512,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             for (&i, answer) in request_lanes.iter().zip(&answers) {
                 let lane = &mut lanes[i];
                 sampler.set_cursor(&lane.cursor);
+                sampler.offer_1d(predrawn_next[i]);
                 let step = match lane.diffuse.then(|| scattered.next()).flatten() {
                     Some(out) => self.0.diffuse_finish(
                         scene,

@@ -447,16 +447,36 @@ pub struct HitRecord {
 pub(crate) struct TriangleHit<'a> {
     /// The triangle.
     pub tri: TriangleOf<&'a TriangleMesh>,
-    /// Its geometric normal and ∂p/∂u (of its frame: what does not depend
-    /// on the point hit).
-    pub ng: Normal3f,
-    pub dpdu: Vector3f,
+    /// Its cached frame (what does not depend on the point hit), if the
+    /// aggregate keeps frames ([`TriangleHit::frame_parts`]).
+    pub frame: Option<&'a TriangleFrame>,
     /// The barycentrics of the hit.
     pub b: [Float; 3],
     /// The primitive's material (`None`: interface).
     pub material: Option<u32>,
     /// The primitive's area light.
     pub area_light: Option<u32>,
+}
+
+impl TriangleHit<'_> {
+    /// Writes the triangle's geometric normal and ∂p/∂u to `ng` and
+    /// `dpdu`: read in place from the cached frame (a hit holding copies,
+    /// or a frame copied whole, goes through the stack and stalls on
+    /// store forwarding), or from a frame computed now.
+    #[inline(always)]
+    pub(crate) fn frame_parts(&self, ng: &mut Normal3f, dpdu: &mut Vector3f) {
+        match self.frame {
+            Some(f) => {
+                *ng = f.n;
+                *dpdu = f.dpdu;
+            }
+            None => {
+                let f = self.tri.frame();
+                *ng = f.n;
+                *dpdu = f.dpdu;
+            }
+        }
+    }
 }
 
 /// How [`PrimitiveAggregate::interaction`] builds a hit's interaction.
@@ -839,7 +859,6 @@ impl PrimitiveAggregate {
         let HitKind::Triangle(b0, b1, b2) = hit.kind else {
             return None;
         };
-        let frame = self.triangle_frames.get(hit.primitive as usize);
         let (p, i) = self.entries.locate(hit.primitive);
         let (tri, material, area_light) = match self.prims.get(p)? {
             Primitive::Geometric(g) => match &g.shape {
@@ -856,18 +875,8 @@ impl PrimitiveAggregate {
             Primitive::Mesh(m) => (m.triangle(i), m.material, None),
             _ => return None,
         };
-        // Two fields of the cached frame, read in place (copying the whole
-        // frame through the stack stalls on store forwarding).
-        let (ng, dpdu) = match frame {
-            Some(f) => (f.n, f.dpdu),
-            None => {
-                let f = tri.frame();
-                (f.n, f.dpdu)
-            }
-        };
         Some(TriangleHit {
-            ng,
-            dpdu,
+            frame: self.triangle_frames.get(hit.primitive as usize),
             tri,
             b: [b0, b1, b2],
             material,

@@ -198,12 +198,17 @@ impl Sampler {
         cursors: &[SamplerCursor],
         batch: &mut FourDrawBatch,
         out: &mut Vec<Option<[Float; 6]>>,
+        next: Option<&mut Vec<Option<Float>>>,
     ) {
         if let Sampler::ZSobol(s) = self {
-            return s.four_draws_batch(level, cursors, batch, out);
+            return s.four_draws_batch(level, cursors, batch, out, next);
         }
         out.clear();
         out.resize(cursors.len(), None);
+        if let Some(next) = next {
+            next.clear();
+            next.resize(cursors.len(), None);
+        }
     }
 
     /// Offers four draws from [`Sampler::four_draws_batch`], computed at
@@ -213,6 +218,16 @@ impl Sampler {
     pub fn offer_four_draws(&mut self, draws: Option<[Float; 6]>) {
         if let Sampler::ZSobol(s) = self {
             s.offer_four_draws(draws);
+        }
+    }
+
+    /// Offers a 1-D draw from [`Sampler::four_draws_batch`]'s `next`,
+    /// computed at the current cursor, to the next [`Sampler::get_1d`] at
+    /// that cursor ([`Sampler::set_cursor`] withdraws it).
+    #[inline]
+    pub fn offer_1d(&mut self, draw: Option<Float>) {
+        if let Sampler::ZSobol(s) = self {
+            s.offer_1d(draw);
         }
     }
 

@@ -499,7 +499,7 @@ pub struct FourDrawBatch {
     v: Vec<u32>,
     seeds: Vec<u32>,
     values: Vec<Float>,
-    found: Vec<bool>,
+    found: Vec<(bool, bool)>,
     order: Vec<u32>,
     counts: Vec<u32>,
 }
@@ -556,6 +556,10 @@ pub struct ZSobolSampler {
     /// the Morton index and dimension they were drawn at, which the next
     /// [`ZSobolSampler::get_1d_2d_1d_2d`] at that position returns.
     offered: Option<(u64, i32, [Float; 6])>,
+    /// A 1-D draw computed ahead (the one after four draws) for the Morton
+    /// index and dimension it was drawn at, which the next
+    /// [`ZSobolSampler::get_1d`] at that position returns.
+    offered_1d: Option<(u64, i32, Float)>,
 }
 
 impl ZSobolSampler {
@@ -589,6 +593,7 @@ impl ZSobolSampler {
                 scramble_hash: std::array::from_fn(|d| mix_bits((d as i32 ^ seed) as i64 as u64)),
             }),
             offered: None,
+            offered_1d: None,
         }
     }
 
@@ -614,6 +619,7 @@ impl ZSobolSampler {
         self.morton_index = c.a;
         self.dimension = c.dimension;
         self.offered = None;
+        self.offered_1d = None;
     }
 
     /// Offers `draws` (from [`ZSobolSampler::four_draws_batch`] at the
@@ -621,6 +627,14 @@ impl ZSobolSampler {
     #[inline]
     pub fn offer_four_draws(&mut self, draws: Option<[Float; 6]>) {
         self.offered = draws.map(|v| (self.morton_index, self.dimension, v));
+    }
+
+    /// Offers a 1-D draw from [`ZSobolSampler::four_draws_batch`]'s `next`,
+    /// computed at the current cursor, to the next [`ZSobolSampler::get_1d`]
+    /// at that cursor.
+    #[inline]
+    pub fn offer_1d(&mut self, draw: Option<Float>) {
+        self.offered_1d = draw.map(|v| (self.morton_index, self.dimension, v));
     }
 
     /// Starts sample `index` of pixel `p` at `dimension`.
@@ -743,6 +757,12 @@ impl ZSobolSampler {
     /// The next 1-D value.
     #[inline]
     pub fn get_1d(&mut self) -> Float {
+        if let Some((m, d, v)) = self.offered_1d.take() {
+            if m == self.morton_index && d == self.dimension {
+                self.dimension += 1;
+                return v;
+            }
+        }
         self.draw_1d()
     }
 
@@ -794,15 +814,20 @@ impl ZSobolSampler {
     /// values are found per cursor, then scrambled and made floats
     /// together, lane-parallel at `level`. `None` where the four draws
     /// take the general route (2 spp, another randomization,
-    /// uncached dimensions); the draw then computes them itself. Leaves the
-    /// sampler's position as it was.
+    /// uncached dimensions); the draw then computes them itself. With
+    /// `next`, also the 1-D draw that follows the four (the path tracer's
+    /// Russian roulette) into it, `None` where the six are or where its
+    /// dimension is not cached. Leaves the sampler's position as it was.
     pub fn four_draws_batch(
         &mut self,
         level: SimdLevel,
         cursors: &[super::SamplerCursor],
         batch: &mut FourDrawBatch,
         out: &mut Vec<Option<[Float; 6]>>,
+        next: Option<&mut Vec<Option<Float>>>,
     ) {
+        const W: usize = 7;
+        let with_next = next.is_some();
         let (morton, dimension) = (self.morton_index, self.dimension);
         let n = cursors.len();
         // Taken in order of dimension, then index, the draws meet their
@@ -810,12 +835,14 @@ impl ZSobolSampler {
         // in flight are at different depths, so in their own order each
         // dimension's entries would change at almost every draw).
         sort_by_dimension(cursors, &mut batch.counts, &mut batch.order);
+        // Seven values a cursor (the seventh, the next draw, left zero
+        // when not asked for).
         batch.v.clear();
-        batch.v.resize(6 * n, 0);
+        batch.v.resize(W * n, 0);
         batch.seeds.clear();
-        batch.seeds.resize(6 * n, 0);
+        batch.seeds.resize(W * n, 0);
         batch.found.clear();
-        batch.found.resize(n, false);
+        batch.found.resize(n, (false, false));
         for &k in &batch.order {
             let k = k as usize;
             let c = &cursors[k];
@@ -823,24 +850,65 @@ impl ZSobolSampler {
             self.dimension = c.dimension;
             if let Some(inputs) = self.four_draw_inputs() {
                 for (j, (v, seed)) in inputs.into_iter().enumerate() {
-                    batch.v[6 * k + j] = v;
-                    batch.seeds[6 * k + j] = seed;
+                    batch.v[W * k + j] = v;
+                    batch.seeds[W * k + j] = seed;
                 }
-                batch.found[k] = true;
+                let mut found_next = false;
+                if with_next {
+                    if let Some((v, seed)) = self.next_draw_input() {
+                        batch.v[W * k + 6] = v;
+                        batch.seeds[W * k + 6] = seed;
+                        found_next = true;
+                    }
+                }
+                batch.found[k] = (true, found_next);
             }
         }
         (self.morton_index, self.dimension) = (morton, dimension);
         batch.values.clear();
-        batch.values.resize(6 * n, 0.0);
+        batch.values.resize(W * n, 0.0);
         fast_owen_01_batch(level, &batch.v, &batch.seeds, &mut batch.values);
         out.clear();
         out.extend(
             batch
                 .found
                 .iter()
-                .zip(batch.values.chunks_exact(6))
-                .map(|(&f, v)| f.then(|| std::array::from_fn(|j| v[j]))),
+                .zip(batch.values.chunks_exact(W))
+                .map(|(&(f, _), v)| f.then(|| std::array::from_fn(|j| v[j]))),
         );
+        if let Some(next) = next {
+            next.clear();
+            next.extend(
+                batch
+                    .found
+                    .iter()
+                    .zip(batch.values.chunks_exact(W))
+                    .map(|(&(_, f), v)| f.then_some(v[6])),
+            );
+        }
+    }
+
+    /// For the 1-D draw that follows [`ZSobolSampler::get_1d_2d_1d_2d`] at
+    /// the current position, once [`ZSobolSampler::four_draw_inputs`] has
+    /// found the six: its bit-reversed Sobol' value and scrambling seed
+    /// (the value is [`fast_owen_01`] of the pair), through the single
+    /// draw's cache; `None` where its dimension is not cached. Does not
+    /// advance the dimension.
+    #[inline(always)]
+    fn next_draw_input(&mut self) -> Option<(u32, u32)> {
+        let d = self.dimension as usize + 6;
+        if d >= ZSOBOL_CACHED_DIMENSIONS {
+            return None;
+        }
+        self.dimension += 6;
+        let index = self.cached_sample_index();
+        let hash = {
+            self.dimension += 1;
+            let h = self.scramble_hash() as u32;
+            self.dimension -= 7;
+            h
+        };
+        Some((sobol_reversed_01(index, 0), hash))
     }
 
     /// For [`ZSobolSampler::get_1d_2d_1d_2d`] at the current position,
@@ -1026,7 +1094,8 @@ mod tests {
             // batch (all but it within the counting sort's range).
             reference.start_pixel_sample(Point2i::new(3, 4), 1, 2000);
             cursors.insert(300, reference.cursor());
-            let want: Vec<[Float; 6]> = cursors
+            // The four draws and the 1-D draw after them.
+            let want: Vec<[Float; 7]> = cursors
                 .iter()
                 .map(|c| {
                     reference.set_cursor(c);
@@ -1036,30 +1105,68 @@ mod tests {
                         reference.get_1d(),
                         reference.get_2d(),
                     );
-                    [a, b.x, b.y, c, d.x, d.y]
+                    [a, b.x, b.y, c, d.x, d.y, reference.get_1d()]
                 })
                 .collect();
             for level in SimdLevel::available() {
                 let mut s = ZSobolSampler::new(spp, Point2i::new(300, 200), rand, 7);
                 let mut batch = FourDrawBatch::default();
-                let mut out = Vec::new();
-                s.four_draws_batch(level, &cursors[300..], &mut batch, &mut out);
-                let far = out.clone();
-                s.four_draws_batch(level, &cursors[..300], &mut batch, &mut out);
+                let (mut out, mut next) = (Vec::new(), Vec::new());
+                s.four_draws_batch(
+                    level,
+                    &cursors[300..],
+                    &mut batch,
+                    &mut out,
+                    Some(&mut next),
+                );
+                let (far, far_next) = (out.clone(), next.clone());
+                s.four_draws_batch(
+                    level,
+                    &cursors[..300],
+                    &mut batch,
+                    &mut out,
+                    Some(&mut next),
+                );
                 out.extend(far);
+                next.extend(far_next);
                 assert_eq!(out.len(), cursors.len());
-                for ((c, got), want) in cursors.iter().zip(&out).zip(&want) {
+                assert_eq!(next.len(), cursors.len());
+                // Without `next`, the same four draws.
+                let mut alone = Vec::new();
+                s.four_draws_batch(level, &cursors[..300], &mut batch, &mut alone, Option::None);
+                assert_eq!(alone[..], out[..300]);
+                for (((c, got), got_next), want) in cursors.iter().zip(&out).zip(&next).zip(&want) {
                     match got {
-                        Some(v) => assert_eq!(v, want, "{level:?} spp {spp} {c:?}"),
+                        Some(v) => assert_eq!(v[..], want[..6], "{level:?} spp {spp} {c:?}"),
                         // Only the general route declines.
                         Option::None => assert!(rand != FastOwen || spp == 2 || c.dimension >= 57),
+                    }
+                    match got_next {
+                        Some(v) => assert_eq!(*v, want[6], "{level:?} spp {spp} {c:?}"),
+                        // Only with the four, here (the next draw's
+                        // dimension is cached wherever theirs are).
+                        Option::None => assert!(got.is_none()),
                     }
                     s.set_cursor(c);
                     s.offer_four_draws(*got);
                     let (a, b, cc, d) = s.get_1d_2d_1d_2d();
-                    assert_eq!([a, b.x, b.y, cc, d.x, d.y], *want);
+                    assert_eq!([a, b.x, b.y, cc, d.x, d.y], want[..6]);
                     assert_eq!(s.dimension, c.dimension + 6);
+                    s.offer_1d(*got_next);
+                    assert_eq!(s.get_1d(), want[6]);
+                    assert_eq!(s.dimension, c.dimension + 7);
                 }
+                // A 1-D offer is taken only at its own position: not by a
+                // 2-D draw there, nor after the cursor moves.
+                s.set_cursor(&cursors[2]);
+                s.offer_1d(Some(0.5));
+                reference.set_cursor(&cursors[2]);
+                assert_eq!(s.get_2d(), reference.get_2d());
+                assert_eq!(s.get_1d(), reference.get_1d());
+                s.offer_1d(Some(0.5));
+                s.set_cursor(&cursors[3]);
+                reference.set_cursor(&cursors[3]);
+                assert_eq!(s.get_1d(), reference.get_1d());
                 // An offer is withdrawn when the cursor moves, and not
                 // taken at another dimension.
                 s.set_cursor(&cursors[0]);
