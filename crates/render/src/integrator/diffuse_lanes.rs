@@ -19,6 +19,11 @@
 //!    the next direction (pbrt-v4's `DiffuseBxDF` through `BSDF::f`,
 //!    `BSDF::PDF` and `BSDF::Sample_f`).
 //!
+//! The surface kernel also serves the specular vertex of a smooth
+//! `dielectric` of constant index ([`specular_surface`]): on its surface
+//! the scalar BSDF's own sampling runs per lane, in the BSDF's frame the
+//! kernel built, with no general interaction built at all.
+//!
 //! Lanes where the scalar code takes a rare branch (a shading normal
 //! perpendicular to the tangent, derivatives rescaled) are flagged and
 //! take the scalar vertex instead.
@@ -26,6 +31,7 @@
 use super::direct::{LightAnswer, LightRequest};
 use super::Scene;
 use crate::bxdf::lanes::{gather_f, gather_s, MAX_LANES, S4};
+use crate::bxdf::DielectricBxDF;
 use crate::light::LightSampleContext;
 use crate::primitive::{HitRecord, TriangleHit};
 use crate::sampler::Sampler;
@@ -65,6 +71,32 @@ pub(crate) fn diffuse_surface(
         return None;
     }
     out.fill(&hit, d).then_some(r)
+}
+
+/// The BxDF of a hit `record` by a ray of direction `d` when it is a
+/// specular vertex the lanes take: a triangle without an area light, of a
+/// constant specular `dielectric` material
+/// ([`MaterialSet::constant_specular_dielectric`]), in a mesh without
+/// shading tangents; the surface kernel's input is written to `out`.
+/// `None`: the scalar vertex takes it (`out` is then unspecified).
+///
+/// [`MaterialSet::constant_specular_dielectric`]: crate::material::MaterialSet::constant_specular_dielectric
+#[inline(always)]
+pub(crate) fn specular_surface(
+    scene: &Scene,
+    record: &HitRecord,
+    d: Vector3f,
+    lambda: &SampledWavelengths,
+    out: &mut SurfaceIn,
+) -> Option<DielectricBxDF> {
+    let hit = scene.aggregate.triangle_hit(record)?;
+    if hit.area_light.is_some() {
+        return None;
+    }
+    let bxdf = scene
+        .materials
+        .constant_specular_dielectric(hit.material?, lambda)?;
+    out.fill(&hit, d).then_some(bxdf)
 }
 
 /// What [`surfaces`] needs of one triangle hit.

@@ -4,12 +4,12 @@
 
 use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
 use super::diffuse_lanes::{
-    diffuse_surface, DiffuseVertex, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut,
+    diffuse_surface, specular_surface, DiffuseVertex, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut,
 };
 use super::direct::{light_request, light_shadow_query, LightAnswer, LightRequest, ShadowQuery};
 use super::vertex::{li_by_vertices, Begin, VertexIntegrator, VertexStep};
 use super::{skip_intersection, RayIntegrator, Scene, VertexOrigins};
-use crate::bxdf::BSDF;
+use crate::bxdf::{BxDF, DielectricBxDF, BSDF};
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
 use crate::lightsampler::LightSampler;
@@ -18,6 +18,7 @@ use crate::sampler::Sampler;
 use crate::sampling::power_heuristic;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::{Float, INV_PI};
+use rpbrt_geometry::frame::Frame;
 use rpbrt_geometry::ray::{Ray, RayDifferential};
 use rpbrt_geometry::tuple::*;
 
@@ -298,6 +299,71 @@ impl VertexIntegrator for PathIntegrator {
             return None;
         }
         diffuse_surface(scene, record, s.ray.ray.d, lambda, out)
+    }
+
+    #[inline(always)]
+    fn specular_hit(
+        &self,
+        scene: &Scene,
+        s: &PathState,
+        record: &HitRecord,
+        lambda: &SampledWavelengths,
+        gbuffer: bool,
+        out: &mut SurfaceIn,
+    ) -> Option<DielectricBxDF> {
+        // As `diffuse_hit`, and not where regularization would roughen
+        // the BSDF.
+        if s.depth >= self.max_depth
+            || scene.force_diffuse
+            || (gbuffer && s.depth == 0)
+            || (self.regularize && s.any_non_specular)
+        {
+            return None;
+        }
+        specular_surface(scene, record, s.ray.ray.d, lambda, out)
+    }
+
+    /// `begin` and `finish` for a specular vertex: the depth, the BSDF's
+    /// sampler draws and its sample (the scalar BSDF's own, in the frame
+    /// the surface kernel built), the next ray and Russian roulette.
+    #[inline(always)]
+    fn specular_step(
+        &self,
+        s: &mut PathState,
+        scratch: &mut SurfaceScratch,
+        surface: &SurfaceOut,
+        bxdf: DielectricBxDF,
+        sampler: &mut Sampler,
+    ) -> VertexStep {
+        scratch.hit = None;
+        scratch.bsdf = None;
+        s.depth += 1;
+        let (u, u2) = (sampler.get_1d(), sampler.get_2d());
+        s.prev_ctx.pi = surface.pi;
+        s.prev_ctx.n = surface.n;
+        s.prev_ctx.ns = surface.ns;
+        let bsdf = BSDF {
+            bxdf: BxDF::Dielectric(bxdf),
+            shading_frame: Frame {
+                x: surface.x,
+                y: surface.y,
+                z: Vector3f::from(surface.ns),
+            },
+        };
+        let wo = -s.ray.ray.d;
+        let Some((bs, p_b)) = BsdfAnswers::default().sample(&bsdf, wo, u, u2) else {
+            return VertexStep::DONE;
+        };
+        s.beta *= bs.f * (abs_dot(bs.wi, surface.ns) / bs.pdf);
+        s.p_b = p_b;
+        s.specular_bounce = bs.is_specular();
+        s.any_non_specular |= !bs.is_specular();
+        if bs.is_transmission() {
+            s.eta_scale *= bs.eta * bs.eta;
+        }
+        let o = surface.sides[(dot(bs.wi, surface.n) < 0.0) as usize];
+        s.ray = RayDifferential::new(Ray::with_time(o, bs.wi, s.ray.ray.time, None));
+        russian_roulette(s, sampler, None)
     }
 
     /// `begin`'s steps for a diffuse vertex: the depth, the sampler draws,

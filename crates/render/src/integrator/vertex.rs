@@ -10,6 +10,7 @@ use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
 use super::diffuse_lanes::{ScatterIn, ScatterOut, SurfaceIn, SurfaceOut};
 use super::direct::{answer_light, LightAnswer, LightRequest, ShadowQuery};
 use super::Scene;
+use crate::bxdf::DielectricBxDF;
 use crate::film::VisibleSurface;
 use crate::primitive::HitRecord;
 use crate::sampler::Sampler;
@@ -125,6 +126,37 @@ pub(crate) trait VertexIntegrator: Sync {
         _out: &mut SurfaceIn,
     ) -> Option<SampledSpectrum> {
         None
+    }
+
+    /// The lane form of a specular vertex (`diffuse_lanes.rs`'s
+    /// [`specular_surface`](super::diffuse_lanes::specular_surface)), for
+    /// the wavefront: for a hit `record` of the path in state `s` that it
+    /// covers, the BxDF, the surface kernel's input written to `out`;
+    /// `None` (the default) where the scalar vertex runs.
+    fn specular_hit(
+        &self,
+        _scene: &Scene,
+        _s: &Self::State,
+        _record: &HitRecord,
+        _lambda: &SampledWavelengths,
+        _gbuffer: bool,
+        _out: &mut SurfaceIn,
+    ) -> Option<DielectricBxDF> {
+        None
+    }
+
+    /// The whole vertex that [`VertexIntegrator::specular_hit`] took,
+    /// given its surface and BxDF (a specular vertex asks for no light
+    /// sample).
+    fn specular_step(
+        &self,
+        _s: &mut Self::State,
+        _scratch: &mut Self::Scratch,
+        _surface: &SurfaceOut,
+        _bxdf: DielectricBxDF,
+        _sampler: &mut Sampler,
+    ) -> VertexStep {
+        unreachable!("specular_step without specular_hit")
     }
 
     /// The first half of a vertex that [`VertexIntegrator::diffuse_hit`]

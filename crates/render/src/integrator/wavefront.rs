@@ -21,7 +21,11 @@
 //!    light sample, the next ray). Diffuse vertices (`diffuse_lanes.rs`)
 //!    take both halves in lanes instead: their surfaces built together
 //!    before the first half, their BSDF's answers together before the
-//!    second;
+//!    second; so do the specular vertices of smooth glass under `path`,
+//!    whose whole vertex (no light sample) is the scalar BSDF's sample in
+//!    the frame the surface kernel built. Before the surfaces, the hit
+//!    meshes' data is prefetched for every path at once where the scene
+//!    is too large for the cache;
 //! 3. **light**: the requests' lights chosen and sampled together
 //!    ([`answer_lights`]: triangle lights' solid-angle samples run
 //!    lane-parallel, at the SIMD level's width);
@@ -50,6 +54,7 @@ use super::stages::{Stage, StageClock};
 use super::tile::{add_estimate, RayIntegrator, RayTiles, TileIntegrator};
 use super::vertex::{Begin, VertexIntegrator};
 use super::Scene;
+use crate::bxdf::DielectricBxDF;
 use crate::film::{FilmTile, SplatBuffer, VisibleSurface};
 use crate::primitive::HitRecord;
 use crate::sampler::{FourDrawBatch, Sampler, SamplerCursor};
@@ -96,6 +101,17 @@ struct Lane<S> {
     camera: bool,
     /// The vertex being shaded is a diffuse vertex taken in lanes.
     diffuse: bool,
+    /// The vertex being shaded is a specular vertex taken in lanes.
+    specular: bool,
+}
+
+/// What a vertex whose surface the kernel builds shades with.
+#[derive(Clone, Copy)]
+enum LaneShade {
+    /// A diffuse vertex's reflectance.
+    Diffuse(SampledSpectrum),
+    /// A specular vertex's BxDF.
+    Specular(DielectricBxDF),
 }
 
 /// A finished sample waiting for its turn to be added to the tile.
@@ -237,7 +253,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let mut predrawn_next: Vec<Option<Float>> = Vec::new();
         let mut diffuse: Vec<usize> = Vec::with_capacity(LANES);
         let mut surface_in: Vec<SurfaceIn> = Vec::with_capacity(LANES);
-        let mut reflectances: Vec<SampledSpectrum> = Vec::with_capacity(LANES);
+        let mut shades: Vec<LaneShade> = Vec::with_capacity(LANES);
         let mut surface_out: Vec<SurfaceOut> = Vec::with_capacity(LANES);
         let mut diffuse_slot: Vec<usize> = Vec::new();
         let mut scatter_in: Vec<ScatterIn> = Vec::with_capacity(LANES);
@@ -249,6 +265,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let mut started = 0;
         let level = opts.simd.unwrap_or_else(crate::simd::level);
         let mut clock = StageClock::new(opts.stage_times.as_deref());
+        let prefetch = scene.aggregate.prefetch_pays();
         loop {
             clock.enter(Stage::Camera);
             // Refill the pool in the tile's sample order. Once
@@ -312,6 +329,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     done: false,
                     camera: true,
                     diffuse: false,
+                    specular: false,
                 };
                 let slot = match free.pop() {
                     Some(slot) => {
@@ -383,11 +401,20 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 predrawn_next[i] = n;
             }
             clock.enter(Stage::Surfaces);
-            // The diffuse vertices' surfaces, lane-parallel (lanes the
-            // surface kernel leaves take the scalar vertex).
+            // The diffuse and specular vertices' surfaces, lane-parallel
+            // (lanes the surface kernel leaves take the scalar vertex).
             diffuse.clear();
             surface_in.clear();
-            reflectances.clear();
+            shades.clear();
+            // Their meshes' indices, then vertices, requested for all
+            // paths before any is read (large meshes miss the cache).
+            for vertices in [false, true].into_iter().filter(|_| prefetch) {
+                for &i in &shade {
+                    if let Some(h) = &hits[i] {
+                        scene.aggregate.prefetch_triangle_hit(h, vertices);
+                    }
+                }
+            }
             for &i in &shade {
                 let lane = &lanes[i];
                 let Some(h) = &hits[i] else { continue };
@@ -398,12 +425,13 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     surface_in.push(SurfaceIn::default());
                 }
                 let out = &mut surface_in[k];
-                if let Some(r) =
-                    self.0
-                        .diffuse_hit(scene, &lane.path, h, &lane.lambda, gbuffer, out)
-                {
+                let (s, lambda) = (&lane.path, &lane.lambda);
+                if let Some(r) = self.0.diffuse_hit(scene, s, h, lambda, gbuffer, out) {
                     diffuse.push(i);
-                    reflectances.push(r);
+                    shades.push(LaneShade::Diffuse(r));
+                } else if let Some(b) = self.0.specular_hit(scene, s, h, lambda, gbuffer, out) {
+                    diffuse.push(i);
+                    shades.push(LaneShade::Specular(b));
                 }
             }
             surface_in.truncate(diffuse.len());
@@ -411,10 +439,14 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             diffuse_slot.resize(lanes.len(), 0);
             for &i in &active {
                 lanes[i].diffuse = false;
+                lanes[i].specular = false;
             }
             for (k, &i) in diffuse.iter().enumerate() {
                 if surface_out[k].ok {
-                    lanes[i].diffuse = true;
+                    match shades[k] {
+                        LaneShade::Diffuse(_) => lanes[i].diffuse = true,
+                        LaneShade::Specular(_) => lanes[i].specular = true,
+                    }
                     diffuse_slot[i] = k;
                 }
             }
@@ -423,17 +455,23 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 let lane = &mut lanes[i];
                 sampler.set_cursor(&lane.cursor);
                 sampler.offer_four_draws(predrawn[i]);
-                let begun = if lane.diffuse {
-                    let k = diffuse_slot[i];
-                    Begin::Light(self.0.diffuse_begin(
+                let k = diffuse_slot[i];
+                let begun = match (lane.diffuse || lane.specular).then(|| shades[k]) {
+                    Some(LaneShade::Diffuse(r)) => Begin::Light(self.0.diffuse_begin(
                         &mut lane.path,
                         &mut scratch[i],
                         &surface_out[k],
-                        reflectances[k],
+                        r,
                         sampler,
-                    ))
-                } else {
-                    self.0.begin(
+                    )),
+                    Some(LaneShade::Specular(b)) => Begin::Step(self.0.specular_step(
+                        &mut lane.path,
+                        &mut scratch[i],
+                        &surface_out[k],
+                        b,
+                        sampler,
+                    )),
+                    None => self.0.begin(
                         scene,
                         &mut lane.path,
                         hits[i],
@@ -441,7 +479,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                         sampler,
                         visibles.get_mut(i),
                         &mut scratch[i],
-                    )
+                    ),
                 };
                 lane.cursor = sampler.cursor();
                 lane.camera = false;

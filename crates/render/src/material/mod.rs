@@ -447,6 +447,39 @@ impl MaterialSet {
         }
     }
 
+    /// The BxDF of `material` when it is a plain `dielectric` (no mix, no
+    /// normal or bump map) of constant index of refraction and constant
+    /// roughness, and that BxDF is specular: the same at every point and
+    /// wavelength, so it is built without the hit (the wavefront's
+    /// lane-parallel specular vertex).
+    pub(crate) fn constant_specular_dielectric(
+        &self,
+        material: u32,
+        lambda: &SampledWavelengths,
+    ) -> Option<crate::bxdf::DielectricBxDF> {
+        use crate::texture::FloatTexture;
+        let Some(Material::Dielectric(m)) = self.materials.get(material as usize) else {
+            return None;
+        };
+        let constant = |t: &FloatTextureRef| matches!(**t, FloatTexture::Constant(_));
+        if m.perturbation.is_some()
+            || !matches!(m.eta, Spectrum::Constant(_))
+            || !constant(&m.roughness.u)
+            || !constant(&m.roughness.v)
+        {
+            return None;
+        }
+        // Nothing `get_bxdf` reads varies over the surface, and a constant
+        // index of refraction leaves the wavelengths as they are.
+        let mut lambda = *lambda;
+        match m.get_bxdf(&MaterialEvalContext::default(), &mut lambda) {
+            BxDF::Dielectric(d) if !crate::bxdf::BxDFMethods::flags(&d).is_non_specular() => {
+                Some(d)
+            }
+            _ => None,
+        }
+    }
+
     /// True when shading material `material` may read the hit's
     /// screen-space differentials: a texture that filters over its
     /// footprint, or bump or normal mapping. Only materials proven to read

@@ -599,6 +599,18 @@ AttributeBegin
   Shape "sphere" "float radius" 0.6
 AttributeEnd
 AttributeBegin
+  # Smooth glass meshes, flat and with vertex normals: the wavefront's
+  # lane-parallel specular vertex.
+  Material "dielectric" "float eta" 1.5
+  Translate 0.5 0.05 -2.4
+  Shape "trianglemesh" "point3 P" [ 0 0 0  0.7 0 0.1  0.3 0.8 0.3  0.35 0.1 0.7 ]
+      "integer indices" [ 0 1 2  0 3 1  1 3 2  2 3 0 ]
+  Translate -1.3 0 0.3
+  Shape "trianglemesh" "point3 P" [ 0 0 0  0.7 0 0.1  0.3 0.8 0.3  0.35 0.1 0.7 ]
+      "normal N" [ -0.5 -0.3 -0.6  0.6 -0.2 -0.5  0 1 0  0.1 -0.2 0.9 ]
+      "integer indices" [ 0 1 2  0 3 1  1 3 2  2 3 0 ]
+AttributeEnd
+AttributeBegin
   Translate 0.2 0.5 0.8
   Material "conductor" "float roughness" 0.1
   Shape "sphere" "float radius" 0.5
