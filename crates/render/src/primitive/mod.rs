@@ -901,8 +901,8 @@ impl PrimitiveAggregate {
     /// reads from memory (for batches of hits, whose loads then overlap
     /// instead of each stalling in turn): with `vertices` false, the
     /// triangle's vertex indices and cached frame; with `vertices` true
-    /// (a pass later, once the indices have arrived), its vertices and
-    /// vertex normals. Nothing for other hits.
+    /// (a pass later, once the indices have arrived), its vertices, vertex
+    /// normals and texture coordinates. Nothing for other hits.
     #[inline]
     pub(crate) fn prefetch_triangle_hit(&self, hit: &HitRecord, vertices: bool) {
         use crate::simd::prefetch_ptr;
@@ -935,6 +935,10 @@ impl PrimitiveAggregate {
             prefetch_ptr(mesh.p.as_ptr().wrapping_add(k as usize));
             if let Some(n) = &mesh.n {
                 prefetch_ptr(n.as_ptr().wrapping_add(k as usize));
+            }
+            // Read by the scalar vertex's interaction.
+            if let Some(uv) = &mesh.uv {
+                prefetch_ptr(uv.as_ptr().wrapping_add(k as usize));
             }
         }
     }
