@@ -130,13 +130,13 @@ impl SurfaceIn {
             return false;
         }
         let v = mesh.vertex_indices(hit.tri.tri_index as usize);
-        for k in 0..3 {
-            self.p[k] = mesh.p[v[k]];
+        for (p, &k) in self.p.iter_mut().zip(&v) {
+            *p = mesh.p[k];
         }
         match &mesh.n {
             Some(nn) => {
-                for k in 0..3 {
-                    self.n[k] = nn[v[k]];
+                for (n, &k) in self.n.iter_mut().zip(&v) {
+                    *n = nn[k];
                 }
                 self.shading = true;
             }
