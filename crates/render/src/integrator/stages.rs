@@ -17,7 +17,7 @@ pub(crate) enum Stage {
     Trace,
     /// The vertices' sampler draws, taken together.
     VertexDraws,
-    /// The diffuse vertices' surfaces, in lanes.
+    /// The diffuse and specular vertices' surfaces, in lanes.
     Surfaces,
     /// The first half of every vertex.
     Begin,
@@ -57,7 +57,7 @@ impl Stage {
             Stage::Camera => "camera samples and rays",
             Stage::Trace => "closest hits",
             Stage::VertexDraws => "vertex sampler draws",
-            Stage::Surfaces => "diffuse surfaces (lanes)",
+            Stage::Surfaces => "surfaces (lanes)",
             Stage::Begin => "vertex first halves",
             Stage::Lights => "light samples",
             Stage::Bsdfs => "other BSDFs (lanes)",
