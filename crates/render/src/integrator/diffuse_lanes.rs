@@ -20,7 +20,7 @@
 //!    `BSDF::PDF` and `BSDF::Sample_f`).
 //!
 //! The surface kernel also serves the specular vertex of a smooth
-//! `dielectric` of constant index ([`specular_surface`]): on its surface
+//! `dielectric` of constant index ([`lane_surface`]): on its surface
 //! the scalar BSDF's own sampling runs per lane, in the BSDF's frame the
 //! kernel built, with no general interaction built at all.
 //!
@@ -45,58 +45,57 @@ use rpbrt_geometry::pointfi::Point3fi;
 use rpbrt_geometry::ray::{spawn_ray_from_origin_to_surface, Ray, SHADOW_EPSILON};
 use rpbrt_geometry::tuple::*;
 
-/// The reflectance at `lambda` of a hit `record` by a ray of direction
-/// `d`, when it is a diffuse vertex: a triangle without an area light, of
-/// a plain `diffuse` material of constant, not black, reflectance, in a
-/// mesh without shading tangents; the surface kernel's input is written
+/// What a vertex that the surface kernel builds shades with.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum LaneShade {
+    /// A diffuse vertex: a plain `diffuse` material of constant, not
+    /// black, reflectance (this, at the path's wavelengths).
+    Diffuse(SampledSpectrum),
+    /// A specular vertex: a constant specular `dielectric` material
+    /// ([`MaterialSet::constant_specular_dielectric`]), its BxDF.
+    ///
+    /// [`MaterialSet::constant_specular_dielectric`]: crate::material::MaterialSet::constant_specular_dielectric
+    Specular(DielectricBxDF),
+}
+
+/// How a hit `record` by a ray of direction `d` shades when it is a vertex
+/// the lanes take: a triangle without an area light, in a mesh without
+/// shading tangents, of a material [`LaneShade`] covers (its specular kind
+/// only where `specular` allows it); the surface kernel's input is written
 /// to `out`. `None`: the scalar vertex takes it (`out` is then
 /// unspecified).
 #[inline(always)]
-pub(crate) fn diffuse_surface(
+pub(crate) fn lane_surface(
     scene: &Scene,
     record: &HitRecord,
     d: Vector3f,
     lambda: &SampledWavelengths,
+    specular: bool,
     out: &mut SurfaceIn,
-) -> Option<SampledSpectrum> {
+) -> Option<LaneShade> {
     let hit = scene.aggregate.triangle_hit(record)?;
     if hit.area_light.is_some() {
         return None;
     }
-    let spectrum = scene.materials.constant_diffuse(hit.material?)?;
-    // `DiffuseMaterial::get_bxdf`; a black reflectance makes a BSDF
-    // without flags, which the scalar vertex handles.
-    let r = spectrum.sample(lambda).clamp(0.0, 1.0);
-    if r.is_black() {
-        return None;
-    }
-    out.fill(&hit, d).then_some(r)
-}
-
-/// The BxDF of a hit `record` by a ray of direction `d` when it is a
-/// specular vertex the lanes take: a triangle without an area light, of a
-/// constant specular `dielectric` material
-/// ([`MaterialSet::constant_specular_dielectric`]), in a mesh without
-/// shading tangents; the surface kernel's input is written to `out`.
-/// `None`: the scalar vertex takes it (`out` is then unspecified).
-///
-/// [`MaterialSet::constant_specular_dielectric`]: crate::material::MaterialSet::constant_specular_dielectric
-#[inline(always)]
-pub(crate) fn specular_surface(
-    scene: &Scene,
-    record: &HitRecord,
-    d: Vector3f,
-    lambda: &SampledWavelengths,
-    out: &mut SurfaceIn,
-) -> Option<DielectricBxDF> {
-    let hit = scene.aggregate.triangle_hit(record)?;
-    if hit.area_light.is_some() {
-        return None;
-    }
-    let bxdf = scene
-        .materials
-        .constant_specular_dielectric(hit.material?, lambda)?;
-    out.fill(&hit, d).then_some(bxdf)
+    let material = hit.material?;
+    let shade = match scene.materials.constant_diffuse(material) {
+        Some(spectrum) => {
+            // `DiffuseMaterial::get_bxdf`; a black reflectance makes a
+            // BSDF without flags, which the scalar vertex handles.
+            let r = spectrum.sample(lambda).clamp(0.0, 1.0);
+            if r.is_black() {
+                return None;
+            }
+            LaneShade::Diffuse(r)
+        }
+        None if specular => LaneShade::Specular(
+            scene
+                .materials
+                .constant_specular_dielectric(material, lambda)?,
+        ),
+        None => return None,
+    };
+    out.fill(&hit, d).then_some(shade)
 }
 
 /// What [`surfaces`] needs of one triangle hit.

@@ -4,7 +4,7 @@
 
 use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
 use super::diffuse_lanes::{
-    diffuse_surface, specular_surface, DiffuseVertex, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut,
+    lane_surface, DiffuseVertex, LaneShade, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut,
 };
 use super::direct::{light_request, light_shadow_query, LightAnswer, LightRequest, ShadowQuery};
 use super::vertex::{li_by_vertices, Begin, VertexIntegrator, VertexStep};
@@ -284,7 +284,7 @@ impl VertexIntegrator for PathIntegrator {
     }
 
     #[inline(always)]
-    fn diffuse_hit(
+    fn lane_hit(
         &self,
         scene: &Scene,
         s: &PathState,
@@ -292,35 +292,15 @@ impl VertexIntegrator for PathIntegrator {
         lambda: &SampledWavelengths,
         gbuffer: bool,
         out: &mut SurfaceIn,
-    ) -> Option<SampledSpectrum> {
+    ) -> Option<LaneShade> {
         // The vertices `begin` ends (the last one) or that draw or write
-        // more than a diffuse vertex does are left to it.
+        // more than a lane vertex does are left to it; so are specular
+        // ones where regularization would roughen the BSDF.
         if s.depth >= self.max_depth || scene.force_diffuse || (gbuffer && s.depth == 0) {
             return None;
         }
-        diffuse_surface(scene, record, s.ray.ray.d, lambda, out)
-    }
-
-    #[inline(always)]
-    fn specular_hit(
-        &self,
-        scene: &Scene,
-        s: &PathState,
-        record: &HitRecord,
-        lambda: &SampledWavelengths,
-        gbuffer: bool,
-        out: &mut SurfaceIn,
-    ) -> Option<DielectricBxDF> {
-        // As `diffuse_hit`, and not where regularization would roughen
-        // the BSDF.
-        if s.depth >= self.max_depth
-            || scene.force_diffuse
-            || (gbuffer && s.depth == 0)
-            || (self.regularize && s.any_non_specular)
-        {
-            return None;
-        }
-        specular_surface(scene, record, s.ray.ray.d, lambda, out)
+        let specular = !(self.regularize && s.any_non_specular);
+        lane_surface(scene, record, s.ray.ray.d, lambda, specular, out)
     }
 
     /// `begin` and `finish` for a specular vertex: the depth, the BSDF's

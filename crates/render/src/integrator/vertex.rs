@@ -7,7 +7,7 @@
 //! the same pixels.
 
 use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
-use super::diffuse_lanes::{ScatterIn, ScatterOut, SurfaceIn, SurfaceOut};
+use super::diffuse_lanes::{LaneShade, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut};
 use super::direct::{answer_light, LightAnswer, LightRequest, ShadowQuery};
 use super::Scene;
 use crate::bxdf::DielectricBxDF;
@@ -111,12 +111,12 @@ pub(crate) trait VertexIntegrator: Sync {
         light: Option<&LightAnswer>,
     ) -> VertexStep;
 
-    /// The lane form of a diffuse vertex (`diffuse_lanes.rs`), for the
-    /// wavefront: for a hit `record` of the path in state `s` that the
-    /// lane form covers, the reflectance at `lambda`, the surface kernel's
-    /// input written to `out`; `None` (the default) where the scalar
-    /// vertex runs. `gbuffer`: the film records the first visible surface.
-    fn diffuse_hit(
+    /// The lane forms of a vertex (`diffuse_lanes.rs`), for the
+    /// wavefront: for a hit `record` of the path in state `s` that a lane
+    /// form covers, what it shades with, the surface kernel's input written
+    /// to `out`; `None` (the default) where the scalar vertex runs.
+    /// `gbuffer`: the film records the first visible surface.
+    fn lane_hit(
         &self,
         _scene: &Scene,
         _s: &Self::State,
@@ -124,30 +124,13 @@ pub(crate) trait VertexIntegrator: Sync {
         _lambda: &SampledWavelengths,
         _gbuffer: bool,
         _out: &mut SurfaceIn,
-    ) -> Option<SampledSpectrum> {
+    ) -> Option<LaneShade> {
         None
     }
 
-    /// The lane form of a specular vertex (`diffuse_lanes.rs`'s
-    /// [`specular_surface`](super::diffuse_lanes::specular_surface)), for
-    /// the wavefront: for a hit `record` of the path in state `s` that it
-    /// covers, the BxDF, the surface kernel's input written to `out`;
-    /// `None` (the default) where the scalar vertex runs.
-    fn specular_hit(
-        &self,
-        _scene: &Scene,
-        _s: &Self::State,
-        _record: &HitRecord,
-        _lambda: &SampledWavelengths,
-        _gbuffer: bool,
-        _out: &mut SurfaceIn,
-    ) -> Option<DielectricBxDF> {
-        None
-    }
-
-    /// The whole vertex that [`VertexIntegrator::specular_hit`] took,
-    /// given its surface and BxDF (a specular vertex asks for no light
-    /// sample).
+    /// The whole vertex that [`VertexIntegrator::lane_hit`] took as
+    /// [`LaneShade::Specular`], given its surface and BxDF (a specular
+    /// vertex asks for no light sample).
     fn specular_step(
         &self,
         _s: &mut Self::State,
@@ -156,11 +139,12 @@ pub(crate) trait VertexIntegrator: Sync {
         _bxdf: DielectricBxDF,
         _sampler: &mut Sampler,
     ) -> VertexStep {
-        unreachable!("specular_step without specular_hit")
+        unreachable!("specular_step without lane_hit")
     }
 
-    /// The first half of a vertex that [`VertexIntegrator::diffuse_hit`]
-    /// took, given its surface and reflectance: its light request.
+    /// The first half of a vertex that [`VertexIntegrator::lane_hit`]
+    /// took as [`LaneShade::Diffuse`], given its surface and reflectance:
+    /// its light request.
     fn diffuse_begin(
         &self,
         _s: &mut Self::State,
@@ -169,7 +153,7 @@ pub(crate) trait VertexIntegrator: Sync {
         _r: SampledSpectrum,
         _sampler: &mut Sampler,
     ) -> LightRequest {
-        unreachable!("diffuse_begin without diffuse_hit")
+        unreachable!("diffuse_begin without lane_hit")
     }
 
     /// The scatter kernel's input for such a vertex, given the answer to
@@ -179,7 +163,7 @@ pub(crate) trait VertexIntegrator: Sync {
         _scratch: &Self::Scratch,
         _light: Option<&LightAnswer>,
     ) -> ScatterIn {
-        unreachable!("scatter_in without diffuse_hit")
+        unreachable!("scatter_in without lane_hit")
     }
 
     /// The second half of such a vertex, given the scatter kernel's
@@ -193,7 +177,7 @@ pub(crate) trait VertexIntegrator: Sync {
         _light: Option<&LightAnswer>,
         _sampler: &mut Sampler,
     ) -> VertexStep {
-        unreachable!("diffuse_finish without diffuse_hit")
+        unreachable!("diffuse_finish without lane_hit")
     }
 }
 

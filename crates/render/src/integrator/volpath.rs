@@ -6,7 +6,7 @@
 
 use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
 use super::diffuse_lanes::{
-    diffuse_surface, DiffuseVertex, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut,
+    lane_surface, DiffuseVertex, LaneShade, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut,
 };
 use super::direct::ShadowQuery;
 use super::direct::{light_request, LightAnswer, LightRequest};
@@ -560,7 +560,7 @@ impl VertexIntegrator for VolPathIntegrator {
     }
 
     #[inline(always)]
-    fn diffuse_hit(
+    fn lane_hit(
         &self,
         scene: &Scene,
         s: &VolPathState,
@@ -568,7 +568,7 @@ impl VertexIntegrator for VolPathIntegrator {
         lambda: &SampledWavelengths,
         gbuffer: bool,
         out: &mut SurfaceIn,
-    ) -> Option<SampledSpectrum> {
+    ) -> Option<LaneShade> {
         // Only where `begin` asks for the light sample (no media, no
         // interfaces: the ray's medium is none and stays none), and not
         // where it ends the path or writes the visible surface.
@@ -580,7 +580,8 @@ impl VertexIntegrator for VolPathIntegrator {
         {
             return None;
         }
-        diffuse_surface(scene, record, s.ray.ray.d, lambda, out)
+        // The diffuse vertex only (`volpath` has no specular step yet).
+        lane_surface(scene, record, s.ray.ray.d, lambda, false, out)
     }
 
     #[inline(always)]

@@ -47,14 +47,15 @@
 
 use super::bsdf_stage::{answer_bsdfs, BsdfAnswers, BsdfBatch, BsdfQuery};
 use super::camera_samples::{differential_scale, CameraBatch, CameraDraws, CameraRaySample};
-use super::diffuse_lanes::{scatters, surfaces, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut};
+use super::diffuse_lanes::{
+    scatters, surfaces, LaneShade, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut,
+};
 use super::direct::{answer_lights, LightAnswer, LightBatch, LightRequest};
 use super::render::RenderOptions;
 use super::stages::{Stage, StageClock};
 use super::tile::{add_estimate, RayIntegrator, RayTiles, TileIntegrator};
 use super::vertex::{Begin, VertexIntegrator};
 use super::Scene;
-use crate::bxdf::DielectricBxDF;
 use crate::film::{FilmTile, SplatBuffer, VisibleSurface};
 use crate::primitive::HitRecord;
 use crate::sampler::{FourDrawBatch, Sampler, SamplerCursor};
@@ -103,15 +104,6 @@ struct Lane<S> {
     diffuse: bool,
     /// The vertex being shaded is a specular vertex taken in lanes.
     specular: bool,
-}
-
-/// What a vertex whose surface the kernel builds shades with.
-#[derive(Clone, Copy)]
-enum LaneShade {
-    /// A diffuse vertex's reflectance.
-    Diffuse(SampledSpectrum),
-    /// A specular vertex's BxDF.
-    Specular(DielectricBxDF),
 }
 
 /// A finished sample waiting for its turn to be added to the tile.
@@ -425,13 +417,12 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     surface_in.push(SurfaceIn::default());
                 }
                 let out = &mut surface_in[k];
-                let (s, lambda) = (&lane.path, &lane.lambda);
-                if let Some(r) = self.0.diffuse_hit(scene, s, h, lambda, gbuffer, out) {
+                if let Some(shade) =
+                    self.0
+                        .lane_hit(scene, &lane.path, h, &lane.lambda, gbuffer, out)
+                {
                     diffuse.push(i);
-                    shades.push(LaneShade::Diffuse(r));
-                } else if let Some(b) = self.0.specular_hit(scene, s, h, lambda, gbuffer, out) {
-                    diffuse.push(i);
-                    shades.push(LaneShade::Specular(b));
+                    shades.push(shade);
                 }
             }
             surface_in.truncate(diffuse.len());
