@@ -109,11 +109,11 @@ pub enum Accelerator {
     /// A binary bounding volume hierarchy (pbrt-v4 `BVHAggregate`;
     /// `Accelerator "bvh" "integer width" 2`).
     Bvh(Bvh),
-    /// The same SAH tree collapsed to 4-wide nodes (`Accelerator "bvh"`,
-    /// the default: the fastest in `benches/accel.rs`).
+    /// The same SAH tree collapsed to 4-wide nodes
+    /// (`Accelerator "bvh" "integer width" 4`).
     Bvh4(Bvh4),
-    /// The same SAH tree collapsed to 8-wide nodes
-    /// (`Accelerator "bvh" "integer width" 8`).
+    /// The same SAH tree collapsed to 8-wide nodes (`Accelerator "bvh"`,
+    /// the default: the fastest in `benches/accel.rs`).
     Bvh8(Bvh8),
     /// An SAH kd-tree (pbrt-v3 `KdTreeAccel`).
     KdTree(KdTree),
@@ -165,7 +165,7 @@ impl Accelerator {
             match EmbreeAccel::build(n, &bounds, triangle) {
                 Ok(a) => return Accelerator::Embree(a),
                 Err(_) => {
-                    return Accelerator::Bvh4(Bvh4::build_from(
+                    return Accelerator::Bvh8(Bvh8::build_from(
                         n,
                         bounds,
                         &BvhParams::default(),
@@ -180,10 +180,10 @@ impl Accelerator {
             AccelKind::Bvh if params.bvh.width == 2 => {
                 Accelerator::Bvh(Bvh::build_from(n, bounds, &params.bvh, threads))
             }
-            AccelKind::Bvh if params.bvh.width == 8 => {
-                Accelerator::Bvh8(Bvh8::build_from(n, bounds, &params.bvh, threads))
+            AccelKind::Bvh if params.bvh.width == 4 => {
+                Accelerator::Bvh4(Bvh4::build_from(n, bounds, &params.bvh, threads))
             }
-            AccelKind::Bvh => Accelerator::Bvh4(Bvh4::build_from(n, bounds, &params.bvh, threads)),
+            AccelKind::Bvh => Accelerator::Bvh8(Bvh8::build_from(n, bounds, &params.bvh, threads)),
             _ => {
                 let b: Vec<Bounds3f> = (0..n as u32).map(bounds).collect();
                 Accelerator::build_with_threads(&b, params, threads)
@@ -205,11 +205,11 @@ impl Accelerator {
             AccelKind::Bvh if params.bvh.width == 2 => {
                 Accelerator::Bvh(Bvh::build_with_threads(prim_bounds, &params.bvh, threads))
             }
-            AccelKind::Bvh if params.bvh.width == 8 => {
-                Accelerator::Bvh8(Bvh8::build_with_threads(prim_bounds, &params.bvh, threads))
+            AccelKind::Bvh if params.bvh.width == 4 => {
+                Accelerator::Bvh4(Bvh4::build_with_threads(prim_bounds, &params.bvh, threads))
             }
             AccelKind::Bvh => {
-                Accelerator::Bvh4(Bvh4::build_with_threads(prim_bounds, &params.bvh, threads))
+                Accelerator::Bvh8(Bvh8::build_with_threads(prim_bounds, &params.bvh, threads))
             }
             AccelKind::KdTree => Accelerator::KdTree(KdTree::build(prim_bounds, &params.kdtree)),
             AccelKind::Grid => Accelerator::Grid(Grid::build(prim_bounds, &params.grid)),
@@ -217,7 +217,7 @@ impl Accelerator {
             AccelKind::Embree => {
                 match EmbreeAccel::build(prim_bounds.len(), |e| prim_bounds[e as usize], |_| None) {
                     Ok(a) => Accelerator::Embree(a),
-                    Err(_) => Accelerator::Bvh4(Bvh4::build_with_threads(
+                    Err(_) => Accelerator::Bvh8(Bvh8::build_with_threads(
                         prim_bounds,
                         &BvhParams::default(),
                         threads,

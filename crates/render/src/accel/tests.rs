@@ -201,7 +201,10 @@ where
         singles.push(got);
     }
     match accel {
-        Accelerator::Bvh4(bvh) => check_packets(name, bvh, rays, &singles, &hit),
+        Accelerator::Bvh4(bvh) => {
+            check_packets(name, bvh, rays, &singles, &hit);
+            check_levels(name, bvh, rays, &singles, &hit);
+        }
         Accelerator::Bvh8(bvh) => {
             check_packets(name, bvh, rays, &singles, &hit);
             check_levels(name, bvh, rays, &singles, &hit);

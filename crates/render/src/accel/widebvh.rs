@@ -6,11 +6,13 @@
 //!
 //! A node stores its children's boxes structure-of-arrays (one `[f32; W]`
 //! per box plane), so the slab test of all its children is a handful of
-//! `W`-lane operations that the compiler maps onto vector registers without
-//! any `unsafe`: SSE or NEON for the 4-wide tree; the 8-wide tree's
-//! traversals run inside [`crate::simd::dispatch`], so that on a processor
-//! with AVX2 they are compiled for it and test the eight boxes with 8-lane
-//! AVX instructions. Per ray, the near and far plane of each axis are chosen
+//! lane operations ([`crate::simd::F32Lanes`]): the traversals run inside
+//! [`crate::simd::dispatch`], and test a node's boxes a whole vector at a
+//! time (the 8-wide tree's eight with one AVX2 instruction per step, or two
+//! SSE ones; the 4-wide tree's four with one SSE instruction). Left to the
+//! compiler, the same loops came out as a mix of scalar and partial vector
+//! code with a long shuffle chain for the mask. Per ray, the near and far
+//! plane of each axis are chosen
 //! once by the direction's sign, so the slab test needs no per-axis min/max.
 //! Leaf children are intersected as soon as their box is hit; interior
 //! children are pushed far to near with their entry distance, and popped
@@ -22,7 +24,7 @@
 
 use super::bvh::{Bvh, BvhNode, STACK_SIZE};
 use super::params::BvhParams;
-use super::{far_pad, fmax, fmin, Aggregate};
+use super::{far_pad, Aggregate};
 use crate::simd::{F32Lanes, Kernel};
 use rpbrt_geometry::{next_float_down, next_float_up, Bounds3f, Float, Ray};
 use std::mem::MaybeUninit;
@@ -197,27 +199,58 @@ impl WideRay {
         }
         w
     }
+}
 
-    /// Entry distances of the four children and the mask of those the ray
-    /// overlaps within `[0, t_max]`.
+/// A [`WideRay`]'s values splatted over lanes `L`, for the slab test of
+/// `L::N` children at a time.
+struct LaneRay<L: F32Lanes> {
+    near: [usize; 3],
+    far: [usize; 3],
+    o_near: [L; 3],
+    o_far: [L; 3],
+    inv: [L; 3],
+    inv_far: [L; 3],
+}
+
+impl<L: F32Lanes> LaneRay<L> {
+    #[inline(always)]
+    fn new(w: &WideRay) -> LaneRay<L> {
+        LaneRay {
+            near: w.near,
+            far: w.far,
+            o_near: w.o_near.map(L::splat),
+            o_far: w.o_far.map(L::splat),
+            inv: w.inv.map(L::splat),
+            inv_far: w.inv_far.map(L::splat),
+        }
+    }
+
+    /// Entry distances of the node's children and the mask of those the
+    /// ray overlaps within `[0, t_max]`, `L::N` children per instruction
+    /// (`W` is a multiple of `L::N`). Each lane computes what the scalar
+    /// slab test computes, in the same order (`max` and `min` keep the
+    /// scalar operand order, so NaNs resolve the same way): the masks and
+    /// distances are bit-identical at every width.
     #[inline(always)]
     fn test<const W: usize>(&self, node: &WideNode<W>, t_max: Float) -> ([Float; W], u32) {
+        debug_assert_eq!(W % L::N, 0);
         let b = &node.bounds;
         let mut t0 = [0.0 as Float; W];
-        let mut t1 = [t_max; W];
-        for a in 0..3 {
-            let nr = &b[self.near[a]];
-            let fr = &b[self.far[a]];
-            let (on, of) = (self.o_near[a], self.o_far[a]);
-            let (inv, inv_far) = (self.inv[a], self.inv_far[a]);
-            for i in 0..W {
-                t0[i] = fmax(t0[i], (nr[i] - on) * inv);
-                t1[i] = fmin(t1[i], (fr[i] - of) * inv_far);
-            }
-        }
         let mut mask = 0u32;
-        for i in 0..W {
-            mask |= ((t0[i] <= t1[i]) as u32) << i;
+        let tm = L::splat(t_max);
+        let mut k = 0;
+        while k < W {
+            let mut near = L::splat(0.0);
+            let mut far = tm;
+            for a in 0..3 {
+                let n = L::load(&b[self.near[a]][k..]);
+                let f = L::load(&b[self.far[a]][k..]);
+                near = near.max(n.sub(self.o_near[a]).mul(self.inv[a]));
+                far = far.min(f.sub(self.o_far[a]).mul(self.inv_far[a]));
+            }
+            near.store(&mut t0[k..]);
+            mask |= L::bits(near.le(far)) << k;
+            k += L::N;
         }
         (t0, mask)
     }
@@ -419,16 +452,21 @@ impl<const W: usize> WideBvh<W> {
     }
 
     /// [`Aggregate::intersect_slots`], compiled for the caller's
-    /// instruction set.
+    /// instruction set, testing boxes `L::N` at a time.
     #[inline(always)]
-    fn closest_slots<F>(&self, ray: &Ray, t_max: Float, mut hit: F) -> Option<(u32, Float)>
+    fn closest_slots<L: F32Lanes, F>(
+        &self,
+        ray: &Ray,
+        t_max: Float,
+        mut hit: F,
+    ) -> Option<(u32, Float)>
     where
         F: FnMut(u32, u32, &Ray, Float) -> Option<Float>,
     {
         if self.nodes.is_empty() {
             return None;
         }
-        let w = WideRay::new(ray);
+        let w = LaneRay::<L>::new(&WideRay::new(ray));
         let mut t_max = t_max;
         let mut best = None;
         let mut stack: Stack<(u32, Float)> = Stack::new();
@@ -474,16 +512,16 @@ impl<const W: usize> WideBvh<W> {
     }
 
     /// [`Aggregate::intersect_p_slots`], compiled for the caller's
-    /// instruction set.
+    /// instruction set, testing boxes `L::N` at a time.
     #[inline(always)]
-    fn any_slots<F>(&self, ray: &Ray, t_max: Float, mut hit: F) -> bool
+    fn any_slots<L: F32Lanes, F>(&self, ray: &Ray, t_max: Float, mut hit: F) -> bool
     where
         F: FnMut(u32, u32, &Ray, Float) -> bool,
     {
         if self.nodes.is_empty() {
             return false;
         }
-        let w = WideRay::new(ray);
+        let w = LaneRay::<L>::new(&WideRay::new(ray));
         let mut stack: Stack<u32> = Stack::new();
         let mut cur = 0u32;
         loop {
@@ -613,11 +651,7 @@ impl<const W: usize> Aggregate for WideBvh<W> {
     where
         F: FnMut(u32, u32, &Ray, Float) -> Option<Float>,
     {
-        if W > 4 {
-            self.intersect_slots_at(crate::simd::level(), ray, t_max, hit)
-        } else {
-            self.closest_slots(ray, t_max, hit)
-        }
+        self.intersect_slots_at(crate::simd::level(), ray, t_max, hit)
     }
 
     #[inline]
@@ -625,11 +659,7 @@ impl<const W: usize> Aggregate for WideBvh<W> {
     where
         F: FnMut(u32, u32, &Ray, Float) -> bool,
     {
-        if W > 4 {
-            self.intersect_p_slots_at(crate::simd::level(), ray, t_max, hit)
-        } else {
-            self.any_slots(ray, t_max, hit)
-        }
+        self.intersect_p_slots_at(crate::simd::level(), ray, t_max, hit)
     }
 
     fn memory_bytes(&self) -> usize {
@@ -664,7 +694,15 @@ where
     type Output = Option<(u32, Float)>;
     #[inline(always)]
     fn run<L: F32Lanes>(self) -> Self::Output {
-        self.bvh.closest_slots(self.ray, self.t_max, self.hit)
+        // Boxes a whole vector at a time: the 4-wide tree at 8 lanes
+        // takes the level's 4-lane vectors.
+        if W >= L::N {
+            self.bvh
+                .closest_slots::<L, F>(self.ray, self.t_max, self.hit)
+        } else {
+            self.bvh
+                .closest_slots::<L::Four, F>(self.ray, self.t_max, self.hit)
+        }
     }
 }
 
@@ -683,7 +721,12 @@ where
     type Output = bool;
     #[inline(always)]
     fn run<L: F32Lanes>(self) -> bool {
-        self.bvh.any_slots(self.ray, self.t_max, self.hit)
+        if W >= L::N {
+            self.bvh.any_slots::<L, F>(self.ray, self.t_max, self.hit)
+        } else {
+            self.bvh
+                .any_slots::<L::Four, F>(self.ray, self.t_max, self.hit)
+        }
     }
 }
 

@@ -571,7 +571,7 @@ pub struct PrimitiveAggregate {
     entries: EntryMap,
     accel: Accelerator,
     /// Per slot of the acceleration structure (its leaf order for the
-    /// 4-wide BVH, so that a leaf's triangles are read from consecutive
+    /// wide BVHs, so that a leaf's triangles are read from consecutive
     /// memory): the vertices of an opaque, non-degenerate triangle, so that
     /// the traversal tests it without going through the primitive and its
     /// mesh (`None` for every other entry; empty for large aggregates).
@@ -772,7 +772,7 @@ impl PrimitiveAggregate {
 
     /// [`PrimitiveAggregate::intersect_record`] of each of up to
     /// [`MAX_PACKET`] rays (no bound on the ray parameter), into the first
-    /// `rays.len()` values of `out`. Under the 4-wide BVH the rays walk the
+    /// `rays.len()` values of `out`. Under a wide BVH the rays walk the
     /// tree as one packet at `level`'s width ([`crate::accel::packet`]);
     /// otherwise, or at [`SimdLevel::Scalar`], one by one. The records are
     /// those of single rays, but where two primitives tie exactly in

@@ -15,6 +15,10 @@ pub trait F32Lanes: Copy {
     type Mask: Copy;
     /// `u32` lanes of the same width.
     type U32: super::U32Lanes;
+    /// Lanes of the same instruction set at most four wide (this type
+    /// where it has four lanes or fewer): for data four wide, such as the
+    /// 4-wide BVH's nodes.
+    type Four: F32Lanes;
     /// Lane-wise `u as f32` (rounded to nearest, ties to even).
     fn from_u32(u: Self::U32) -> Self;
     /// Every lane `x`.
@@ -98,6 +102,7 @@ impl F32Lanes for Scalar1 {
     const N: usize = 1;
     type Mask = bool;
     type U32 = super::U32x1;
+    type Four = Scalar1;
     #[inline(always)]
     fn from_u32(u: super::U32x1) -> Self {
         Scalar1(u.0 as f32)
@@ -258,6 +263,7 @@ mod x86 {
         const N: usize = 8;
         type Mask = __m256;
         type U32 = U32x8;
+        type Four = F32x4;
         #[inline(always)]
         fn from_u32(u: U32x8) -> Self {
             // The high and low halves convert exactly (as signed values
@@ -443,6 +449,7 @@ mod x86 {
         const N: usize = 4;
         type Mask = __m128;
         type U32 = U32x4;
+        type Four = F32x4;
         #[inline(always)]
         fn from_u32(u: U32x4) -> Self {
             // As F32x8's.

@@ -25,7 +25,7 @@ fn embree_without_the_feature_warns_and_uses_the_bvh() {
     };
     assert!(matches!(
         created.scene.aggregate.accelerator(),
-        Accelerator::Bvh4(_)
+        Accelerator::Bvh8(_)
     ));
     let w: Vec<String> = created.warnings.iter().map(|d| d.to_string()).collect();
     // One located warning, at the directive; its (ignored) parameters are
