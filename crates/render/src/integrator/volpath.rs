@@ -17,7 +17,7 @@ use super::volume::{
 };
 use super::{skip_intersection, RayIntegrator, Scene, VertexOrigins};
 use crate::bssrdf::{Bssrdf, SeparableBssrdf};
-use crate::bxdf::{BxDFReflTransFlags, TransportMode, BSDF};
+use crate::bxdf::{BxDF, BxDFReflTransFlags, DielectricBxDF, TransportMode, BSDF};
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
 use crate::medium::{sample_t_maj, HGPhaseFunction};
@@ -26,6 +26,7 @@ use crate::rng::{mix_bits, Rng};
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::{Float, INV_PI};
+use rpbrt_geometry::frame::Frame;
 use rpbrt_geometry::interaction::SurfaceInteraction;
 use rpbrt_geometry::ray::{
     spawn_ray_from_origin_to_surface, MediumId, Ray, RayDifferential, SHADOW_EPSILON,
@@ -580,8 +581,57 @@ impl VertexIntegrator for VolPathIntegrator {
         {
             return None;
         }
-        // The diffuse vertex only (`volpath` has no specular step yet).
-        lane_surface(scene, record, s.ray.ray.d, lambda, false, out)
+        // Specular vertices too, but where regularization would roughen
+        // the BSDF.
+        let specular = !(self.regularize && s.any_non_specular);
+        lane_surface(scene, record, s.ray.ray.d, lambda, specular, out)
+    }
+
+    /// `begin` and `finish` for a specular vertex in a scene without
+    /// media: the depth, the BSDF's draws and its sample from ωo (the
+    /// scalar BSDF's own, in the frame the surface kernel built), the
+    /// path's probabilities, the next ray (its medium stays none: there
+    /// are no interfaces) and Russian roulette; no subsurface scattering
+    /// (a `dielectric` has none).
+    #[inline(always)]
+    fn specular_step(
+        &self,
+        s: &mut VolPathState,
+        scratch: &mut VolPathScratch,
+        surface: &SurfaceOut,
+        bxdf: DielectricBxDF,
+        sampler: &mut Sampler,
+    ) -> VertexStep {
+        scratch.hit = None;
+        scratch.bsdf = None;
+        s.depth += 1;
+        let (u, u2) = (sampler.get_1d(), sampler.get_2d());
+        // `LightSampleContext::from_si`.
+        s.prev_ctx.pi = surface.pi;
+        s.prev_ctx.n = surface.n;
+        s.prev_ctx.ns = surface.ns;
+        let bsdf = BSDF {
+            bxdf: BxDF::Dielectric(bxdf),
+            shading_frame: Frame {
+                x: surface.x,
+                y: surface.y,
+                z: Vector3f::from(surface.ns),
+            },
+        };
+        let Some((bs, p_b)) = BsdfAnswers::default().sample(&bsdf, surface.wo, u, u2) else {
+            return VertexStep::DONE;
+        };
+        s.beta *= bs.f * (abs_dot(bs.wi, surface.ns) / bs.pdf);
+        s.r_l = s.r_u / p_b;
+        s.specular_bounce = bs.is_specular();
+        s.any_non_specular |= !bs.is_specular();
+        if bs.is_transmission() {
+            s.eta_scale *= bs.eta * bs.eta;
+        }
+        // `VertexOrigins::spawn_ray`'s side test.
+        let o = surface.sides[(dot(bs.wi, surface.n) < 0.0) as usize];
+        s.ray = RayDifferential::new(Ray::with_time(o, bs.wi, s.ray.ray.time, None));
+        russian_roulette(s, sampler, None)
     }
 
     #[inline(always)]
