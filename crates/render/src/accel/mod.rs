@@ -37,6 +37,7 @@ pub use grid::Grid;
 pub use kdtree::{KdNode, KdTree};
 pub use params::{
     AccelKind, AccelParams, BvhParams, GridParams, KdTreeParams, ParamValue, SplitMethod,
+    LARGE_BVH_ENTRIES,
 };
 pub use widebvh::{Bvh4, Bvh4Node, Bvh8, Bvh8Node, WideBvh, WideNode};
 
@@ -110,10 +111,12 @@ pub enum Accelerator {
     /// `Accelerator "bvh" "integer width" 2`).
     Bvh(Bvh),
     /// The same SAH tree collapsed to 4-wide nodes
-    /// (`Accelerator "bvh" "integer width" 4`).
+    /// (`Accelerator "bvh" "integer width" 4`, and the default for larger
+    /// aggregates: see [`BvhParams::width_for`]).
     Bvh4(Bvh4),
     /// The same SAH tree collapsed to 8-wide nodes (`Accelerator "bvh"`,
-    /// the default: the fastest in `benches/accel.rs`).
+    /// the default below [`params::LARGE_BVH_ENTRIES`] entries: the fastest
+    /// in `benches/accel.rs`).
     Bvh8(Bvh8),
     /// An SAH kd-tree (pbrt-v3 `KdTreeAccel`).
     KdTree(KdTree),
@@ -176,11 +179,12 @@ impl Accelerator {
         }
         #[cfg(not(feature = "embree"))]
         let _ = triangle;
+        let width = params.bvh.width_for(n);
         match params.kind {
-            AccelKind::Bvh if params.bvh.width == 2 => {
+            AccelKind::Bvh if width == 2 => {
                 Accelerator::Bvh(Bvh::build_from(n, bounds, &params.bvh, threads))
             }
-            AccelKind::Bvh if params.bvh.width == 4 => {
+            AccelKind::Bvh if width == 4 => {
                 Accelerator::Bvh4(Bvh4::build_from(n, bounds, &params.bvh, threads))
             }
             AccelKind::Bvh => Accelerator::Bvh8(Bvh8::build_from(n, bounds, &params.bvh, threads)),
@@ -201,11 +205,12 @@ impl Accelerator {
         params: &AccelParams,
         threads: usize,
     ) -> Accelerator {
+        let width = params.bvh.width_for(prim_bounds.len());
         match params.kind {
-            AccelKind::Bvh if params.bvh.width == 2 => {
+            AccelKind::Bvh if width == 2 => {
                 Accelerator::Bvh(Bvh::build_with_threads(prim_bounds, &params.bvh, threads))
             }
-            AccelKind::Bvh if params.bvh.width == 4 => {
+            AccelKind::Bvh if width == 4 => {
                 Accelerator::Bvh4(Bvh4::build_with_threads(prim_bounds, &params.bvh, threads))
             }
             AccelKind::Bvh => {

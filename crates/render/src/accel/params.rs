@@ -52,14 +52,13 @@ pub struct BvhParams {
     /// default 4, at most 255 as in pbrt-v4). Middle and equal-count splits
     /// also stop at this many primitives (pbrt splits them down to one).
     pub max_prims_in_node: u32,
-    /// Children per node (`"width"`, an rpbrt extension): 8 (the default)
-    /// collapses the SAH tree into 8-wide nodes tested together
-    /// ([`Bvh8`](super::Bvh8): one AVX2 instruction per step, or two SSE
-    /// ones), 4 into 4-wide ones ([`Bvh4`](super::Bvh4)), 2 keeps pbrt-v4's
-    /// binary layout ([`Bvh`](super::Bvh)). All give identical hits (but
-    /// for exact ties in distance). The 8-wide tree is the default because
-    /// it was the fastest in the accel bench on every mesh, at AVX2 and at
-    /// SSE4.1 (the README gives the figures).
+    /// Children per node (`"width"`, an rpbrt extension): 8 collapses the
+    /// SAH tree into 8-wide nodes tested together ([`Bvh8`](super::Bvh8):
+    /// one AVX2 instruction per step, or two SSE ones), 4 into 4-wide ones
+    /// ([`Bvh4`](super::Bvh4)), 2 keeps pbrt-v4's binary layout
+    /// ([`Bvh`](super::Bvh)). All give identical hits (but for exact ties
+    /// in distance). 0 (the default) chooses by size
+    /// ([`BvhParams::width_for`]).
     pub width: u32,
 }
 
@@ -68,7 +67,28 @@ impl Default for BvhParams {
         BvhParams {
             split_method: SplitMethod::Sah,
             max_prims_in_node: 4,
-            width: 8,
+            width: 0,
+        }
+    }
+}
+
+/// Above this many entries the default BVH is 4-wide
+/// ([`BvhParams::width_for`]).
+pub const LARGE_BVH_ENTRIES: usize = 1 << 22;
+
+impl BvhParams {
+    /// The width to build over `n` entries: the one the file gave, else 8
+    /// (the fastest in the accel bench on every mesh, at AVX2 and at
+    /// SSE4.1; the README gives the figures), or 4 above
+    /// [`LARGE_BVH_ENTRIES`]: the 8-wide tree's nodes are less full, and
+    /// over the 10-million-triangle scale bench it took 662 MB against the
+    /// 4-wide tree's 516 MB (peak 942 against 859 MiB), where memory counts
+    /// more than its 5–15% more rays per second.
+    pub fn width_for(&self, n: usize) -> u32 {
+        match self.width {
+            0 if n > LARGE_BVH_ENTRIES => 4,
+            0 => 8,
+            w => w,
         }
     }
 }
@@ -298,7 +318,9 @@ mod tests {
         let p = AccelParams::new("bvh").unwrap();
         assert_eq!(p.bvh.max_prims_in_node, 4);
         assert_eq!(p.bvh.split_method, SplitMethod::Sah);
-        assert_eq!(p.bvh.width, 8);
+        assert_eq!(p.bvh.width, 0);
+        assert_eq!(p.bvh.width_for(1000), 8);
+        assert_eq!(p.bvh.width_for(LARGE_BVH_ENTRIES + 1), 4);
         let p = AccelParams::parse("bvh", [("width", ParamValue::Int(2))]).unwrap();
         assert_eq!(p.bvh.width, 2);
         let p = AccelParams::parse(
