@@ -167,14 +167,8 @@ impl Accelerator {
         if params.kind == AccelKind::Embree {
             match EmbreeAccel::build(n, &bounds, triangle) {
                 Ok(a) => return Accelerator::Embree(a),
-                Err(_) => {
-                    return Accelerator::Bvh8(Bvh8::build_from(
-                        n,
-                        bounds,
-                        &BvhParams::default(),
-                        threads,
-                    ))
-                }
+                // The default BVH, its width chosen by size as always.
+                Err(_) => return Accelerator::build_from(n, bounds, &AccelParams::default()),
             }
         }
         #[cfg(not(feature = "embree"))]
@@ -222,11 +216,11 @@ impl Accelerator {
             AccelKind::Embree => {
                 match EmbreeAccel::build(prim_bounds.len(), |e| prim_bounds[e as usize], |_| None) {
                     Ok(a) => Accelerator::Embree(a),
-                    Err(_) => Accelerator::Bvh8(Bvh8::build_with_threads(
+                    Err(_) => Accelerator::build_with_threads(
                         prim_bounds,
-                        &BvhParams::default(),
+                        &AccelParams::default(),
                         threads,
-                    )),
+                    ),
                 }
             }
         }
