@@ -28,10 +28,11 @@
 //! perpendicular to the tangent, derivatives rescaled) are flagged and
 //! take the scalar vertex instead.
 
+use super::bsdf_stage::BsdfAnswers;
 use super::direct::{LightAnswer, LightRequest};
 use super::Scene;
 use crate::bxdf::lanes::{gather_f, gather_s, MAX_LANES, S4};
-use crate::bxdf::DielectricBxDF;
+use crate::bxdf::{BSDFSample, BxDF, DielectricBxDF, BSDF};
 use crate::light::LightSampleContext;
 use crate::primitive::{HitRecord, TriangleHit};
 use crate::sampler::Sampler;
@@ -173,6 +174,45 @@ pub(crate) struct SurfaceOut {
     /// False where the scalar code takes a branch this kernel does not:
     /// the lane must take the scalar vertex.
     pub ok: bool,
+}
+
+impl SurfaceOut {
+    /// The vertex's BSDF sample on this surface when it is specular (a
+    /// [`LaneShade::Specular`] vertex): `bxdf` in the frame the kernel
+    /// built, sampled from `wo` with the vertex's draws (a 1-D, then a
+    /// 2-D one) as the scalar vertex samples its BSDF, with its MIS
+    /// density and the next ray, leaving at `time` to the side of the
+    /// sampled direction (`VertexOrigins::spawn_ray`'s test).
+    #[inline(always)]
+    pub(crate) fn specular_sample(
+        &self,
+        bxdf: DielectricBxDF,
+        wo: Vector3f,
+        time: Float,
+        sampler: &mut Sampler,
+    ) -> Option<(BSDFSample, Float, Ray)> {
+        let (u, u2) = (sampler.get_1d(), sampler.get_2d());
+        let bsdf = BSDF {
+            bxdf: BxDF::Dielectric(bxdf),
+            shading_frame: Frame {
+                x: self.x,
+                y: self.y,
+                z: Vector3f::from(self.ns),
+            },
+        };
+        let (bs, p_b) = BsdfAnswers::default().sample(&bsdf, wo, u, u2)?;
+        let o = self.sides[(dot(bs.wi, self.n) < 0.0) as usize];
+        Some((bs, p_b, Ray::with_time(o, bs.wi, time, None)))
+    }
+
+    /// Writes the vertex's light-sampling context
+    /// (`LightSampleContext::from_si`).
+    #[inline(always)]
+    pub(crate) fn write_context(&self, ctx: &mut LightSampleContext) {
+        ctx.pi = self.pi;
+        ctx.n = self.n;
+        ctx.ns = self.ns;
+    }
 }
 
 /// A diffuse vertex between its two halves: what the second half reads

@@ -9,7 +9,7 @@ use super::diffuse_lanes::{
 use super::direct::{light_request, light_shadow_query, LightAnswer, LightRequest, ShadowQuery};
 use super::vertex::{li_by_vertices, Begin, VertexIntegrator, VertexStep};
 use super::{skip_intersection, RayIntegrator, Scene, VertexOrigins};
-use crate::bxdf::{BxDF, DielectricBxDF, BSDF};
+use crate::bxdf::{DielectricBxDF, BSDF};
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
 use crate::lightsampler::LightSampler;
@@ -18,7 +18,6 @@ use crate::sampler::Sampler;
 use crate::sampling::power_heuristic;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::{Float, INV_PI};
-use rpbrt_geometry::frame::Frame;
 use rpbrt_geometry::ray::{Ray, RayDifferential};
 use rpbrt_geometry::tuple::*;
 
@@ -318,20 +317,10 @@ impl VertexIntegrator for PathIntegrator {
         scratch.hit = None;
         scratch.bsdf = None;
         s.depth += 1;
-        let (u, u2) = (sampler.get_1d(), sampler.get_2d());
-        s.prev_ctx.pi = surface.pi;
-        s.prev_ctx.n = surface.n;
-        s.prev_ctx.ns = surface.ns;
-        let bsdf = BSDF {
-            bxdf: BxDF::Dielectric(bxdf),
-            shading_frame: Frame {
-                x: surface.x,
-                y: surface.y,
-                z: Vector3f::from(surface.ns),
-            },
-        };
+        surface.write_context(&mut s.prev_ctx);
         let wo = -s.ray.ray.d;
-        let Some((bs, p_b)) = BsdfAnswers::default().sample(&bsdf, wo, u, u2) else {
+        let Some((bs, p_b, next)) = surface.specular_sample(bxdf, wo, s.ray.ray.time, sampler)
+        else {
             return VertexStep::DONE;
         };
         s.beta *= bs.f * (abs_dot(bs.wi, surface.ns) / bs.pdf);
@@ -341,8 +330,7 @@ impl VertexIntegrator for PathIntegrator {
         if bs.is_transmission() {
             s.eta_scale *= bs.eta * bs.eta;
         }
-        let o = surface.sides[(dot(bs.wi, surface.n) < 0.0) as usize];
-        s.ray = RayDifferential::new(Ray::with_time(o, bs.wi, s.ray.ray.time, None));
+        s.ray = RayDifferential::new(next);
         russian_roulette(s, sampler, None)
     }
 

@@ -17,7 +17,7 @@ use super::volume::{
 };
 use super::{skip_intersection, RayIntegrator, Scene, VertexOrigins};
 use crate::bssrdf::{Bssrdf, SeparableBssrdf};
-use crate::bxdf::{BxDF, BxDFReflTransFlags, DielectricBxDF, TransportMode, BSDF};
+use crate::bxdf::{BxDFReflTransFlags, DielectricBxDF, TransportMode, BSDF};
 use crate::film::VisibleSurface;
 use crate::light::LightSampleContext;
 use crate::medium::{sample_t_maj, HGPhaseFunction};
@@ -26,7 +26,6 @@ use crate::rng::{mix_bits, Rng};
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::{Float, INV_PI};
-use rpbrt_geometry::frame::Frame;
 use rpbrt_geometry::interaction::SurfaceInteraction;
 use rpbrt_geometry::ray::{
     spawn_ray_from_origin_to_surface, MediumId, Ray, RayDifferential, SHADOW_EPSILON,
@@ -605,20 +604,10 @@ impl VertexIntegrator for VolPathIntegrator {
         scratch.hit = None;
         scratch.bsdf = None;
         s.depth += 1;
-        let (u, u2) = (sampler.get_1d(), sampler.get_2d());
-        // `LightSampleContext::from_si`.
-        s.prev_ctx.pi = surface.pi;
-        s.prev_ctx.n = surface.n;
-        s.prev_ctx.ns = surface.ns;
-        let bsdf = BSDF {
-            bxdf: BxDF::Dielectric(bxdf),
-            shading_frame: Frame {
-                x: surface.x,
-                y: surface.y,
-                z: Vector3f::from(surface.ns),
-            },
-        };
-        let Some((bs, p_b)) = BsdfAnswers::default().sample(&bsdf, surface.wo, u, u2) else {
+        surface.write_context(&mut s.prev_ctx);
+        let Some((bs, p_b, next)) =
+            surface.specular_sample(bxdf, surface.wo, s.ray.ray.time, sampler)
+        else {
             return VertexStep::DONE;
         };
         s.beta *= bs.f * (abs_dot(bs.wi, surface.ns) / bs.pdf);
@@ -628,9 +617,8 @@ impl VertexIntegrator for VolPathIntegrator {
         if bs.is_transmission() {
             s.eta_scale *= bs.eta * bs.eta;
         }
-        // `VertexOrigins::spawn_ray`'s side test.
-        let o = surface.sides[(dot(bs.wi, surface.n) < 0.0) as usize];
-        s.ray = RayDifferential::new(Ray::with_time(o, bs.wi, s.ray.ray.time, None));
+        // Without media or interfaces the next ray's medium stays none.
+        s.ray = RayDifferential::new(next);
         russian_roulette(s, sampler, None)
     }
 
