@@ -694,11 +694,15 @@ where
     type Output = Option<(u32, Float)>;
     #[inline(always)]
     fn run<L: F32Lanes>(self) -> Self::Output {
-        // Boxes a whole vector at a time: the 4-wide tree at 8 lanes
-        // takes the level's 4-lane vectors.
+        // Boxes a whole vector at a time: the 8-wide tree at 16 lanes
+        // takes the level's 8-lane vectors, the 4-wide tree at 8 or 16
+        // its 4-lane ones.
         if W >= L::N {
             self.bvh
                 .closest_slots::<L, F>(self.ray, self.t_max, self.hit)
+        } else if W >= <L::Eight as F32Lanes>::N {
+            self.bvh
+                .closest_slots::<L::Eight, F>(self.ray, self.t_max, self.hit)
         } else {
             self.bvh
                 .closest_slots::<L::Four, F>(self.ray, self.t_max, self.hit)
@@ -723,6 +727,9 @@ where
     fn run<L: F32Lanes>(self) -> bool {
         if W >= L::N {
             self.bvh.any_slots::<L, F>(self.ray, self.t_max, self.hit)
+        } else if W >= <L::Eight as F32Lanes>::N {
+            self.bvh
+                .any_slots::<L::Eight, F>(self.ray, self.t_max, self.hit)
         } else {
             self.bvh
                 .any_slots::<L::Four, F>(self.ray, self.t_max, self.hit)

@@ -242,10 +242,7 @@ fn batched_bvh_choices_match_single_ones() {
                 .zip(&queries)
                 .map(|(c, q)| s.sample(c, q.u))
                 .collect();
-            for level in [SimdLevel::Scalar, SimdLevel::Sse4, SimdLevel::Avx2] {
-                if level > SimdLevel::detected() {
-                    continue;
-                }
+            for level in SimdLevel::available() {
                 let mut got = Vec::new();
                 s.sample_batch(level, &queries, &mut got);
                 let bits = |v: &[Option<SampledLight>]| -> Vec<Option<(u32, u32)>> {

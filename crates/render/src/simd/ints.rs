@@ -79,18 +79,23 @@ impl U32Lanes for U32x1 {
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use x86::{U32x4, U32x8};
+pub use x86::{U32x16, U32x4, U32x8};
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::U32Lanes;
     use std::arch::x86_64::*;
 
-    /// Eight `u32` lanes in an AVX register (AVX2 kernels only).
+    /// Eight `u32` lanes in an AVX register (AVX2 and AVX-512 kernels).
     #[derive(Clone, Copy, Debug)]
     pub struct U32x8(pub(in crate::simd) __m256i);
 
-    /// Four `u32` lanes in an SSE register (SSE4.1 and AVX2 kernels).
+    /// Sixteen `u32` lanes in an AVX-512 register (AVX-512 kernels only).
+    #[derive(Clone, Copy, Debug)]
+    pub struct U32x16(pub(in crate::simd) __m512i);
+
+    /// Four `u32` lanes in an SSE register (SSE4.1, AVX2 and AVX-512
+    /// kernels).
     #[derive(Clone, Copy, Debug)]
     pub struct U32x4(pub(in crate::simd) __m128i);
 
@@ -126,8 +131,70 @@ mod x86 {
 
     // SAFETY (every `unsafe` block below): these types are only used by
     // kernels that `dispatch` runs after checking that the processor has
-    // the instructions (AVX2 for U32x8, SSE4.1 for U32x4); slices are
-    // length-checked before unaligned loads and stores.
+    // the instructions (AVX-512 F and BW for U32x16, AVX2 for U32x8,
+    // SSE4.1 for U32x4); slices are length-checked before unaligned loads
+    // and stores.
+    impl U32Lanes for U32x16 {
+        const N: usize = 16;
+        #[inline(always)]
+        fn splat(x: u32) -> Self {
+            unsafe { U32x16(_mm512_set1_epi32(x as i32)) }
+        }
+        #[inline(always)]
+        fn load(s: &[u32]) -> Self {
+            let s = &s[..16];
+            unsafe { U32x16(_mm512_loadu_epi32(s.as_ptr() as *const i32)) }
+        }
+        #[inline(always)]
+        fn store(self, s: &mut [u32]) {
+            let s = &mut s[..16];
+            unsafe { _mm512_storeu_epi32(s.as_mut_ptr() as *mut i32, self.0) }
+        }
+        #[inline(always)]
+        fn add(self, o: Self) -> Self {
+            unsafe { U32x16(_mm512_add_epi32(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn mul(self, o: Self) -> Self {
+            unsafe { U32x16(_mm512_mullo_epi32(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn xor(self, o: Self) -> Self {
+            unsafe { U32x16(_mm512_xor_si512(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn or(self, o: Self) -> Self {
+            unsafe { U32x16(_mm512_or_si512(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn and(self, o: Self) -> Self {
+            unsafe { U32x16(_mm512_and_si512(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn shr<const K: i32>(self) -> Self {
+            // The shift count in a register (the immediate form takes a
+            // `u32` constant); folded to the immediate form when inlined.
+            unsafe { U32x16(_mm512_srl_epi32(self.0, _mm_cvtsi32_si128(K))) }
+        }
+        #[inline(always)]
+        fn reverse_bits(self) -> Self {
+            // As U32x8's, the tables repeated in each 128-bit quarter.
+            unsafe {
+                let swap = _mm512_broadcast_i32x4(table128(&BYTE_SWAP));
+                let rev = _mm512_broadcast_i32x4(table128(&REV_NIBBLE));
+                let rev_high = _mm512_broadcast_i32x4(table128(&REV_NIBBLE_HIGH));
+                let v = _mm512_shuffle_epi8(self.0, swap);
+                let low = _mm512_set1_epi8(0x0f);
+                let lo = _mm512_and_si512(v, low);
+                let hi = _mm512_and_si512(_mm512_srli_epi16::<4>(v), low);
+                U32x16(_mm512_or_si512(
+                    _mm512_shuffle_epi8(rev_high, lo),
+                    _mm512_shuffle_epi8(rev, hi),
+                ))
+            }
+        }
+    }
+
     impl U32Lanes for U32x8 {
         const N: usize = 8;
         #[inline(always)]

@@ -19,6 +19,9 @@ pub trait F32Lanes: Copy {
     /// where it has four lanes or fewer): for data four wide, such as the
     /// 4-wide BVH's nodes.
     type Four: F32Lanes;
+    /// Lanes of the same instruction set at most eight wide, as `Four`:
+    /// for the 8-wide BVH's nodes.
+    type Eight: F32Lanes;
     /// Lane-wise `u as f32` (rounded to nearest, ties to even).
     fn from_u32(u: Self::U32) -> Self;
     /// Every lane `x`.
@@ -103,6 +106,7 @@ impl F32Lanes for Scalar1 {
     type Mask = bool;
     type U32 = super::U32x1;
     type Four = Scalar1;
+    type Eight = Scalar1;
     #[inline(always)]
     fn from_u32(u: super::U32x1) -> Self {
         Scalar1(u.0 as f32)
@@ -237,33 +241,239 @@ impl F32Lanes for Scalar1 {
 }
 
 #[cfg(target_arch = "x86_64")]
-pub use x86::{F32x4, F32x8};
+pub use x86::{F32x16, F32x4, F32x8};
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::F32Lanes;
-    use crate::simd::{U32x4, U32x8};
+    use crate::simd::{U32x16, U32x4, U32x8};
     use std::arch::x86_64::*;
 
     /// Eight lanes in an AVX register. Only [`crate::simd::dispatch`]'s
-    /// AVX2 path runs code that uses it (the processor has AVX2 there).
+    /// AVX2 and AVX-512 paths run code that uses it (the processor has
+    /// AVX2 there).
     #[derive(Clone, Copy, Debug)]
     pub struct F32x8(__m256);
 
+    /// Sixteen lanes in an AVX-512 register, with a 16-bit mask register
+    /// for masks. Only [`crate::simd::dispatch`]'s AVX-512 path runs code
+    /// that uses it.
+    #[derive(Clone, Copy, Debug)]
+    pub struct F32x16(__m512);
+
     /// Four lanes in an SSE register. Only [`crate::simd::dispatch`]'s
-    /// SSE4.1 and AVX2 paths run code that uses it.
+    /// SSE4.1, AVX2 and AVX-512 paths run code that uses it.
     #[derive(Clone, Copy, Debug)]
     pub struct F32x4(__m128);
 
     // SAFETY (every `unsafe` block below): these types are only used by
     // kernels that `dispatch` runs after checking that the processor has
-    // the instructions (AVX for F32x8, SSE4.1 for F32x4); slices are
-    // length-checked before unaligned loads and stores.
+    // the instructions (AVX-512 F, BW, DQ and VL for F32x16, AVX for
+    // F32x8, SSE4.1 for F32x4); slices are length-checked before unaligned
+    // loads and stores.
+    impl F32Lanes for F32x16 {
+        const N: usize = 16;
+        type Mask = __mmask16;
+        type U32 = U32x16;
+        type Four = F32x4;
+        type Eight = F32x8;
+        #[inline(always)]
+        fn from_u32(u: U32x16) -> Self {
+            // One rounding to nearest, as `u as f32`.
+            unsafe { F32x16(_mm512_cvtepu32_ps(u.0)) }
+        }
+        #[inline(always)]
+        fn splat(x: f32) -> Self {
+            unsafe { F32x16(_mm512_set1_ps(x)) }
+        }
+        #[inline(always)]
+        fn load(s: &[f32]) -> Self {
+            let s = &s[..16];
+            unsafe { F32x16(_mm512_loadu_ps(s.as_ptr())) }
+        }
+        #[inline(always)]
+        fn store(self, s: &mut [f32]) {
+            let s = &mut s[..16];
+            unsafe { _mm512_storeu_ps(s.as_mut_ptr(), self.0) }
+        }
+        #[inline(always)]
+        fn add(self, o: Self) -> Self {
+            unsafe { F32x16(_mm512_add_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn sub(self, o: Self) -> Self {
+            unsafe { F32x16(_mm512_sub_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn mul(self, o: Self) -> Self {
+            unsafe { F32x16(_mm512_mul_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn min(self, o: Self) -> Self {
+            // vminps(a, b) = a < b ? a : b, as minps.
+            unsafe { F32x16(_mm512_min_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn max(self, o: Self) -> Self {
+            unsafe { F32x16(_mm512_max_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn lt(self, o: Self) -> __mmask16 {
+            unsafe { _mm512_cmp_ps_mask::<_CMP_LT_OQ>(self.0, o.0) }
+        }
+        #[inline(always)]
+        fn le(self, o: Self) -> __mmask16 {
+            unsafe { _mm512_cmp_ps_mask::<_CMP_LE_OQ>(self.0, o.0) }
+        }
+        #[inline(always)]
+        fn select(m: __mmask16, a: Self, b: Self) -> Self {
+            // The blend takes its second operand where the mask is set.
+            unsafe { F32x16(_mm512_mask_blend_ps(m, b.0, a.0)) }
+        }
+        #[inline(always)]
+        fn and(a: __mmask16, b: __mmask16) -> __mmask16 {
+            a & b
+        }
+        #[inline(always)]
+        fn bits(m: __mmask16) -> u32 {
+            m as u32
+        }
+        #[inline(always)]
+        fn from_bits(bits: u32) -> __mmask16 {
+            bits as __mmask16
+        }
+        #[inline(always)]
+        fn div(self, o: Self) -> Self {
+            unsafe { F32x16(_mm512_div_ps(self.0, o.0)) }
+        }
+        #[inline(always)]
+        fn sqrt(self) -> Self {
+            unsafe { F32x16(_mm512_sqrt_ps(self.0)) }
+        }
+        #[inline(always)]
+        fn abs(self) -> Self {
+            unsafe {
+                let b = _mm512_castps_si512(self.0);
+                F32x16(_mm512_castsi512_ps(_mm512_and_si512(
+                    b,
+                    _mm512_set1_epi32(i32::MAX),
+                )))
+            }
+        }
+        #[inline(always)]
+        fn neg(self) -> Self {
+            unsafe {
+                let b = _mm512_castps_si512(self.0);
+                F32x16(_mm512_castsi512_ps(_mm512_xor_si512(
+                    b,
+                    _mm512_set1_epi32(i32::MIN),
+                )))
+            }
+        }
+        #[inline(always)]
+        fn floor(self) -> Self {
+            // Round toward −∞, no precision exception: `floor`.
+            unsafe {
+                F32x16(_mm512_roundscale_ps::<
+                    { _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC },
+                >(self.0))
+            }
+        }
+        #[inline(always)]
+        fn eq(self, o: Self) -> __mmask16 {
+            unsafe { _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(self.0, o.0) }
+        }
+        #[inline(always)]
+        fn is_nan(self) -> __mmask16 {
+            unsafe { _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(self.0, self.0) }
+        }
+        #[inline(always)]
+        fn or(a: __mmask16, b: __mmask16) -> __mmask16 {
+            a | b
+        }
+        #[inline(always)]
+        fn not(a: __mmask16) -> __mmask16 {
+            !a
+        }
+        #[inline(always)]
+        fn difference_of_products(a: Self, b: Self, c: Self, d: Self) -> Self {
+            unsafe {
+                let (lo, hi) = products_pd16(a.0, b.0, c.0, d.0);
+                let l = _mm512_cvtpd_ps(_mm512_sub_pd(lo.0, lo.1));
+                let h = _mm512_cvtpd_ps(_mm512_sub_pd(hi.0, hi.1));
+                F32x16(_mm512_insertf32x8::<1>(_mm512_castps256_ps512(l), h))
+            }
+        }
+        #[inline(always)]
+        fn sum_of_products(a: Self, b: Self, c: Self, d: Self) -> Self {
+            unsafe {
+                let (lo, hi) = products_pd16(a.0, b.0, c.0, d.0);
+                let l = _mm512_cvtpd_ps(_mm512_add_pd(lo.0, lo.1));
+                let h = _mm512_cvtpd_ps(_mm512_add_pd(hi.0, hi.1));
+                F32x16(_mm512_insertf32x8::<1>(_mm512_castps256_ps512(l), h))
+            }
+        }
+        #[inline(always)]
+        fn pow2i(n: Self) -> Self {
+            unsafe {
+                let e = _mm512_add_epi32(_mm512_cvttps_epi32(n.0), _mm512_set1_epi32(127));
+                F32x16(_mm512_castsi512_ps(_mm512_slli_epi32::<23>(e)))
+            }
+        }
+        #[inline(always)]
+        fn step_bits(self, up: __mmask16) -> Self {
+            unsafe {
+                let b = _mm512_castps_si512(self.0);
+                let one = _mm512_set1_epi32(1);
+                let plus = _mm512_add_epi32(b, one);
+                let minus = _mm512_sub_epi32(b, one);
+                F32x16(_mm512_castsi512_ps(_mm512_mask_blend_epi32(
+                    up, minus, plus,
+                )))
+            }
+        }
+    }
+
+    /// The exact products `a·b` and `c·d` in `f64`, of the low eight lanes
+    /// and of the high eight.
+    #[inline(always)]
+    #[allow(clippy::type_complexity)]
+    unsafe fn products_pd16(
+        a: __m512,
+        b: __m512,
+        c: __m512,
+        d: __m512,
+    ) -> ((__m512d, __m512d), (__m512d, __m512d)) {
+        (
+            (
+                _mm512_mul_pd(pd_lo(a), pd_lo(b)),
+                _mm512_mul_pd(pd_lo(c), pd_lo(d)),
+            ),
+            (
+                _mm512_mul_pd(pd_hi(a), pd_hi(b)),
+                _mm512_mul_pd(pd_hi(c), pd_hi(d)),
+            ),
+        )
+    }
+
+    /// The low eight lanes of `x` as `f64` (exact).
+    #[inline(always)]
+    unsafe fn pd_lo(x: __m512) -> __m512d {
+        _mm512_cvtps_pd(_mm512_castps512_ps256(x))
+    }
+
+    /// The high eight lanes of `x` as `f64` (exact).
+    #[inline(always)]
+    unsafe fn pd_hi(x: __m512) -> __m512d {
+        _mm512_cvtps_pd(_mm512_extractf32x8_ps::<1>(x))
+    }
+
     impl F32Lanes for F32x8 {
         const N: usize = 8;
         type Mask = __m256;
         type U32 = U32x8;
         type Four = F32x4;
+        type Eight = F32x8;
         #[inline(always)]
         fn from_u32(u: U32x8) -> Self {
             // The high and low halves convert exactly (as signed values
@@ -450,6 +660,7 @@ mod x86 {
         type Mask = __m128;
         type U32 = U32x4;
         type Four = F32x4;
+        type Eight = F32x4;
         #[inline(always)]
         fn from_u32(u: U32x4) -> Self {
             // As F32x8's.

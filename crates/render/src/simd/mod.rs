@@ -5,14 +5,14 @@
 //! A kernel is written once, generic over [`F32Lanes`] (a few `f32` lanes
 //! and their operations, with [`U32Lanes`] of the same width beside them
 //! for bit work), and [`dispatch`] runs it at the widest width the
-//! processor offers: AVX2 with FMA (8 lanes), SSE4.1 (4 lanes) or plain
-//! scalar code (1 lane), chosen once per process from
-//! `is_x86_feature_detected!`, or forced with `RPBRT_SIMD=scalar|sse4|avx2`
-//! (for tests and benchmarks; a level the processor lacks falls back to
-//! the best it has). Every lane operation is the IEEE operation the scalar
-//! code performs (`min`/`max` with the scalar code's NaN order), so a
-//! kernel gives the same values at every width. AVX-512 is not built yet:
-//! processors that have it run the AVX2 kernels.
+//! processor offers: AVX-512 (16 lanes), AVX2 with FMA (8 lanes), SSE4.1
+//! (4 lanes) or plain scalar code (1 lane), chosen once per process from
+//! `is_x86_feature_detected!`, or forced with
+//! `RPBRT_SIMD=scalar|sse4|avx2|avx512` (for tests and benchmarks; a level
+//! the processor lacks falls back to the best it has). Every lane
+//! operation is the IEEE operation the scalar code performs (`min`/`max`
+//! with the scalar code's NaN order), so a kernel gives the same values at
+//! every width.
 
 mod ints;
 mod lanes;
@@ -20,10 +20,10 @@ pub mod math;
 
 pub use ints::{U32Lanes, U32x1};
 #[cfg(target_arch = "x86_64")]
-pub use ints::{U32x4, U32x8};
+pub use ints::{U32x16, U32x4, U32x8};
 pub use lanes::{F32Lanes, Scalar1};
 #[cfg(target_arch = "x86_64")]
-pub use lanes::{F32x4, F32x8};
+pub use lanes::{F32x16, F32x4, F32x8};
 
 use std::sync::OnceLock;
 
@@ -40,6 +40,8 @@ pub enum SimdLevel {
     Sse4,
     /// AVX2 with FMA: 8 lanes.
     Avx2,
+    /// AVX-512 (F, BW, DQ and VL, beside AVX2 and FMA): 16 lanes.
+    Avx512,
 }
 
 impl SimdLevel {
@@ -49,6 +51,7 @@ impl SimdLevel {
             SimdLevel::Scalar => 1,
             SimdLevel::Sse4 => 4,
             SimdLevel::Avx2 => 8,
+            SimdLevel::Avx512 => 16,
         }
     }
 
@@ -58,6 +61,7 @@ impl SimdLevel {
             SimdLevel::Scalar => "scalar",
             SimdLevel::Sse4 => "sse4",
             SimdLevel::Avx2 => "avx2",
+            SimdLevel::Avx512 => "avx512",
         }
     }
 
@@ -67,23 +71,38 @@ impl SimdLevel {
             "scalar" => Some(SimdLevel::Scalar),
             "sse4" | "sse4.1" | "sse41" => Some(SimdLevel::Sse4),
             "avx2" => Some(SimdLevel::Avx2),
+            "avx512" | "avx-512" => Some(SimdLevel::Avx512),
             _ => None,
         }
     }
 
     /// Every level this processor runs, lowest first.
     pub fn available() -> Vec<SimdLevel> {
-        [SimdLevel::Scalar, SimdLevel::Sse4, SimdLevel::Avx2]
-            .into_iter()
-            .filter(|&l| l <= SimdLevel::detected())
-            .collect()
+        [
+            SimdLevel::Scalar,
+            SimdLevel::Sse4,
+            SimdLevel::Avx2,
+            SimdLevel::Avx512,
+        ]
+        .into_iter()
+        .filter(|&l| l <= SimdLevel::detected())
+        .collect()
     }
 
     /// The best level this processor runs.
     pub fn detected() -> SimdLevel {
         #[cfg(target_arch = "x86_64")]
         {
-            if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma") {
+            let avx2 = is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma");
+            if avx2
+                && is_x86_feature_detected!("avx512f")
+                && is_x86_feature_detected!("avx512bw")
+                && is_x86_feature_detected!("avx512dq")
+                && is_x86_feature_detected!("avx512vl")
+            {
+                return SimdLevel::Avx512;
+            }
+            if avx2 {
                 return SimdLevel::Avx2;
             }
             if is_x86_feature_detected!("sse4.1") {
@@ -119,7 +138,7 @@ pub fn env_warning() -> Option<String> {
     let v = std::env::var("RPBRT_SIMD").ok()?;
     match SimdLevel::parse(&v) {
         None => Some(format!(
-            "RPBRT_SIMD=\"{v}\" is not one of scalar, sse4, avx2; using {}",
+            "RPBRT_SIMD=\"{v}\" is not one of scalar, sse4, avx2, avx512; using {}",
             level().name()
         )),
         Some(l) if l > SimdLevel::detected() => Some(format!(
@@ -179,6 +198,12 @@ pub fn dispatch<K: Kernel>(level: SimdLevel, k: K) -> K::Output {
     let level = level.min(SimdLevel::detected());
     match level {
         #[cfg(target_arch = "x86_64")]
+        SimdLevel::Avx512 => {
+            // SAFETY: the processor has AVX-512 F, BW, DQ and VL, AVX2 and
+            // FMA (`level` is at most `detected()`).
+            unsafe { run_avx512(k) }
+        }
+        #[cfg(target_arch = "x86_64")]
         SimdLevel::Avx2 => {
             // SAFETY: the processor has AVX2 and FMA (`level` is at most
             // `detected()`).
@@ -191,6 +216,12 @@ pub fn dispatch<K: Kernel>(level: SimdLevel, k: K) -> K::Output {
         }
         _ => k.run::<Scalar1>(),
     }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512bw,avx512dq,avx512vl,avx2,fma")]
+unsafe fn run_avx512<K: Kernel>(k: K) -> K::Output {
+    k.run::<F32x16>()
 }
 
 #[cfg(target_arch = "x86_64")]

@@ -122,12 +122,14 @@ fn levels_parse_and_order() {
     assert_eq!(SimdLevel::parse("AVX2"), Some(SimdLevel::Avx2));
     assert_eq!(SimdLevel::parse("sse4.1"), Some(SimdLevel::Sse4));
     assert_eq!(SimdLevel::parse("scalar"), Some(SimdLevel::Scalar));
+    assert_eq!(SimdLevel::parse("AVX512"), Some(SimdLevel::Avx512));
     assert_eq!(SimdLevel::parse("avx9"), None);
     assert!(SimdLevel::Scalar < SimdLevel::Sse4 && SimdLevel::Sse4 < SimdLevel::Avx2);
+    assert!(SimdLevel::Avx2 < SimdLevel::Avx512 && SimdLevel::Avx512.lanes() == 16);
     // Asking for more than the processor has runs what it has.
     assert!(level() <= SimdLevel::detected());
     let sum = dispatch(
-        SimdLevel::Avx2,
+        SimdLevel::Avx512,
         AllOps {
             a: &[1.0; 16],
             b: &[2.0; 16],
