@@ -89,8 +89,16 @@ impl SimdLevel {
         .collect()
     }
 
-    /// The best level this processor runs.
+    /// The best level this processor runs (found once per process:
+    /// [`dispatch`] asks on every call).
+    #[inline]
     pub fn detected() -> SimdLevel {
+        static DETECTED: OnceLock<SimdLevel> = OnceLock::new();
+        *DETECTED.get_or_init(SimdLevel::detect)
+    }
+
+    /// Asks the processor which level it runs.
+    fn detect() -> SimdLevel {
         #[cfg(target_arch = "x86_64")]
         {
             let avx2 = is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma");
