@@ -456,20 +456,29 @@ fn packet_figures<const W: usize>(
     if w == 1 {
         return String::new();
     }
+    // Every slot a triangle: all tested in lanes, one triangle against
+    // the packet's rays at a time.
+    let tris: Vec<Option<Tri>> = slot_tris.iter().map(|t| Some(*t)).collect();
     let packet = |g: &[Ray]| {
-        let trs: Vec<TriangleRay> = g.iter().map(TriangleRay::new).collect();
         let mut t_max = [Float::INFINITY; 16];
         let mut best = [None; 16];
-        bvh.intersect_packet(
+        let mut bary = [None; 16];
+        bvh.intersect_packet_triangles(
             level,
             g,
             &mut t_max[..g.len()],
             &mut best[..g.len()],
-            |lane, s, _, _, t| hit_tri(slot_tris, &trs[lane], s, t),
+            &tris,
+            &mut bary[..g.len()],
+            |_, _, _, _, _| None,
         );
         best[..g.len()].iter().filter(|b| b.is_some()).count()
     };
-    let (tw, th) = if w == 8 { (4, 2) } else { (2, 2) };
+    let (tw, th) = match w {
+        16 => (4, 4),
+        8 => (4, 2),
+        _ => (2, 2),
+    };
     let (pc, _) = run_groups(&tiled(cam_set, tw, th), w, threads, packet);
     let (pi, _) = run_groups(bounce_set, w, threads, packet);
     format!(

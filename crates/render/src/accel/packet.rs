@@ -14,11 +14,20 @@
 //! their rays are coherent (camera rays through nearby pixels); a node is
 //! visited when any active ray enters it, and popped entries are culled
 //! per lane against each ray's closest hit so far.
+//!
+//! Where the caller gives the slots' triangles
+//! ([`WideBvh::intersect_packet_triangles`]), a leaf's triangles are
+//! tested against all the rays entering it at once
+//! ([`TriangleRayLanes`], the scalar watertight test in lanes: the same
+//! hits), in the leaf's order, so each ray meets them in the order the
+//! single-ray traversal does; other primitives take the closure per ray.
 
 use super::far_pad;
 use super::widebvh::{closest_in_leaf, WideBvh};
-use crate::simd::{F32Lanes, Kernel};
-use rpbrt_geometry::{next_float_down, next_float_up, Float, Ray};
+use crate::shape::triangle::TriangleRay;
+use crate::shape::triangle_lanes::TriangleRayLanes;
+use crate::simd::{F32Lanes, Kernel, MAX_LANES};
+use rpbrt_geometry::{next_float_down, next_float_up, Float, Point3f, Ray};
 use std::mem::MaybeUninit;
 
 /// The most rays a packet holds (the widest lane count).
@@ -37,6 +46,13 @@ pub(crate) struct PacketClosest<'a, const W: usize, F> {
     pub rays: &'a [Ray],
     pub t_max: &'a mut [Float],
     pub best: &'a mut [Option<(u32, Float)>],
+    /// The vertices of the triangle at each slot (`None` for other
+    /// primitives; empty when the caller gives none): these are tested
+    /// in lanes, without the closure.
+    pub tris: &'a [Option<[Point3f; 3]>],
+    /// Per ray: the barycentrics of its closest hit where that hit is one
+    /// of `tris`, `None` where the closure found it (or there is none).
+    pub bary: &'a mut [Option<[Float; 3]>],
     pub hit: F,
 }
 
@@ -49,7 +65,12 @@ where
     #[inline(always)]
     fn run<L: F32Lanes>(mut self) {
         let n = self.rays.len();
-        assert!(n <= MAX_PACKET && self.t_max.len() >= n && self.best.len() >= n);
+        assert!(
+            n <= MAX_PACKET
+                && self.t_max.len() >= n
+                && self.best.len() >= n
+                && self.bary.len() >= n
+        );
         // Rays beyond the lane count go in further packets.
         let mut first = 0;
         while first < n {
@@ -59,6 +80,8 @@ where
                 &self.rays[first..end],
                 &mut self.t_max[first..end],
                 &mut self.best[first..end],
+                self.tris,
+                &mut self.bary[first..end],
                 first,
                 &mut self.hit,
             );
@@ -125,6 +148,8 @@ fn packet_closest<const W: usize, L: F32Lanes, F>(
     rays: &[Ray],
     t_max: &mut [Float],
     best: &mut [Option<(u32, Float)>],
+    tris: &[Option<[Point3f; 3]>],
+    bary: &mut [Option<[Float; 3]>],
     lane_offset: usize,
     hit: &mut F,
 ) where
@@ -136,6 +161,11 @@ fn packet_closest<const W: usize, L: F32Lanes, F>(
     }
     let prims = bvh.prim_indices();
     let pr = packet_rays::<L>(rays);
+    let mut trs = [TriangleRay::new(&rays[0]); MAX_PACKET];
+    for (t, r) in trs.iter_mut().zip(rays) {
+        *t = TriangleRay::new(r);
+    }
+    let tri_lanes = TriangleRayLanes::<L>::new(&trs[..rays.len()]);
     let mut t_max_lanes = [Float::NEG_INFINITY; MAX_PACKET];
     t_max_lanes[..rays.len()].copy_from_slice(t_max);
     let mut t_max_v = L::load(&t_max_lanes);
@@ -213,6 +243,22 @@ fn packet_closest<const W: usize, L: F32Lanes, F>(
             leaf_hit = true;
             let start = node.child[c] as usize;
             let count = node.count[c] as usize;
+            if !tris.is_empty() {
+                leaf_lanes(
+                    &tri_lanes,
+                    &prims[start..start + count],
+                    start,
+                    lanes,
+                    rays,
+                    t_max,
+                    best,
+                    tris,
+                    bary,
+                    lane_offset,
+                    hit,
+                );
+                continue;
+            }
             while lanes != 0 {
                 let i = lanes.trailing_zeros() as usize;
                 lanes &= lanes - 1;
@@ -274,6 +320,73 @@ fn packet_closest<const W: usize, L: F32Lanes, F>(
     }
 }
 
+/// One leaf (its entries `leaf`, the first at slot `start`) against the
+/// rays in `lanes`: each triangle of `tris` against all of them at once,
+/// other entries with the closure ray by ray, in the leaf's order.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn leaf_lanes<L: F32Lanes, F>(
+    tri_lanes: &TriangleRayLanes<L>,
+    leaf: &[u32],
+    start: usize,
+    lanes: u32,
+    rays: &[Ray],
+    t_max: &mut [Float],
+    best: &mut [Option<(u32, Float)>],
+    tris: &[Option<[Point3f; 3]>],
+    bary: &mut [Option<[Float; 3]>],
+    lane_offset: usize,
+    hit: &mut F,
+) where
+    F: FnMut(usize, u32, u32, &Ray, Float) -> Option<Float>,
+{
+    let mut t_lanes = [Float::INFINITY; MAX_LANES];
+    t_lanes[..rays.len()].copy_from_slice(t_max);
+    let mut t_v = L::load(&t_lanes);
+    let active = L::from_bits(lanes);
+    for (k, &entry) in leaf.iter().enumerate() {
+        let slot = start + k;
+        if let Some(Some([p0, p1, p2])) = tris.get(slot) {
+            let h = tri_lanes.intersect(active, t_v, *p0, *p1, *p2);
+            let mut bits = L::bits(h.mask);
+            if bits == 0 {
+                continue;
+            }
+            t_v = L::select(h.mask, h.t, t_v);
+            let mut t = [0.0 as Float; MAX_LANES];
+            let mut b = [[0.0 as Float; MAX_LANES]; 3];
+            h.t.store(&mut t);
+            for (row, v) in b.iter_mut().zip(h.b) {
+                v.store(row);
+            }
+            while bits != 0 {
+                let i = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                t_max[i] = t[i];
+                best[i] = Some((entry, t[i]));
+                bary[i] = Some([b[0][i], b[1][i], b[2][i]]);
+            }
+        } else {
+            let mut bits = lanes;
+            let mut any = false;
+            while bits != 0 {
+                let i = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                if let Some(t) = hit(lane_offset + i, slot as u32, entry, &rays[i], t_max[i]) {
+                    t_max[i] = t;
+                    best[i] = Some((entry, t));
+                    bary[i] = None;
+                    any = true;
+                }
+            }
+            if any {
+                t_lanes[..rays.len()].copy_from_slice(t_max);
+                t_v = L::load(&t_lanes);
+            }
+        }
+    }
+}
+
 impl<const W: usize> WideBvh<W> {
     /// The closest hits of up to [`MAX_PACKET`] rays traced as packets of
     /// `level`'s width (see the module documentation):
@@ -291,6 +404,29 @@ impl<const W: usize> WideBvh<W> {
     ) where
         F: FnMut(usize, u32, u32, &Ray, Float) -> Option<Float>,
     {
+        let mut bary = [None; MAX_PACKET];
+        let n = rays.len().min(MAX_PACKET);
+        self.intersect_packet_triangles(level, rays, t_max, best, &[], &mut bary[..n], hit);
+    }
+
+    /// [`WideBvh::intersect_packet`] where `tris` gives the vertices of
+    /// the triangle at each slot (`None` for other primitives): those are
+    /// tested in lanes, the closure is called for the others only, and
+    /// `bary` receives each ray's barycentrics where its closest hit is
+    /// one of `tris`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn intersect_packet_triangles<F>(
+        &self,
+        level: crate::simd::SimdLevel,
+        rays: &[Ray],
+        t_max: &mut [Float],
+        best: &mut [Option<(u32, Float)>],
+        tris: &[Option<[Point3f; 3]>],
+        bary: &mut [Option<[Float; 3]>],
+        hit: F,
+    ) where
+        F: FnMut(usize, u32, u32, &Ray, Float) -> Option<Float>,
+    {
         crate::simd::dispatch(
             level,
             PacketClosest {
@@ -298,6 +434,8 @@ impl<const W: usize> WideBvh<W> {
                 rays,
                 t_max,
                 best,
+                tris,
+                bary,
                 hit,
             },
         );

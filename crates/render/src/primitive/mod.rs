@@ -815,29 +815,34 @@ impl PrimitiveAggregate {
         }
         let mut t_max = [Float::INFINITY; MAX_PACKET];
         let mut best = [None; MAX_PACKET];
+        let mut bary = [None; MAX_PACKET];
         let mut records = [None::<HitRecord>; MAX_PACKET];
-        bvh.intersect_packet(
+        // Triangles are tested in lanes (their records built below from
+        // the barycentrics); the closure sees the other primitives only.
+        bvh.intersect_packet_triangles(
             level,
             rays,
             &mut t_max[..n],
             &mut best[..n],
-            |lane: usize, slot: u32, i: u32, ray: &Ray, t: Float| {
-                let tr = &trs[lane];
-                if let Some(Some([p0, p1, p2])) = self.triangle_vertices.get(slot as usize) {
-                    let (b0, b1, b2, t_hit) = intersect_prepared_triangle(tr, t, *p0, *p1, *p2)?;
-                    records[lane] = Some(HitRecord {
-                        primitive: i,
-                        t_hit,
-                        kind: HitKind::Triangle(b0, b1, b2),
-                    });
-                    return Some(t_hit);
-                }
-                let record = self.record_other(i, ray, tr, t)?;
+            &self.triangle_vertices,
+            &mut bary[..n],
+            |lane: usize, _slot: u32, i: u32, ray: &Ray, t: Float| {
+                let record = self.record_other(i, ray, &trs[lane], t)?;
                 records[lane] = Some(record);
                 Some(record.t_hit)
             },
         );
-        out[..n].copy_from_slice(&records[..n]);
+        for lane in 0..n {
+            out[lane] = match (best[lane], bary[lane]) {
+                (Some((i, t_hit)), Some([b0, b1, b2])) => Some(HitRecord {
+                    primitive: i,
+                    t_hit,
+                    kind: HitKind::Triangle(b0, b1, b2),
+                }),
+                (Some(_), None) => records[lane],
+                (None, _) => None,
+            };
+        }
     }
 
     /// The interaction of a hit that [`PrimitiveAggregate::intersect_record`]

@@ -40,6 +40,7 @@ pub mod loopsubdiv;
 pub mod paraboloid;
 pub mod sphere;
 pub mod triangle;
+pub mod triangle_lanes;
 
 /// A ray's hit on a shape.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -372,12 +372,12 @@ pub fn triangle_is_nondegenerate(p0: Point3f, p1: Point3f, p2: Point3f) -> bool 
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleRay {
     /// The ray origin with a zero fourth lane.
-    o: [Float; 4],
+    pub(super) o: [Float; 4],
     /// Which components become x, y and z (each < 3).
-    perm: [usize; 3],
-    sx: Float,
-    sy: Float,
-    sz: Float,
+    pub(super) perm: [usize; 3],
+    pub(super) sx: Float,
+    pub(super) sy: Float,
+    pub(super) sz: Float,
 }
 
 /// `v` with its components reordered by `perm` (each < 4; lane 3 holds
