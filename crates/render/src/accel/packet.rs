@@ -142,6 +142,7 @@ fn packet_rays<L: F32Lanes>(rays: &[Ray]) -> PacketRays<L> {
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn packet_closest<const W: usize, L: F32Lanes, F>(
     bvh: &WideBvh<W>,

@@ -47,15 +47,15 @@ impl<L: F32Lanes> TriangleRayLanes<L> {
         let mut from = [[0u32; 2]; 3];
         for i in 0..L::N {
             let tr = trs.get(i).unwrap_or(&trs[0]);
-            for a in 0..3 {
-                o[a][i] = tr.o[a];
+            for (row, &v) in o.iter_mut().zip(&tr.o) {
+                row[i] = v;
             }
             s[0][i] = tr.sx;
             s[1][i] = tr.sy;
             s[2][i] = tr.sz;
-            for k in 0..3 {
-                from[k][0] |= u32::from(tr.perm[k] == 0) << i;
-                from[k][1] |= u32::from(tr.perm[k] == 1) << i;
+            for (f, &p) in from.iter_mut().zip(&tr.perm) {
+                f[0] |= u32::from(p == 0) << i;
+                f[1] |= u32::from(p == 1) << i;
             }
         }
         TriangleRayLanes {
@@ -179,6 +179,8 @@ mod tests {
 
     impl Kernel for Lanes<'_> {
         type Output = Vec<Option<[u32; 4]>>;
+        // Lane i of four stored rows: indexing reads best.
+        #[allow(clippy::needless_range_loop)]
         fn run<L: F32Lanes>(self) -> Self::Output {
             let mut out = Vec::new();
             for group in self.rays.chunks(L::N) {
