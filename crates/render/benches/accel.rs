@@ -592,7 +592,7 @@ fn bench_mesh(mesh: &Mesh, only: &Option<Vec<String>>) {
                 ""
             };
             // The wide BVHs' packet traversal at the processor's SIMD
-            // width: camera rays in 4×2 (8 lanes) or 2×2 (4 lanes) pixel
+            // width: camera rays in 4×4 (16 lanes), 4×2 (8) or 2×2 (4) pixel
             // tiles, and the incoherent rays in groups of the same size.
             let extra = match &a {
                 Accelerator::Bvh4(bvh) => {

@@ -690,7 +690,7 @@ fn check_wavefront_bits(text: &str) {
     assert_same_pixels(&scalar, &one, text);
     assert_same_pixels(&scalar, &two, text);
     // At every SIMD width this processor runs (camera-ray packets of
-    // 1, 4 or 8 rays, pinhole rays 1, 4 or 8 lanes at a time).
+    // 1, 4, 8 or 16 rays, pinhole rays as many lanes at a time).
     for level in SimdLevel::available() {
         let im = common::render_opts(text, 2, true, Some(level));
         assert_same_pixels(&scalar, &im, &format!("{level:?}\n{text}"));
