@@ -28,6 +28,7 @@ macro_rules! diagln {
 
 mod args;
 mod imgtool;
+mod oidn;
 mod preview;
 mod serve;
 mod tev;

@@ -14,6 +14,7 @@ mod average;
 mod bloom;
 mod cat;
 mod convert;
+mod denoise;
 mod diff;
 mod error;
 mod falsecolor;
@@ -65,6 +66,12 @@ const COMMANDS: &[Command] = &[
         summary: "convert format; scale, tone map, crop, recolour",
         usage: convert::USAGE,
         run: convert::run,
+    },
+    Command {
+        name: "denoise",
+        summary: "denoise with Intel Open Image Denoise (CPU; colour, albedo, normal)",
+        usage: denoise::USAGE,
+        run: denoise::run,
     },
     Command {
         name: "diff",
