@@ -40,6 +40,9 @@ pub struct Options {
     pub wavefront: Option<bool>,
     /// `--disable-pixel-jitter`.
     pub disable_pixel_jitter: bool,
+    /// `--denoise`: an `rgb` film also records albedo and normal, and the
+    /// image is denoised with Open Image Denoise after the render.
+    pub denoise: bool,
     /// `--disable-wavelength-jitter`.
     pub disable_wavelength_jitter: bool,
     /// `--disable-texture-filtering`.
@@ -90,6 +93,12 @@ Renders pbrt-v4 (and pbrt-v3) scene files. Flag names ignore case, '-' and '_'.
 
 Rendering options:
   --cropwindow <x0,x1,y0,y1>   Render only this part of the image (NDC, [0,1]).
+  --denoise                    Denoise the image with Intel Open Image Denoise (CPU)
+                               after the render, from its colour, albedo and normal
+                               (an rgb film renders as a gbuffer film to record them).
+                               The denoised R, G, B go to the output name; the raw
+                               render, with its albedo and normal, beside it as
+                               <name>-noisy.exr. Needs `pip install pyoidn`.
   --disable-pixel-jitter       Always sample pixels at their centres.
   --disable-texture-filtering  Point-sample all textures.
   --disable-wavelength-jitter  Always sample the same four wavelengths of light.
@@ -342,6 +351,7 @@ pub fn parse_args(args: &[String]) -> Result<Options, ArgError> {
             "wavefront" => o.wavefront = Some(true),
             "nowavefront" => o.wavefront = Some(false),
             "disablepixeljitter" => o.disable_pixel_jitter = true,
+            "denoise" => o.denoise = true,
             "disablewavelengthjitter" => o.disable_wavelength_jitter = true,
             "disabletexturefiltering" => o.disable_texture_filtering = true,
             "forcediffuse" => o.force_diffuse = true,

@@ -28,6 +28,18 @@ macro_rules! diagln {
 
 mod args;
 mod imgtool;
+
+/// Where `--denoise` writes the raw render of output `out`: beside it,
+/// `<stem>-noisy.exr` (EXR, which keeps the albedo and normal).
+fn noisy_name(out: &str) -> String {
+    let p = std::path::Path::new(out);
+    let stem = p
+        .file_stem()
+        .map_or_else(|| "pbrt".into(), |s| s.to_string_lossy());
+    p.with_file_name(format!("{stem}-noisy.exr"))
+        .to_string_lossy()
+        .into_owned()
+}
 mod oidn;
 mod preview;
 mod serve;
@@ -203,6 +215,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
             pixel_bounds: opts.pixel_bounds,
             quick: opts.quick,
             tile: opts.tile,
+            aovs: opts.denoise,
         },
         disable_texture_filtering: opts.disable_texture_filtering
             || desc_flag(&desc, "disabletexturefiltering"),
@@ -247,6 +260,27 @@ fn render_command(opts: &args::Options) -> ExitCode {
             );
         }
     }
+
+    // `--denoise`: the render is written beside the output name, which
+    // the denoised image takes.
+    let denoise_to = if opts.denoise {
+        if opts.tile.is_some() || opts.spp_range.is_some() || opts.serve_parts {
+            diagln!(
+                "rpbrt: error: --denoise: a tile or sample range is a part of an image; denoise the assembled image (rpbrt imgtool denoise) instead"
+            );
+            return ExitCode::FAILURE;
+        }
+        if !scene.film.uses_visible_surface() && !opts.quiet {
+            diagln!(
+                "rpbrt: warning: --denoise: a spectral film records no albedo or normal; denoising from the colour alone"
+            );
+        }
+        let out = scene.film.filename().to_string();
+        scene.film.set_filename(noisy_name(&out));
+        Some(out)
+    } else {
+        None
+    };
 
     // The outputs' directories are checked now, not after the render.
     if !opts.serve_parts {
@@ -381,6 +415,20 @@ fn render_command(opts: &args::Options) -> ExitCode {
     if !opts.quiet {
         for w in &stats.warnings {
             diagln!("rpbrt: warning: {w}");
+        }
+    }
+    if let Some(out) = &denoise_to {
+        let job = imgtool::denoise::Job {
+            infile: scene.film.filename(),
+            outfile: out,
+            albedo_file: None,
+            normal_file: None,
+            color_only: false,
+            quality: oidn::Quality::High,
+        };
+        if let Err(e) = imgtool::denoise::denoise_file(&job, &budget) {
+            diagln!("rpbrt: error: --denoise: {e}");
+            return ExitCode::FAILURE;
         }
     }
     if let Some(path) = &opts.mse_reference_out {

@@ -249,10 +249,10 @@ impl Oidn {
         }
         let f = device.filter()?;
         f.image("color", &mut color, width, height)?;
-        if let Some(a) = albedo.as_deref_mut() {
+        if let Some(a) = albedo {
             f.image("albedo", a, width, height)?;
         }
-        if let Some(nrm) = normal.as_deref_mut() {
+        if let Some(nrm) = normal {
             f.image("normal", nrm, width, height)?;
         }
         f.image("output", &mut output, width, height)?;

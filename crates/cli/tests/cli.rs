@@ -1155,3 +1155,56 @@ fn the_design_defaults_to_the_wavefront_except_through_media() {
         assert_eq!(design, want, "{name}: {e}");
     }
 }
+
+/// `--denoise`: the raw render beside the output name has the plain
+/// render's pixels (an `rgb` film recorded as `gbuffer`) plus albedo and
+/// normal, the output is the denoised image; tiles are refused. Skipped,
+/// with a message, where there is no Open Image Denoise.
+#[test]
+fn denoise_writes_the_raw_render_beside_the_denoised_one() {
+    let scene = temp_scene(
+        "denoise.pbrt",
+        "LookAt 0 0 5 0 0 0 0 1 0\nCamera \"perspective\" \"float fov\" 30\n\
+         Sampler \"independent\" \"integer pixelsamples\" 4\n\
+         Film \"rgb\" \"integer xresolution\" 24 \"integer yresolution\" 16 \"string filename\" \"unused.exr\"\n\
+         WorldBegin\nLightSource \"infinite\" \"rgb L\" [0.5 0.5 0.5]\n\
+         Material \"diffuse\" \"rgb reflectance\" [0.2 0.5 0.8]\nShape \"sphere\"\n",
+    );
+    let dir = scene.parent().unwrap().to_path_buf();
+    let (plain, out) = (dir.join("plain.exr"), dir.join("den.exr"));
+    let noisy = dir.join("den-noisy.exr");
+    run_ok(
+        rpbrt()
+            .args(["--quiet", "--outfile"])
+            .arg(&plain)
+            .arg(&scene),
+    );
+    let o = rpbrt()
+        .args(["--quiet", "--denoise", "--outfile"])
+        .arg(&out)
+        .arg(&scene)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    if err.contains("not found: install it with `pip install pyoidn`") {
+        eprintln!("skipping the --denoise test: no Open Image Denoise here ({err})");
+        return;
+    }
+    assert!(o.status.success(), "{err}");
+    assert_eq!(differing_pixels(&plain, &noisy), "0");
+    let info = run_ok(rpbrt().args(["imgtool", "info"]).arg(&noisy));
+    assert!(info.contains("Albedo.R") && info.contains("Ns.Z"), "{info}");
+    let info = run_ok(rpbrt().args(["imgtool", "info"]).arg(&out));
+    assert!(
+        !info.contains("Albedo.R") && info.contains("resolution 24x16"),
+        "{info}"
+    );
+    let o = rpbrt()
+        .args(["--quiet", "--denoise", "--tile", "1/2", "--outfile"])
+        .arg(&out)
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("denoise the assembled image"));
+}

@@ -61,20 +61,46 @@ pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
     if color_only && (albedo_file.is_some() || normal_file.is_some()) {
         return Err(a.err("--color-only takes no --albedo or --normal"));
     }
-    let input = load_md(&infile, budget)?;
+    let job = Job {
+        infile: &infile,
+        outfile: &outfile,
+        albedo_file: albedo_file.as_deref(),
+        normal_file: normal_file.as_deref(),
+        color_only,
+        quality,
+    };
+    denoise_file(&job, budget).map_err(|e| a.err(e))
+}
+
+/// One denoise: the files and options of `imgtool denoise` (and of
+/// `rpbrt --denoise`, on the render it wrote).
+pub(crate) struct Job<'a> {
+    pub infile: &'a str,
+    pub outfile: &'a str,
+    pub albedo_file: Option<&'a str>,
+    pub normal_file: Option<&'a str>,
+    pub color_only: bool,
+    pub quality: Quality,
+}
+
+/// Denoises `job.infile` into `job.outfile` (see [`USAGE`]); warnings go
+/// to standard error, errors name the file.
+pub(crate) fn denoise_file(job: &Job, budget: &MemoryBudget) -> Result<(), String> {
+    let infile = job.infile;
+    let input = load_md(infile, budget)?;
     let res = input.image.resolution();
     let mut color = channels(&input.image, &[&["R", "G", "B"]])
-        .ok_or_else(|| a.err(format!("{infile}: no R, G, B channels to denoise")))?;
+        .ok_or_else(|| format!("{infile}: no R, G, B channels to denoise"))?;
     let bad = zero_non_finite(&mut color);
     if bad > 0 {
         diagln!(
-            "rpbrt imgtool denoise: warning: {infile}: {bad} pixel(s) with non-finite colour set to zero before denoising"
+            "rpbrt: warning: denoise: {infile}: {bad} pixel(s) with non-finite colour set to zero before denoising"
         );
     }
     // The auxiliary images: from their own files, else from the input.
     let aux =
-        |file: &Option<String>, sets: &[&[&str]], what: &str| -> Result<Option<Vec<f32>>, String> {
-            if color_only {
+        |file: Option<&str>, sets: &[&[&str]], what: &str| -> Result<Option<Vec<f32>>, String> {
+            if job.color_only {
                 return Ok(None);
             }
             let Some(file) = file else {
@@ -82,16 +108,16 @@ pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
             };
             let im = load_md(file, budget)?.image;
             if im.resolution() != res {
-                return Err(a.err(format!(
+                return Err(format!(
                     "{file}: {}x{} {what} image for a {}x{} colour image ({infile})",
                     im.resolution().x,
                     im.resolution().y,
                     res.x,
                     res.y
-                )));
+                ));
             }
             let v = channels(&im, sets)
-                .ok_or_else(|| a.err(format!("{file}: no {what} channels ({})", names(sets))))?;
+                .ok_or_else(|| format!("{file}: no {what} channels ({})", names(sets)))?;
             Ok(Some(v))
         };
     let albedo_sets: &[&[&str]] = &[&["Albedo.R", "Albedo.G", "Albedo.B"], &["R", "G", "B"]];
@@ -100,16 +126,17 @@ pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
         &["N.X", "N.Y", "N.Z"],
         &["R", "G", "B"],
     ];
-    let mut albedo = aux(&albedo_file, albedo_sets, "albedo")?;
-    let mut normal = aux(&normal_file, normal_sets, "normal")?;
+    let mut albedo = aux(job.albedo_file, albedo_sets, "albedo")?;
+    let mut normal = aux(job.normal_file, normal_sets, "normal")?;
     if normal.is_some() && albedo.is_none() {
-        return Err(a.err(
-            "a normal image needs an albedo image too (Open Image Denoise's rule): give --albedo",
-        ));
+        return Err(
+            "a normal image needs an albedo image too (Open Image Denoise's rule): give --albedo"
+                .into(),
+        );
     }
     for (v, what, file) in [
-        (&albedo, "albedo", albedo_file.as_deref()),
-        (&normal, "normal", normal_file.as_deref()),
+        (&albedo, "albedo", job.albedo_file),
+        (&normal, "normal", job.normal_file),
     ] {
         let bad = v.as_ref().map_or(0, |v| {
             v.chunks_exact(3)
@@ -117,15 +144,14 @@ pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
                 .count()
         });
         if bad > 0 {
-            return Err(a.err(format!(
+            return Err(format!(
                 "{}: {bad} pixel(s) with a non-finite {what}",
-                file.unwrap_or(&infile)
-            )));
+                file.unwrap_or(infile)
+            ));
         }
     }
-    charge_output(budget, res.x.into(), res.y.into(), 3, "the denoised image")
-        .map_err(|e| a.err(e))?;
-    let oidn = Oidn::load().map_err(|e| a.err(e))?;
+    charge_output(budget, res.x.into(), res.y.into(), 3, "the denoised image")?;
+    let oidn = Oidn::load()?;
     let out = oidn
         .denoise(Inputs {
             width: res.x.max(0) as usize,
@@ -133,11 +159,11 @@ pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
             color: &color,
             albedo: albedo.as_deref_mut(),
             normal: normal.as_deref_mut(),
-            quality,
+            quality: job.quality,
         })
-        .map_err(|e| a.err(format!("{infile}: {e}")))?;
-    let image = Image::from_f32(out, res, &["R", "G", "B"]).map_err(|e| a.err(e))?;
-    save(&image, &outfile, &input.metadata)
+        .map_err(|e| format!("{infile}: {e}"))?;
+    let image = Image::from_f32(out, res, &["R", "G", "B"]).map_err(|e| e.to_string())?;
+    save(&image, job.outfile, &input.metadata)
 }
 
 /// The first of `sets` of three channels that `image` has, as interleaved

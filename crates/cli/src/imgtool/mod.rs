@@ -14,7 +14,7 @@ mod average;
 mod bloom;
 mod cat;
 mod convert;
-mod denoise;
+pub(crate) mod denoise;
 mod diff;
 mod error;
 mod falsecolor;

@@ -41,6 +41,10 @@ pub struct FilmOverrides {
     /// `--tile K/N`: render only tile K of N of the pixel bounds
     /// ([`super::tile_bounds`]).
     pub tile: Option<(u32, u32)>,
+    /// `--denoise`: an `rgb` film is made a `gbuffer` film with the same
+    /// parameters (the same R, G, B, plus the first visible surface's
+    /// albedo and normal, in camera space, for the denoiser).
+    pub aovs: bool,
 }
 
 fn extension(name: &str) -> String {
@@ -122,6 +126,11 @@ pub fn create_film(
     overrides: &FilmOverrides,
 ) -> Result<Film, Diagnostic> {
     let loc = fp.loc();
+    let name = if overrides.aovs && name == "rgb" {
+        "gbuffer"
+    } else {
+        name
+    };
     if !FILM_NAMES.contains(&name) {
         return Err(unknown_type("film", name, FILM_NAMES, loc));
     }

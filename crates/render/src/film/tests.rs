@@ -522,3 +522,21 @@ fn sample_bounds_grow_by_filter_radius() {
     let b = f.sample_bounds();
     assert_eq!((b.p_min.x, b.p_max.x), (0.0, 4.0));
 }
+
+#[test]
+fn denoise_makes_an_rgb_film_a_gbuffer_film() {
+    let ov = FilmOverrides {
+        aovs: true,
+        ..Default::default()
+    };
+    let params = [P::I("xresolution", &[8]), P::I("yresolution", &[4])];
+    let f = make("rgb", &params, &ov).expect("rgb with aovs");
+    assert!(f.uses_visible_surface());
+    assert_eq!(f.full_resolution(), Point2i::new(8, 4));
+    // Without the override, the same film records no surface.
+    let plain = make("rgb", &params, &FilmOverrides::default()).expect("rgb");
+    assert!(!plain.uses_visible_surface());
+    // Other films are kept.
+    let s = make("spectral", &params, &ov).expect("spectral");
+    assert!(!s.uses_visible_surface());
+}
