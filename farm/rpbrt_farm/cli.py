@@ -49,6 +49,10 @@ def parse_args(argv: Optional[List[str]] = None) -> argparse.Namespace:
                    help="one rpbrt run per part (default: each worker parses a scene once and "
                         "renders all its parts of it in one rpbrt --serve-parts process)")
     p.add_argument("--retries", type=int, default=2, help="retries of a failed part (default 2)")
+    p.add_argument("--denoise", action="store_true",
+                   help="record albedo and normal in the parts, then denoise each joined frame with "
+                        "Intel Open Image Denoise (pip install pyoidn); the raw frame is kept as "
+                        "<name>-noisy.exr")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     argv = list(sys.argv[1:] if argv is None else argv)
     # After "--": more rpbrt options for every part (e.g. -- --seed 3).
@@ -105,6 +109,7 @@ def main(argv: Optional[List[str]] = None) -> int:
                 rpbrt=args.rpbrt, worker_rpbrt=worker_rpbrt, extra_args=extra,
                 ship=args.ship, retries=args.retries, reuse=not args.no_reuse,
                 progress=None if args.quiet else sys.stderr,
+                denoise=args.denoise,
             )
         finally:
             client.close()

@@ -113,6 +113,24 @@ def join_parts(rpbrt: str, kind: str, files: Sequence[str], outfile: str) -> Non
         raise FarmError(f"joining the parts into {outfile} failed: {proc.stderr.strip()}")
 
 
+def noisy_name(outfile: str) -> str:
+    """Where a denoised frame's raw (joined) render goes: beside it, as
+    ``<stem>-noisy.exr`` (rpbrt --denoise's name)."""
+    stem = os.path.splitext(os.path.basename(outfile))[0]
+    return os.path.join(os.path.dirname(outfile), f"{stem}-noisy.exr")
+
+
+def denoise_frame(rpbrt: str, raw: str, outfile: str) -> None:
+    """Denoises the joined ``raw`` frame (with its albedo and normal) into
+    ``outfile`` with ``rpbrt imgtool denoise``."""
+    proc = subprocess.run([rpbrt, "imgtool", "denoise", raw, "--outfile", outfile],
+                          capture_output=True, text=True)
+    if proc.returncode != 0:
+        raise FarmError(f"denoising {raw} failed: {proc.stderr.strip()}")
+    if proc.stderr.strip():
+        print(proc.stderr.strip(), file=sys.stderr)
+
+
 def render_frames(
     client,
     scenes: Sequence[str],
@@ -127,6 +145,7 @@ def render_frames(
     reuse: bool = True,
     progress: Optional[TextIO] = sys.stderr,
     on_submitted: Optional[Callable[[List], None]] = None,
+    denoise: bool = False,
 ) -> List[str]:
     """Renders each scene in ``scenes`` as one frame split into ``parts`` on
     the Dask ``client``'s cluster, writing frame i to ``outfiles[i]``.
@@ -138,11 +157,18 @@ def render_frames(
     reschedules it); a part that fails every try raises FarmError with
     rpbrt's message. With ``reuse`` each worker parses a scene once and
     renders all its parts of it in one ``rpbrt --serve-parts`` process.
-    ``on_submitted`` hears the futures once submitted.
+    ``on_submitted`` hears the futures once submitted. With ``denoise``
+    the parts record albedo and normal (``rpbrt --gbuffer``), and each
+    joined frame is written as ``<stem>-noisy.exr`` and denoised into its
+    output name (``rpbrt imgtool denoise``; Open Image Denoise must be on
+    this machine: ``pip install pyoidn``).
     """
     if len(scenes) != len(outfiles):
         raise FarmError("one output file per scene is needed")
     local_rpbrt = find_rpbrt(rpbrt)
+    if denoise and parts and parts[0].kind != "tile":
+        raise FarmError("--denoise needs tiles (--tiles): sample ranges keep only the rgb film's "
+                        "sums, not the albedo and normal")
     session = uuid.uuid4().hex
     futures = []
     meta: Dict[object, tuple] = {}
@@ -161,7 +187,8 @@ def render_frames(
             scene_ref = os.path.relpath(scene_ref, folder)
         for part in parts:
             label = f"{os.path.basename(scene)}: {part.label()}"
-            spec = TaskSpec(worker_rpbrt, scene_ref, tuple(extra_args), tuple(part.rpbrt_args()),
+            args = (*extra_args, "--gbuffer") if denoise else tuple(extra_args)
+            spec = TaskSpec(worker_rpbrt, scene_ref, args, tuple(part.rpbrt_args()),
                             label, archive_id, reuse, session)
             fut = client.submit(
                 render_part,
@@ -210,6 +237,9 @@ def render_frames(
                 with open(p, "wb") as f:
                     f.write(results[frame][part.index])
                 files.append(p)
-            join_parts(local_rpbrt, parts[0].kind, files, outfile)
+            joined = noisy_name(outfile) if denoise else outfile
+            join_parts(local_rpbrt, parts[0].kind, files, joined)
+        if denoise:
+            denoise_frame(local_rpbrt, joined, outfile)
         written.append(outfile)
     return written

@@ -89,6 +89,36 @@ def test_tiles_and_ranges_are_bit_identical(rpbrt, client, tmp_path, ship, reuse
         assert differing_pixels(rpbrt, out, full) == 0, parts[0].kind
 
 
+@pytest.mark.parametrize("split", ["tiles", "ranges"])
+def test_denoise_joins_the_parts_then_denoises(rpbrt, client, tmp_path, split):
+    """--denoise: the parts record albedo and normal, the joined raw frame
+    (kept as <name>-noisy.exr) has one rpbrt run's colour, and the output
+    is its denoised image. Skipped where there is no Open Image Denoise."""
+    spp = 4
+    full = str(tmp_path / "full.exr")
+    single_render(rpbrt, full, spp)
+    parts = plan_frame(4, None, None) if split == "tiles" else plan_frame(None, 2, spp)
+    out = str(tmp_path / "den.exr")
+    if split == "ranges":
+        with pytest.raises(FarmError, match="--denoise needs tiles"):
+            render_frames(client, [SCENE], parts, [out], rpbrt=rpbrt, progress=None, denoise=True)
+        return
+    try:
+        render_frames(client, [SCENE], parts, [out], rpbrt=rpbrt, worker_rpbrt=rpbrt,
+                      extra_args=["--spp", str(spp), "--nthreads", "1"], progress=None,
+                      denoise=True)
+    except FarmError as e:
+        if "pip install pyoidn" in str(e):
+            pytest.skip(f"no Open Image Denoise here: {e}")
+        raise
+    noisy = str(tmp_path / "den-noisy.exr")
+    assert differing_pixels(rpbrt, full, noisy) == 0
+    info = subprocess.run([rpbrt, "imgtool", "info", noisy], check=True,
+                          capture_output=True, text=True).stdout
+    assert "Albedo.R" in info and "Ns.Z" in info
+    assert differing_pixels(rpbrt, out, full) > 0
+
+
 def test_a_killed_worker_loses_nothing(rpbrt, client, tmp_path):
     spp = 32
     full = str(tmp_path / "full.exr")

@@ -43,6 +43,9 @@ pub struct Options {
     /// `--denoise`: an `rgb` film also records albedo and normal, and the
     /// image is denoised with Open Image Denoise after the render.
     pub denoise: bool,
+    /// `--gbuffer`: an `rgb` film renders as a `gbuffer` film (what
+    /// `--denoise` does before denoising; for parts denoised once joined).
+    pub gbuffer: bool,
     /// `--disable-wavelength-jitter`.
     pub disable_wavelength_jitter: bool,
     /// `--disable-texture-filtering`.
@@ -99,6 +102,10 @@ Rendering options:
                                The denoised R, G, B go to the output name; the raw
                                render, with its albedo and normal, beside it as
                                <name>-noisy.exr. Needs `pip install pyoidn`.
+  --gbuffer                    Render an rgb film as a gbuffer film with the same
+                               parameters (the same R, G, B, plus albedo, normals and
+                               more): for tiles and sample ranges that are denoised
+                               once joined (rpbrt-farm --denoise).
   --disable-pixel-jitter       Always sample pixels at their centres.
   --disable-texture-filtering  Point-sample all textures.
   --disable-wavelength-jitter  Always sample the same four wavelengths of light.
@@ -352,6 +359,7 @@ pub fn parse_args(args: &[String]) -> Result<Options, ArgError> {
             "nowavefront" => o.wavefront = Some(false),
             "disablepixeljitter" => o.disable_pixel_jitter = true,
             "denoise" => o.denoise = true,
+            "gbuffer" => o.gbuffer = true,
             "disablewavelengthjitter" => o.disable_wavelength_jitter = true,
             "disabletexturefiltering" => o.disable_texture_filtering = true,
             "forcediffuse" => o.force_diffuse = true,

@@ -215,7 +215,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
             pixel_bounds: opts.pixel_bounds,
             quick: opts.quick,
             tile: opts.tile,
-            aovs: opts.denoise,
+            aovs: opts.denoise || opts.gbuffer,
         },
         disable_texture_filtering: opts.disable_texture_filtering
             || desc_flag(&desc, "disabletexturefiltering"),
@@ -266,7 +266,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
     let denoise_to = if opts.denoise {
         if opts.tile.is_some() || opts.spp_range.is_some() || opts.serve_parts {
             diagln!(
-                "rpbrt: error: --denoise: a tile or sample range is a part of an image; denoise the assembled image (rpbrt imgtool denoise) instead"
+                "rpbrt: error: --denoise: a tile or sample range is a part of an image; render the parts with --gbuffer and denoise the joined image (rpbrt imgtool denoise; rpbrt-farm --denoise does both)"
             );
             return ExitCode::FAILURE;
         }

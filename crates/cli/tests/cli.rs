@@ -1206,5 +1206,5 @@ fn denoise_writes_the_raw_render_beside_the_denoised_one() {
         .output()
         .unwrap();
     assert_eq!(o.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("denoise the assembled image"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("denoise the joined image"));
 }
