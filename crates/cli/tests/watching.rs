@@ -157,6 +157,36 @@ fn preview_in_a_real_browser() {
         "{second}"
     );
 
+    // The "denoised" toggle, mid-render: the denoised snapshot is shown
+    // (or, without Open Image Denoise, the reason and the raw image);
+    // unticked, the raw image again.
+    let toggle = |on: bool| {
+        format!(
+            r#"(() => {{ const d = document.getElementById("denoised"); d.checked = {on};
+                        d.dispatchEvent(new Event("change")); return 1; }})()"#
+        )
+    };
+    const DENOISE_STATE: &str = r#"({ src: frameSrc,
+        error: document.getElementById("denoise-error").textContent,
+        checked: document.getElementById("denoised").checked })"#;
+    page.eval(&toggle(true));
+    let den = page.wait_for(
+        "the denoised image, or why not",
+        minute,
+        DENOISE_STATE,
+        |v| v["src"] == "/denoised" || v["error"].as_str().is_some_and(|e| !e.is_empty()),
+    );
+    if den["src"] != "/denoised" {
+        let why = den["error"].as_str().unwrap_or_default();
+        assert!(why.contains("pip install pyoidn"), "{den}");
+        assert_eq!(den["checked"], false, "{den}");
+        eprintln!("the denoised toggle said why it cannot denoise here: {why}");
+    }
+    page.eval(&toggle(false));
+    page.wait_for("the raw image again", minute, DENOISE_STATE, |v| {
+        v["src"] == "/image"
+    });
+
     // Closed and reopened mid-render (a reload): it picks up again.
     page.eval("location.reload(), 1");
     let again = page.wait_for("the reloaded page's image", minute, PAGE_STATE, |v| {

@@ -125,6 +125,17 @@ struct Shared {
     clients: Mutex<Clients>,
     /// The encoded snapshots being sent (see [`MAX_IMAGE_BUFFERS`]).
     images: Mutex<Images>,
+    /// `/denoised`: Open Image Denoise, loaded on the first request, and
+    /// the latest denoised snapshot (denoised once per version; requests
+    /// wait on the lock, so one denoise runs at a time).
+    denoiser: Mutex<Denoiser>,
+}
+
+/// What `/denoised` keeps between requests.
+#[derive(Default)]
+struct Denoiser {
+    oidn: Option<Result<crate::oidn::Oidn, String>>,
+    latest: Option<Encoded>,
 }
 
 /// A snapshot encoded for `/image`, shared by every request sending it.
@@ -190,6 +201,54 @@ fn client_key(ip: IpAddr) -> IpAddr {
 impl Shared {
     fn clients(&self) -> std::sync::MutexGuard<'_, Clients> {
         self.clients.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The latest snapshot denoised (from its colour alone: a snapshot has
+    /// no albedo or normal) and encoded as `/image` encodes it; `None`
+    /// before the first snapshot, `Some(Err)` without Open Image Denoise.
+    fn denoised(&self) -> Option<Result<Encoded, String>> {
+        let frame = self.watch.state().frame.clone()?;
+        let mut d = self.denoiser.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(e) = d.latest.as_ref().filter(|e| e.version == frame.version) {
+            return Some(Ok(e.clone()));
+        }
+        let oidn = match d.oidn.get_or_insert_with(crate::oidn::Oidn::load) {
+            Ok(o) => o,
+            Err(e) => return Some(Err(e.clone())),
+        };
+        let s = &frame.snapshot;
+        let mut rgb = s.rgb.clone();
+        for p in rgb.chunks_exact_mut(3) {
+            if p.iter().any(|v| !v.is_finite()) {
+                p.fill(0.0);
+            }
+        }
+        let out = oidn.denoise(crate::oidn::Inputs {
+            width: s.width,
+            height: s.height,
+            color: &rgb,
+            albedo: None,
+            normal: None,
+            quality: crate::oidn::Quality::High,
+        });
+        let rgb = match out {
+            Ok(v) => v,
+            Err(e) => return Some(Err(e)),
+        };
+        let denoised = Frame {
+            version: frame.version,
+            snapshot: rpbrt_render::integrator::Snapshot {
+                rgb,
+                ..frame.snapshot.clone()
+            },
+        };
+        let e = Encoded {
+            version: frame.version,
+            done: frame.snapshot.done,
+            bytes: Arc::new(encode_image(&denoised)),
+        };
+        d.latest = Some(e.clone());
+        Some(Ok(e))
     }
 
     /// The latest snapshot encoded for `/image` (see
@@ -272,6 +331,7 @@ impl Preview {
             final_status_served: AtomicBool::new(false),
             limits,
             clients: Mutex::new(Clients::default()),
+            denoiser: Mutex::new(Denoiser::default()),
             images: Mutex::new(Images::default()),
         });
         let s = Arc::clone(&shared);
@@ -521,6 +581,26 @@ fn serve(stream: TcpStream, deadline: Instant, shared: &Shared) -> std::io::Resu
                     }
                     Ok(())
                 }
+                None => respond(&mut out, "404 Not Found", text, b"no image yet", head_only),
+            }
+        }
+        "/denoised" => {
+            shared.watch.viewer_seen();
+            match shared.denoised() {
+                Some(Ok(e)) => respond(
+                    &mut out,
+                    "200 OK",
+                    "application/octet-stream",
+                    e.bytes.as_slice(),
+                    head_only,
+                ),
+                Some(Err(why)) => respond(
+                    &mut out,
+                    "503 Service Unavailable",
+                    text,
+                    why.as_bytes(),
+                    head_only,
+                ),
                 None => respond(&mut out, "404 Not Found", text, b"no image yet", head_only),
             }
         }
