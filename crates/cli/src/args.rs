@@ -104,8 +104,8 @@ Rendering options:
                                <name>-noisy.exr. Needs `pip install pyoidn`.
   --gbuffer                    Render an rgb film as a gbuffer film with the same
                                parameters (the same R, G, B, plus albedo, normals and
-                               more): for tiles and sample ranges that are denoised
-                               once joined (rpbrt-farm --denoise).
+                               more): for tiles that are denoised once joined
+                               (rpbrt-farm --denoise).
   --disable-pixel-jitter       Always sample pixels at their centres.
   --disable-texture-filtering  Point-sample all textures.
   --disable-wavelength-jitter  Always sample the same four wavelengths of light.

@@ -28,18 +28,6 @@ macro_rules! diagln {
 
 mod args;
 mod imgtool;
-
-/// Where `--denoise` writes the raw render of output `out`: beside it,
-/// `<stem>-noisy.exr` (EXR, which keeps the albedo and normal).
-fn noisy_name(out: &str) -> String {
-    let p = std::path::Path::new(out);
-    let stem = p
-        .file_stem()
-        .map_or_else(|| "pbrt".into(), |s| s.to_string_lossy());
-    p.with_file_name(format!("{stem}-noisy.exr"))
-        .to_string_lossy()
-        .into_owned()
-}
 mod oidn;
 mod preview;
 mod serve;
@@ -60,6 +48,18 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Instant;
+
+/// Where `--denoise` writes the raw render of output `out`: beside it,
+/// `<stem>-noisy.exr` (EXR, which keeps the albedo and normal).
+fn noisy_name(out: &str) -> String {
+    let p = std::path::Path::new(out);
+    let stem = p
+        .file_stem()
+        .map_or_else(|| "pbrt".into(), |s| s.to_string_lossy());
+    p.with_file_name(format!("{stem}-noisy.exr"))
+        .to_string_lossy()
+        .into_owned()
+}
 
 fn main() -> ExitCode {
     let argv: Vec<String> = std::env::args().skip(1).collect();

@@ -41,7 +41,7 @@ pub struct FilmOverrides {
     /// `--tile K/N`: render only tile K of N of the pixel bounds
     /// ([`super::tile_bounds`]).
     pub tile: Option<(u32, u32)>,
-    /// `--denoise`: an `rgb` film is made a `gbuffer` film with the same
+    /// `--denoise`, `--gbuffer`: an `rgb` film is made a `gbuffer` film with the same
     /// parameters (the same R, G, B, plus the first visible surface's
     /// albedo and normal, in camera space, for the denoiser).
     pub aovs: bool,
