@@ -183,7 +183,7 @@ fn names(sets: &[&[&str]]) -> String {
 
 /// Sets every RGB triple of `v` that has a non-finite value to zero;
 /// returns how many there were.
-fn zero_non_finite(v: &mut [f32]) -> usize {
+pub(crate) fn zero_non_finite(v: &mut [f32]) -> usize {
     let mut n = 0;
     for p in v.chunks_exact_mut(3) {
         if p.iter().any(|x| !x.is_finite()) {

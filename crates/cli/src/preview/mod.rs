@@ -218,11 +218,7 @@ impl Shared {
         };
         let s = &frame.snapshot;
         let mut rgb = s.rgb.clone();
-        for p in rgb.chunks_exact_mut(3) {
-            if p.iter().any(|v| !v.is_finite()) {
-                p.fill(0.0);
-            }
-        }
+        crate::imgtool::denoise::zero_non_finite(&mut rgb);
         let out = oidn.denoise(crate::oidn::Inputs {
             width: s.width,
             height: s.height,
@@ -238,8 +234,11 @@ impl Shared {
         let denoised = Frame {
             version: frame.version,
             snapshot: rpbrt_render::integrator::Snapshot {
+                width: s.width,
+                height: s.height,
                 rgb,
-                ..frame.snapshot.clone()
+                spp: s.spp,
+                done: s.done,
             },
         };
         let e = Encoded {
