@@ -5,12 +5,15 @@
 //! translations, rendered at 128×128 with one sample per pixel; and
 //! (`--scene instances`) 1,000,000 `ObjectInstance`s, each with its own
 //! `Translate` and `Rotate`, of one 19,602-triangle mesh (99 MB of text),
-//! rendered the same way.
+//! rendered the same way; and (`--scene textures`) 48 quads, each with its
+//! own 4096×4096 8-bit PNG `imagemap` texture (generated once, 2.4 GB of
+//! texels), rendered the same way.
 //!
 //!     cargo bench -p rpbrt --bench scale                  # generate, render, report
 //!     cargo bench -p rpbrt --bench scale -- --write-only  # just write the files
 //!     cargo bench -p rpbrt --bench scale -- --scene motion
 //!     cargo bench -p rpbrt --bench scale -- --scene instances
+//!     cargo bench -p rpbrt --bench scale -- --scene textures
 //!
 //! The mesh is a displaced grid of 2237×2237 vertices (9,999,392 triangles),
 //! binary little-endian, positions and triangle indices only (`float x y z`,
@@ -249,6 +252,112 @@ fn write_instances_scene(dir: &Path) -> std::io::Result<PathBuf> {
     Ok(scene)
 }
 
+/// Textures in the textures scene, and their side in pixels.
+const TEXTURES: u32 = 48;
+const TEXTURE_SIZE: u32 = 4096;
+
+/// The 8-bit RGB texel (x, y) of texture `k`: a few waves of the texture's
+/// own directions and frequencies with a hashed grain on top, so that every
+/// texture is distinct and compresses about as well as a photograph (PNG
+/// files of 20-30 MB).
+fn texel(k: u32, x: u32, y: u32) -> [u8; 3] {
+    use std::f32::consts::TAU;
+    let (u, v) = (
+        x as f32 / TEXTURE_SIZE as f32,
+        y as f32 / TEXTURE_SIZE as f32,
+    );
+    let f = 2.0 + (k % 7) as f32;
+    let g = 3.0 + (k % 5) as f32;
+    let mut h =
+        (x.wrapping_mul(0x9e37_79b9) ^ y.wrapping_mul(0x85eb_ca6b) ^ k.wrapping_mul(0xc2b2_ae35))
+            .wrapping_mul(0x27d4_eb2f);
+    h ^= h >> 15;
+    let grain = (h & 15) as f32 / 15.0 - 0.5;
+    let wave = |a: f32, b: f32, p: f32| 0.5 + 0.4 * (TAU * (a * u + b * v) + p).sin();
+    let to8 = |c: f32| ((c + 0.06 * grain).clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+    [
+        to8(wave(f, 0.5 * g, k as f32)),
+        to8(wave(-0.7 * g, f, 0.5 * k as f32)),
+        to8(wave(0.3 * f, 0.9 * g, 2.0)),
+    ]
+}
+
+/// Writes `texture-{k}.png` (RGB, 8-bit, fast compression) into `dir`.
+fn write_texture(dir: &Path, k: u32) -> std::io::Result<()> {
+    let path = dir.join(format!("texture-{k}.png"));
+    let tmp = dir.join(format!("texture-{k}.png.part"));
+    let w = BufWriter::with_capacity(1 << 20, File::create(&tmp)?);
+    let mut enc = png::Encoder::new(w, TEXTURE_SIZE, TEXTURE_SIZE);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    enc.set_compression(png::Compression::Fast);
+    let mut writer = enc.write_header().map_err(std::io::Error::other)?;
+    let mut stream = writer.stream_writer().map_err(std::io::Error::other)?;
+    let mut row = vec![0u8; 3 * TEXTURE_SIZE as usize];
+    for y in 0..TEXTURE_SIZE {
+        for (x, px) in row.chunks_exact_mut(3).enumerate() {
+            px.copy_from_slice(&texel(k, x as u32, y));
+        }
+        stream.write_all(&row)?;
+    }
+    stream.finish().map_err(std::io::Error::other)?;
+    std::fs::rename(&tmp, &path)
+}
+
+/// Writes `textures.pbrt` into `dir`: [`TEXTURES`] quads in a grid facing
+/// the camera, each with its own [`TEXTURE_SIZE`]² 8-bit PNG `imagemap`
+/// (generated once, on two threads; files already there are reused).
+fn write_textures_scene(dir: &Path) -> std::io::Result<PathBuf> {
+    std::fs::create_dir_all(dir)?;
+    let missing: Vec<u32> = (0..TEXTURES)
+        .filter(|k| !dir.join(format!("texture-{k}.png")).exists())
+        .collect();
+    if !missing.is_empty() {
+        let t = Instant::now();
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        std::thread::scope(|s| -> std::io::Result<()> {
+            let workers: Vec<_> = (0..2)
+                .map(|_| {
+                    s.spawn(|| -> std::io::Result<()> {
+                        loop {
+                            let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                            let Some(&k) = missing.get(i) else {
+                                return Ok(());
+                            };
+                            write_texture(dir, k)?;
+                        }
+                    })
+                })
+                .collect();
+            for w in workers {
+                w.join()
+                    .map_err(|_| std::io::Error::other("texture writer panicked"))??;
+            }
+            Ok(())
+        })?;
+        eprintln!(
+            "wrote {} textures in {:.1} s",
+            missing.len(),
+            t.elapsed().as_secs_f64()
+        );
+    }
+    let (scene, mut w) = generated_scene(dir, "textures", 16, "")?;
+    // 8 columns by 6 rows of unit quads, 1.1 apart, in the plane z = 0.
+    for k in 0..TEXTURES {
+        let (x0, y0) = ((k % 8) as f32 * 1.1 - 4.4, (k / 8) as f32 * 1.1 - 3.3);
+        let (x1, y1) = (x0 + 1.0, y0 + 1.0);
+        writeln!(
+            w,
+            "Texture \"t{k}\" \"spectrum\" \"imagemap\" \"string filename\" \"texture-{k}.png\"\n\
+             AttributeBegin\nMaterial \"diffuse\" \"texture reflectance\" \"t{k}\"\n\
+             Shape \"bilinearmesh\" \"point3 P\" [{x0} {y0} 0 {x1} {y0} 0 {x0} {y1} 0 {x1} {y1} 0]\n\
+             \"point2 uv\" [0 0 1 0 0 1 1 1]\nAttributeEnd"
+        )?;
+    }
+    w.flush()?;
+    Ok(scene)
+}
+
 /// One timed run: (wall seconds, peak RSS in KiB if `/usr/bin/time` gave it).
 fn run_once(scene: &Path, threads: u32) -> Result<(f64, Option<u64>), String> {
     let rpbrt = env!("CARGO_BIN_EXE_rpbrt");
@@ -298,6 +407,7 @@ enum Scene {
     Triangles,
     Motion,
     Instances,
+    Textures,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -327,8 +437,11 @@ fn parse_args() -> Result<Args, String> {
                     "triangles" => Scene::Triangles,
                     "motion" => Scene::Motion,
                     "instances" => Scene::Instances,
+                    "textures" => Scene::Textures,
                     other => {
-                        return Err(format!("--scene {other:?}: triangles, motion or instances"))
+                        return Err(format!(
+                            "--scene {other:?}: triangles, motion, instances or textures"
+                        ))
                     }
                 }
             }
@@ -355,6 +468,7 @@ fn main() -> ExitCode {
         Scene::Triangles => write_scene(&args.dir, args.n),
         Scene::Motion => write_motion_scene(&args.dir),
         Scene::Instances => write_instances_scene(&args.dir),
+        Scene::Textures => write_textures_scene(&args.dir),
     };
     let scene = match written {
         Ok(s) => s,
@@ -392,6 +506,7 @@ fn main() -> ExitCode {
         ),
         Scene::Motion => format!("motion spheres={MOTION_SPHERES}"),
         Scene::Instances => format!("instances instances={INSTANCES}"),
+        Scene::Textures => format!("textures textures={TEXTURES} size={TEXTURE_SIZE}"),
     };
     println!(
         "RESULT scale {what} threads={} best_wall_s={best:.2} peak_rss_gb={peak_gb}",

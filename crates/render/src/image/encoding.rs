@@ -41,6 +41,13 @@ pub fn linear_to_srgb(v: f32) -> f32 {
 
 /// Linear value to an 8-bit sRGB value, clamping to [0, 1] first and rounding to the
 /// nearest code (pbrt-v4 `LinearToSRGB8` without dither). NaN maps to 0.
+///
+/// The same code as [`linear_to_srgb8_exact`] (the formula, with a `powf`),
+/// found without one: the code at the value's 1/4096th of [0, 1] from a
+/// table, then stepped up past the codes' thresholds (the least values
+/// that the formula rounds to each code, found once by bisection). The
+/// steepest part of the curve (the linear segment, 3294 codes per unit)
+/// makes a 1/4096th span at most one threshold, so it steps at most once.
 #[inline]
 pub fn linear_to_srgb8(v: f32) -> u8 {
     if v.is_nan() || v <= 0.0 {
@@ -49,7 +56,68 @@ pub fn linear_to_srgb8(v: f32) -> u8 {
     if v >= 1.0 {
         return 255;
     }
+    let t = srgb8_thresholds();
+    // v·4096 is exact, so the bucket starts at or below v.
+    let mut code = t.bucket_code[(v * SRGB8_BUCKETS as f32) as usize];
+    while code < 255 && v >= t.at_least[code as usize] {
+        code += 1;
+    }
+    code
+}
+
+/// [`linear_to_srgb8`] by the formula (what its tables are built from).
+#[inline]
+pub fn linear_to_srgb8_exact(v: f32) -> u8 {
+    if v.is_nan() || v <= 0.0 {
+        return 0;
+    }
+    if v >= 1.0 {
+        return 255;
+    }
     (255.0 * linear_to_srgb(v)).round().clamp(0.0, 255.0) as u8
+}
+
+/// Buckets of [0, 1) in [`linear_to_srgb8`]'s first guess.
+const SRGB8_BUCKETS: usize = 4096;
+
+/// [`linear_to_srgb8`]'s tables.
+struct Srgb8Thresholds {
+    /// `at_least[k]`: the least value in (0, 1) that the formula encodes as
+    /// `k + 1` or more.
+    at_least: [f32; 255],
+    /// The code of each bucket's first value.
+    bucket_code: [u8; SRGB8_BUCKETS],
+}
+
+fn srgb8_thresholds() -> &'static Srgb8Thresholds {
+    static TABLES: OnceLock<Srgb8Thresholds> = OnceLock::new();
+    TABLES.get_or_init(|| {
+        // The formula rises with the value, so each threshold is where a
+        // bisection over the positive floats' bit patterns (in the
+        // floats' order) says the code first reaches k + 1.
+        let at_least: [f32; 255] = std::array::from_fn(|k| {
+            let want = k as u8 + 1;
+            let (mut lo, mut hi) = (0u32, 1.0f32.to_bits());
+            // Invariant: code(lo) < want <= code(hi).
+            while hi - lo > 1 {
+                let mid = lo + (hi - lo) / 2;
+                if linear_to_srgb8_exact(f32::from_bits(mid)) >= want {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            f32::from_bits(hi)
+        });
+        let bucket_code = std::array::from_fn(|i| {
+            let start = i as f32 / SRGB8_BUCKETS as f32;
+            at_least.iter().take_while(|&&t| t <= start).count() as u8
+        });
+        Srgb8Thresholds {
+            at_least,
+            bucket_code,
+        }
+    })
 }
 
 fn srgb8_table() -> &'static [f32; 256] {

@@ -166,13 +166,13 @@ pub struct MIPMap {
 impl MIPMap {
     /// Builds the pyramid of `image` (see [`Image::generate_pyramid`]).
     pub fn new(
-        image: &Image,
+        image: Image,
         color_space: &str,
         wrap_mode: WrapMode,
         options: MIPMapFilterOptions,
     ) -> MIPMap {
         MIPMap {
-            pyramid: Image::generate_pyramid(image, wrap_mode.into()),
+            pyramid: image.into_pyramid(wrap_mode.into()),
             color_space: color_space.to_string(),
             wrap_mode,
             options,
@@ -239,11 +239,11 @@ impl MIPMap {
                 (Some(rgba), Some(rgb)) => {
                     let nc = image.n_channels();
                     let a = rgba.offset[3];
-                    let vals = image.to_f32_vec();
-                    let all_one = vals.chunks_exact(nc).all(|p| p[a] == 1.0);
-                    image.select_channels(if all_one { &rgb } else { &rgba })
+                    let n = image.data_len();
+                    let all_one = (a..n).step_by(nc).all(|i| image.value_at(i) == 1.0);
+                    image.into_channels(if all_one { &rgb } else { &rgba })
                 }
-                (None, Some(rgb)) => image.select_channels(&rgb),
+                (None, Some(rgb)) => image.into_channels(&rgb),
                 _ => {
                     return Err(ImageError::Format {
                         path: path.display().to_string(),
@@ -263,7 +263,7 @@ impl MIPMap {
                 message: e.to_string(),
             })?;
         Ok(MIPMap::new(
-            &image,
+            image,
             read.metadata.color_space_name(),
             wrap_mode,
             options,

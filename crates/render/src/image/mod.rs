@@ -25,7 +25,8 @@ use half::f16;
 use rpbrt_geometry::{Bounds2i, Point2f, Point2i};
 
 pub use encoding::{
-    linear_to_srgb, linear_to_srgb8, srgb8_to_linear, srgb_to_linear, ColorEncoding,
+    linear_to_srgb, linear_to_srgb8, linear_to_srgb8_exact, srgb8_to_linear, srgb_to_linear,
+    ColorEncoding,
 };
 pub use io::{ImageAndMetadata, ImageError, ImageMetadata};
 pub use mipmap::{FilterFunction, MIPMap, MIPMapCache, MIPMapFilterOptions};
@@ -550,6 +551,25 @@ impl Image {
     pub fn all_channels_desc(&self) -> ImageChannelDesc {
         ImageChannelDesc {
             offset: (0..self.n_channels()).collect(),
+        }
+    }
+
+    /// [`Image::select_channels`], taking the image: itself when `desc`
+    /// is all its channels in order.
+    pub fn into_channels(self, desc: &ImageChannelDesc) -> Image {
+        if desc.offset.iter().copied().eq(0..self.n_channels()) {
+            self
+        } else {
+            self.select_channels(desc)
+        }
+    }
+
+    /// Number of stored values (pixels times channels).
+    fn data_len(&self) -> usize {
+        match &self.data {
+            PixelData::U256(v) => v.len(),
+            PixelData::Half(v) => v.len(),
+            PixelData::Float(v) => v.len(),
         }
     }
 

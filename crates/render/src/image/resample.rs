@@ -129,73 +129,212 @@ impl Image {
     /// converted to float), then each level is the 2x2 box-filtered previous one. Levels
     /// are stored in the original pixel format and encoding, finest first.
     pub fn generate_pyramid(image: &Image, wrap: WrapMode2D) -> Vec<Image> {
-        let orig_format = image.format();
-        let orig_encoding = image.encoding;
-        let nc = image.n_channels();
-        let res = image.resolution;
+        image.clone().into_pyramid(wrap)
+    }
+
+    /// [`Image::generate_pyramid`], taking the image: pbrt-v4's levels bit for bit,
+    /// built without its float copy of the finest level. Rows flow down the
+    /// levels as they are made (each level holds one float row waiting for its
+    /// pair), so building takes a few rows of floats besides the levels
+    /// themselves. Where converting to floats and back gives the stored values
+    /// (8-bit images whose encoding round-trips every code, half and float images
+    /// without NaNs) the image itself is the finest level.
+    pub fn into_pyramid(self, wrap: WrapMode2D) -> Vec<Image> {
+        let res = self.resolution;
         if res.x <= 0 || res.y <= 0 {
-            return vec![image.clone()];
+            return vec![self];
         }
-        let mut img = if !(res.x as u32).is_power_of_two() || !(res.y as u32).is_power_of_two() {
-            image.float_resize_up(
+        let pow2 = (res.x as u32).is_power_of_two() && (res.y as u32).is_power_of_two();
+        if !pow2 {
+            // pbrt-v4 resamples up to powers of two first.
+            let up = self.float_resize_up(
                 Point2i {
                     x: round_up_pow2(res.x),
                     y: round_up_pow2(res.y),
                 },
                 wrap,
-            )
-        } else {
-            image.convert_to_format(PixelFormat::Float, orig_encoding)
-        };
-        let n_levels = 1 + (img.resolution.x.max(img.resolution.y) as u32).ilog2() as usize;
-        let mut pyramid = Vec::with_capacity(n_levels);
-        let mut level_res = img.resolution;
-        for _ in 0..n_levels - 1 {
-            pyramid.push(img.convert_to_format(orig_format, orig_encoding));
-            let next_res = Point2i {
-                x: (level_res.x / 2).max(1),
-                y: (level_res.y / 2).max(1),
-            };
-            let mut next = Image::new(
-                PixelFormat::Float,
-                next_res,
-                &img.channel_names,
-                orig_encoding,
             );
-            let rx = level_res.x as usize;
-            let mut deltas = [0, nc, nc * rx, nc * rx + nc];
-            if level_res.x == 1 {
-                deltas[1] = 0;
-                deltas[3] -= nc;
+            let super::PixelData::Float(floats) = &up.data else {
+                unreachable!("resampling makes floats")
+            };
+            let mut cascade = Cascade::new(&self, up.resolution, true);
+            for row in floats.chunks_exact(up.resolution.x as usize * up.n_channels()) {
+                cascade.push_row(0, row.to_vec());
             }
-            if level_res.y == 1 {
-                deltas[2] = 0;
-                deltas[3] -= nc * rx;
-            }
-            if let (super::PixelData::Float(src), super::PixelData::Float(dst)) =
-                (&img.data, &mut next.data)
-            {
-                for y in 0..next_res.y as usize {
-                    let mut so = 2 * y * rx * nc;
-                    let mut no = y * next_res.x as usize * nc;
-                    for _ in 0..next_res.x {
-                        for _ in 0..nc {
-                            dst[no] = 0.25
-                                * (src[so]
-                                    + src[so + deltas[1]]
-                                    + src[so + deltas[2]]
-                                    + src[so + deltas[3]]);
-                            so += 1;
-                            no += 1;
-                        }
-                        so += nc;
-                    }
+            return cascade.finish();
+        }
+        let keep = self.keeps_own_values();
+        let mut cascade = Cascade::new(&self, res, !keep);
+        let row_len = res.x as usize * self.n_channels();
+        let enc = self.encoding;
+        match &self.data {
+            super::PixelData::U256(v) => {
+                let lut: [f32; 256] = std::array::from_fn(|b| enc.to_linear(b as u8));
+                for row in v.chunks_exact(row_len) {
+                    cascade.push_row(0, row.iter().map(|&b| lut[b as usize]).collect());
                 }
             }
-            img = next;
-            level_res = next_res;
+            super::PixelData::Half(v) => {
+                // Converting to floats stores NaN as zero.
+                let value = |h: &half::f16| if h.is_nan() { 0.0 } else { h.to_f32() };
+                for row in v.chunks_exact(row_len) {
+                    cascade.push_row(0, row.iter().map(value).collect());
+                }
+            }
+            super::PixelData::Float(v) => {
+                for row in v.chunks_exact(row_len) {
+                    cascade.push_row(0, row.to_vec());
+                }
+            }
         }
-        pyramid.push(img.convert_to_format(orig_format, orig_encoding));
-        pyramid
+        let mut levels = cascade.finish();
+        if keep {
+            levels[0] = self;
+        }
+        levels
     }
+
+    /// Whether converting the image to floats and back gives its own values
+    /// (what lets [`Image::into_pyramid`] keep it as the finest level).
+    fn keeps_own_values(&self) -> bool {
+        match &self.data {
+            super::PixelData::U256(_) => {
+                (0..=255u8).all(|b| self.encoding.from_linear(self.encoding.to_linear(b)) == b)
+            }
+            // Storing turns NaN into zero.
+            super::PixelData::Half(v) => !v.iter().any(|h| h.is_nan()),
+            // Float to float is a copy.
+            super::PixelData::Float(_) => true,
+        }
+    }
+
+    /// An image of resolution `res` holding `values` stored as this image
+    /// stores its values (what `convert_to_format` to its format gives).
+    fn stored_like(&self, res: Point2i, values: &[f32]) -> Image {
+        let mut out = Image {
+            resolution: res,
+            channel_names: self.channel_names.clone(),
+            encoding: self.encoding,
+            data: match &self.data {
+                super::PixelData::U256(_) => super::PixelData::U256(Vec::new()),
+                super::PixelData::Half(_) => super::PixelData::Half(Vec::new()),
+                super::PixelData::Float(_) => super::PixelData::Float(Vec::new()),
+            },
+        };
+        out.append_stored(values);
+        out
+    }
+
+    /// Appends `values` to the image's storage, converted as
+    /// `convert_to_format` to its format converts them.
+    fn append_stored(&mut self, values: &[f32]) {
+        let enc = self.encoding;
+        match &mut self.data {
+            super::PixelData::U256(d) => d.extend(values.iter().map(|&v| enc.from_linear(v))),
+            super::PixelData::Half(d) => d.extend(
+                values
+                    .iter()
+                    .map(|&v| half::f16::from_f32(if v.is_nan() { 0.0 } else { v })),
+            ),
+            super::PixelData::Float(d) => d.extend_from_slice(values),
+        }
+    }
+}
+
+/// The levels of a pyramid being built a row at a time, finest first.
+/// Level `l + 1`'s rows are the 2x2 means of level `l`'s pairs of rows, in
+/// pbrt-v4's order of summing (a side of one texel is repeated).
+struct Cascade {
+    levels: Vec<Image>,
+    /// Each level's float row waiting for its pair.
+    pending: Vec<Option<Vec<f32>>>,
+    /// Whether the finest level is stored (or given back by the caller).
+    store_finest: bool,
+}
+
+impl Cascade {
+    /// Empty levels stored like `like`, the finest of resolution `res`
+    /// (left empty, for the caller to fill, unless `store_finest`).
+    fn new(like: &Image, res: Point2i, store_finest: bool) -> Cascade {
+        let n = 1 + (res.x.max(res.y) as u32).ilog2() as usize;
+        let nc = like.n_channels();
+        let mut levels = Vec::with_capacity(n);
+        let mut r = res;
+        for l in 0..n {
+            let mut level = like.stored_like(r, &[]);
+            let len = if l > 0 || store_finest {
+                r.x as usize * r.y as usize * nc
+            } else {
+                0
+            };
+            match &mut level.data {
+                super::PixelData::U256(d) => d.reserve_exact(len),
+                super::PixelData::Half(d) => d.reserve_exact(len),
+                super::PixelData::Float(d) => d.reserve_exact(len),
+            }
+            levels.push(level);
+            r = half_res(r);
+        }
+        Cascade {
+            pending: vec![None; n],
+            levels,
+            store_finest,
+        }
+    }
+
+    /// Adds the next row of level `l`, in floats.
+    fn push_row(&mut self, l: usize, row: Vec<f32>) {
+        if l > 0 || self.store_finest {
+            self.levels[l].append_stored(&row);
+        }
+        if l + 1 == self.levels.len() {
+            return;
+        }
+        let res = self.levels[l].resolution;
+        let nc = self.levels[l].n_channels();
+        let below = if res.y == 1 {
+            // A level one row high pairs the row with itself.
+            halve_rows(&row, &row, res.x as usize, nc)
+        } else {
+            match self.pending[l].take() {
+                None => {
+                    self.pending[l] = Some(row);
+                    return;
+                }
+                Some(first) => halve_rows(&first, &row, res.x as usize, nc),
+            }
+        };
+        self.push_row(l + 1, below);
+    }
+
+    /// The levels, finest first (the finest empty when the caller keeps it).
+    fn finish(self) -> Vec<Image> {
+        self.levels
+    }
+}
+
+/// The next coarser level's resolution.
+fn half_res(res: Point2i) -> Point2i {
+    Point2i {
+        x: (res.x / 2).max(1),
+        y: (res.y / 2).max(1),
+    }
+}
+
+/// The row of 2x2 means of rows `a` and `b` (the same row where the level
+/// is one row high) of a level `width` texels wide with `nc` channels.
+#[inline]
+fn halve_rows(a: &[f32], b: &[f32], width: usize, nc: usize) -> Vec<f32> {
+    let next = (width / 2).max(1);
+    // The second texel of a pair: the next one, or the same at width 1.
+    let dx = if width == 1 { 0 } else { nc };
+    let mut out = Vec::with_capacity(next * nc);
+    for x in 0..next {
+        let so = 2 * x * nc;
+        for c in 0..nc {
+            let i = so + c;
+            out.push(0.25 * (a[i] + a[i + dx] + b[i] + b[i + dx]));
+        }
+    }
+    out
 }

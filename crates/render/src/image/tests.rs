@@ -605,8 +605,8 @@ fn mipmap_constant_filters_to_constant() {
                 filter,
                 max_anisotropy: 8.0,
             };
-            let m = MIPMap::new(&img, "srgb", wrap, opts);
-            let mg = MIPMap::new(&grey, "srgb", wrap, opts);
+            let m = MIPMap::new(img.clone(), "srgb", wrap, opts);
+            let mg = MIPMap::new(grey.clone(), "srgb", wrap, opts);
             for level in 0..m.levels() {
                 let r = m.level_resolution(level);
                 assert_eq!(m.texel_rgb(level, p(r.x - 1, 0)), c);
@@ -658,7 +658,7 @@ fn mipmap_checkerboard_averages_at_coarse_levels() {
         FilterFunction::EWA,
     ] {
         let m = MIPMap::new(
-            &img,
+            img.clone(),
             "srgb",
             WrapMode::Repeat,
             MIPMapFilterOptions {
@@ -679,7 +679,7 @@ fn mipmap_checkerboard_averages_at_coarse_levels() {
         }
         // At the finest level a texel centre returns the texel itself.
         let bil = MIPMap::new(
-            &img,
+            img.clone(),
             "srgb",
             WrapMode::Repeat,
             MIPMapFilterOptions {
@@ -702,7 +702,7 @@ fn mipmap_checkerboard_averages_at_coarse_levels() {
     }
     // Point sampling at level 0 picks the nearest texel.
     let m = MIPMap::new(
-        &img,
+        img.clone(),
         "srgb",
         WrapMode::Repeat,
         MIPMapFilterOptions {
@@ -728,7 +728,7 @@ fn ewa_matches_direct_gaussian_weighting() {
     let data = (0..n * n).map(|i| (i % n) as f32).collect();
     let img = Image::from_f32(data, p(n, n), &["Y"]).unwrap();
     let m = MIPMap::new(
-        &img,
+        img.clone(),
         "srgb",
         WrapMode::Clamp,
         MIPMapFilterOptions::default(),
@@ -903,7 +903,7 @@ fn reads_shared_scene_images() {
                     path.display()
                 );
                 let m = MIPMap::new(
-                    &img,
+                    img.clone(),
                     "srgb",
                     WrapMode::OctahedralSphere,
                     MIPMapFilterOptions::default(),
@@ -1068,4 +1068,130 @@ fn channel_lists_keep_commas_of_spectral_names() {
     );
     assert_eq!(split_channel_list("Q,R", &avail), ["Q", "R"]);
     assert_eq!(split_channel_list("S0.418", &avail), ["S0.418"]);
+}
+
+/// pbrt-v4's `GeneratePyramid` for a power-of-two image, written out: the
+/// image in floats, each level the 2x2 mean of the one above, every level
+/// stored converted back to the image's format.
+fn reference_pyramid(img: &Image) -> Vec<Image> {
+    let (format, enc, nc) = (img.format(), img.encoding(), img.n_channels());
+    let names: Vec<&str> = img.channel_names().iter().map(|s| s.as_str()).collect();
+    let mut f = img.convert_to_format(PixelFormat::Float, enc);
+    let mut out = Vec::new();
+    loop {
+        let fl = Image::from_f32(f.to_f32_vec(), f.resolution(), &names).unwrap();
+        out.push(fl.convert_to_format(format, enc));
+        let r = f.resolution();
+        if r.x == 1 && r.y == 1 {
+            return out;
+        }
+        let v = f.to_f32_vec();
+        let (nx, ny) = ((r.x / 2).max(1), (r.y / 2).max(1));
+        let at = |x: i32, y: i32, c: usize| {
+            v[((y.min(r.y - 1) * r.x + x.min(r.x - 1)) as usize) * nc + c]
+        };
+        let mut next = Vec::new();
+        for y in 0..ny {
+            for x in 0..nx {
+                for c in 0..nc {
+                    next.push(
+                        0.25 * (at(2 * x, 2 * y, c)
+                            + at(2 * x + 1, 2 * y, c)
+                            + at(2 * x, 2 * y + 1, c)
+                            + at(2 * x + 1, 2 * y + 1, c)),
+                    );
+                }
+            }
+        }
+        f = Image::from_f32(next, p(nx, ny), &names).unwrap();
+    }
+}
+
+/// The stored bits of every value of `img`, with its format and encoding.
+fn stored_bits(img: &Image) -> (PixelFormat, ColorEncoding, Point2i, Vec<u32>) {
+    let bits = match img.format() {
+        PixelFormat::U256 => img.as_u8().unwrap().iter().map(|&b| u32::from(b)).collect(),
+        _ => img.to_f32_vec().iter().map(|v| v.to_bits()).collect(),
+    };
+    (img.format(), img.encoding(), img.resolution(), bits)
+}
+
+#[test]
+fn pyramids_are_pbrt_v4s_bit_for_bit() {
+    let mut images = Vec::new();
+    for (w, h) in [(1, 1), (1, 8), (8, 1), (16, 4), (32, 32)] {
+        for (k, enc) in [
+            ColorEncoding::SRGB,
+            ColorEncoding::Linear,
+            ColorEncoding::Gamma(2.2),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let u = random_u8_image(w, h, &["R", "G", "B"], 10 + k as u64);
+            let data = u.as_u8().unwrap().to_vec();
+            images.push(Image::from_u8(data, p(w, h), &["R", "G", "B"], enc).unwrap());
+        }
+        let mut f = random_float_image(w, h, &["R", "G", "B", "A"], 20).to_f32_vec();
+        let halves: Vec<half::f16> = f.iter().map(|&v| half::f16::from_f32(v)).collect();
+        images.push(Image::from_f16(halves.clone(), p(w, h), &["R", "G", "B", "A"]).unwrap());
+        f[1] = f32::NAN;
+        let mut nan_halves = halves;
+        nan_halves[2] = half::f16::NAN;
+        images.push(Image::from_f32(f, p(w, h), &["R", "G", "B", "A"]).unwrap());
+        images.push(Image::from_f16(nan_halves, p(w, h), &["R", "G", "B", "A"]).unwrap());
+    }
+    for img in &images {
+        let want: Vec<_> = reference_pyramid(img).iter().map(stored_bits).collect();
+        let got: Vec<_> = img.clone().into_pyramid(WrapMode::Repeat.into());
+        let got: Vec<_> = got.iter().map(stored_bits).collect();
+        assert_eq!(got, want, "{:?} {:?}", img.format(), img.encoding());
+    }
+}
+
+#[test]
+fn fast_srgb8_encoding_is_the_formulas() {
+    // Around every code's threshold, and a sweep of the whole range.
+    let mut checked = 0;
+    let mut at = |v: f32| {
+        assert_eq!(linear_to_srgb8(v), linear_to_srgb8_exact(v), "{v:e}");
+        checked += 1;
+    };
+    for code in 0..=255u8 {
+        let mid = if code == 0 {
+            0.0
+        } else {
+            srgb8_to_linear(code)
+        };
+        let lo = srgb8_to_linear(code.saturating_sub(1));
+        // Bisect down to the threshold between lo and mid, then test the
+        // floats on either side of it.
+        let (mut a, mut b) = (lo.to_bits(), mid.to_bits());
+        while b > a + 1 {
+            let m = a + (b - a) / 2;
+            if linear_to_srgb8_exact(f32::from_bits(m)) >= code {
+                b = m;
+            } else {
+                a = m;
+            }
+        }
+        for bits in b.saturating_sub(300)..b + 300 {
+            at(f32::from_bits(bits));
+        }
+    }
+    for i in 0..=1_000_000u32 {
+        at(i as f32 / 1_000_000.0);
+    }
+    for v in [
+        -0.0,
+        1e-45,
+        1e-38,
+        0.003_130_8,
+        0.999_999_94,
+        1.0,
+        f32::INFINITY,
+    ] {
+        at(v);
+    }
+    assert!(checked > 1_000_000);
 }

@@ -9,9 +9,11 @@
 //! [`SpectrumType`]. Anonymous materials keep their indices `0..n` (the
 //! description's `MaterialRef::Index`); named ones follow in definition
 //! order. As in pbrt-v4, a named `mix` may only use named materials
-//! defined before it; anonymous ones may use any.
+//! defined before it; anonymous ones may use any. Image textures' files
+//! are read first, in parallel.
 
 use std::collections::{HashMap, HashSet};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 use rpbrt_parser::{Diagnostic, MemoryBudget};
 
@@ -21,8 +23,8 @@ use crate::image::MIPMapCache;
 use crate::material::{create_material, Material, MaterialSet, NormalMapCache};
 use crate::spectrum::SpectrumType;
 use crate::texture::{
-    create_float_texture, create_spectrum_texture, NamedTextures, TextureDef, TextureOptions,
-    TextureParams,
+    create_float_texture, create_spectrum_texture, ImageRequest, NamedTextures, TextureDef,
+    TextureOptions, TextureParams,
 };
 
 fn texture_def(e: &TextureSceneEntity) -> TextureDef<'_> {
@@ -31,6 +33,41 @@ fn texture_def(e: &TextureSceneEntity) -> TextureDef<'_> {
         class: &e.base.name,
         render_from_texture: e.render_from_object.start_transform,
     }
+}
+
+/// Reads the image textures' files into `cache` in parallel (pbrt-v4
+/// reads them while parsing, asynchronously), so that creating the
+/// textures in order then finds them there. Only the requests are read
+/// here: a texture whose parameters or file fail is left to its creation,
+/// which reports it (failed reads are not cached).
+fn preload_images<'e>(
+    entities: impl Iterator<Item = &'e TextureSceneEntity>,
+    cache: &MIPMapCache,
+    options: &TextureOptions,
+    budget: &MemoryBudget,
+) {
+    let requests: Vec<ImageRequest> = entities
+        .filter(|e| e.base.name == "imagemap")
+        .filter_map(|e| {
+            let r = reader(&e.base, budget).ok()?;
+            ImageRequest::read(&texture_def(e), &r, options).ok()
+        })
+        .collect();
+    let threads = crate::accel::default_threads().min(requests.len());
+    if threads < 2 {
+        return;
+    }
+    let next = AtomicUsize::new(0);
+    std::thread::scope(|s| {
+        for _ in 0..threads {
+            s.spawn(|| {
+                while let Some(r) = requests.get(next.fetch_add(1, Ordering::Relaxed)) {
+                    // Errors are reported when the texture is created.
+                    let _ = r.load(cache);
+                }
+            });
+        }
+    });
 }
 
 /// Creates every named texture. A texture that fails is left out (later
@@ -45,6 +82,12 @@ pub(super) fn create_textures(
 ) -> Option<NamedTextures> {
     let mut named = NamedTextures::default();
     let errors_before = problems.errors.len();
+    preload_images(
+        float_entities.iter().chain(spectrum_entities),
+        cache,
+        options,
+        budget,
+    );
     let spectrum_names: HashSet<String> =
         spectrum_entities.iter().map(|e| e.name.clone()).collect();
     for e in float_entities {

@@ -16,7 +16,9 @@ use super::params::TextureParams;
 use super::procedural::*;
 use super::ptex::{load_ptex, FloatPtexTexture, PtexTextureBase, SpectrumPtexTexture};
 use super::{FloatTexture, FloatTextureRef, SpectrumTexture, SpectrumTextureRef};
-use crate::image::{ColorEncoding, FilterFunction, MIPMapCache, MIPMapFilterOptions, WrapMode};
+use crate::image::{
+    ColorEncoding, FilterFunction, MIPMap, MIPMapCache, MIPMapFilterOptions, WrapMode,
+};
 use crate::params::{unknown_type, ParamReader};
 use crate::spectrum::{RgbColorSpace, Spectrum, SpectrumType};
 use rpbrt_geometry::float::Float;
@@ -82,6 +84,80 @@ const FILTER_NAMES: &str = "point, bilinear, trilinear, ewa";
 /// Names `WrapMode::parse` accepts.
 const WRAP_NAMES: &str = "repeat, black, clamp, octahedralsphere";
 
+/// The MIP map an image texture's parameters ask for (its file and how it
+/// is filtered, wrapped and decoded), before it is loaded.
+#[derive(Clone, Debug)]
+pub struct ImageRequest {
+    path: std::path::PathBuf,
+    filter_options: MIPMapFilterOptions,
+    wrap: WrapMode,
+    encoding: ColorEncoding,
+}
+
+impl ImageRequest {
+    /// Reads the request from an image texture's parameters (`filter`,
+    /// `maxanisotropy`, `wrap`, `filename`, `encoding`; pbrt-v4's defaults).
+    pub fn read(
+        def: &TextureDef,
+        tp: &ParamReader,
+        options: &TextureOptions,
+    ) -> Result<ImageRequest, Diagnostic> {
+        let max_anisotropy = tp.float("maxanisotropy", 8.0)?;
+        let filter_name = tp.string("filter", "bilinear")?;
+        let Some(mut filter) = FilterFunction::parse(&filter_name) else {
+            return Err(Diagnostic::error(
+                tp.param_loc("filter"),
+                format!("\"{filter_name}\": filter function unknown (known: {FILTER_NAMES})"),
+            ));
+        };
+        if options.disable_texture_filtering {
+            filter = FilterFunction::Point;
+        }
+        let wrap_name = tp.string("wrap", "repeat")?;
+        let Some(wrap) = WrapMode::parse(&wrap_name) else {
+            return Err(Diagnostic::error(
+                tp.param_loc("wrap"),
+                format!("\"{wrap_name}\": wrap mode unknown (known: {WRAP_NAMES})"),
+            ));
+        };
+        let filename = tp.string("filename", "")?;
+        if filename.is_empty() {
+            return Err(tp.error(format!(
+                "{} texture \"{}\": no \"filename\" given",
+                def.class, def.name
+            )));
+        }
+        let path = tp.resolve("filename", &filename);
+        let is_png = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        let encoding_name = tp.string("encoding", if is_png { "sRGB" } else { "linear" })?;
+        let Some(encoding) = ColorEncoding::parse(&encoding_name) else {
+            return Err(Diagnostic::error(
+                tp.param_loc("encoding"),
+                format!(
+                    "\"{encoding_name}\": color encoding unknown (known: linear, sRGB, gamma <value>)"
+                ),
+            ));
+        };
+        Ok(ImageRequest {
+            path,
+            filter_options: MIPMapFilterOptions {
+                filter,
+                max_anisotropy,
+            },
+            wrap,
+            encoding,
+        })
+    }
+
+    /// The MIP map, from `cache` or read now.
+    pub fn load(&self, cache: &MIPMapCache) -> Result<Arc<MIPMap>, crate::image::ImageError> {
+        cache.get_or_load(&self.path, self.filter_options, self.wrap, self.encoding)
+    }
+}
+
 /// Reads the shared image-texture parameters and loads the MIP map.
 fn image_base(
     def: &TextureDef,
@@ -90,64 +166,21 @@ fn image_base(
     options: &TextureOptions,
 ) -> Result<ImageTextureBase, Diagnostic> {
     let mapping = TextureMapping2D::create(tp, &def.render_from_texture)?;
-    let max_anisotropy = tp.float("maxanisotropy", 8.0)?;
-    let filter_name = tp.string("filter", "bilinear")?;
-    let Some(mut filter) = FilterFunction::parse(&filter_name) else {
-        return Err(Diagnostic::error(
-            tp.param_loc("filter"),
-            format!("\"{filter_name}\": filter function unknown (known: {FILTER_NAMES})"),
-        ));
-    };
-    if options.disable_texture_filtering {
-        filter = FilterFunction::Point;
-    }
-    let wrap_name = tp.string("wrap", "repeat")?;
-    let Some(wrap) = WrapMode::parse(&wrap_name) else {
-        return Err(Diagnostic::error(
-            tp.param_loc("wrap"),
-            format!("\"{wrap_name}\": wrap mode unknown (known: {WRAP_NAMES})"),
-        ));
-    };
+    let request = ImageRequest::read(def, tp, options)?;
     let scale = tp.float("scale", 1.0)?;
     let invert = tp.bool("invert", false)?;
-    let filename = tp.string("filename", "")?;
-    if filename.is_empty() {
-        return Err(tp.error(format!(
-            "{} texture \"{}\": no \"filename\" given",
-            def.class, def.name
-        )));
-    }
-    let path = tp.resolve("filename", &filename);
-    let is_png = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-    let encoding_name = tp.string("encoding", if is_png { "sRGB" } else { "linear" })?;
-    let Some(encoding) = ColorEncoding::parse(&encoding_name) else {
-        return Err(Diagnostic::error(
-            tp.param_loc("encoding"),
+    let path = &request.path;
+    let mipmap = request.load(cache).map_err(|e| {
+        tp.error_at(
+            "filename",
             format!(
-                "\"{encoding_name}\": color encoding unknown (known: linear, sRGB, gamma <value>)"
+                "{} texture \"{}\": unable to read image \"{}\": {e}",
+                def.class,
+                def.name,
+                path.display()
             ),
-        ));
-    };
-    let filter_options = MIPMapFilterOptions {
-        filter,
-        max_anisotropy,
-    };
-    let mipmap = cache
-        .get_or_load(&path, filter_options, wrap, encoding)
-        .map_err(|e| {
-            tp.error_at(
-                "filename",
-                format!(
-                    "{} texture \"{}\": unable to read image \"{}\": {e}",
-                    def.class,
-                    def.name,
-                    path.display()
-                ),
-            )
-        })?;
+        )
+    })?;
     Ok(ImageTextureBase {
         mapping,
         filename: path.display().to_string(),

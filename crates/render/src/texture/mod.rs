@@ -24,8 +24,8 @@ pub mod ptex;
 mod tests;
 
 pub use create::{
-    create_float_texture, create_spectrum_texture, NamedTextures, TextureDef, TextureOptions,
-    FLOAT_TEXTURE_NAMES, SPECTRUM_TEXTURE_NAMES, TEXTURE_NAMES,
+    create_float_texture, create_spectrum_texture, ImageRequest, NamedTextures, TextureDef,
+    TextureOptions, FLOAT_TEXTURE_NAMES, SPECTRUM_TEXTURE_NAMES, TEXTURE_NAMES,
 };
 pub use imagemap::{FloatImageTexture, ImageTextureBase, SpectrumImageTexture};
 pub use mapping::{TexCoord2D, TexCoord3D, TextureMapping2D, TextureMapping3D};
