@@ -52,6 +52,11 @@ pub struct Options {
     pub disable_texture_filtering: bool,
     /// `--force-diffuse`.
     pub force_diffuse: bool,
+    /// `--texture-cache-mb <n>`: image textures tiled on disk, read
+    /// through a cache of this many megabytes (10^6 bytes).
+    pub texture_cache_mb: Option<f64>,
+    /// `--texture-cache-dir <dir>`: where the tiled pyramids go.
+    pub texture_cache_dir: Option<String>,
     /// `--render-coord-sys camera|cameraworld|world`.
     pub render_coord_sys: Option<String>,
     /// `--mse-reference-image`.
@@ -128,6 +133,12 @@ Rendering options:
   --quick                      Reduced quality for a fast preview.
   --quiet                      No progress bar or informational messages.
   --render-coord-sys <name>    Rendering space: camera, cameraworld (default), world.
+  --texture-cache-mb <n>       Keep image textures on disk, converted once into tiled
+                               MIP maps, and read their tiles through a cache of n MB
+                               (the same image as without; for texture sets larger
+                               than memory). Default: textures held in memory.
+  --texture-cache-dir <dir>    Where the tiled MIP maps go (default:
+                               $XDG_CACHE_HOME/rpbrt/textures or ~/.cache/...).
   --seed <n>                   Seed for the random number generators.
   --spp <n>                    Samples per pixel (overrides the Sampler).
   --spp-range <a..b>           Render samples a..b-1 of every pixel, as a full render
@@ -363,6 +374,20 @@ pub fn parse_args(args: &[String]) -> Result<Options, ArgError> {
             "disablewavelengthjitter" => o.disable_wavelength_jitter = true,
             "disabletexturefiltering" => o.disable_texture_filtering = true,
             "forcediffuse" => o.force_diffuse = true,
+            "texturecachemb" => {
+                let v = value(&mut i)?;
+                match v.trim().parse::<f64>() {
+                    Ok(mb) if mb.is_finite() && mb >= 0.0 && mb <= 1e9 => {
+                        o.texture_cache_mb = Some(mb)
+                    }
+                    _ => {
+                        return Err(ArgError(format!(
+                            "--texture-cache-mb \"{v}\": expected a size in megabytes (e.g. 256)"
+                        )))
+                    }
+                }
+            }
+            "texturecachedir" => o.texture_cache_dir = Some(value(&mut i)?),
             "rendercoordsys" => {
                 let v = value(&mut i)?;
                 if !["camera", "cameraworld", "world"].contains(&v.as_str()) {
@@ -521,5 +546,29 @@ mod tests {
         for bad in ["0", "lots", "-1G", "6X"] {
             assert!(p(&["--max-memory", bad]).is_err(), "{bad}");
         }
+        for bad in ["-1", "lots", "NaN", "inf", "1e10"] {
+            assert!(p(&["--texture-cache-mb", bad]).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn texture_cache_flags() {
+        let o = p(&[
+            "--texture-cache-mb",
+            "256",
+            "--texture-cache-dir",
+            "/tmp/t",
+            "a.pbrt",
+        ])
+        .unwrap();
+        assert_eq!(o.texture_cache_mb, Some(256.0));
+        assert_eq!(o.texture_cache_dir.as_deref(), Some("/tmp/t"));
+        assert_eq!(
+            p(&["--texture-cache-mb=0.5", "a.pbrt"])
+                .unwrap()
+                .texture_cache_mb,
+            Some(0.5)
+        );
+        assert_eq!(p(&["a.pbrt"]).unwrap().texture_cache_mb, None);
     }
 }

@@ -38,6 +38,7 @@ use rpbrt_parser::{FormattingTarget, MemoryBudget, ParseOptions, Parser};
 use rpbrt_render::accel::Aggregate;
 use rpbrt_render::camera::RenderingCoordinateSystem;
 use rpbrt_render::film::{FilmOverrides, SampleRange};
+use rpbrt_render::image::tiled::TileCache;
 use rpbrt_render::image::ImageMetadata;
 use rpbrt_render::integrator::{Progress, RenderOptions};
 use rpbrt_render::scene::assemble::{create_scene, CreateOptions};
@@ -201,6 +202,14 @@ fn render_command(opts: &args::Options) -> ExitCode {
         }
     };
     let t_parse = t0.elapsed();
+    let texture_cache = opts.texture_cache_mb.map(|mb| {
+        let dir = opts
+            .texture_cache_dir
+            .as_ref()
+            .map(PathBuf::from)
+            .unwrap_or_else(TileCache::default_dir);
+        Arc::new(TileCache::new((mb * 1e6) as u64, dir))
+    });
     let create_opts = CreateOptions {
         spp: opts.spp,
         seed: opts.seed.or_else(|| {
@@ -220,6 +229,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
         disable_texture_filtering: opts.disable_texture_filtering
             || desc_flag(&desc, "disabletexturefiltering"),
         force_diffuse: opts.force_diffuse || desc_flag(&desc, "forcediffuse"),
+        texture_cache: texture_cache.clone(),
     };
     let mut all = diags;
     let created = match create_scene(&desc, &create_opts) {
@@ -513,6 +523,19 @@ fn render_command(opts: &args::Options) -> ExitCode {
             budget.used() as f64 / (1024.0 * 1024.0),
             budget.limit() as f64 / (1024.0 * 1024.0)
         );
+        if let Some(t) = &texture_cache {
+            let st = t.stats();
+            let reads = (st.hits + st.misses).max(1);
+            diagln!(
+                "  Texture cache              {:>10.1} MB, {} tile reads, {:.1}% hits; {} maps converted, {} reused ({})",
+                st.capacity_bytes as f64 / 1e6,
+                st.hits + st.misses,
+                100.0 * st.hits as f64 / reads as f64,
+                st.converted,
+                st.reused,
+                t.dir().display()
+            );
+        }
         if let Some(m) = peak_memory_bytes() {
             diagln!(
                 "  Peak memory                {:>10.1} MiB",

@@ -9,7 +9,11 @@ use std::sync::{Arc, Mutex};
 
 use rpbrt_geometry::{Point2f, Point2i, Vector2f};
 
-use super::{ColorEncoding, Image, ImageError, PixelFormat, WrapMode, WrapMode2D};
+use super::tiled::{pyramid_file_name, write_pyramid, TileCache, TiledPyramid};
+use super::{
+    bilerp4, remap_pixel_coords, ColorEncoding, Image, ImageError, PixelFormat, WrapMode,
+    WrapMode2D,
+};
 use rpbrt_parser::MemoryBudget;
 
 /// How MIP-map lookups filter.
@@ -90,9 +94,22 @@ impl MipValue for f32 {
         self * s
     }
     fn texel(m: &MIPMap, level: usize, st: Point2i) -> Self {
+        if let Some(t) = &m.tiled {
+            let mut v = [0.0; 4];
+            m.tiled_texel(t, level, st, &mut v[..1]);
+            return v[0];
+        }
         m.pyramid[level].get_channel(st, 0, m.wrap2d())
     }
     fn bilerp(m: &MIPMap, level: usize, st: Point2f) -> Self {
+        if let Some(t) = &m.tiled {
+            let v = m.tiled_bilerp(t, level, st);
+            return match t.n_channels() {
+                3 => v[..3].iter().sum::<f32>() / 3.0,
+                4 => v[3],
+                _ => v[0],
+            };
+        }
         let im = &m.pyramid[level];
         let w = m.wrap2d();
         match im.n_channels() {
@@ -120,6 +137,16 @@ impl MipValue for [f32; 3] {
         [self[0] * s, self[1] * s, self[2] * s]
     }
     fn texel(m: &MIPMap, level: usize, st: Point2i) -> Self {
+        if let Some(t) = &m.tiled {
+            let mut v = [0.0; 4];
+            let n = t.n_channels().min(3);
+            m.tiled_texel(t, level, st, &mut v[..n]);
+            return if n >= 3 {
+                [v[0], v[1], v[2]]
+            } else {
+                [v[0]; 3]
+            };
+        }
         let im = &m.pyramid[level];
         let w = m.wrap2d();
         if im.n_channels() >= 3 {
@@ -134,6 +161,14 @@ impl MipValue for [f32; 3] {
         }
     }
     fn bilerp(m: &MIPMap, level: usize, st: Point2f) -> Self {
+        if let Some(t) = &m.tiled {
+            let v = m.tiled_bilerp(t, level, st);
+            return if t.n_channels() >= 3 {
+                [v[0], v[1], v[2]]
+            } else {
+                [v[0]; 3]
+            };
+        }
         let im = &m.pyramid[level];
         let w = m.wrap2d();
         if im.n_channels() >= 3 {
@@ -157,7 +192,10 @@ fn lerp_v<T: MipValue>(t: f32, a: T, b: T) -> T {
 /// An image pyramid with filtered lookups.
 #[derive(Clone, Debug)]
 pub struct MIPMap {
+    /// The levels, in memory (empty when they are tiled).
     pyramid: Vec<Image>,
+    /// The levels, tiled on disk behind the texture cache.
+    tiled: Option<Arc<TiledPyramid>>,
     color_space: String,
     wrap_mode: WrapMode,
     options: MIPMapFilterOptions,
@@ -173,6 +211,7 @@ impl MIPMap {
     ) -> MIPMap {
         MIPMap {
             pyramid: image.into_pyramid(wrap_mode.into()),
+            tiled: None,
             color_space: color_space.to_string(),
             wrap_mode,
             options,
@@ -231,37 +270,8 @@ impl MIPMap {
         wrap_mode: WrapMode,
         budget: &MemoryBudget,
     ) -> Result<MIPMap, ImageError> {
-        let mut image = read.image;
-        if image.n_channels() != 1 {
-            let rgba = image.get_channel_desc(&["R", "G", "B", "A"]);
-            let rgb = image.get_channel_desc(&["R", "G", "B"]);
-            image = match (rgba, rgb) {
-                (Some(rgba), Some(rgb)) => {
-                    let nc = image.n_channels();
-                    let a = rgba.offset[3];
-                    let n = image.data_len();
-                    let all_one = (a..n).step_by(nc).all(|i| image.value_at(i) == 1.0);
-                    image.into_channels(if all_one { &rgb } else { &rgba })
-                }
-                (None, Some(rgb)) => image.into_channels(&rgb),
-                _ => {
-                    return Err(ImageError::Format {
-                        path: path.display().to_string(),
-                        message: "image doesn't have R, G, and B channels".into(),
-                    })
-                }
-            };
-        }
-        let (pyramid, scratch) =
-            Self::memory_bytes(image.resolution(), image.n_channels(), image.format());
-        let what = "this texture's MIP map";
-        budget
-            .check(pyramid.saturating_add(scratch), what)
-            .and_then(|()| budget.charge(pyramid, what))
-            .map_err(|e| ImageError::Format {
-                path: path.display().to_string(),
-                message: e.to_string(),
-            })?;
+        let image = texture_channels(path, read.image)?;
+        Self::check_room(path, &image, budget, true)?;
         Ok(MIPMap::new(
             image,
             read.metadata.color_space_name(),
@@ -270,20 +280,170 @@ impl MIPMap {
         ))
     }
 
+    /// Checks that `budget` has room for `image`'s pyramid and the scratch
+    /// building it takes, and charges it for the pyramid if `charge`.
+    fn check_room(
+        path: &Path,
+        image: &Image,
+        budget: &MemoryBudget,
+        charge: bool,
+    ) -> Result<(), ImageError> {
+        let (pyramid, scratch) =
+            Self::memory_bytes(image.resolution(), image.n_channels(), image.format());
+        let what = "this texture's MIP map";
+        budget
+            .check(pyramid.saturating_add(scratch), what)
+            .and_then(|()| {
+                if charge {
+                    budget.charge(pyramid, what)
+                } else {
+                    Ok(())
+                }
+            })
+            .map_err(|e| ImageError::Format {
+                path: path.display().to_string(),
+                message: e.to_string(),
+            })
+    }
+
+    /// [`MIPMap::from_file_within`] behind the texture cache `tiles`: the
+    /// pyramid file of the image's bytes from the cache folder, converted
+    /// and written there first when it is missing or not whole. Where the
+    /// folder cannot be written, the levels stay in memory (the cache warns
+    /// once).
+    pub fn from_file_tiled(
+        path: &Path,
+        options: MIPMapFilterOptions,
+        wrap_mode: WrapMode,
+        encoding: ColorEncoding,
+        budget: &MemoryBudget,
+        tiles: &Arc<TileCache>,
+    ) -> Result<MIPMap, ImageError> {
+        let bytes = Image::file_bytes_within(path, budget)?;
+        let file_len = bytes.len() as u64;
+        let name = pyramid_file_name(&bytes, encoding, wrap_mode as u8);
+        let cached = tiles.dir().join(name);
+        let tiled = |t: TiledPyramid| MIPMap {
+            pyramid: Vec::new(),
+            color_space: t.color_space.clone(),
+            tiled: Some(Arc::new(t)),
+            wrap_mode,
+            options,
+        };
+        if let Ok(Some(t)) = TiledPyramid::open(&cached, encoding, tiles) {
+            budget.release(file_len);
+            tiles.count_reused();
+            return Ok(tiled(t));
+        }
+        let read = Image::read_from_bytes_within(
+            &bytes,
+            &Image::format_name(path),
+            Some(encoding),
+            budget,
+        );
+        drop(bytes);
+        budget.release(file_len);
+        let read = read?;
+        let read_bytes = read.image.bytes_used() as u64;
+        let color_space = read.metadata.color_space_name().to_string();
+        let image = texture_channels(path, read.image)?;
+        let room = Self::check_room(path, &image, budget, false);
+        budget.release(read_bytes);
+        room?;
+        let levels = image.into_pyramid(wrap_mode.into());
+        let written = std::fs::create_dir_all(tiles.dir())
+            .and_then(|()| write_pyramid(&cached, &levels, &color_space))
+            .and_then(|()| {
+                TiledPyramid::open(&cached, encoding, tiles)?.ok_or_else(|| {
+                    std::io::Error::other("the file written does not read back whole")
+                })
+            });
+        match written {
+            Ok(t) => {
+                tiles.count_converted();
+                Ok(tiled(t))
+            }
+            Err(e) => {
+                tiles.fall_back(path, &e.to_string());
+                let bytes: u64 = levels.iter().map(|l| l.bytes_used() as u64).sum();
+                budget
+                    .charge(bytes, "this texture's MIP map")
+                    .map_err(|e| ImageError::Format {
+                        path: path.display().to_string(),
+                        message: e.to_string(),
+                    })?;
+                Ok(MIPMap {
+                    pyramid: levels,
+                    tiled: None,
+                    color_space,
+                    wrap_mode,
+                    options,
+                })
+            }
+        }
+    }
+
     fn wrap2d(&self) -> WrapMode2D {
         self.wrap_mode.into()
     }
     /// Number of levels (finest is 0).
     pub fn levels(&self) -> usize {
-        self.pyramid.len()
+        match &self.tiled {
+            Some(t) => t.levels(),
+            None => self.pyramid.len(),
+        }
     }
     /// Resolution of a level.
     pub fn level_resolution(&self, level: usize) -> Point2i {
-        self.pyramid[level].resolution()
+        match &self.tiled {
+            Some(t) => t.level_resolution(level),
+            None => self.pyramid[level].resolution(),
+        }
     }
-    /// The image of a level.
-    pub fn level(&self, level: usize) -> &Image {
-        &self.pyramid[level]
+    /// The image of a level, when the levels are in memory (not behind the
+    /// texture cache).
+    pub fn level(&self, level: usize) -> Option<&Image> {
+        self.pyramid.get(level)
+    }
+    /// Whether the levels are tiled behind the texture cache.
+    pub fn is_tiled(&self) -> bool {
+        self.tiled.is_some()
+    }
+
+    /// Texel `st` of a tiled level, remapped by the wrap mode (zero outside
+    /// with `Black`), as `Image::get_channel` reads it for each channel.
+    fn tiled_texel(&self, t: &TiledPyramid, level: usize, st: Point2i, out: &mut [f32]) {
+        match remap_pixel_coords(st, t.level_resolution(level), self.wrap2d()) {
+            Some(p) => t.texel_into(level, p, out),
+            None => out.fill(0.0),
+        }
+    }
+
+    /// Bilinear lookup of every channel of a tiled level (what
+    /// `Image::bilerp_channel` gives for each).
+    fn tiled_bilerp(&self, t: &TiledPyramid, level: usize, st: Point2f) -> [f32; 4] {
+        let res = t.level_resolution(level);
+        let x = st.x * res.x as f32 - 0.5;
+        let y = st.y * res.y as f32 - 0.5;
+        let (xf, yf) = (x.floor(), y.floor());
+        let (dx, dy) = (x - xf, y - yf);
+        let (xi, yi) = (xf as i32, yf as i32);
+        let nc = t.n_channels().min(4);
+        let mut corners = [[0.0f32; 4]; 4];
+        for (k, (ox, oy)) in [(0, 0), (1, 0), (0, 1), (1, 1)].into_iter().enumerate() {
+            let p = Point2i {
+                x: xi + ox,
+                y: yi + oy,
+            };
+            self.tiled_texel(t, level, p, &mut corners[k][..nc]);
+        }
+        std::array::from_fn(|c| {
+            bilerp4(
+                dx,
+                dy,
+                [corners[0][c], corners[1][c], corners[2][c], corners[3][c]],
+            )
+        })
     }
     /// Name of the RGB colour space of the texels.
     pub fn color_space(&self) -> &str {
@@ -297,7 +457,7 @@ impl MIPMap {
     pub fn options(&self) -> MIPMapFilterOptions {
         self.options
     }
-    /// Bytes of pixel storage over all levels.
+    /// Bytes of pixel storage over all levels in memory.
     pub fn total_bytes_used(&self) -> usize {
         self.pyramid.iter().map(|i| i.bytes_used()).sum()
     }
@@ -439,6 +599,33 @@ impl MIPMap {
     }
 }
 
+/// A texture's channels of `image` (read from `path`): R, G, B (and A
+/// unless alpha is 1 everywhere) of a multi-channel image, as pbrt-v4
+/// reduces them; a one-channel image as it is.
+fn texture_channels(path: &Path, image: Image) -> Result<Image, ImageError> {
+    if image.n_channels() == 1 {
+        return Ok(image);
+    }
+    let rgba = image.get_channel_desc(&["R", "G", "B", "A"]);
+    let rgb = image.get_channel_desc(&["R", "G", "B"]);
+    Ok(match (rgba, rgb) {
+        (Some(rgba), Some(rgb)) => {
+            let nc = image.n_channels();
+            let a = rgba.offset[3];
+            let n = image.data_len();
+            let all_one = (a..n).step_by(nc).all(|i| image.value_at(i) == 1.0);
+            image.into_channels(if all_one { &rgb } else { &rgba })
+        }
+        (None, Some(rgb)) => image.into_channels(&rgb),
+        _ => {
+            return Err(ImageError::Format {
+                path: path.display().to_string(),
+                message: "image doesn't have R, G, and B channels".into(),
+            })
+        }
+    })
+}
+
 /// Key of a cached MIP map: file, filter, anisotropy (bits), wrap mode, encoding.
 type CacheKey = (PathBuf, FilterFunction, u32, WrapMode, (u8, u32));
 
@@ -453,6 +640,8 @@ pub struct MIPMapCache {
     files_read: AtomicUsize,
     /// What the maps are charged to (`None`: the default budget).
     budget: Option<MemoryBudget>,
+    /// The texture cache, when the maps are tiled behind it.
+    tiles: Option<Arc<TileCache>>,
 }
 
 impl MIPMapCache {
@@ -467,6 +656,12 @@ impl MIPMapCache {
             budget: Some(budget.clone()),
             ..Self::default()
         }
+    }
+
+    /// The maps from now on go behind the texture cache `tiles`.
+    pub fn with_tiles(mut self, tiles: Arc<TileCache>) -> Self {
+        self.tiles = Some(tiles);
+        self
     }
 
     /// The MIP map for these settings, reading the file on first use. Failures are not
@@ -495,9 +690,17 @@ impl MIPMapCache {
             return Ok(m.clone());
         }
         self.files_read.fetch_add(1, Ordering::Relaxed);
-        let m = match &self.budget {
-            Some(b) => MIPMap::from_file_within(path, options, wrap_mode, encoding, b)?,
-            None => MIPMap::from_file(path, options, wrap_mode, encoding)?,
+        let default_budget;
+        let budget = match &self.budget {
+            Some(b) => b,
+            None => {
+                default_budget = MemoryBudget::default();
+                &default_budget
+            }
+        };
+        let m = match &self.tiles {
+            Some(t) => MIPMap::from_file_tiled(path, options, wrap_mode, encoding, budget, t)?,
+            None => MIPMap::from_file_within(path, options, wrap_mode, encoding, budget)?,
         };
         let m = Arc::new(m);
         *slot = Some(m.clone());

@@ -17,6 +17,7 @@ mod resample;
 pub mod sky;
 #[cfg(test)]
 mod tests;
+pub mod tiled;
 
 use std::fmt;
 use std::ops::{Deref, DerefMut};

@@ -775,7 +775,7 @@ fn mipmap_cache_reads_each_file_once() {
     let maps: Vec<_> = threads.into_iter().map(|t| t.join().unwrap()).collect();
     assert!(maps.iter().all(|m| std::sync::Arc::ptr_eq(m, &maps[0])));
     assert_eq!(cache.files_read(), 1);
-    assert_eq!(maps[0].level(0).n_channels(), 4);
+    assert_eq!(maps[0].level(0).map(|l| l.n_channels()), Some(4));
     cache
         .get_or_load(&path, opts, WrapMode::Clamp, ColorEncoding::SRGB)
         .unwrap();
@@ -1194,4 +1194,189 @@ fn fast_srgb8_encoding_is_the_formulas() {
         at(v);
     }
     assert!(checked > 1_000_000);
+}
+
+/// Every kind of lookup of `a` and `b` at fixed-seed random places and
+/// footprints, compared bit for bit.
+fn assert_same_lookups(a: &MIPMap, b: &MIPMap, seed: u64) {
+    assert_eq!(a.levels(), b.levels());
+    let mut rng = Rng::new(seed, 0);
+    for _ in 0..2000 {
+        let st = Point2f {
+            x: rng.uniform_float() * 3.0 - 1.0,
+            y: rng.uniform_float() * 3.0 - 1.0,
+        };
+        let d = |rng: &mut Rng| Vector2f {
+            x: (rng.uniform_float() - 0.5) * 0.2,
+            y: (rng.uniform_float() - 0.5) * 0.2,
+        };
+        let (d0, d1) = (d(&mut rng), d(&mut rng));
+        let level = (rng.uniform_float() * a.levels() as f32) as usize;
+        let sti = Point2i {
+            x: (st.x * 40.0) as i32,
+            y: (st.y * 40.0) as i32,
+        };
+        let bits = |v: [f32; 3]| v.map(f32::to_bits);
+        assert_eq!(
+            bits(a.filter_rgb(st, d0, d1)),
+            bits(b.filter_rgb(st, d0, d1))
+        );
+        assert_eq!(
+            a.filter_float(st, d0, d1).to_bits(),
+            b.filter_float(st, d0, d1).to_bits()
+        );
+        assert_eq!(bits(a.bilerp_rgb(level, st)), bits(b.bilerp_rgb(level, st)));
+        assert_eq!(
+            a.bilerp_float(level, st).to_bits(),
+            b.bilerp_float(level, st).to_bits()
+        );
+        assert_eq!(bits(a.texel_rgb(level, sti)), bits(b.texel_rgb(level, sti)));
+        assert_eq!(
+            a.texel_float(level, sti).to_bits(),
+            b.texel_float(level, sti).to_bits()
+        );
+    }
+}
+
+/// A fresh folder under the temporary one for a texture cache test.
+fn cache_test_dir(name: &str) -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("rpbrt-tiles-{name}-{}", std::process::id()));
+    std::fs::remove_dir_all(&dir).ok();
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[test]
+fn tiled_maps_look_up_what_maps_in_memory_do() {
+    use super::tiled::TileCache;
+    use std::sync::Arc;
+    let dir = cache_test_dir("same");
+    // 8-bit RGB, RGBA and grey; half and float; a power of two and not;
+    // a tile and a half wide.
+    let files = [
+        ("rgb.png", random_u8_image(96, 64, &["R", "G", "B"], 1)),
+        (
+            "rgba.png",
+            random_u8_image(32, 32, &["R", "G", "B", "A"], 2),
+        ),
+        ("grey.png", random_u8_image(70, 33, &["Y"], 3)),
+        ("half.exr", {
+            let f = random_float_image(128, 16, &["R", "G", "B"], 4).to_f32_vec();
+            let h = f.iter().map(|&v| half::f16::from_f32(v)).collect();
+            Image::from_f16(h, p(128, 16), &["R", "G", "B"]).unwrap()
+        }),
+        ("float.pfm", random_float_image(50, 20, &["R", "G", "B"], 5)),
+    ];
+    for (name, img) in &files {
+        img.write(dir.join(name), &ImageMetadata::default())
+            .unwrap();
+    }
+    // Big enough for every tile; smaller than one tile (nothing kept).
+    for capacity in [1 << 24, 1000] {
+        let tiles = Arc::new(TileCache::new(capacity, dir.join("cache")));
+        let tiled = MIPMapCache::new().with_tiles(tiles.clone());
+        let memory = MIPMapCache::new();
+        for (k, (name, _)) in files.iter().enumerate() {
+            for wrap in [WrapMode::Repeat, WrapMode::Black, WrapMode::Clamp] {
+                for filter in FILTERS {
+                    let opts = MIPMapFilterOptions {
+                        filter,
+                        max_anisotropy: 8.0,
+                    };
+                    let enc = if name.ends_with(".png") {
+                        ColorEncoding::SRGB
+                    } else {
+                        ColorEncoding::Linear
+                    };
+                    let path = dir.join(name);
+                    let a = tiled.get_or_load(&path, opts, wrap, enc).unwrap();
+                    let b = memory.get_or_load(&path, opts, wrap, enc).unwrap();
+                    assert!(a.is_tiled() && !b.is_tiled());
+                    assert_eq!(a.color_space(), b.color_space());
+                    assert_same_lookups(&a, &b, k as u64);
+                }
+            }
+        }
+        let st = tiles.stats();
+        assert!(st.misses > 0);
+        if capacity == 1000 {
+            assert_eq!(st.hits, 0, "a cache smaller than a tile keeps none");
+        } else {
+            assert!(st.hits > st.misses);
+        }
+        assert!(tiles.take_warnings().is_empty());
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn tiled_maps_are_never_stale_and_mend_corrupt_files() {
+    use super::tiled::TileCache;
+    use std::sync::Arc;
+    let dir = cache_test_dir("stale");
+    let path = dir.join("t.png");
+    let opts = MIPMapFilterOptions::default();
+    let load = |tiles: &Arc<TileCache>| {
+        MIPMapCache::new()
+            .with_tiles(tiles.clone())
+            .get_or_load(&path, opts, WrapMode::Repeat, ColorEncoding::SRGB)
+            .unwrap()
+    };
+    let in_memory = || {
+        MIPMapCache::new()
+            .get_or_load(&path, opts, WrapMode::Repeat, ColorEncoding::SRGB)
+            .unwrap()
+    };
+    let cache_dir = dir.join("cache");
+    let run = || Arc::new(TileCache::new(1 << 20, cache_dir.clone()));
+    random_u8_image(64, 64, &["R", "G", "B"], 7)
+        .write(&path, &ImageMetadata::default())
+        .unwrap();
+    let first = run();
+    assert_same_lookups(&load(&first), &in_memory(), 1);
+    assert_eq!((first.stats().converted, first.stats().reused), (1, 0));
+    // A later run reuses the file.
+    let second = run();
+    assert_same_lookups(&load(&second), &in_memory(), 2);
+    assert_eq!((second.stats().converted, second.stats().reused), (0, 1));
+    // The image changes (same name, same size): converted again, and the
+    // lookups are the new image's.
+    random_u8_image(64, 64, &["R", "G", "B"], 8)
+        .write(&path, &ImageMetadata::default())
+        .unwrap();
+    let third = run();
+    assert_same_lookups(&load(&third), &in_memory(), 3);
+    assert_eq!((third.stats().converted, third.stats().reused), (1, 0));
+    // A byte of a pyramid file flipped, and one cut short: both rebuilt.
+    let pyramid = std::fs::read_dir(&cache_dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .max_by_key(|p| std::fs::metadata(p).unwrap().modified().unwrap())
+        .unwrap();
+    let mut bytes = std::fs::read(&pyramid).unwrap();
+    let middle = bytes.len() / 2;
+    bytes[middle] ^= 0x40;
+    std::fs::write(&pyramid, &bytes).unwrap();
+    let fourth = run();
+    assert_same_lookups(&load(&fourth), &in_memory(), 4);
+    assert_eq!((fourth.stats().converted, fourth.stats().reused), (1, 0));
+    let whole = std::fs::read(&pyramid).unwrap();
+    std::fs::write(&pyramid, &whole[..whole.len() - 100]).unwrap();
+    let fifth = run();
+    assert_same_lookups(&load(&fifth), &in_memory(), 5);
+    assert_eq!((fifth.stats().converted, fifth.stats().reused), (1, 0));
+    assert_eq!(std::fs::read(&pyramid).unwrap(), whole);
+    // A folder that cannot be made (under a file): in memory, one warning.
+    let blocked = Arc::new(TileCache::new(1 << 20, path.join("cache")));
+    let m = load(&blocked);
+    assert!(!m.is_tiled());
+    assert_same_lookups(&m, &in_memory(), 6);
+    MIPMapCache::new()
+        .with_tiles(blocked.clone())
+        .get_or_load(&path, opts, WrapMode::Clamp, ColorEncoding::SRGB)
+        .unwrap();
+    let warnings = blocked.take_warnings();
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0].contains("cannot be used"), "{}", warnings[0]);
+    std::fs::remove_dir_all(&dir).ok();
 }

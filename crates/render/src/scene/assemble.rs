@@ -49,6 +49,9 @@ pub struct CreateOptions {
     pub disable_texture_filtering: bool,
     /// `--force-diffuse`.
     pub force_diffuse: bool,
+    /// `--texture-cache-mb`: image textures tiled on disk behind this
+    /// cache (`None`: held in memory).
+    pub texture_cache: Option<std::sync::Arc<crate::image::tiled::TileCache>>,
 }
 
 /// The result of [`create_scene`].
@@ -392,7 +395,10 @@ pub fn create_scene(
     });
 
     // Textures and materials.
-    let cache = MIPMapCache::with_budget(&desc.budget);
+    let mut cache = MIPMapCache::with_budget(&desc.budget);
+    if let Some(tiles) = &opts.texture_cache {
+        cache = cache.with_tiles(tiles.clone());
+    }
     let texture_options = TextureOptions {
         disable_texture_filtering: opts.disable_texture_filtering,
     };
@@ -406,6 +412,15 @@ pub fn create_scene(
     ) else {
         return Err(problems.errors);
     };
+    if let Some(tiles) = &opts.texture_cache {
+        // About the cache folder (a command-line setting), not a directive.
+        p.warnings
+            .extend(tiles.take_warnings().into_iter().map(|message| Diagnostic {
+                severity: rpbrt_parser::Severity::Warning,
+                loc: None,
+                message,
+            }));
+    }
     let Some((materials, named_material_ids)) = create_materials(
         &desc.materials,
         &desc.named_materials,

@@ -269,6 +269,26 @@ impl Image {
         budget: &MemoryBudget,
     ) -> Result<ImageAndMetadata, ImageError> {
         let path = path.as_ref();
+        let bytes = Self::file_bytes_within(path, budget)?;
+        let image =
+            Self::read_from_bytes_within(&bytes, &Self::format_name(path), encoding, budget);
+        budget.release(bytes.len() as u64);
+        image
+    }
+
+    /// The name whose extension says how `path`'s bytes are decoded (a
+    /// `.gz` suffix is not the image's extension).
+    pub(crate) fn format_name(path: &Path) -> String {
+        let name = path.display().to_string();
+        name.strip_suffix(".gz").unwrap_or(&name).to_string()
+    }
+
+    /// The bytes of the image file at `path` (inflated when gzip-compressed),
+    /// charged to `budget`: the caller releases `len()` bytes when done.
+    pub(crate) fn file_bytes_within(
+        path: &Path,
+        budget: &MemoryBudget,
+    ) -> Result<Vec<u8>, ImageError> {
         let name = path.display().to_string();
         // The project's one file reader (gzip-compressed images are
         // inflated as they are read). The file's bytes are held while the
@@ -288,17 +308,13 @@ impl Image {
                 }
             }
         })?;
-        // A `.gz` suffix is not the image's extension.
-        let format_name = name.strip_suffix(".gz").unwrap_or(&name);
         budget
             .charge(bytes.len() as u64, "this image file")
             .map_err(|e| ImageError::Format {
                 path: name.clone(),
                 message: e.to_string(),
             })?;
-        let image = Self::read_from_bytes_within(&bytes, format_name, encoding, budget);
-        budget.release(bytes.len() as u64);
-        image
+        Ok(bytes)
     }
 
     /// Decodes an in-memory file; `name` supplies the extension and the
