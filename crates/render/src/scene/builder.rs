@@ -65,6 +65,10 @@ pub struct SceneBuilder {
     /// pbrt-v3's redefined textures and named materials (see
     /// [`SceneBuilder::redefine`]).
     renames: [Renames; 2],
+    /// Redefinitions met before anything marked the files as pbrt-v3:
+    /// pbrt-v4's error and pbrt-v3's warning, one of which the end of the
+    /// files gives.
+    undecided_redefinitions: Vec<(Diagnostic, Diagnostic)>,
     /// A pbrt-v1/v2 file's `Renderer`, `SurfaceIntegrator` and
     /// `VolumeIntegrator`, made into one integrator once all files are read.
     legacy: LegacyTransport,
@@ -137,6 +141,7 @@ impl SceneBuilder {
             named_material_uses: Vec::new(),
             medium_uses: Vec::new(),
             pending: Vec::new(),
+            undecided_redefinitions: Vec::new(),
             renames: Default::default(),
             legacy: LegacyTransport::default(),
             options_look_at: false,
@@ -524,11 +529,13 @@ impl SceneBuilder {
 
     /// A name defined again (`defined`: the name is taken). pbrt-v4 refuses
     /// it; pbrt-v3 warns and the later definition wins for what follows,
-    /// while what was defined before keeps the earlier one. So in a file
-    /// read as pbrt-v3 the definition is stored as `<name>-renamed-<n>`
-    /// (the name `--upgrade` gives it) and later references to `name` are
-    /// renamed to it ([`SceneBuilder::renamed_refs`]). Returns the name to
-    /// store the definition under, or pbrt-v4's error `refusal`.
+    /// while what was defined before keeps the earlier one. So the
+    /// definition is stored as `<name>-renamed-<n>` (the name `--upgrade`
+    /// gives it) and later references to `name` are renamed to it
+    /// ([`SceneBuilder::renamed_refs`]); at the end of the files, pbrt-v4's
+    /// error `refusal` stands unless something marked them as pbrt-v3
+    /// (before or after this directive). Returns the name to store the
+    /// definition under.
     fn redefine(
         &mut self,
         kind: Reference,
@@ -536,12 +543,9 @@ impl SceneBuilder {
         defined: bool,
         loc: &FileLoc,
         refusal: String,
-    ) -> Result<String, Diagnostic> {
+    ) -> String {
         if !defined {
-            return Ok(name.to_string());
-        }
-        if self.scene.pbrt_v3.is_none() {
-            return Err(Diagnostic::error(loc.clone(), refusal));
+            return name.to_string();
         }
         let r = &mut self.renames[kind as usize];
         let stored = format!("{name}-renamed-{}", r.count);
@@ -550,14 +554,22 @@ impl SceneBuilder {
             Reference::Texture => "texture",
             Reference::NamedMaterial => "named material",
         };
-        self.pending.push(Diagnostic::warning(
+        let warning = Diagnostic::warning(
             loc.clone(),
             format!(
                 "\"{name}\": {what} defined again; as in pbrt-v3, this definition is used from \
                  here on (stored as \"{stored}\")"
             ),
-        ));
-        Ok(stored)
+        );
+        if self.scene.pbrt_v3.is_some() {
+            self.pending.push(warning);
+        } else {
+            // A pbrt-v3 construct later in the files makes this pbrt-v3's
+            // redefinition; without one it is pbrt-v4's error.
+            self.undecided_redefinitions
+                .push((Diagnostic::error(loc.clone(), refusal), warning));
+        }
+        stored
     }
 
     /// Records that `name`'s latest definition is stored as `stored`.
@@ -1166,7 +1178,7 @@ impl ParserTarget for SceneBuilder {
             defined,
             &loc,
             format!("redefining texture \"{name}\""),
-        )?;
+        );
         let attrs = self.state.texture_attributes.clone();
         // Its own references still mean the earlier definitions.
         let base = self.entity_with(u.name, u.params, &attrs, loc);
@@ -1228,7 +1240,7 @@ impl ParserTarget for SceneBuilder {
             self.named_material_names.contains(name),
             &loc,
             format!("\"{name}\": named material redefined"),
-        )?;
+        );
         params.insert(
             0,
             ParsedParameter::with_strings("string", "type", ty_loc, vec![ty.clone()]),
@@ -1261,6 +1273,8 @@ impl ParserTarget for SceneBuilder {
         let pbrt_v3 = params
             .iter()
             .any(|p| p.name == "mapname" && p.ty == "string");
+        let mut params = params;
+        v3_emission::spectral_emission_as_rgb(name, &mut params, &loc)?;
         let (name, mut params) =
             self.upgraded(upgrade::upgrade_light_for_render, name, params, &loc);
         EntityKind::Light.check(&name, &loc)?;
@@ -1287,6 +1301,8 @@ impl ParserTarget for SceneBuilder {
         loc: FileLoc,
     ) -> DirectiveResult {
         self.verify_world("AreaLightSource", &loc)?;
+        let mut params = params;
+        v3_emission::spectral_emission_as_rgb(name, &mut params, &loc)?;
         let (name, params) = self.upgraded(upgrade::upgrade_area_light, name, params, &loc);
         EntityKind::AreaLight.check(&name, &loc)?;
         let attrs = self.state.light_attributes.clone();
@@ -1466,6 +1482,10 @@ impl ParserTarget for SceneBuilder {
         } else if self.scene.pbrt_v3.is_some() {
             self.use_pbrt_v3_defaults();
         }
+        let v3 = self.scene.pbrt_v3.is_some();
+        for (error, warning) in std::mem::take(&mut self.undecided_redefinitions) {
+            self.pending.push(if v3 { warning } else { error });
+        }
         if self.block != Block::World {
             self.pending.push(Diagnostic::unlocated_error(
                 "end of files before \"WorldBegin\"",
@@ -1527,3 +1547,4 @@ impl ParserTarget for SceneBuilder {
 
 #[cfg(test)]
 mod tests;
+mod v3_emission;

@@ -448,6 +448,42 @@ fn pbrt_v3_redefinitions_take_effect_from_there_on() {
     );
 }
 
+/// A redefinition before anything marks the file as pbrt-v3 is pbrt-v3's
+/// when a marker comes later (here only the closing `WorldEnd`), and
+/// pbrt-v4's error when none does.
+#[test]
+fn redefinitions_wait_for_a_later_pbrt_v3_marker() {
+    let v4 = "WorldBegin\n\
+        Texture \"t\" \"spectrum\" \"checkerboard\"\n\
+        Texture \"t\" \"spectrum\" \"checkerboard\" \"float uscale\" 4\n\
+        Material \"diffuse\" \"texture reflectance\" \"t\"\n\
+        MakeNamedMaterial \"m\" \"string type\" \"diffuse\"\n\
+        MakeNamedMaterial \"m\" \"string type\" \"conductor\"\n\
+        NamedMaterial \"m\"\n\
+        Shape \"sphere\"\n";
+    let (s, diags) = build_scene_from_str(&format!("{v4}WorldEnd\n"), &BuildOptions::default())
+        .expect("builds as pbrt-v3");
+    assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
+    let warned: Vec<String> = diags
+        .iter()
+        .filter(|d| d.severity == Severity::Warning && d.message.contains("defined again"))
+        .map(|d| d.to_string())
+        .collect();
+    assert_eq!(warned.len(), 2, "{warned:#?}");
+    assert!(warned[0].starts_with("<string>:3:1:"), "{warned:#?}");
+    assert!(warned[1].starts_with("<string>:6:1:"), "{warned:#?}");
+    let names: Vec<&str> = s
+        .spectrum_textures
+        .iter()
+        .map(|t| t.name.as_str())
+        .collect();
+    assert_eq!(names, ["t", "t-renamed-0"]);
+    let named: Vec<&str> = s.named_materials.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(named, ["m", "m-renamed-0"]);
+    assert_error(v4, "<string>:3:1:", "redefining texture \"t\"");
+    assert_error(v4, "<string>:6:1:", "named material redefined");
+}
+
 #[test]
 fn pbrt_v3_only_constructs_mark_the_scene() {
     let first = |text: &str| build(text).pbrt_v3.map(|l| (l.line, l.column));
@@ -953,4 +989,63 @@ fn pbrt_v1_defaults_materials_and_camera() {
         "<string>:2:1:",
         "SearchPath",
     );
+}
+
+/// pbrt-v3's colour `scale` on a light with a spectral or blackbody
+/// emission multiplies the RGB pbrt-v3 made of that emission (its XYZ in
+/// sRGB); a uniform scale stays a float scale.
+#[test]
+fn pbrt_v3_colour_scale_multiplies_spectral_emission() {
+    use crate::spectrum::{
+        spectrum_to_xyz, BlackbodySpectrum, PiecewiseLinearSpectrum, RgbColorSpace, Spectrum,
+    };
+    let text = "WorldBegin\n\
+        LightSource \"point\" \"spectrum I\" [400 1 500 2 600 3 700 4] \"color scale\" [1 0.5 0.25]\n\
+        LightSource \"distant\" \"blackbody L\" [3000 2] \"rgb scale\" [0.5 1 1]\n\
+        LightSource \"spot\" \"spectrum I\" [400 1 700 1] \"color scale\" [2 2 2]\n\
+        AttributeBegin\n\
+        AreaLightSource \"area\" \"spectrum L\" [400 1 700 3] \"color scale\" [1 0 1]\n\
+        Shape \"sphere\"\n\
+        AttributeEnd\n\
+        WorldEnd\n";
+    let (s, diags) = build_scene_from_str(text, &BuildOptions::default()).expect("builds");
+    assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
+    let rgb_of = |sp: Spectrum| {
+        let c = RgbColorSpace::srgb().to_rgb(spectrum_to_xyz(&sp));
+        [c.r, c.g, c.b]
+    };
+    let close = |got: [f32; 3], want: [f32; 3]| {
+        got.iter()
+            .zip(want)
+            .all(|(a, b)| (a - b).abs() <= 1e-5 * b.abs().max(1.0))
+    };
+    let emission = |params: &rpbrt_parser::ParameterDictionary, name: &str| {
+        assert_eq!(params.param_type(name), Some("rgb"), "{params:?}");
+        params.get_one_rgb(name).unwrap().unwrap()
+    };
+    let sampled = |v: &[f32]| {
+        Spectrum::PiecewiseLinear(std::sync::Arc::new(
+            PiecewiseLinearSpectrum::from_interleaved(v, false).unwrap(),
+        ))
+    };
+    let want = rgb_of(sampled(&[400.0, 1.0, 500.0, 2.0, 600.0, 3.0, 700.0, 4.0]));
+    let got = emission(&s.lights[0].base.params, "I");
+    assert!(
+        close(got, [want[0], want[1] * 0.5, want[2] * 0.25]),
+        "{got:?} {want:?}"
+    );
+    let bb = rgb_of(Spectrum::Blackbody(BlackbodySpectrum::new(3000.0)));
+    let got = emission(&s.lights[1].base.params, "L");
+    assert!(
+        close(got, [bb[0], bb[1] * 2.0, bb[2] * 2.0]),
+        "{got:?} {bb:?}"
+    );
+    // A uniform scale folds into the float scale; the spectrum stays.
+    let spot = &s.lights[2].base.params;
+    assert_eq!(spot.param_type("I"), Some("spectrum"));
+    assert_eq!(spot.get_one_float("scale", 1.0).ok(), Some(2.0));
+    let area = &s.area_lights[s.shapes[0].attributes.light_index.expect("area light")];
+    let want = rgb_of(sampled(&[400.0, 1.0, 700.0, 3.0]));
+    let got = emission(&area.params, "L");
+    assert!(close(got, [want[0], 0.0, want[2]]), "{got:?} {want:?}");
 }
