@@ -514,7 +514,9 @@ pub fn upgrade_light(name: &str, params: Vec<ParsedParameter>, loc: &FileLoc) ->
 
 /// [`upgrade_light`] for rpbrt's renderer, which also renders what pbrt-v4
 /// cannot express: a pbrt-v3 `projection` light's non-uniform RGB `I` with
-/// its `mapname` stays `"rgb I"`, which rpbrt multiplies into the map.
+/// its `mapname` stays `"rgb I"`, and an `infinite` light's non-uniform
+/// RGB `L` (or colour `scale`) with its `mapname` stays (or becomes)
+/// `"rgb L"`, which rpbrt multiplies into the map.
 pub fn upgrade_light_for_render(
     name: &str,
     params: Vec<ParsedParameter>,
@@ -536,7 +538,11 @@ fn upgrade_light_with(
     let emission = match name {
         "point" | "spot" | "goniometric" => Some("I"),
         "distant" => Some("L"),
-        "infinite" | "exinfinite" | "infinitesample" if e.get("mapname", &["string"]).is_none() => {
+        // With a map, only a renderer that multiplies the map by an RGB
+        // `L` (pbrt-v3's meaning; pbrt-v4 has no such parameter) takes it.
+        "infinite" | "exinfinite" | "infinitesample"
+            if render || e.get("mapname", &["string"]).is_none() =>
+        {
             Some("L")
         }
         _ => None,
@@ -560,7 +566,11 @@ fn upgrade_light_with(
         e.name = "infinite".into();
     }
     let has_map = e.get("mapname", &["string"]).is_some();
-    if has_map && e.name == "infinite" && !e.rgb_into_scale("L", &mut scale) {
+    if has_map
+        && e.name == "infinite"
+        && !e.rgb_into_scale("L", &mut scale)
+        && !(render && e.get("L", &["rgb"]).is_some_and(|p| p.floats.len() == 3))
+    {
         let l = e.get("L", &SPECTRUM_TYPES).map(|p| p.loc.clone());
         e.error(l.as_ref(), "a non-uniform \"L\" with \"mapname\" on an \"infinite\" light is not supported by pbrt-v4".into());
         return e.finish();

@@ -520,10 +520,20 @@ fn create_infinite(
 ) -> Result<Light, Diagnostic> {
     let cs = lp.color_space();
     let loc = lp.loc();
-    let l = spectrum_param(lp, "L")?;
+    let filename = lp.string("filename", "")?;
+    // pbrt-v3 multiplies its map by `L` (an RGB here: the upgrade folds a
+    // uniform one into `scale`, and a colour `scale` into it).
+    let v3_map_factor = if pbrt_v3 && !filename.is_empty() && lp.param_type("L") == Some("rgb") {
+        lp.rgbs("L")?.first().copied()
+    } else {
+        None
+    };
+    let l = match v3_map_factor {
+        Some(_) => None,
+        None => spectrum_param(lp, "L")?,
+    };
     let scale = scale_param(lp)?;
     let portal = lp.point3s("portal")?;
-    let filename = lp.string("filename", "")?;
     let e_v = lp.float("illuminance", -1.0)?;
     if l.is_some() && !portal.is_empty() {
         return Err(Diagnostic::error(
@@ -553,7 +563,10 @@ fn create_infinite(
     let floc = lp.param_loc("filename");
     let (im, ics) = read_image(lp, &filename)?;
     let image = rgb_image(&im, &filename, "infinite", &floc)?;
-    let image = equal_area_env_map(lp, image, &filename, &floc, pbrt_v3)?;
+    let mut image = equal_area_env_map(lp, image, &filename, &floc, pbrt_v3)?;
+    if let Some([r, g, b]) = v3_map_factor {
+        image = scaled_rgb(&image, [r, g, b], &floc)?;
+    }
     let res = image.resolution();
     let mut scale = normalize_scale(scale, &ics.illuminant_spectrum(), "image colour space", loc)?;
     if e_v > 0.0 {

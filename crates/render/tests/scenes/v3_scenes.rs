@@ -185,6 +185,9 @@ fn cases() -> Vec<Case> {
         native("texture uv", ("", "Texture \"t\" \"color\" \"uv\"\nMaterial \"matte\" \"texture Kd\" \"t\"\nShape \"sphere\"")),
         // ---- lights and area lights
         case("light point", ("", "LightSource \"point\" \"color I\" [ 3 3 3 ] \"point from\" [ 0 1 3 ]\nShape \"sphere\""), ("", "LightSource \"point\" \"rgb I\" [ 3 3 3 ] \"point3 from\" [ 0 1 3 ]\nShape \"sphere\"")),
+        // pbrt-v3 multiplies a colour `scale` into the RGB it made of a
+        // spectral emission.
+        native("light point spectrum colour scale", ("", "LightSource \"point\" \"spectrum I\" [ 400 1 700 3 ] \"color scale\" [ 3 1.5 1 ] \"point from\" [ 0 1 3 ]\nShape \"sphere\"")),
         case("light spot", ("", "LightSource \"spot\" \"color I\" [ 9 9 9 ] \"point from\" [ 0 0 4 ] \"point to\" [ 0 0 0 ] \"float coneangle\" 20\nShape \"sphere\""), ("", "LightSource \"spot\" \"rgb I\" [ 9 9 9 ] \"point3 from\" [ 0 0 4 ] \"point3 to\" [ 0 0 0 ] \"float coneangle\" 20\nShape \"sphere\"")),
         case("light distant", ("", "LightSource \"distant\" \"blackbody L\" [ 5500 2 ] \"point from\" [ 0 0 5 ]\nShape \"sphere\""), ("", "LightSource \"distant\" \"float scale\" 2 \"blackbody L\" [ 5500 ] \"point3 from\" [ 0 0 5 ]\nShape \"sphere\"")),
         case("light infinite", ("", "LightSource \"infinite\" \"color L\" [ 0.5 0.6 0.7 ] \"integer nsamples\" 8\nShape \"sphere\""), ("", "LightSource \"infinite\" \"rgb L\" [ 0.5 0.6 0.7 ]\nShape \"sphere\"")),
@@ -309,6 +312,9 @@ fn file_cases() -> Vec<Case> {
         // pbrt-v3's `mapname` is a latitude–longitude map, resampled to
         // pbrt-v4's equal-area square on load (not pbrt-v4's `filename`).
         native("light infinite map", ("", "LightSource \"infinite\" \"string mapname\" \"img.pfm\" \"color L\" [ 0.5 0.5 0.5 ]\nShape \"sphere\"")),
+        // pbrt-v3 multiplies its map by a colour `L` or `scale`.
+        native("light infinite map colour scale", ("", "LightSource \"infinite\" \"string mapname\" \"img.pfm\" \"color scale\" [ 1 0.5 0.25 ]\nShape \"sphere\"")),
+        native("light infinite map colour L", ("", "LightSource \"infinite\" \"string mapname\" \"img.pfm\" \"color L\" [ 0.2 0.5 1 ]\nShape \"sphere\"")),
         case("camera realistic", ("Camera \"realistic\" \"string lensfile\" \"lens.dat\" \"float aperturediameter\" 5 \"float focusdistance\" 5 \"bool simpleweighting\" \"true\"", SPHERE), ("Camera \"realistic\" \"string lensfile\" \"lens.dat\" \"float aperturediameter\" 5 \"float focusdistance\" 5", SPHERE)),
         native("material fourier", ("", "Material \"fourier\" \"string bsdffile\" \"smooth.bsdf\"\nShape \"sphere\"")),
     ]
