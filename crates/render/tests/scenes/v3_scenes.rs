@@ -314,6 +314,7 @@ fn file_cases() -> Vec<Case> {
         native("light infinite map", ("", "LightSource \"infinite\" \"string mapname\" \"img.pfm\" \"color L\" [ 0.5 0.5 0.5 ]\nShape \"sphere\"")),
         // pbrt-v3 multiplies its map by a colour `L` or `scale`.
         native("light infinite map colour scale", ("", "LightSource \"infinite\" \"string mapname\" \"img.pfm\" \"color scale\" [ 1 0.5 0.25 ]\nShape \"sphere\"")),
+        native("light infinite map spectrum L", ("", "LightSource \"infinite\" \"string mapname\" \"img.pfm\" \"blackbody L\" [ 5000 1 ]\nShape \"sphere\"")),
         native("light infinite map colour L", ("", "LightSource \"infinite\" \"string mapname\" \"img.pfm\" \"color L\" [ 0.2 0.5 1 ]\nShape \"sphere\"")),
         case("camera realistic", ("Camera \"realistic\" \"string lensfile\" \"lens.dat\" \"float aperturediameter\" 5 \"float focusdistance\" 5 \"bool simpleweighting\" \"true\"", SPHERE), ("Camera \"realistic\" \"string lensfile\" \"lens.dat\" \"float aperturediameter\" 5 \"float focusdistance\" 5", SPHERE)),
         native("material fourier", ("", "Material \"fourier\" \"string bsdffile\" \"smooth.bsdf\"\nShape \"sphere\"")),

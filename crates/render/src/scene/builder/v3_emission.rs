@@ -17,22 +17,18 @@ use crate::spectrum::{
 };
 
 /// The emission parameter a colour `scale` multiplies on light `name`.
-fn emission_of(name: &str, params: &[ParsedParameter]) -> Option<&'static str> {
+fn emission_of(name: &str) -> Option<&'static str> {
     match name {
         "point" | "spot" | "goniometric" | "projection" => Some("I"),
-        "distant" | "area" | "diffuse" => Some("L"),
-        "infinite" | "exinfinite" | "infinitesample"
-            if !params.iter().any(|p| p.name == "mapname") =>
-        {
-            Some("L")
-        }
+        "distant" | "area" | "diffuse" | "infinite" | "exinfinite" | "infinitesample" => Some("L"),
         _ => None,
     }
 }
 
 /// Replaces the spectral or blackbody emission of a pbrt-v3 light with a
-/// non-uniform colour `scale` by the RGB pbrt-v3 made of it (see the
-/// module's note). Other lights are left as they are.
+/// non-uniform colour `scale`, or of an `infinite` light with a `mapname`,
+/// by the RGB pbrt-v3 made of it (see the module's note). Other lights are
+/// left as they are.
 pub(super) fn spectral_emission_as_rgb(
     name: &str,
     params: &mut [ParsedParameter],
@@ -44,7 +40,11 @@ pub(super) fn spectral_emission_as_rgb(
             && p.floats.len() == 3
             && !(p.floats[0] == p.floats[1] && p.floats[1] == p.floats[2])
     });
-    let Some(emission) = emission_of(name, params).filter(|_| non_uniform_scale) else {
+    // pbrt-v3 also multiplies an environment map by its `L`, which
+    // rpbrt's renderer takes as an RGB.
+    let map = matches!(name, "infinite" | "exinfinite" | "infinitesample")
+        && params.iter().any(|p| p.name == "mapname");
+    let Some(emission) = emission_of(name).filter(|_| non_uniform_scale || map) else {
         return Ok(());
     };
     let Some(p) = params
