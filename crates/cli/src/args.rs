@@ -377,9 +377,7 @@ pub fn parse_args(args: &[String]) -> Result<Options, ArgError> {
             "texturecachemb" => {
                 let v = value(&mut i)?;
                 match v.trim().parse::<f64>() {
-                    Ok(mb) if mb.is_finite() && mb >= 0.0 && mb <= 1e9 => {
-                        o.texture_cache_mb = Some(mb)
-                    }
+                    Ok(mb) if (0.0..=1e9).contains(&mb) => o.texture_cache_mb = Some(mb),
                     _ => {
                         return Err(ArgError(format!(
                             "--texture-cache-mb \"{v}\": expected a size in megabytes (e.g. 256)"

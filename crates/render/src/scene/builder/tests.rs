@@ -395,6 +395,26 @@ fn pbrt_v3_matte_becomes_diffuse() {
     assert!(diags.iter().all(|d| !d.is_error()));
 }
 
+/// The description of pbrt-v3 `text` that defines texture `t` twice
+/// (checked: stored as `t` and `t-renamed-0`, no errors), and its
+/// redefinition warnings.
+fn built_with_redefinitions(text: &str) -> (SceneDescription, Vec<String>) {
+    let (s, diags) = build_scene_from_str(text, &BuildOptions::default()).expect("builds");
+    assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
+    let warned = diags
+        .iter()
+        .filter(|d| d.severity == Severity::Warning && d.message.contains("defined again"))
+        .map(|d| d.to_string())
+        .collect();
+    let names: Vec<&str> = s
+        .spectrum_textures
+        .iter()
+        .map(|t| t.name.as_str())
+        .collect();
+    assert_eq!(names, ["t", "t-renamed-0"]);
+    (s, warned)
+}
+
 /// pbrt-v3 warns about a texture or named material defined again and uses
 /// the later definition from there on; what was defined before keeps the
 /// earlier one (pbrt-v3 makes each when it reads it). pbrt-v4 refuses both
@@ -412,21 +432,9 @@ fn pbrt_v3_redefinitions_take_effect_from_there_on() {
         MakeNamedMaterial \"both\" \"string type\" \"mix\" \"string namedmaterial1\" \"m\" \"string namedmaterial2\" \"m\"\n\
         NamedMaterial \"m\"\n\
         Shape \"sphere\"\n";
-    let (s, diags) = build_scene_from_str(text, &BuildOptions::default()).expect("builds");
-    assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
-    let warned: Vec<String> = diags
-        .iter()
-        .filter(|d| d.severity == Severity::Warning && d.message.contains("defined again"))
-        .map(|d| d.to_string())
-        .collect();
+    let (s, warned) = built_with_redefinitions(text);
     assert_eq!(warned.len(), 2, "{warned:#?}");
     assert!(warned[0].starts_with("<string>:4:1:"), "{warned:#?}");
-    let names: Vec<&str> = s
-        .spectrum_textures
-        .iter()
-        .map(|t| t.name.as_str())
-        .collect();
-    assert_eq!(names, ["t", "t-renamed-0"]);
     // The redefinition builds on the texture it replaces.
     let tex1 = s.spectrum_textures[1].base.params.get_texture("tex");
     assert_eq!(tex1.ok().flatten().as_deref(), Some("t"));
@@ -461,23 +469,10 @@ fn redefinitions_wait_for_a_later_pbrt_v3_marker() {
         MakeNamedMaterial \"m\" \"string type\" \"conductor\"\n\
         NamedMaterial \"m\"\n\
         Shape \"sphere\"\n";
-    let (s, diags) = build_scene_from_str(&format!("{v4}WorldEnd\n"), &BuildOptions::default())
-        .expect("builds as pbrt-v3");
-    assert!(diags.iter().all(|d| !d.is_error()), "{diags:?}");
-    let warned: Vec<String> = diags
-        .iter()
-        .filter(|d| d.severity == Severity::Warning && d.message.contains("defined again"))
-        .map(|d| d.to_string())
-        .collect();
+    let (s, warned) = built_with_redefinitions(&format!("{v4}WorldEnd\n"));
     assert_eq!(warned.len(), 2, "{warned:#?}");
     assert!(warned[0].starts_with("<string>:3:1:"), "{warned:#?}");
     assert!(warned[1].starts_with("<string>:6:1:"), "{warned:#?}");
-    let names: Vec<&str> = s
-        .spectrum_textures
-        .iter()
-        .map(|t| t.name.as_str())
-        .collect();
-    assert_eq!(names, ["t", "t-renamed-0"]);
     let named: Vec<&str> = s.named_materials.iter().map(|(n, _)| n.as_str()).collect();
     assert_eq!(named, ["m", "m-renamed-0"]);
     assert_error(v4, "<string>:3:1:", "redefining texture \"t\"");
