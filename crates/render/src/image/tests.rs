@@ -1199,9 +1199,14 @@ fn fast_srgb8_encoding_is_the_formulas() {
 /// Every kind of lookup of `a` and `b` at fixed-seed random places and
 /// footprints, compared bit for bit.
 fn assert_same_lookups(a: &MIPMap, b: &MIPMap, seed: u64) {
+    assert_n_same_lookups(a, b, seed, 2000);
+}
+
+/// [`assert_same_lookups`] with `n` places.
+fn assert_n_same_lookups(a: &MIPMap, b: &MIPMap, seed: u64, n: usize) {
     assert_eq!(a.levels(), b.levels());
     let mut rng = Rng::new(seed, 0);
-    for _ in 0..2000 {
+    for _ in 0..n {
         let st = Point2f {
             x: rng.uniform_float() * 3.0 - 1.0,
             y: rng.uniform_float() * 3.0 - 1.0,
@@ -1276,12 +1281,15 @@ fn tiled_maps_look_up_what_maps_in_memory_do() {
         let tiles = Arc::new(TileCache::new(capacity, dir.join("cache")));
         let tiled = MIPMapCache::new().with_tiles(tiles.clone());
         let memory = MIPMapCache::new();
+        let mut maps = Vec::new();
         for (k, (name, _)) in files.iter().enumerate() {
             for wrap in [WrapMode::Repeat, WrapMode::Black, WrapMode::Clamp] {
-                for filter in FILTERS {
+                // More maps than files are kept open: the first are
+                // opened again when looked up at the end.
+                for (filter, max_anisotropy) in FILTERS.iter().flat_map(|&f| [(f, 8.0), (f, 2.0)]) {
                     let opts = MIPMapFilterOptions {
                         filter,
-                        max_anisotropy: 8.0,
+                        max_anisotropy,
                     };
                     let enc = if name.ends_with(".png") {
                         ColorEncoding::SRGB
@@ -1294,8 +1302,14 @@ fn tiled_maps_look_up_what_maps_in_memory_do() {
                     assert!(a.is_tiled() && !b.is_tiled());
                     assert_eq!(a.color_space(), b.color_space());
                     assert_same_lookups(&a, &b, k as u64);
+                    maps.push((a, b));
                 }
             }
+        }
+        assert_eq!(maps.len(), 120);
+        assert!(tiles.open_files() <= 64);
+        for (k, (a, b)) in maps.iter().enumerate() {
+            assert_n_same_lookups(a, b, 100 + k as u64, 50);
         }
         let st = tiles.stats();
         assert!(st.misses > 0);

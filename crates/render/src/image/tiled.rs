@@ -15,7 +15,9 @@
 //! Lookups read the same stored values as the in-memory levels, so the
 //! filtered values, and the images, are identical. The cache holds tiles
 //! in shards under a clock (second-chance) eviction; a tile larger than a
-//! shard's share is read and used without being kept.
+//! shard's share is read and used without being kept. At most
+//! [`OPEN_FILES`] pyramid files are open at once, whatever the number of
+//! textures.
 
 use std::collections::{HashMap, VecDeque};
 use std::fs::File;
@@ -35,6 +37,10 @@ use super::{ColorEncoding, Image, PixelData, PixelFormat};
 pub const TILE: usize = 64;
 /// Independently locked parts of the cache.
 const SHARDS: usize = 16;
+/// Pyramid files held open at once (each map's file is opened again when
+/// it is needed after others pushed it out), well under the usual limit of
+/// 1024 open files per process however many textures a scene has.
+const OPEN_FILES: usize = 64;
 /// The pyramid files' first bytes (the layout's version is the last).
 const MAGIC: &[u8; 8] = b"RPBRTTX1";
 
@@ -46,6 +52,8 @@ pub struct TileCache {
     /// Where the pyramid files go.
     dir: PathBuf,
     shards: Vec<Mutex<Shard>>,
+    /// The pyramid files open now, by number, oldest first.
+    open: Mutex<VecDeque<(u32, Arc<File>)>>,
     next_file: AtomicU32,
     hits: AtomicU64,
     misses: AtomicU64,
@@ -89,6 +97,7 @@ impl TileCache {
             capacity,
             dir,
             shards: (0..SHARDS).map(|_| Mutex::default()).collect(),
+            open: Mutex::default(),
             next_file: AtomicU32::new(0),
             hits: AtomicU64::new(0),
             misses: AtomicU64::new(0),
@@ -159,11 +168,30 @@ impl TileCache {
         }
     }
 
-    /// The tile `key` of `file`, `len` bytes at `offset`, from the cache or
-    /// read now.
+    /// Pyramid file `id` (at `path`), from the open ones or opened now.
+    fn file(&self, id: u32, path: &Path) -> std::io::Result<Arc<File>> {
+        let mut open = self.open.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, f)) = open.iter().find(|(i, _)| *i == id) {
+            return Ok(f.clone());
+        }
+        let f = Arc::new(File::open(path)?);
+        if open.len() == OPEN_FILES {
+            open.pop_front();
+        }
+        open.push_back((id, f.clone()));
+        Ok(f)
+    }
+
+    /// How many pyramid files are open now.
+    pub fn open_files(&self) -> usize {
+        self.open.lock().unwrap_or_else(|e| e.into_inner()).len()
+    }
+
+    /// The tile `key` of the pyramid file at `path`, `len` bytes at
+    /// `offset`, from the cache or read now.
     fn tile(
         &self,
-        file: &File,
+        path: &Path,
         key: TileKey,
         offset: u64,
         len: usize,
@@ -184,7 +212,7 @@ impl TileCache {
         }
         self.misses.fetch_add(1, Ordering::Relaxed);
         let mut buf = vec![0u8; len];
-        file.read_exact_at(&mut buf, offset)?;
+        self.file(key.0, path)?.read_exact_at(&mut buf, offset)?;
         let tile: Arc<[u8]> = buf.into();
         let share = self.capacity / SHARDS as u64;
         if len as u64 <= share {
@@ -241,7 +269,8 @@ struct TiledLevel {
 #[derive(Debug)]
 pub struct TiledPyramid {
     id: u32,
-    file: File,
+    /// The pyramid file (opened through the cache's open files).
+    path: PathBuf,
     levels: Vec<TiledLevel>,
     nc: usize,
     format: PixelFormat,
@@ -462,7 +491,7 @@ impl TiledPyramid {
         drop(r);
         Ok(Some(TiledPyramid {
             id: cache.next_file.fetch_add(1, Ordering::Relaxed),
-            file,
+            path: path.to_path_buf(),
             levels,
             nc,
             format,
@@ -499,7 +528,7 @@ impl TiledPyramid {
         let tile_bytes = TILE * TILE * self.nc * vb;
         let key = (self.id, level as u32, index as u32);
         let Ok(tile) = self.cache.tile(
-            &self.file,
+            &self.path,
             key,
             l.offset + (index * tile_bytes) as u64,
             tile_bytes,
