@@ -41,7 +41,7 @@ use rpbrt_render::film::{FilmOverrides, SampleRange};
 use rpbrt_render::image::tiled::TileCache;
 use rpbrt_render::image::ImageMetadata;
 use rpbrt_render::integrator::{Progress, RenderOptions};
-use rpbrt_render::scene::assemble::{create_scene, CreateOptions};
+use rpbrt_render::scene::assemble::{create_scene_taking_instances, CreateOptions};
 use rpbrt_render::scene::{build_scene, BuildOptions, OptionValue, SceneDescription};
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -194,7 +194,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
         build.render_coord_sys = r;
     }
     let paths: Vec<PathBuf> = opts.files.iter().map(PathBuf::from).collect();
-    let (desc, diags) = match build_scene(&paths, &build) {
+    let (mut desc, diags) = match build_scene(&paths, &build) {
         Ok(r) => r,
         Err(d) => {
             diag!("{}", d.render());
@@ -232,7 +232,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
         texture_cache: texture_cache.clone(),
     };
     let mut all = diags;
-    let created = match create_scene(&desc, &create_opts) {
+    let created = match create_scene_taking_instances(&mut desc, &create_opts) {
         Ok(c) => c,
         Err(errors) => {
             all.items.extend(errors);

@@ -638,8 +638,22 @@ impl PrimitiveAggregate {
             params,
         );
         // 40 bytes per entry: bounded so that huge scenes do not pay
-        // gigabytes for it (they fall back to going through the mesh).
-        let cached = n <= max_vertices;
+        // gigabytes for it (they fall back to going through the mesh),
+        // and kept only where at least half the entries are triangles (a
+        // million object instances over a small mesh would pay 100 MB
+        // for this and the frames below, and cache nothing).
+        let triangle_entries: usize = prims
+            .iter()
+            .map(|p| match p {
+                Primitive::Mesh(m) => m.mesh.n_triangles(),
+                Primitive::Geometric(GeometricPrimitive {
+                    shape: Shape::Triangle(_),
+                    ..
+                }) => 1,
+                _ => 0,
+            })
+            .sum();
+        let cached = n <= max_vertices && 2 * triangle_entries >= n;
         let triangle_vertices: Vec<Option<[Point3f; 3]>> = match accel.slot_entries() {
             _ if !cached => Vec::new(),
             Some(order) => order.iter().map(|&e| opaque_triangle(e)).collect(),

@@ -323,6 +323,118 @@ pub fn create_scene(
     desc: &SceneDescription,
     opts: &CreateOptions,
 ) -> Result<CreatedScene, Vec<Diagnostic>> {
+    create(desc, Instances::Borrowed(&desc.instances), opts)
+}
+
+/// [`create_scene`], taking the description's object instances (left
+/// empty): their memory (about 180 bytes each) is freed once they are
+/// render primitives, before the scene's accelerator is built, instead of
+/// being held through the build beside it.
+pub fn create_scene_taking_instances(
+    desc: &mut SceneDescription,
+    opts: &CreateOptions,
+) -> Result<CreatedScene, Vec<Diagnostic>> {
+    let instances = std::mem::take(&mut desc.instances);
+    create(desc, Instances::Owned(instances), opts)
+}
+
+/// The object instances [`create`] places.
+enum Instances<'a> {
+    /// Read from the description.
+    Borrowed(&'a [InstanceSceneEntity]),
+    /// Taken from it, freed as soon as they are placed.
+    Owned(Vec<InstanceSceneEntity>),
+}
+
+impl Instances<'_> {
+    fn as_slice(&self) -> &[InstanceSceneEntity] {
+        match self {
+            Instances::Borrowed(v) => v,
+            Instances::Owned(v) => v,
+        }
+    }
+}
+
+/// Appends the primitives of `instances` to `prims`, in order: each
+/// instance of a defined, non-empty object, until the memory budget runs
+/// out (reported at the first instance over it, as every error here is).
+/// Instances taken from the description are placed from the last, their
+/// list shrunk as it goes, so that the description's copy and the
+/// primitives are not both held whole.
+fn place_instances(
+    desc: &SceneDescription,
+    instances: Instances,
+    definitions: &HashMap<&str, Arc<PrimitiveAggregate>>,
+    prims: &mut Vec<Primitive>,
+    p: &mut Problems,
+) {
+    // Errors and the budget first, in order.
+    let list = instances.as_slice();
+    let mut end = list.len();
+    let mut placed = 0;
+    for (k, inst) in list.iter().enumerate() {
+        let Some(def) = definitions.get(&*inst.name) else {
+            p.errors.push(Diagnostic::error(
+                inst.loc.clone(),
+                format!("object \"{}\" is not defined", inst.name),
+            ));
+            continue;
+        };
+        if def.primitives().is_empty() {
+            continue;
+        }
+        // The instance's primitive and its accelerator entry.
+        if let Err(e) = desc.budget.charge(INSTANCE_BYTES, "this object instance") {
+            p.errors
+                .push(Diagnostic::error(inst.loc.clone(), e.to_string()));
+            end = k;
+            break;
+        }
+        placed += 1;
+    }
+    let primitive = |inst: &InstanceSceneEntity| {
+        let def = definitions.get(&*inst.name)?;
+        if def.primitives().is_empty() {
+            return None;
+        }
+        Some(match &inst.render_from_instance {
+            InstanceTransform::Fixed(t) => Primitive::Transformed(Box::new(TransformedPrimitive {
+                primitive: def.clone(),
+                render_from_primitive: *t,
+            })),
+            InstanceTransform::Animated(a) => Primitive::Animated(Box::new(AnimatedPrimitive {
+                primitive: Moving::Many(def.clone()),
+                render_from_primitive: **a,
+            })),
+        })
+    };
+    prims.reserve_exact(placed);
+    match instances {
+        Instances::Borrowed(list) => prims.extend(list[..end].iter().filter_map(primitive)),
+        Instances::Owned(mut list) => {
+            list.truncate(end);
+            let base = prims.len();
+            // Shrinking a large allocation gives its tail's pages back.
+            let chunk = (list.len() / 16).max(1 << 12);
+            let mut since = 0;
+            while let Some(inst) = list.pop() {
+                prims.extend(primitive(&inst));
+                since += 1;
+                if since == chunk {
+                    list.shrink_to_fit();
+                    since = 0;
+                }
+            }
+            prims[base..].reverse();
+        }
+    }
+}
+
+fn create(
+    desc: &SceneDescription,
+    instances: Instances,
+    opts: &CreateOptions,
+) -> Result<CreatedScene, Vec<Diagnostic>> {
     let mut problems = Problems::default();
     let p = &mut problems;
 
@@ -518,34 +630,7 @@ pub fn create_scene(
             Arc::new(PrimitiveAggregate::new(inner, &default_accel)),
         );
     }
-    for inst in &desc.instances {
-        let Some(def) = definitions.get(&*inst.name) else {
-            p.errors.push(Diagnostic::error(
-                inst.loc.clone(),
-                format!("object \"{}\" is not defined", inst.name),
-            ));
-            continue;
-        };
-        if def.primitives().is_empty() {
-            continue;
-        }
-        // The instance's primitive and its accelerator entry.
-        if let Err(e) = desc.budget.charge(INSTANCE_BYTES, "this object instance") {
-            p.errors
-                .push(Diagnostic::error(inst.loc.clone(), e.to_string()));
-            break;
-        }
-        prims.push(match &inst.render_from_instance {
-            InstanceTransform::Fixed(t) => Primitive::Transformed(Box::new(TransformedPrimitive {
-                primitive: def.clone(),
-                render_from_primitive: *t,
-            })),
-            InstanceTransform::Animated(a) => Primitive::Animated(Box::new(AnimatedPrimitive {
-                primitive: Moving::Many(def.clone()),
-                render_from_primitive: **a,
-            })),
-        });
-    }
+    place_instances(desc, instances, &definitions, &mut prims, p);
 
     let accel = p
         .take(reader(&desc.accelerator, &desc.budget))
