@@ -67,6 +67,12 @@ impl Default for GraphicsState {
 impl GraphicsState {
     /// Applies `f` to each active transformation.
     pub(super) fn for_active(&mut self, f: impl Fn(&Transform) -> Transform) {
+        // Both, and the same (no motion): computed once.
+        if self.active == ALL_BITS && self.ctm[0].same_bits(&self.ctm[1]) {
+            let t = f(&self.ctm[0]);
+            self.ctm = [t, t];
+            return;
+        }
         for (i, t) in self.ctm.iter_mut().enumerate() {
             if self.active & (1 << i) != 0 {
                 *t = f(t);
