@@ -125,6 +125,18 @@ impl MemoryBudget {
         }
     }
 
+    /// [`MemoryBudget::charge`], describing what asked only when the
+    /// charge fails (a scene of a million directives charges a million
+    /// times).
+    pub fn charge_lazily(
+        &self,
+        bytes: u64,
+        what: impl FnOnce() -> String,
+    ) -> Result<(), OverBudget> {
+        self.charge(bytes, "")
+            .map_err(|e| OverBudget { what: what(), ..e })
+    }
+
     /// Whether `bytes` more would fit, without charging them: for memory
     /// held only for a moment (a decoder's buffer that is converted and
     /// dropped).

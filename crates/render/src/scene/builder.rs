@@ -180,7 +180,7 @@ impl SceneBuilder {
     fn charge(&self, bytes: usize, what: &str, loc: &FileLoc) -> DirectiveResult {
         self.scene
             .budget
-            .charge(bytes as u64, &format!("this {what}"))
+            .charge_lazily(bytes as u64, || format!("this {what}"))
             .map_err(|e| Diagnostic::error(loc.clone(), e.to_string()))
     }
 
