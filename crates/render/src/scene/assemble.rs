@@ -355,6 +355,28 @@ impl Instances<'_> {
     }
 }
 
+/// The object definitions by name, remembering the last name looked up
+/// (consecutive instances mostly share their object's name, an `Arc` the
+/// definition's instances share: a pointer comparison instead of hashing
+/// the name).
+struct Definitions<'a> {
+    map: &'a HashMap<&'a str, Arc<PrimitiveAggregate>>,
+    last: Option<(Arc<str>, Option<&'a Arc<PrimitiveAggregate>>)>,
+}
+
+impl<'a> Definitions<'a> {
+    fn get(&mut self, name: &Arc<str>) -> Option<&'a Arc<PrimitiveAggregate>> {
+        match &self.last {
+            Some((n, def)) if Arc::ptr_eq(n, name) => *def,
+            _ => {
+                let def = self.map.get(&**name);
+                self.last = Some((name.clone(), def));
+                def
+            }
+        }
+    }
+}
+
 /// Appends the primitives of `instances` to `prims`, in order: each
 /// instance of a defined, non-empty object, until the memory budget runs
 /// out (reported at the first instance over it, as every error here is).
@@ -368,12 +390,16 @@ fn place_instances(
     prims: &mut Vec<Primitive>,
     p: &mut Problems,
 ) {
+    let mut definition = Definitions {
+        map: definitions,
+        last: None,
+    };
     // Errors and the budget first, in order.
     let list = instances.as_slice();
     let mut end = list.len();
     let mut placed = 0;
     for (k, inst) in list.iter().enumerate() {
-        let Some(def) = definitions.get(&*inst.name) else {
+        let Some(def) = definition.get(&inst.name) else {
             p.errors.push(Diagnostic::error(
                 inst.loc.clone(),
                 format!("object \"{}\" is not defined", inst.name),
@@ -392,8 +418,8 @@ fn place_instances(
         }
         placed += 1;
     }
-    let primitive = |inst: &InstanceSceneEntity| {
-        let def = definitions.get(&*inst.name)?;
+    let mut primitive = |inst: &InstanceSceneEntity| {
+        let def = definition.get(&inst.name)?;
         if def.primitives().is_empty() {
             return None;
         }
@@ -410,7 +436,7 @@ fn place_instances(
     };
     prims.reserve_exact(placed);
     match instances {
-        Instances::Borrowed(list) => prims.extend(list[..end].iter().filter_map(primitive)),
+        Instances::Borrowed(list) => prims.extend(list[..end].iter().filter_map(&mut primitive)),
         Instances::Owned(mut list) => {
             list.truncate(end);
             let base = prims.len();
