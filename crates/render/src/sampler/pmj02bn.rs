@@ -269,6 +269,48 @@ pub struct Pmj02bnSampler {
     pixel: Point2i,
     sample_index: i32,
     dimension: i32,
+    blue_noise: BlueNoiseCache,
+}
+
+/// Slots of [`BlueNoiseCache`] (a power of two).
+const BLUE_NOISE_SLOTS: usize = 1024;
+
+/// The blue-noise offsets taken lately, by pixel (mod 256) and dimension:
+/// every sample of a pixel takes the same ones, and each costs eight
+/// hashes ([`blue_noise_sample`]). Direct-mapped, 8 KB a sampler (one
+/// per thread); a pixel's dimensions and the few pixels a thread has in
+/// flight fit.
+#[derive(Clone, Debug)]
+struct BlueNoiseCache {
+    /// Per slot, its key (`u32::MAX`: empty) and value.
+    slots: Box<[(u32, Float)]>,
+}
+
+impl Default for BlueNoiseCache {
+    fn default() -> Self {
+        BlueNoiseCache {
+            slots: vec![(u32::MAX, 0.0); BLUE_NOISE_SLOTS].into_boxed_slice(),
+        }
+    }
+}
+
+impl BlueNoiseCache {
+    /// [`blue_noise_sample`] of `p` and `dimension`.
+    #[inline]
+    fn get(&mut self, p: Point2i, dimension: i32) -> Float {
+        // The key: the pixel mod 256 and the dimension below 2^15 (others
+        // are computed every time; `u32::MAX` marks an empty slot).
+        if !(0..1 << 15).contains(&dimension) {
+            return blue_noise_sample(p, dimension);
+        }
+        let key = (((p.x & 255) as u32) << 23) | (((p.y & 255) as u32) << 15) | dimension as u32;
+        let slot = (key.wrapping_mul(0x9e37_79b1) >> 22) as usize & (BLUE_NOISE_SLOTS - 1);
+        let entry = &mut self.slots[slot];
+        if entry.0 != key {
+            *entry = (key, blue_noise_sample(p, dimension));
+        }
+        entry.1
+    }
 }
 
 impl Pmj02bnSampler {
@@ -314,6 +356,7 @@ impl Pmj02bnSampler {
             pixel: Point2i::new(0, 0),
             sample_index: 0,
             dimension: 0,
+            blue_noise: BlueNoiseCache::default(),
         })
     }
 
@@ -369,7 +412,7 @@ impl Pmj02bnSampler {
     #[inline]
     pub fn get_1d(&mut self) -> Float {
         let index = self.permuted_index();
-        let delta = blue_noise_sample(self.pixel, self.dimension);
+        let delta = self.blue_noise.get(self.pixel, self.dimension);
         self.dimension += 1;
         ((index as Float + delta) / self.samples_per_pixel as Float).min(ONE_MINUS_EPSILON)
     }
@@ -384,8 +427,8 @@ impl Pmj02bnSampler {
             self.sample_index as usize
         };
         let mut u = pmj02bn_sample(instance, index);
-        u.x += blue_noise_sample(self.pixel, self.dimension);
-        u.y += blue_noise_sample(self.pixel, self.dimension + 1);
+        u.x += self.blue_noise.get(self.pixel, self.dimension);
+        u.y += self.blue_noise.get(self.pixel, self.dimension + 1);
         if u.x >= 1.0 {
             u.x -= 1.0;
         }
@@ -403,5 +446,32 @@ impl Pmj02bnSampler {
         let py = self.pixel.y.rem_euclid(self.pixel_tile_size);
         let offset = ((px + py * self.pixel_tile_size) * self.samples_per_pixel) as usize;
         self.pixel_samples[offset + self.sample_index as usize]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cache gives `blue_noise_sample`'s values whatever it holds:
+    /// pixels and dimensions taken in an order that keeps evicting
+    /// (fixed), past the cached dimensions and at negative pixels.
+    #[test]
+    fn blue_noise_cache_gives_the_samples() {
+        let mut cache = BlueNoiseCache::default();
+        for round in 0..3 {
+            for y in (-40..300).step_by(7) {
+                for x in (-20..600).step_by(13) {
+                    for d in [0, 1, 2, 5, 37, 200, 32_767, 32_768, 1 << 20] {
+                        let p = Point2i::new(x + round, y);
+                        assert_eq!(
+                            cache.get(p, d).to_bits(),
+                            blue_noise_sample(p, d).to_bits(),
+                            "{p:?}, {d}"
+                        );
+                    }
+                }
+            }
+        }
     }
 }
