@@ -323,6 +323,14 @@ impl Pmj02bnSampler {
                 "pmj02bn sampler supports 1 to {N_PMJ02BN_SAMPLES} samples per pixel, not {samples_per_pixel}"
             ));
         }
+        // Every set is generated now, together (a render takes all five,
+        // one after another on first use they took 0.7 s of a process).
+        std::thread::scope(|s| {
+            for set in 1..N_PMJ02BN_SETS {
+                s.spawn(move || pmj02bn_set(set).len());
+            }
+            pmj02bn_set(0);
+        });
         let spp = samples_per_pixel as usize;
         let log4_n = LOG2_PMJ02BN_SAMPLES / 2;
         let log4_spp = (spp as u32)
