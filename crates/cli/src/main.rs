@@ -41,7 +41,7 @@ use rpbrt_render::film::{FilmOverrides, SampleRange};
 use rpbrt_render::image::tiled::TileCache;
 use rpbrt_render::image::ImageMetadata;
 use rpbrt_render::integrator::{Progress, RenderOptions};
-use rpbrt_render::scene::assemble::{create_scene_taking_instances, CreateOptions};
+use rpbrt_render::scene::assemble::{create_scene_taking_entities, CreateOptions};
 use rpbrt_render::scene::{build_scene, BuildOptions, OptionValue, SceneDescription};
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -232,7 +232,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
         texture_cache: texture_cache.clone(),
     };
     let mut all = diags;
-    let created = match create_scene_taking_instances(&mut desc, &create_opts) {
+    let created = match create_scene_taking_entities(&mut desc, &create_opts) {
         Ok(c) => c,
         Err(errors) => {
             all.items.extend(errors);

@@ -323,19 +323,34 @@ pub fn create_scene(
     desc: &SceneDescription,
     opts: &CreateOptions,
 ) -> Result<CreatedScene, Vec<Diagnostic>> {
-    create(desc, Instances::Borrowed(&desc.instances), opts)
+    create(
+        desc,
+        Instances::Borrowed(&desc.instances),
+        Taken::default(),
+        opts,
+    )
 }
 
-/// [`create_scene`], taking the description's object instances (left
-/// empty): their memory (about 180 bytes each) is freed once they are
-/// render primitives, before the scene's accelerator is built, instead of
-/// being held through the build beside it.
-pub fn create_scene_taking_instances(
+/// [`create_scene`], taking the description's object instances and
+/// animated shapes (left empty): their memory (about 180 and 700 bytes
+/// each) is freed as they become render primitives, before the scene's
+/// accelerator is built, instead of being held whole beside them.
+pub fn create_scene_taking_entities(
     desc: &mut SceneDescription,
     opts: &CreateOptions,
 ) -> Result<CreatedScene, Vec<Diagnostic>> {
     let instances = std::mem::take(&mut desc.instances);
-    create(desc, Instances::Owned(instances), opts)
+    let taken = Taken {
+        animated_shapes: Some(std::mem::take(&mut desc.animated_shapes)),
+    };
+    create(desc, Instances::Owned(instances), taken, opts)
+}
+
+/// The description's entities [`create`] was given to free as it goes
+/// (`None`: read from the description).
+#[derive(Default)]
+struct Taken {
+    animated_shapes: Option<Vec<AnimatedShapeSceneEntity>>,
 }
 
 /// The object instances [`create`] places.
@@ -459,6 +474,7 @@ fn place_instances(
 fn create(
     desc: &SceneDescription,
     instances: Instances,
+    taken: Taken,
     opts: &CreateOptions,
 ) -> Result<CreatedScene, Vec<Diagnostic>> {
     let mut problems = Problems::default();
@@ -610,21 +626,59 @@ fn create(
     for s in &desc.shapes {
         create_primitives(&cx, s, &mut lights, p, &mut prims);
     }
-    for s in &desc.animated_shapes {
+    // One primitive for each animated shape (they carry no lights).
+    let animated = |s: &AnimatedShapeSceneEntity,
+                    lights: &mut Vec<Light>,
+                    p: &mut Problems,
+                    prims: &mut Vec<Primitive>| {
         if s.attributes.light_index.is_some() {
             p.errors.push(Diagnostic::error(
                 s.base.loc.clone(),
                 "area lights on animated shapes are not supported (as in pbrt-v4)",
             ));
-            continue;
+            return;
         }
         let mut inner = Vec::new();
-        create_primitives(&cx, &at_origin(s), &mut lights, p, &mut inner);
+        create_primitives(&cx, &at_origin(s), lights, p, &mut inner);
         if let Some(moving) = Moving::of(inner, &default_accel) {
             prims.push(Primitive::Animated(Box::new(AnimatedPrimitive {
                 primitive: moving,
                 render_from_primitive: s.render_from_object,
             })));
+        }
+    };
+    match taken.animated_shapes {
+        None => {
+            for s in &desc.animated_shapes {
+                animated(s, &mut lights, p, &mut prims);
+            }
+        }
+        Some(mut list) => {
+            // Taken from the description: made from the last, the list
+            // shrunk as it goes (as the instances below), each shape's
+            // problems kept apart and reported in the files' order.
+            let (base, n_lights) = (prims.len(), lights.len());
+            let mut reported = Vec::new();
+            let chunk = (list.len() / 16).max(1 << 12);
+            let mut since = 0;
+            while let Some(s) = list.pop() {
+                let mut own = Problems::default();
+                animated(&s, &mut lights, &mut own, &mut prims);
+                if !own.errors.is_empty() || !own.warnings.is_empty() {
+                    reported.push(own);
+                }
+                since += 1;
+                if since == chunk {
+                    list.shrink_to_fit();
+                    since = 0;
+                }
+            }
+            debug_assert_eq!(lights.len(), n_lights);
+            prims[base..].reverse();
+            for own in reported.into_iter().rev() {
+                p.errors.extend(own.errors);
+                p.warnings.extend(own.warnings);
+            }
         }
     }
     // Object definitions, built once and shared by their instances.

@@ -7,6 +7,7 @@ mod budget;
 mod camera;
 mod materials;
 mod media;
+mod taking;
 mod textures;
 
 use std::collections::HashMap;
