@@ -455,18 +455,24 @@ fn place_instances(
         Instances::Owned(mut list) => {
             list.truncate(end);
             let base = prims.len();
-            // Shrinking a large allocation gives its tail's pages back.
-            let chunk = (list.len() / 16).max(1 << 12);
-            let mut since = 0;
-            while let Some(inst) = list.pop() {
-                prims.extend(primitive(&inst));
-                since += 1;
-                if since == chunk {
-                    list.shrink_to_fit();
-                    since = 0;
-                }
-            }
+            take_from_end(list, |inst| prims.extend(primitive(&inst)));
             prims[base..].reverse();
+        }
+    }
+}
+
+/// Calls `f` on each entry of `list`, the last first, shrinking the list
+/// as it goes (a large allocation gives its tail's pages back), so that
+/// the entries and what `f` makes of them are not both held whole.
+fn take_from_end<T>(mut list: Vec<T>, mut f: impl FnMut(T)) {
+    let chunk = (list.len() / 16).max(1 << 12);
+    let mut since = 0;
+    while let Some(entry) = list.pop() {
+        f(entry);
+        since += 1;
+        if since == chunk {
+            list.shrink_to_fit();
+            since = 0;
         }
     }
 }
@@ -653,26 +659,19 @@ fn create(
                 animated(s, &mut lights, p, &mut prims);
             }
         }
-        Some(mut list) => {
+        Some(list) => {
             // Taken from the description: made from the last, the list
             // shrunk as it goes (as the instances below), each shape's
             // problems kept apart and reported in the files' order.
             let (base, n_lights) = (prims.len(), lights.len());
             let mut reported = Vec::new();
-            let chunk = (list.len() / 16).max(1 << 12);
-            let mut since = 0;
-            while let Some(s) = list.pop() {
+            take_from_end(list, |s| {
                 let mut own = Problems::default();
                 animated(&s, &mut lights, &mut own, &mut prims);
                 if !own.errors.is_empty() || !own.warnings.is_empty() {
                     reported.push(own);
                 }
-                since += 1;
-                if since == chunk {
-                    list.shrink_to_fit();
-                    since = 0;
-                }
-            }
+            });
             debug_assert_eq!(lights.len(), n_lights);
             prims[base..].reverse();
             for own in reported.into_iter().rev() {
