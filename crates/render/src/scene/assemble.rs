@@ -323,12 +323,7 @@ pub fn create_scene(
     desc: &SceneDescription,
     opts: &CreateOptions,
 ) -> Result<CreatedScene, Vec<Diagnostic>> {
-    create(
-        desc,
-        Instances::Borrowed(&desc.instances),
-        Taken::default(),
-        opts,
-    )
+    create(desc, Taken::default(), opts)
 }
 
 /// [`create_scene`], taking the description's object instances and
@@ -339,35 +334,19 @@ pub fn create_scene_taking_entities(
     desc: &mut SceneDescription,
     opts: &CreateOptions,
 ) -> Result<CreatedScene, Vec<Diagnostic>> {
-    let instances = std::mem::take(&mut desc.instances);
     let taken = Taken {
+        instances: Some(std::mem::take(&mut desc.instances)),
         animated_shapes: Some(std::mem::take(&mut desc.animated_shapes)),
     };
-    create(desc, Instances::Owned(instances), taken, opts)
+    create(desc, taken, opts)
 }
 
 /// The description's entities [`create`] was given to free as it goes
 /// (`None`: read from the description).
 #[derive(Default)]
 struct Taken {
+    instances: Option<Vec<InstanceSceneEntity>>,
     animated_shapes: Option<Vec<AnimatedShapeSceneEntity>>,
-}
-
-/// The object instances [`create`] places.
-enum Instances<'a> {
-    /// Read from the description.
-    Borrowed(&'a [InstanceSceneEntity]),
-    /// Taken from it, freed as soon as they are placed.
-    Owned(Vec<InstanceSceneEntity>),
-}
-
-impl Instances<'_> {
-    fn as_slice(&self) -> &[InstanceSceneEntity] {
-        match self {
-            Instances::Borrowed(v) => v,
-            Instances::Owned(v) => v,
-        }
-    }
 }
 
 /// The object definitions by name, remembering the last name looked up
@@ -400,7 +379,7 @@ impl<'a> Definitions<'a> {
 /// primitives are not both held whole.
 fn place_instances(
     desc: &SceneDescription,
-    instances: Instances,
+    taken: Option<Vec<InstanceSceneEntity>>,
     definitions: &HashMap<&str, Arc<PrimitiveAggregate>>,
     prims: &mut Vec<Primitive>,
     p: &mut Problems,
@@ -410,7 +389,7 @@ fn place_instances(
         last: None,
     };
     // Errors and the budget first, in order.
-    let list = instances.as_slice();
+    let list = taken.as_deref().unwrap_or(&desc.instances);
     let mut end = list.len();
     let mut placed = 0;
     for (k, inst) in list.iter().enumerate() {
@@ -450,9 +429,9 @@ fn place_instances(
         })
     };
     prims.reserve_exact(placed);
-    match instances {
-        Instances::Borrowed(list) => prims.extend(list[..end].iter().filter_map(&mut primitive)),
-        Instances::Owned(mut list) => {
+    match taken {
+        None => prims.extend(list[..end].iter().filter_map(&mut primitive)),
+        Some(mut list) => {
             list.truncate(end);
             let base = prims.len();
             take_from_end(list, |inst| prims.extend(primitive(&inst)));
@@ -479,7 +458,6 @@ fn take_from_end<T>(mut list: Vec<T>, mut f: impl FnMut(T)) {
 
 fn create(
     desc: &SceneDescription,
-    instances: Instances,
     taken: Taken,
     opts: &CreateOptions,
 ) -> Result<CreatedScene, Vec<Diagnostic>> {
@@ -709,7 +687,7 @@ fn create(
             Arc::new(PrimitiveAggregate::new(inner, &default_accel)),
         );
     }
-    place_instances(desc, instances, &definitions, &mut prims, p);
+    place_instances(desc, taken.instances, &definitions, &mut prims, p);
 
     let accel = p
         .take(reader(&desc.accelerator, &desc.budget))
