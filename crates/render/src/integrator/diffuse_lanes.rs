@@ -19,6 +19,11 @@
 //!    the next direction (pbrt-v4's `DiffuseBxDF` through `BSDF::f`,
 //!    `BSDF::PDF` and `BSDF::Sample_f`).
 //!
+//! A pass's vertices are held as columns ([`LaneVertices`]): the kernels
+//! load and store vectors of consecutive vertices, and each vertex's
+//! halves read its entries in place, so nothing is gathered from or
+//! scattered back to per-path structs.
+//!
 //! The surface kernel also serves the specular vertex of a smooth
 //! `dielectric` of constant index ([`lane_surface`]): on its surface
 //! the scalar BSDF's own sampling runs per lane, in the BSDF's frame the
@@ -29,9 +34,9 @@
 //! take the scalar vertex instead.
 
 use super::bsdf_stage::BsdfAnswers;
-use super::direct::{LightAnswer, LightRequest};
+use super::direct::LightRequest;
 use super::Scene;
-use crate::bxdf::lanes::{gather_f, gather_s, MAX_LANES, S4};
+use crate::bxdf::lanes::MAX_LANES;
 use crate::bxdf::{BSDFSample, BxDF, DielectricBxDF, BSDF};
 use crate::light::LightSampleContext;
 use crate::primitive::{HitRecord, TriangleHit};
@@ -62,9 +67,8 @@ pub(crate) enum LaneShade {
 /// How a hit `record` by a ray of direction `d` shades when it is a vertex
 /// the lanes take: a triangle without an area light, in a mesh without
 /// shading tangents, of a material [`LaneShade`] covers (its specular kind
-/// only where `specular` allows it); the surface kernel's input is written
-/// to `out`. `None`: the scalar vertex takes it (`out` is then
-/// unspecified).
+/// only where `specular` allows it); the surface kernel's input then
+/// takes the next slot of `out`. `None`: the scalar vertex takes it.
 #[inline(always)]
 pub(crate) fn lane_surface(
     scene: &Scene,
@@ -72,7 +76,7 @@ pub(crate) fn lane_surface(
     d: Vector3f,
     lambda: &SampledWavelengths,
     specular: bool,
-    out: &mut SurfaceIn,
+    out: &mut LaneVertices,
 ) -> Option<LaneShade> {
     let hit = scene.aggregate.triangle_hit(record)?;
     if hit.area_light.is_some() {
@@ -96,69 +100,377 @@ pub(crate) fn lane_surface(
         ),
         None => return None,
     };
-    out.fill(&hit, d).then_some(shade)
+    out.push(&hit, d).then_some(shade)
 }
 
-/// What [`surfaces`] needs of one triangle hit.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct SurfaceIn {
-    /// The barycentrics.
-    b: [Float; 3],
-    /// The vertices.
-    p: [Point3f; 3],
-    /// The vertex normals (zero when the mesh has none).
-    n: [Normal3f; 3],
-    /// The mesh has vertex normals.
-    shading: bool,
-    /// The triangle's geometric normal and ∂p/∂u.
-    ng: Normal3f,
-    dpdu: Vector3f,
-    /// The ray's direction.
-    d: Vector3f,
+/// The components of a point, vector or normal.
+macro_rules! xyz {
+    ($v:expr) => {{
+        let v = $v;
+        [v.x, v.y, v.z]
+    }};
 }
 
-impl SurfaceIn {
-    /// Writes the input of a hit on `hit` by a ray of direction `d`;
-    /// false for meshes with shading tangents (left to the scalar vertex).
-    /// Field by field, in place: a whole input built on the stack and
-    /// copied would be written in 8- and 4-byte pieces and read back in
-    /// 16-byte ones, which stalls on store forwarding.
+/// Column indices of [`LaneVertices`]: a vector's components, and a
+/// spectrum's wavelengths, are consecutive columns.
+mod col {
+    // The surface kernel's input: the barycentrics, the triangle's
+    // vertices and vertex normals (vertex `j`'s component `a` at
+    // `P + 3j + a`), the geometric normal and ∂p/∂u, the ray's direction.
+    pub const B: usize = 0;
+    pub const P: usize = B + 3;
+    pub const N: usize = P + 9;
+    pub const NG: usize = N + 9;
+    pub const DPDU: usize = NG + 3;
+    pub const D: usize = DPDU + 3;
+    // Its output: the point's interval and midpoint, the offset origins
+    // to the side of the geometric normal and to the other side, that
+    // normal (on the shading normal's side), the shading normal, ωo and
+    // the BSDF frame's x and y axes.
+    pub const LO: usize = D + 3;
+    pub const HI: usize = LO + 3;
+    pub const MID: usize = HI + 3;
+    pub const SIDE0: usize = MID + 3;
+    pub const SIDE1: usize = SIDE0 + 3;
+    pub const N_OUT: usize = SIDE1 + 3;
+    pub const NS: usize = N_OUT + 3;
+    pub const WO: usize = NS + 3;
+    pub const X: usize = WO + 3;
+    pub const Y: usize = X + 3;
+    // The scatter kernel's other input: the reflectance, the BSDF
+    // sample's draws and the light sample's direction.
+    pub const R: usize = Y + 3;
+    pub const U2: usize = R + 4;
+    pub const WI: usize = U2 + 2;
+    // Its output: the BSDF's value (times the cosine) and density toward
+    // the light sample; the sampled direction, its density and cosine
+    // over density.
+    pub const F_LIGHT: usize = WI + 3;
+    pub const PDF_LIGHT: usize = F_LIGHT + 4;
+    pub const WI_S: usize = PDF_LIGHT + 1;
+    pub const PDF: usize = WI_S + 3;
+    pub const COS_OVER_PDF: usize = PDF + 1;
+    pub const COUNT: usize = COS_OVER_PDF + 1;
+}
+
+/// Slots of [`LaneVertices`]: the most vertices a wavefront pass takes in
+/// lanes.
+pub(crate) const LANE_SLOTS: usize = 256;
+
+/// A column's entries: the slots and [`MAX_LANES`] spare ones.
+const STRIDE: usize = LANE_SLOTS + MAX_LANES;
+
+/// The vertices of one wavefront pass that the surface kernel takes, as
+/// columns: slot `k`'s value of column `c` is at `data[c][k]`. The
+/// kernels load and store whole vectors of consecutive slots, with no
+/// gathering from per-path structs, and the halves of a vertex read the
+/// slot's entries in place. Each column ends in [`MAX_LANES`] spare
+/// entries, so that a vector loads at any slot (what lanes past the last
+/// slot compute is never read). (The sizes are constants, so that the
+/// many reads of one slot share one bounds check.)
+pub(crate) struct LaneVertices {
+    data: Box<[[Float; STRIDE]; col::COUNT]>,
+    /// Slots taken.
+    len: usize,
+    /// Per slot: the mesh has vertex normals; the surface kernel took it
+    /// (false where the scalar code takes a branch the kernel does not:
+    /// the scalar vertex takes it); the BSDF sample exists.
+    shading: [bool; STRIDE],
+    ok: [bool; STRIDE],
+    sampled: [bool; STRIDE],
+}
+
+impl Default for LaneVertices {
+    fn default() -> Self {
+        LaneVertices {
+            data: Box::new([[0.0; STRIDE]; col::COUNT]),
+            len: 0,
+            shading: [false; STRIDE],
+            ok: [false; STRIDE],
+            sampled: [false; STRIDE],
+        }
+    }
+}
+
+impl LaneVertices {
+    /// Every slot free again.
+    #[inline]
+    pub(crate) fn clear(&mut self) {
+        self.len = 0;
+    }
+
     #[inline(always)]
-    pub(crate) fn fill(&mut self, hit: &TriangleHit, d: Vector3f) -> bool {
+    fn at(&self, c: usize, k: usize) -> Float {
+        self.data[c][k]
+    }
+
+    #[inline(always)]
+    fn set(&mut self, c: usize, k: usize, v: Float) {
+        self.data[c][k] = v;
+    }
+
+    #[inline(always)]
+    fn set3(&mut self, c: usize, k: usize, v: [Float; 3]) {
+        for (a, x) in v.into_iter().enumerate() {
+            self.set(c + a, k, x);
+        }
+    }
+
+    #[inline(always)]
+    fn get3(&self, c: usize, k: usize) -> [Float; 3] {
+        [self.at(c, k), self.at(c + 1, k), self.at(c + 2, k)]
+    }
+
+    #[inline(always)]
+    fn vector(&self, c: usize, k: usize) -> Vector3f {
+        let [x, y, z] = self.get3(c, k);
+        Vector3f::new(x, y, z)
+    }
+
+    #[inline(always)]
+    fn point(&self, c: usize, k: usize) -> Point3f {
+        let [x, y, z] = self.get3(c, k);
+        Point3f::new(x, y, z)
+    }
+
+    #[inline(always)]
+    fn normal(&self, c: usize, k: usize) -> Normal3f {
+        let [x, y, z] = self.get3(c, k);
+        Normal3f::new(x, y, z)
+    }
+
+    #[inline(always)]
+    fn spectrum(&self, c: usize, k: usize) -> SampledSpectrum {
+        SampledSpectrum {
+            values: std::array::from_fn(|w| self.at(c + w, k)),
+        }
+    }
+
+    #[inline(always)]
+    fn load<L: F32Lanes>(&self, c: usize, k: usize) -> L {
+        L::load(&self.data[c][k..])
+    }
+
+    #[inline(always)]
+    fn load3<L: F32Lanes>(&self, c: usize, k: usize) -> V3<L> {
+        V3 {
+            x: self.load(c, k),
+            y: self.load(c + 1, k),
+            z: self.load(c + 2, k),
+        }
+    }
+
+    #[inline(always)]
+    fn store<L: F32Lanes>(&mut self, c: usize, k: usize, v: L) {
+        v.store(&mut self.data[c][k..]);
+    }
+
+    #[inline(always)]
+    fn store3<L: F32Lanes>(&mut self, c: usize, k: usize, v: V3<L>) {
+        self.store(c, k, v.x);
+        self.store(c + 1, k, v.y);
+        self.store(c + 2, k, v.z);
+    }
+
+    /// The lane mask of `flags` at slots `k..`, of which `n` are taken.
+    #[inline(always)]
+    fn mask<L: F32Lanes>(flags: &[bool], k: usize, n: usize) -> L::Mask {
+        L::from_bits(
+            flags[k..k + n]
+                .iter()
+                .enumerate()
+                .fold(0, |m, (i, &f)| m | ((f as u32) << i)),
+        )
+    }
+
+    /// Takes the next slot for the surface kernel's input: a hit on `hit`
+    /// by a ray of direction `d`. False (no slot taken) for meshes with
+    /// shading tangents, which the scalar vertex takes, and when every
+    /// slot is taken.
+    #[inline(always)]
+    pub(crate) fn push(&mut self, hit: &TriangleHit, d: Vector3f) -> bool {
         let mesh = hit.tri.mesh;
-        if mesh.s.is_some() {
+        let k = self.len;
+        if mesh.s.is_some() || k >= LANE_SLOTS {
             return false;
         }
         let v = mesh.vertex_indices(hit.tri.tri_index as usize);
-        for (p, &k) in self.p.iter_mut().zip(&v) {
-            *p = mesh.p[k];
+        for (j, &i) in v.iter().enumerate() {
+            self.set3(col::P + 3 * j, k, xyz!(mesh.p[i]));
         }
         match &mesh.n {
             Some(nn) => {
-                for (n, &k) in self.n.iter_mut().zip(&v) {
-                    *n = nn[k];
+                for (j, &i) in v.iter().enumerate() {
+                    self.set3(col::N + 3 * j, k, xyz!(nn[i]));
                 }
-                self.shading = true;
+                self.shading[k] = true;
             }
             None => {
-                self.n = [Normal3f::default(); 3];
-                self.shading = false;
+                for j in 0..3 {
+                    self.set3(col::N + 3 * j, k, [0.0; 3]);
+                }
+                self.shading[k] = false;
             }
         }
-        self.b = hit.b;
-        hit.frame_parts(&mut self.ng, &mut self.dpdu);
-        self.d = d;
+        for (j, &b) in hit.b.iter().enumerate() {
+            self.set(col::B + j, k, b);
+        }
+        let (mut ng, mut dpdu) = (Normal3f::default(), Vector3f::default());
+        hit.frame_parts(&mut ng, &mut dpdu);
+        self.set3(col::NG, k, xyz!(ng));
+        self.set3(col::DPDU, k, xyz!(dpdu));
+        self.set3(col::D, k, xyz!(d));
+        self.len += 1;
         true
+    }
+
+    /// Whether the surface kernel took slot `k` (if not, the scalar vertex
+    /// takes it).
+    #[inline(always)]
+    pub(crate) fn ok(&self, k: usize) -> bool {
+        self.ok[k]
+    }
+
+    /// The hit point's interval at slot `k`.
+    #[inline(always)]
+    fn pi(&self, k: usize) -> Point3fi {
+        let (lo, hi) = (self.get3(col::LO, k), self.get3(col::HI, k));
+        let i = |a: usize| Interval {
+            low: lo[a],
+            high: hi[a],
+        };
+        Point3fi::new(i(0), i(1), i(2))
+    }
+
+    /// The surface at slot `k`, whole (for the specular vertex).
+    pub(crate) fn surface_out(&self, k: usize) -> SurfaceOut {
+        SurfaceOut {
+            pi: self.pi(k),
+            sides: [self.point(col::SIDE0, k), self.point(col::SIDE1, k)],
+            n: self.normal(col::N_OUT, k),
+            ns: self.normal(col::NS, k),
+            wo: self.vector(col::WO, k),
+            x: self.vector(col::X, k),
+            y: self.vector(col::Y, k),
+        }
+    }
+
+    /// The first half of the diffuse vertex at slot `k` (after the
+    /// integrator has counted it), of reflectance `r`: its sampler draws
+    /// taken (the BSDF's kept for the scatter kernel), its light request.
+    #[inline(always)]
+    pub(crate) fn begin(
+        &mut self,
+        k: usize,
+        r: SampledSpectrum,
+        sampler: &mut Sampler,
+    ) -> LightRequest {
+        let (u_light, u_light_2d, _, u2) = sampler.get_vertex_samples();
+        for (w, &v) in r.values.iter().enumerate() {
+            self.set(col::R + w, k, v);
+        }
+        self.set(col::U2, k, u2.x);
+        self.set(col::U2 + 1, k, u2.y);
+        // The light-sampling context: the point offset toward ωo (the
+        // BSDF only reflects), the normals.
+        let (n, ns, wo) = (
+            self.normal(col::N_OUT, k),
+            self.normal(col::NS, k),
+            self.vector(col::WO, k),
+        );
+        let z = Vector3f::from(ns);
+        LightRequest {
+            ctx: LightSampleContext {
+                pi: Point3fi::from(self.toward(k, wo)),
+                n,
+                ns,
+            },
+            u: u_light,
+            u_light: u_light_2d,
+            hemisphere: Some((z, dot(wo, z))),
+        }
+    }
+
+    /// Sets the light sample's direction at slot `k` for the scatter
+    /// kernel (any, without a light sample: its answers are then not
+    /// read).
+    #[inline(always)]
+    pub(crate) fn set_light_direction(&mut self, k: usize, wi: Vector3f) {
+        self.set3(col::WI, k, xyz!(wi));
+    }
+
+    /// Writes the vertex at slot `k` as the light-sampling context of the
+    /// next vertex's MIS weights (`LightSampleContext::from_si`).
+    #[inline(always)]
+    pub(crate) fn write_context(&self, k: usize, ctx: &mut LightSampleContext) {
+        ctx.pi = self.pi(k);
+        ctx.n = self.normal(col::N_OUT, k);
+        ctx.ns = self.normal(col::NS, k);
+    }
+
+    /// The ray origin at slot `k` offset off the surface toward `w`'s
+    /// side.
+    #[inline(always)]
+    fn toward(&self, k: usize, w: Vector3f) -> Point3f {
+        let side = (dot(w, self.normal(col::N_OUT, k)) < 0.0) as usize;
+        self.point([col::SIDE0, col::SIDE1][side], k)
+    }
+
+    /// The ray leaving slot `k`'s vertex toward `wi` at `time`.
+    #[inline(always)]
+    pub(crate) fn spawn_ray(&self, k: usize, wi: Vector3f, time: Float) -> Ray {
+        Ray::with_time(self.toward(k, wi), wi, time, None)
+    }
+
+    /// The shadow ray from slot `k`'s vertex at `time` toward a light
+    /// sample's point `to_p` (normal `to_n`), and its extent.
+    #[inline(always)]
+    pub(crate) fn shadow_ray(
+        &self,
+        k: usize,
+        time: Float,
+        to_p: Point3fi,
+        to_n: Normal3f,
+    ) -> (Ray, Float) {
+        let p_to = to_p.midpoint();
+        let pf = self.toward(k, p_to - self.point(col::MID, k));
+        let r = spawn_ray_from_origin_to_surface(pf, time, p_to, to_p.error(), to_n);
+        (r, 1.0 - SHADOW_EPSILON)
+    }
+
+    /// The reflectance at slot `k`.
+    #[inline(always)]
+    pub(crate) fn r(&self, k: usize) -> SampledSpectrum {
+        self.spectrum(col::R, k)
+    }
+
+    /// `bsdf.f(ωo, ωi) · |ωi · ns|` and `bsdf.pdf(ωo, ωi)` toward slot
+    /// `k`'s light sample.
+    #[inline(always)]
+    pub(crate) fn light_answers(&self, k: usize) -> (SampledSpectrum, Float) {
+        (self.spectrum(col::F_LIGHT, k), self.at(col::PDF_LIGHT, k))
+    }
+
+    /// Slot `k`'s BSDF sample (`bsdf.sample_f`): its direction in
+    /// rendering space, its density, and `|ωi · ns| / pdf`; `None` where
+    /// the scalar method returns none.
+    #[inline(always)]
+    pub(crate) fn sample(&self, k: usize) -> Option<(Vector3f, Float, Float)> {
+        self.sampled[k].then(|| {
+            (
+                self.vector(col::WI_S, k),
+                self.at(col::PDF, k),
+                self.at(col::COS_OVER_PDF, k),
+            )
+        })
     }
 }
 
 /// The surface at a hit, as the scalar interaction and BSDF have it.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct SurfaceOut {
-    /// The hit point's interval, and its midpoint (what the interaction
-    /// reads as its point).
+    /// The hit point's interval.
     pub pi: Point3fi,
-    pub p: Point3f,
     /// The ray origins offset off the surface (`offset_ray_origin`) to
     /// the side of `n` and to the other side.
     pub sides: [Point3f; 2],
@@ -171,9 +483,6 @@ pub(crate) struct SurfaceOut {
     /// The BSDF frame's x and y axes (its z axis is `ns`).
     pub x: Vector3f,
     pub y: Vector3f,
-    /// False where the scalar code takes a branch this kernel does not:
-    /// the lane must take the scalar vertex.
-    pub ok: bool,
 }
 
 impl SurfaceOut {
@@ -215,149 +524,6 @@ impl SurfaceOut {
     }
 }
 
-/// A diffuse vertex between its two halves: what the second half reads
-/// of the surface, the BSDF and the sampler draws.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct DiffuseVertex {
-    /// The hit point's interval and its midpoint.
-    pub pi: Point3fi,
-    p: Point3f,
-    /// Geometric and shading normals.
-    pub n: Normal3f,
-    pub ns: Normal3f,
-    /// ωo (normalized).
-    pub wo: Vector3f,
-    /// The ray's time.
-    pub time: Float,
-    /// The BSDF's frame and reflectance.
-    pub frame: Frame,
-    pub r: SampledSpectrum,
-    /// The BSDF sample's draws.
-    pub u2: Point2f,
-    /// The offset origins to the side of `n` and to the other side.
-    sides: [Point3f; 2],
-}
-
-impl DiffuseVertex {
-    /// The first half of a diffuse vertex (after the integrator has
-    /// counted it): this vertex becomes the one of surface `s` hit at
-    /// `time` with reflectance `r`, its sampler draws taken; returns its
-    /// light request. (Written in place, field by field, for the reason
-    /// [`SurfaceIn::fill`] gives.)
-    #[inline(always)]
-    pub(crate) fn begin(
-        &mut self,
-        s: &SurfaceOut,
-        time: Float,
-        r: SampledSpectrum,
-        sampler: &mut Sampler,
-    ) -> LightRequest {
-        let (u_light, u_light_2d, _, u2) = sampler.get_vertex_samples();
-        self.pi = s.pi;
-        self.p = s.p;
-        self.n = s.n;
-        self.ns = s.ns;
-        self.wo = s.wo;
-        self.time = time;
-        self.frame.x = s.x;
-        self.frame.y = s.y;
-        self.frame.z = Vector3f::from(s.ns);
-        self.r = r;
-        self.u2 = u2;
-        self.sides[0] = s.sides[0];
-        self.sides[1] = s.sides[1];
-        // The light-sampling context: the point offset toward ωo (the
-        // BSDF only reflects), the normals; read from `s`, not from the
-        // fields just written.
-        let z = Vector3f::from(s.ns);
-        LightRequest {
-            ctx: LightSampleContext {
-                pi: Point3fi::from(s.sides[(dot(s.wo, s.n) < 0.0) as usize]),
-                n: s.n,
-                ns: s.ns,
-            },
-            u: u_light,
-            u_light: u_light_2d,
-            hemisphere: Some((z, dot(s.wo, z))),
-        }
-    }
-
-    /// The context of this vertex for the next vertex's MIS weights.
-    #[inline(always)]
-    pub(crate) fn write_context(&self, ctx: &mut LightSampleContext) {
-        // Field by field (see `SurfaceIn::fill`).
-        ctx.pi = self.pi;
-        ctx.n = self.n;
-        ctx.ns = self.ns;
-    }
-
-    /// The ray origin offset off the surface toward `w`'s side.
-    #[inline(always)]
-    pub(crate) fn toward(&self, w: Vector3f) -> Point3f {
-        self.sides[(dot(w, self.n) < 0.0) as usize]
-    }
-
-    /// The ray leaving the vertex toward `wi`.
-    #[inline(always)]
-    pub(crate) fn spawn_ray(&self, wi: Vector3f) -> Ray {
-        Ray::with_time(self.toward(wi), wi, self.time, None)
-    }
-
-    /// The shadow ray toward a light sample's point `to_p` (normal `to_n`)
-    /// and its extent.
-    #[inline(always)]
-    pub(crate) fn shadow_ray(&self, to_p: Point3fi, to_n: Normal3f) -> (Ray, Float) {
-        let p_to = to_p.midpoint();
-        let pf = self.toward(p_to - self.p);
-        let r = spawn_ray_from_origin_to_surface(pf, self.time, p_to, to_p.error(), to_n);
-        (r, 1.0 - SHADOW_EPSILON)
-    }
-}
-
-/// The components of a point, vector or normal.
-macro_rules! xyz {
-    ($v:expr) => {{
-        let v = $v;
-        [v.x, v.y, v.z]
-    }};
-}
-
-/// Lanes of a 3-vector per item.
-#[inline(always)]
-fn gather_v<L: F32Lanes>(n: usize, f: impl Fn(usize) -> [Float; 3]) -> V3<L> {
-    V3 {
-        x: gather_f(n, |i| f(i)[0]),
-        y: gather_f(n, |i| f(i)[1]),
-        z: gather_f(n, |i| f(i)[2]),
-    }
-}
-
-/// The lanes of `x`, stored.
-#[inline(always)]
-fn stored<L: F32Lanes>(x: L) -> [Float; MAX_LANES] {
-    let mut a = [0.0; MAX_LANES];
-    x.store(&mut a);
-    a
-}
-
-/// The lanes of a vector, stored: one array per component.
-struct Stored3([[Float; MAX_LANES]; 3]);
-
-impl Stored3 {
-    #[inline(always)]
-    fn new<L: F32Lanes>(v: V3<L>) -> Self {
-        Stored3([stored(v.x), stored(v.y), stored(v.z)])
-    }
-    #[inline(always)]
-    fn vector(&self, i: usize) -> Vector3f {
-        Vector3f::new(self.0[0][i], self.0[1][i], self.0[2][i])
-    }
-    #[inline(always)]
-    fn normal(&self, i: usize) -> Normal3f {
-        Normal3f::new(self.0[0][i], self.0[1][i], self.0[2][i])
-    }
-}
-
 /// Component-wise |v|.
 #[inline(always)]
 fn abs_v<L: F32Lanes>(v: V3<L>) -> V3<L> {
@@ -368,15 +534,20 @@ fn abs_v<L: F32Lanes>(v: V3<L>) -> V3<L> {
     }
 }
 
-/// `if m { -v } else { v }` (a sign flip, as `face_forward`).
+/// `-v`.
 #[inline(always)]
-fn flip_if<L: F32Lanes>(m: L::Mask, v: V3<L>) -> V3<L> {
-    let neg = V3 {
+fn neg_v<L: F32Lanes>(v: V3<L>) -> V3<L> {
+    V3 {
         x: v.x.neg(),
         y: v.y.neg(),
         z: v.z.neg(),
-    };
-    V3::select(m, neg, v)
+    }
+}
+
+/// `if m { -v } else { v }` (a sign flip, as `face_forward`).
+#[inline(always)]
+fn flip_if<L: F32Lanes>(m: L::Mask, v: V3<L>) -> V3<L> {
+    V3::select(m, neg_v(v), v)
 }
 
 /// Each component of `v` one float up where `o`'s is positive, one down
@@ -398,215 +569,142 @@ fn round_off_l<L: F32Lanes>(v: L, o: L) -> L {
     L::select(o.gt(zero), math::next_float_up(v), down)
 }
 
-/// [`surfaces`] of at most one width's items.
-struct Surfaces<'a> {
-    items: &'a [SurfaceIn],
-    out: &'a mut [SurfaceOut],
-}
+/// [`surfaces`] as a kernel.
+struct Surfaces<'a>(&'a mut LaneVertices);
 
 impl Kernel for Surfaces<'_> {
     type Output = ();
 
     #[inline(always)]
     fn run<L: F32Lanes>(self) {
-        let it = self.items;
-        let n = it.len();
-        let s = L::splat;
-        let zero = s(0.0);
-        let b0: L = gather_f(n, |i| it[i].b[0]);
-        let b1: L = gather_f(n, |i| it[i].b[1]);
-        let b2: L = gather_f(n, |i| it[i].b[2]);
-        let p0 = gather_v::<L>(n, |i| xyz!(it[i].p[0]));
-        let p1 = gather_v::<L>(n, |i| xyz!(it[i].p[1]));
-        let p2 = gather_v::<L>(n, |i| xyz!(it[i].p[2]));
-        let ng = gather_v::<L>(n, |i| xyz!(it[i].ng));
-        let dpdu = gather_v::<L>(n, |i| xyz!(it[i].dpdu));
-        let d = gather_v::<L>(n, |i| xyz!(it[i].d));
-        let shading = L::from_bits(
-            it.iter()
-                .enumerate()
-                .fold(0, |m, (i, x)| m | ((x.shading as u32) << i)),
-        );
-
-        // The point, its error bound and ωo (`Triangle::interaction`).
-        let (pb0, pb1, pb2) = (p0.scale(b0), p1.scale(b1), p2.scale(b2));
-        let p = pb0.add(pb1).add(pb2);
-        let p_error = abs_v(pb0)
-            .add(abs_v(pb1))
-            .add(abs_v(pb2))
-            .scale(s(gamma(7)));
-        let (wo, wo_ok) = V3 {
-            x: d.x.neg(),
-            y: d.y.neg(),
-            z: d.z.neg(),
-        }
-        .try_normalize();
-        let wo = V3::select(
-            wo_ok,
-            wo,
-            V3 {
-                x: zero,
-                y: zero,
-                z: zero,
-            },
-        );
-
-        // The shading geometry of meshes with vertex normals: the
-        // interpolated normal (the geometric one where it vanishes), the
-        // tangent ∂p/∂u made perpendicular to it, and the geometric normal
-        // turned to its side.
-        let n0 = gather_v::<L>(n, |i| xyz!(it[i].n[0]));
-        let n1 = gather_v::<L>(n, |i| xyz!(it[i].n[1]));
-        let n2 = gather_v::<L>(n, |i| xyz!(it[i].n[2]));
-        let nsum = n0.scale(b0).add(n1.scale(b1)).add(n2.scale(b2));
-        let nonzero = nsum.dot(nsum).gt(zero);
-        let ns = V3::select(L::and(shading, nonzero), nsum.normalize(), ng);
-        let ts = ns.cross(dpdu);
-        let ts2 = ts.dot(ts);
-        let ss = ts.cross(ns);
-        let ss = V3::select(shading, ss, dpdu);
-        let n_out = V3::select(shading, flip_if::<L>(ng.dot(ns).lt(zero), ng), ng);
-        // Lanes with normals whose tangent cross product vanishes, or whose
-        // derivatives the interaction would rescale, go to the scalar code.
-        let big = s(1e16);
-        let rare = L::or(L::not(ts2.gt(zero)), L::or(ss.dot(ss).gt(big), ts2.gt(big)));
-        let ok = L::not(L::and(shading, rare));
-
-        // The BSDF frame: x along the shading tangent, z the shading
-        // normal (`Frame::from_xz`).
-        let x = ss.normalize();
-        let y = ns.cross(x);
-
-        // The point as the interaction holds it (an interval, read back as
-        // its midpoint and half-width) and the ray origins offset off the
-        // surface to either side (`offset_ray_origin`).
-        let (lx, hx) = math::interval_from_value_and_error(p.x, p_error.x);
-        let (ly, hy) = math::interval_from_value_and_error(p.y, p_error.y);
-        let (lz, hz) = math::interval_from_value_and_error(p.z, p_error.z);
-        let two = s(2.0);
-        let mid = V3 {
-            x: lx.add(hx).div(two),
-            y: ly.add(hy).div(two),
-            z: lz.add(hz).div(two),
-        };
-        let err = V3 {
-            x: hx.sub(lx).div(two),
-            y: hy.sub(ly).div(two),
-            z: hz.sub(lz).div(two),
-        };
-        let offset = n_out.scale(abs_v(n_out).dot(err));
-        let back = V3 {
-            x: offset.x.neg(),
-            y: offset.y.neg(),
-            z: offset.z.neg(),
-        };
-        let side0 = round_off_v(mid.add(offset), offset);
-        let side1 = round_off_v(mid.add(back), back);
-
-        let okb = L::bits(ok);
-        let (lo, hi) = (
-            Stored3::new(V3 {
-                x: lx,
-                y: ly,
-                z: lz,
-            }),
-            Stored3::new(V3 {
-                x: hx,
-                y: hy,
-                z: hz,
-            }),
-        );
-        let mid = Stored3::new(mid);
-        let (side0, side1) = (Stored3::new(side0), Stored3::new(side1));
-        let (n_out, ns, wo) = (Stored3::new(n_out), Stored3::new(ns), Stored3::new(wo));
-        let (x, y) = (Stored3::new(x), Stored3::new(y));
-        for (i, o) in self.out.iter_mut().enumerate().take(n) {
-            let (l, h) = (lo.vector(i), hi.vector(i));
-            *o = SurfaceOut {
-                pi: Point3fi::new(
-                    Interval {
-                        low: l.x,
-                        high: h.x,
-                    },
-                    Interval {
-                        low: l.y,
-                        high: h.y,
-                    },
-                    Interval {
-                        low: l.z,
-                        high: h.z,
-                    },
-                ),
-                p: Point3f::from(mid.vector(i)),
-                sides: [
-                    Point3f::from(side0.vector(i)),
-                    Point3f::from(side1.vector(i)),
-                ],
-                n: n_out.normal(i),
-                ns: ns.normal(i),
-                wo: wo.vector(i),
-                x: x.vector(i),
-                y: y.vector(i),
-                ok: (okb >> i) & 1 != 0,
-            };
+        let mut k = 0;
+        while k < self.0.len {
+            surface_lanes::<L>(self.0, k);
+            k += L::N;
         }
     }
 }
 
-/// The surfaces of `items` into `out` (cleared first), at `level`'s width.
-pub(crate) fn surfaces(level: SimdLevel, items: &[SurfaceIn], out: &mut Vec<SurfaceOut>) {
-    out.clear();
-    out.resize(items.len(), SurfaceOut::default());
-    let width = level.lanes().max(1);
-    for (items, out) in items.chunks(width).zip(out.chunks_mut(width)) {
-        dispatch(level, Surfaces { items, out });
+/// The surface kernel on the slots from `k`, `L::N` of them.
+#[inline(always)]
+fn surface_lanes<L: F32Lanes>(v: &mut LaneVertices, k: usize) {
+    let n = (v.len - k).min(L::N);
+    let s = L::splat;
+    let zero = s(0.0);
+    let b0: L = v.load(col::B, k);
+    let b1: L = v.load(col::B + 1, k);
+    let b2: L = v.load(col::B + 2, k);
+    let p0 = v.load3::<L>(col::P, k);
+    let p1 = v.load3::<L>(col::P + 3, k);
+    let p2 = v.load3::<L>(col::P + 6, k);
+    let ng = v.load3::<L>(col::NG, k);
+    let dpdu = v.load3::<L>(col::DPDU, k);
+    let d = v.load3::<L>(col::D, k);
+    let shading = LaneVertices::mask::<L>(&v.shading, k, n);
+
+    // The point, its error bound and ωo (`Triangle::interaction`).
+    let (pb0, pb1, pb2) = (p0.scale(b0), p1.scale(b1), p2.scale(b2));
+    let p = pb0.add(pb1).add(pb2);
+    let p_error = abs_v(pb0)
+        .add(abs_v(pb1))
+        .add(abs_v(pb2))
+        .scale(s(gamma(7)));
+    let (wo, wo_ok) = neg_v(d).try_normalize();
+    let wo = V3::select(
+        wo_ok,
+        wo,
+        V3 {
+            x: zero,
+            y: zero,
+            z: zero,
+        },
+    );
+
+    // The shading geometry of meshes with vertex normals: the
+    // interpolated normal (the geometric one where it vanishes), the
+    // tangent ∂p/∂u made perpendicular to it, and the geometric normal
+    // turned to its side.
+    let n0 = v.load3::<L>(col::N, k);
+    let n1 = v.load3::<L>(col::N + 3, k);
+    let n2 = v.load3::<L>(col::N + 6, k);
+    let nsum = n0.scale(b0).add(n1.scale(b1)).add(n2.scale(b2));
+    let nonzero = nsum.dot(nsum).gt(zero);
+    let ns = V3::select(L::and(shading, nonzero), nsum.normalize(), ng);
+    let ts = ns.cross(dpdu);
+    let ts2 = ts.dot(ts);
+    let ss = ts.cross(ns);
+    let ss = V3::select(shading, ss, dpdu);
+    let n_out = V3::select(shading, flip_if::<L>(ng.dot(ns).lt(zero), ng), ng);
+    // Lanes with normals whose tangent cross product vanishes, or whose
+    // derivatives the interaction would rescale, go to the scalar code.
+    let big = s(1e16);
+    let rare = L::or(L::not(ts2.gt(zero)), L::or(ss.dot(ss).gt(big), ts2.gt(big)));
+    let ok = L::not(L::and(shading, rare));
+
+    // The BSDF frame: x along the shading tangent, z the shading normal
+    // (`Frame::from_xz`).
+    let x = ss.normalize();
+    let y = ns.cross(x);
+
+    // The point as the interaction holds it (an interval, read back as
+    // its midpoint and half-width) and the ray origins offset off the
+    // surface to either side (`offset_ray_origin`).
+    let (lx, hx) = math::interval_from_value_and_error(p.x, p_error.x);
+    let (ly, hy) = math::interval_from_value_and_error(p.y, p_error.y);
+    let (lz, hz) = math::interval_from_value_and_error(p.z, p_error.z);
+    let two = s(2.0);
+    let mid = V3 {
+        x: lx.add(hx).div(two),
+        y: ly.add(hy).div(two),
+        z: lz.add(hz).div(two),
+    };
+    let err = V3 {
+        x: hx.sub(lx).div(two),
+        y: hy.sub(ly).div(two),
+        z: hz.sub(lz).div(two),
+    };
+    let offset = n_out.scale(abs_v(n_out).dot(err));
+    let side0 = round_off_v(mid.add(offset), offset);
+    let back = neg_v(offset);
+    let side1 = round_off_v(mid.add(back), back);
+
+    v.store3(
+        col::LO,
+        k,
+        V3 {
+            x: lx,
+            y: ly,
+            z: lz,
+        },
+    );
+    v.store3(
+        col::HI,
+        k,
+        V3 {
+            x: hx,
+            y: hy,
+            z: hz,
+        },
+    );
+    v.store3(col::MID, k, mid);
+    v.store3(col::SIDE0, k, side0);
+    v.store3(col::SIDE1, k, side1);
+    v.store3(col::N_OUT, k, n_out);
+    v.store3(col::NS, k, ns);
+    v.store3(col::WO, k, wo);
+    v.store3(col::X, k, x);
+    v.store3(col::Y, k, y);
+    let okb = L::bits(ok);
+    for (i, o) in v.ok[k..k + n].iter_mut().enumerate() {
+        *o = (okb >> i) & 1 != 0;
     }
 }
 
-/// What [`scatters`] needs of one vertex.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct ScatterIn {
-    /// The BSDF frame (z: the shading normal).
-    frame: Frame,
-    /// ωo (normalized) toward the light sample; the ray's direction, whose
-    /// negation is ωo for the BSDF sample (as the scalar vertex has them).
-    wo: Vector3f,
-    d: Vector3f,
-    /// The light sample's direction (any, without a light sample: its
-    /// answers are then not read).
-    wi: Vector3f,
-    /// The reflectance and the BSDF sample's draws.
-    r: SampledSpectrum,
-    u2: Point2f,
-}
-
-impl ScatterIn {
-    /// The input of vertex `v`, reached along direction `d`, given its
-    /// light sample.
-    #[inline(always)]
-    pub(crate) fn new(v: &DiffuseVertex, d: Vector3f, light: Option<&LightAnswer>) -> Self {
-        ScatterIn {
-            frame: v.frame,
-            wo: v.wo,
-            d,
-            wi: light.map_or(Vector3f::default(), |a| a.ls.wi),
-            r: v.r,
-            u2: v.u2,
-        }
-    }
-}
-
-/// The BSDF's answers at one vertex.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct ScatterOut {
-    /// `bsdf.f(ωo, ωi) · |ωi · ns|` and `bsdf.pdf(ωo, ωi)` toward the
-    /// light sample.
-    pub f_light: SampledSpectrum,
-    pub pdf_light: Float,
-    /// The BSDF sample (`bsdf.sample_f`): its direction in rendering
-    /// space, its density, and `|ωi · ns| / pdf`; `None` where the scalar
-    /// method returns none.
-    pub sample: Option<(Vector3f, Float, Float)>,
+/// The surface kernel at `level`'s width over every slot taken: the hit
+/// point and its error bound, ωo, the interpolated shading normal, the
+/// shading tangents and the BSDF's frame.
+pub(crate) fn surfaces(level: SimdLevel, v: &mut LaneVertices) {
+    dispatch(level, Surfaces(v));
 }
 
 /// `v` in the frame of axes `x`, `y`, `z` (`Frame::to_local`). (A function,
@@ -621,10 +719,10 @@ fn to_local<L: F32Lanes>(x: V3<L>, y: V3<L>, z: V3<L>, v: V3<L>) -> V3<L> {
     }
 }
 
-/// [`scatters`] of at most one width's items.
+/// [`scatters`] as a kernel.
 struct Scatters<'a> {
-    items: &'a [ScatterIn],
-    out: &'a mut [ScatterOut],
+    v: &'a mut LaneVertices,
+    from_wo: bool,
 }
 
 impl Kernel for Scatters<'_> {
@@ -632,111 +730,95 @@ impl Kernel for Scatters<'_> {
 
     #[inline(always)]
     fn run<L: F32Lanes>(self) {
-        let it = self.items;
-        let n = it.len();
-        let s = L::splat;
-        let zero = s(0.0);
-        let fx = gather_v::<L>(n, |i| xyz!(it[i].frame.x));
-        let fy = gather_v::<L>(n, |i| xyz!(it[i].frame.y));
-        let fz = gather_v::<L>(n, |i| xyz!(it[i].frame.z));
-        let r = gather_s::<L>(n, |i| it[i].r);
-        let f = S4([
-            r.0[0].mul(s(INV_PI)),
-            r.0[1].mul(s(INV_PI)),
-            r.0[2].mul(s(INV_PI)),
-            r.0[3].mul(s(INV_PI)),
-        ]);
-
-        // Toward the light: `BSDF::f` (zero for a grazing ωo or across
-        // hemispheres) times the cosine, and `BSDF::pdf`.
-        let wo = to_local(fx, fy, fz, gather_v::<L>(n, |i| xyz!(it[i].wo)));
-        let wi_r = gather_v::<L>(n, |i| xyz!(it[i].wi));
-        let wi = to_local(fx, fy, fz, wi_r);
-        let same = L::and(wo.z.mul(wi.z).gt(zero), L::not(wo.z.eq(zero)));
-        let cos = wi_r.dot(fz).abs();
-        let f_light = [
-            L::select(same, f.0[0], zero).mul(cos),
-            L::select(same, f.0[1], zero).mul(cos),
-            L::select(same, f.0[2], zero).mul(cos),
-            L::select(same, f.0[3], zero).mul(cos),
-        ];
-        let pdf_light = L::select(same, wi.z.abs().mul(s(INV_PI)), zero);
-
-        // The sample: a cosine-weighted direction on ωo's side (the
-        // concentric disk lifted to the hemisphere).
-        let d = gather_v::<L>(n, |i| xyz!(it[i].d));
-        let wo_s = to_local(
-            fx,
-            fy,
-            fz,
-            V3 {
-                x: d.x.neg(),
-                y: d.y.neg(),
-                z: d.z.neg(),
-            },
-        );
-        let ux: L = gather_f(n, |i| it[i].u2.x);
-        let uy: L = gather_f(n, |i| it[i].u2.y);
-        let ox = s(2.0).mul(ux).sub(s(1.0));
-        let oy = s(2.0).mul(uy).sub(s(1.0));
-        let center = L::and(ox.eq(zero), oy.eq(zero));
-        let x_major = ox.abs().gt(oy.abs());
-        let radius = L::select(x_major, ox, oy);
-        let phi = s(PI_OVER_4).mul(L::select(x_major, oy.div(ox), ox.div(oy)));
-        // The library's sine and cosine, as the scalar sample takes them.
-        let mut sin = [0.0f32; MAX_LANES];
-        let mut cos_phi = [0.0f32; MAX_LANES];
-        let mut phis = [0.0f32; MAX_LANES];
-        phi.store(&mut phis);
-        for i in 0..n {
-            (sin[i], cos_phi[i]) = phis[i].sin_cos();
-        }
-        let (sin, cos_phi) = (L::load(&sin), L::load(&cos_phi));
-        let cos_t = L::select(x_major, cos_phi, sin);
-        let sin_t = L::select(x_major, sin, cos_phi);
-        let dx = L::select(center, zero, radius.mul(cos_t));
-        let dy = L::select(center, zero, radius.mul(sin_t));
-        let z = s(1.0).sub(dx.mul(dx)).sub(dy.mul(dy)).max(zero).sqrt();
-        let z = L::select(wo_s.z.lt(zero), z.neg(), z);
-        let pdf = z.abs().mul(s(INV_PI));
-        let sampled = L::and(
-            L::not(wo_s.z.eq(zero)),
-            L::and(L::not(pdf.eq(zero)), L::not(z.eq(zero))),
-        );
-        // Back to rendering space (`Frame::from_local`).
-        let wi_s = fx.scale(dx).add(fy.scale(dy)).add(fz.scale(z));
-        let cos_over_pdf = wi_s.dot(fz).abs().div(pdf);
-
-        let sb = L::bits(sampled);
-        let f_light = [
-            stored(f_light[0]),
-            stored(f_light[1]),
-            stored(f_light[2]),
-            stored(f_light[3]),
-        ];
-        let (pdf_light, pdf, cos_over_pdf) = (stored(pdf_light), stored(pdf), stored(cos_over_pdf));
-        let wi_s = Stored3::new(wi_s);
-        for (i, o) in self.out.iter_mut().enumerate().take(n) {
-            *o = ScatterOut {
-                f_light: SampledSpectrum {
-                    values: [f_light[0][i], f_light[1][i], f_light[2][i], f_light[3][i]],
-                },
-                pdf_light: pdf_light[i],
-                sample: ((sb >> i) & 1 != 0).then(|| (wi_s.vector(i), pdf[i], cos_over_pdf[i])),
-            };
+        let mut k = 0;
+        while k < self.v.len {
+            scatter_lanes::<L>(self.v, k, self.from_wo);
+            k += L::N;
         }
     }
 }
 
-/// The BSDF answers of `items` into `out` (cleared first), at `level`'s
-/// width.
-pub(crate) fn scatters(level: SimdLevel, items: &[ScatterIn], out: &mut Vec<ScatterOut>) {
-    out.clear();
-    out.resize(items.len(), ScatterOut::default());
-    let width = level.lanes().max(1);
-    for (items, out) in items.chunks(width).zip(out.chunks_mut(width)) {
-        dispatch(level, Scatters { items, out });
+/// The scatter kernel on the slots from `k`, `L::N` of them.
+#[inline(always)]
+fn scatter_lanes<L: F32Lanes>(v: &mut LaneVertices, k: usize, from_wo: bool) {
+    let n = (v.len - k).min(L::N);
+    let s = L::splat;
+    let zero = s(0.0);
+    let fx = v.load3::<L>(col::X, k);
+    let fy = v.load3::<L>(col::Y, k);
+    let fz = v.load3::<L>(col::NS, k);
+    let f: [L; 4] = std::array::from_fn(|w| v.load::<L>(col::R + w, k).mul(s(INV_PI)));
+
+    // Toward the light: `BSDF::f` (zero for a grazing ωo or across
+    // hemispheres) times the cosine, and `BSDF::pdf`.
+    let wo_r = v.load3::<L>(col::WO, k);
+    let wo = to_local(fx, fy, fz, wo_r);
+    let wi_r = v.load3::<L>(col::WI, k);
+    let wi = to_local(fx, fy, fz, wi_r);
+    let same = L::and(wo.z.mul(wi.z).gt(zero), L::not(wo.z.eq(zero)));
+    let cos = wi_r.dot(fz).abs();
+    for (w, &fw) in f.iter().enumerate() {
+        v.store(col::F_LIGHT + w, k, L::select(same, fw, zero).mul(cos));
     }
+    let pdf_light = L::select(same, wi.z.abs().mul(s(INV_PI)), zero);
+    v.store(col::PDF_LIGHT, k, pdf_light);
+
+    // The sample: a cosine-weighted direction on ωo's side (the
+    // concentric disk lifted to the hemisphere), from ωo itself or from
+    // the negated ray direction, as the integrator's scalar vertex takes
+    // it.
+    let wo_s = if from_wo {
+        wo
+    } else {
+        to_local(fx, fy, fz, neg_v(v.load3::<L>(col::D, k)))
+    };
+    let ux: L = v.load(col::U2, k);
+    let uy: L = v.load(col::U2 + 1, k);
+    let ox = s(2.0).mul(ux).sub(s(1.0));
+    let oy = s(2.0).mul(uy).sub(s(1.0));
+    let center = L::and(ox.eq(zero), oy.eq(zero));
+    let x_major = ox.abs().gt(oy.abs());
+    let radius = L::select(x_major, ox, oy);
+    let phi = s(PI_OVER_4).mul(L::select(x_major, oy.div(ox), ox.div(oy)));
+    // The library's sine and cosine, as the scalar sample takes them.
+    let mut sin = [0.0f32; MAX_LANES];
+    let mut cos_phi = [0.0f32; MAX_LANES];
+    let mut phis = [0.0f32; MAX_LANES];
+    phi.store(&mut phis);
+    for i in 0..n {
+        (sin[i], cos_phi[i]) = phis[i].sin_cos();
+    }
+    let (sin, cos_phi) = (L::load(&sin), L::load(&cos_phi));
+    let cos_t = L::select(x_major, cos_phi, sin);
+    let sin_t = L::select(x_major, sin, cos_phi);
+    let dx = L::select(center, zero, radius.mul(cos_t));
+    let dy = L::select(center, zero, radius.mul(sin_t));
+    let z = s(1.0).sub(dx.mul(dx)).sub(dy.mul(dy)).max(zero).sqrt();
+    let z = L::select(wo_s.z.lt(zero), z.neg(), z);
+    let pdf = z.abs().mul(s(INV_PI));
+    let sampled = L::and(
+        L::not(wo_s.z.eq(zero)),
+        L::and(L::not(pdf.eq(zero)), L::not(z.eq(zero))),
+    );
+    // Back to rendering space (`Frame::from_local`).
+    let wi_s = fx.scale(dx).add(fy.scale(dy)).add(fz.scale(z));
+    let cos_over_pdf = wi_s.dot(fz).abs().div(pdf);
+    v.store3(col::WI_S, k, wi_s);
+    v.store(col::PDF, k, pdf);
+    v.store(col::COS_OVER_PDF, k, cos_over_pdf);
+    let sb = L::bits(sampled);
+    for (i, o) in v.sampled[k..k + n].iter_mut().enumerate() {
+        *o = (sb >> i) & 1 != 0;
+    }
+}
+
+/// The scatter kernel at `level`'s width over every slot taken: the
+/// Lambertian BSDF's value and density toward the light sample, and its
+/// cosine-weighted sample of the next direction, from ωo (`from_wo`) or
+/// from the negated ray direction (pbrt-v4's `DiffuseBxDF` through
+/// `BSDF::f`, `BSDF::PDF` and `BSDF::Sample_f`).
+pub(crate) fn scatters(level: SimdLevel, v: &mut LaneVertices, from_wo: bool) {
+    dispatch(level, Scatters { v, from_wo });
 }
 
 #[cfg(test)]
@@ -813,22 +895,29 @@ mod tests {
                 material: None,
                 area_light: None,
             };
-            let mut input = SurfaceIn::default();
-            assert!(input.fill(&hit, d), "no shading tangents");
             let wi = vector(&mut rng, 1.0).normalize();
             let u2 = Point2f::new(rng.uniform_float(), rng.uniform_float());
             for level in SimdLevel::available() {
-                let mut out = Vec::new();
-                surfaces(level, &[input; 3], &mut out);
-                let s = out[1];
-                if !s.ok {
+                // Slots 0..3 with the same hit, so that slot 1 has
+                // neighbours in its vector; then slots of another vertex
+                // up to a whole vector and one more.
+                let mut v = LaneVertices::default();
+                for _ in 0..3 {
+                    assert!(v.push(&hit, d), "no shading tangents");
+                }
+                for _ in 3..17 {
+                    assert!(v.push(&hit, -d));
+                }
+                surfaces(level, &mut v);
+                if !v.ok(1) {
                     continue;
                 }
+                let s = v.surface_out(1);
                 taken += 1;
                 let bits = |v: Vector3f| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()];
                 assert_eq!(s.pi, si.pi, "{level:?} case {case}");
                 let pbits = |p: Point3f| [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
-                assert_eq!(pbits(s.p), pbits(si.p()));
+                assert_eq!(pbits(v.point(col::MID, 1)), pbits(si.p()));
                 for (k, w) in [Vector3f::from(si.n), -Vector3f::from(si.n)]
                     .into_iter()
                     .enumerate()
@@ -852,42 +941,54 @@ mod tests {
                     "{level:?} case {case}"
                 );
                 assert_eq!(bits(s.y), bits(bsdf.shading_frame.y));
+                let mut ctx = LightSampleContext::default();
+                v.write_context(1, &mut ctx);
+                assert_eq!(ctx.pi, si.pi);
 
-                let input = ScatterIn {
-                    frame: bsdf.shading_frame,
-                    wo: si.wo,
-                    d,
-                    wi,
-                    r,
-                    u2,
-                };
-                let mut out = Vec::new();
-                scatters(level, &[input; 5], &mut out);
-                let o = out[3];
-                let mode = TransportMode::Radiance;
-                let all = BxDFReflTransFlags::ALL;
-                let f = bsdf.f(si.wo, wi, mode) * abs_dot(wi, si.shading.n);
-                assert_eq!(o.f_light, f, "{level:?} case {case}");
-                let pdf = bsdf.pdf(si.wo, wi, mode, all);
-                assert_eq!(o.pdf_light.to_bits(), pdf.to_bits());
-                let bs = bsdf.sample_f(-d, 0.5, u2, mode, all);
-                match (o.sample, bs) {
-                    (Some((w, p, c)), Some(bs)) => {
-                        assert_eq!(bits(w), bits(bs.wi), "{level:?} case {case}");
-                        assert_eq!(p.to_bits(), bs.pdf.to_bits());
-                        let want = abs_dot(bs.wi, si.shading.n) / bs.pdf;
-                        assert_eq!(c.to_bits(), want.to_bits());
-                        assert_eq!(bs.f, r * INV_PI);
-                        sampled += 1;
+                // The scatter kernel, from the negated ray direction (the
+                // path tracer) and from ωo (the volumetric one: the same
+                // direction here, normalized).
+                for from_wo in [false, true] {
+                    for k in 0..v.len {
+                        let mut draws = Sampler::Independent(
+                            crate::sampler::IndependentSampler::new(1, k as i32),
+                        );
+                        v.begin(k, r, &mut draws);
+                        v.set_light_direction(k, wi);
                     }
-                    (None, None) => {}
-                    (got, want) => panic!("{level:?} case {case}: {got:?} against {want:?}"),
+                    // `begin` took the BSDF's draws from the sampler: set
+                    // this case's at slot 1.
+                    v.set(col::U2, 1, u2.x);
+                    v.set(col::U2 + 1, 1, u2.y);
+                    scatters(level, &mut v, from_wo);
+                    let mode = TransportMode::Radiance;
+                    let all = BxDFReflTransFlags::ALL;
+                    let f = bsdf.f(si.wo, wi, mode) * abs_dot(wi, si.shading.n);
+                    let (f_light, pdf_light) = v.light_answers(1);
+                    assert_eq!(f_light, f, "{level:?} case {case}");
+                    let pdf = bsdf.pdf(si.wo, wi, mode, all);
+                    assert_eq!(pdf_light.to_bits(), pdf.to_bits());
+                    assert_eq!(v.r(1), r);
+                    let wo = if from_wo { si.wo } else { -d };
+                    let bs = bsdf.sample_f(wo, 0.5, u2, mode, all);
+                    match (v.sample(1), bs) {
+                        (Some((w, p, c)), Some(bs)) => {
+                            assert_eq!(bits(w), bits(bs.wi), "{level:?} case {case}");
+                            assert_eq!(p.to_bits(), bs.pdf.to_bits());
+                            let want = abs_dot(bs.wi, si.shading.n) / bs.pdf;
+                            assert_eq!(c.to_bits(), want.to_bits());
+                            assert_eq!(bs.f, r * INV_PI);
+                            sampled += 1;
+                        }
+                        (None, None) => {}
+                        (got, want) => panic!("{level:?} case {case}: {got:?} against {want:?}"),
+                    }
                 }
                 compared += 1;
             }
         }
         let levels = SimdLevel::available().len();
         assert!(taken > 2900 * levels, "{taken}");
-        assert!(compared == taken && sampled > 2500 * levels, "{sampled}");
+        assert!(compared == taken && sampled > 5000 * levels, "{sampled}");
     }
 }

@@ -3,9 +3,7 @@
 //! optional BSDF regularization.
 
 use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
-use super::diffuse_lanes::{
-    lane_surface, DiffuseVertex, LaneShade, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut,
-};
+use super::diffuse_lanes::{lane_surface, LaneShade, LaneVertices, SurfaceOut};
 use super::direct::{light_request, light_shadow_query, LightAnswer, LightRequest, ShadowQuery};
 use super::vertex::{li_by_vertices, Begin, VertexIntegrator, VertexStep};
 use super::{skip_intersection, RayIntegrator, Scene, VertexOrigins};
@@ -102,8 +100,6 @@ pub(crate) struct SurfaceScratch {
     u: Float,
     u2: Point2f,
     answers: BsdfAnswers,
-    /// A vertex the wavefront takes in lanes (`diffuse_lanes.rs`).
-    diffuse: DiffuseVertex,
 }
 
 impl VertexIntegrator for PathIntegrator {
@@ -290,7 +286,7 @@ impl VertexIntegrator for PathIntegrator {
         record: &HitRecord,
         lambda: &SampledWavelengths,
         gbuffer: bool,
-        out: &mut SurfaceIn,
+        out: &mut LaneVertices,
     ) -> Option<LaneShade> {
         // The vertices `begin` ends (the last one) or that draw or write
         // more than a lane vertex does are left to it; so are specular
@@ -336,29 +332,21 @@ impl VertexIntegrator for PathIntegrator {
 
     /// `begin`'s steps for a diffuse vertex: the depth, the sampler draws,
     /// the light request (the surface kernel built the interaction and the
-    /// BSDF's frame).
+    /// BSDF's frame at slot `k`).
     #[inline(always)]
     fn diffuse_begin(
         &self,
         s: &mut PathState,
         scratch: &mut SurfaceScratch,
-        surface: &SurfaceOut,
+        lanes: &mut LaneVertices,
+        k: usize,
         r: SampledSpectrum,
         sampler: &mut Sampler,
     ) -> LightRequest {
         s.depth += 1;
         scratch.hit = None;
         scratch.bsdf = None;
-        scratch.diffuse.begin(surface, s.ray.ray.time, r, sampler)
-    }
-
-    #[inline(always)]
-    fn scatter_in(
-        s: &PathState,
-        scratch: &SurfaceScratch,
-        light: Option<&LightAnswer>,
-    ) -> ScatterIn {
-        ScatterIn::new(&scratch.diffuse, s.ray.ray.d, light)
+        lanes.begin(k, r, sampler)
     }
 
     /// `finish` for a diffuse vertex, given the BSDF's answers.
@@ -367,25 +355,25 @@ impl VertexIntegrator for PathIntegrator {
         &self,
         scene: &Scene,
         s: &mut PathState,
-        scratch: &mut SurfaceScratch,
-        scatter: &ScatterOut,
+        lanes: &LaneVertices,
+        k: usize,
         light: Option<&LightAnswer>,
         sampler: &mut Sampler,
     ) -> VertexStep {
-        let v = &mut scratch.diffuse;
+        let time = s.ray.ray.time;
         // `light_shadow_query`.
         let shadow = light.and_then(|a| {
-            let f = scatter.f_light;
+            let (f, pdf_light) = lanes.light_answers(k);
             if f.is_black() {
                 return None;
             }
             let ls = &a.ls;
-            let (ray, t_max) = v.shadow_ray(ls.p_light, ls.n_light);
+            let (ray, t_max) = lanes.shadow_ray(k, time, ls.p_light, ls.n_light);
             let p_l = a.p * ls.pdf;
             let ld = if scene.lights[a.light as usize].light_type().is_delta() {
                 ls.l * f / p_l
             } else {
-                let w_l = power_heuristic(1.0, p_l, 1.0, scatter.pdf_light);
+                let w_l = power_heuristic(1.0, p_l, 1.0, pdf_light);
                 ls.l * f * (w_l / p_l)
             };
             Some(ShadowQuery {
@@ -394,11 +382,11 @@ impl VertexIntegrator for PathIntegrator {
                 ld: s.beta * ld,
             })
         });
-        v.write_context(&mut s.prev_ctx);
-        let Some((wi, pdf, cos_over_pdf)) = scatter.sample else {
+        lanes.write_context(k, &mut s.prev_ctx);
+        let Some((wi, pdf, cos_over_pdf)) = lanes.sample(k) else {
             return VertexStep { shadow, done: true };
         };
-        let f = v.r * INV_PI;
+        let f = lanes.r(k) * INV_PI;
         if f.is_black() {
             return VertexStep { shadow, done: true };
         }
@@ -406,7 +394,7 @@ impl VertexIntegrator for PathIntegrator {
         s.p_b = pdf;
         s.specular_bounce = false;
         s.any_non_specular = true;
-        s.ray = RayDifferential::new(v.spawn_ray(wi));
+        s.ray = RayDifferential::new(lanes.spawn_ray(k, wi, time));
         russian_roulette(s, sampler, shadow)
     }
 }

@@ -7,7 +7,7 @@
 //! the same pixels.
 
 use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
-use super::diffuse_lanes::{LaneShade, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut};
+use super::diffuse_lanes::{LaneShade, LaneVertices, SurfaceOut};
 use super::direct::{answer_light, LightAnswer, LightRequest, ShadowQuery};
 use super::Scene;
 use crate::bxdf::DielectricBxDF;
@@ -113,9 +113,10 @@ pub(crate) trait VertexIntegrator: Sync {
 
     /// The lane forms of a vertex (`diffuse_lanes.rs`), for the
     /// wavefront: for a hit `record` of the path in state `s` that a lane
-    /// form covers, what it shades with, the surface kernel's input written
-    /// to `out`; `None` (the default) where the scalar vertex runs.
-    /// `gbuffer`: the film records the first visible surface.
+    /// form covers, what it shades with, the surface kernel's input
+    /// taking the next slot of `out`; `None` (the default) where the
+    /// scalar vertex runs. `gbuffer`: the film records the first visible
+    /// surface.
     fn lane_hit(
         &self,
         _scene: &Scene,
@@ -123,7 +124,7 @@ pub(crate) trait VertexIntegrator: Sync {
         _record: &HitRecord,
         _lambda: &SampledWavelengths,
         _gbuffer: bool,
-        _out: &mut SurfaceIn,
+        _out: &mut LaneVertices,
     ) -> Option<LaneShade> {
         None
     }
@@ -142,38 +143,33 @@ pub(crate) trait VertexIntegrator: Sync {
         unreachable!("specular_step without lane_hit")
     }
 
+    /// The diffuse vertex's BSDF sample leaves from ωo (true) or from the
+    /// negated ray direction (false), as the scalar vertex samples it.
+    const DIFFUSE_SAMPLE_FROM_WO: bool = false;
+
     /// The first half of a vertex that [`VertexIntegrator::lane_hit`]
-    /// took as [`LaneShade::Diffuse`], given its surface and reflectance:
-    /// its light request.
+    /// took as [`LaneShade::Diffuse`], at slot `k` of `lanes` after the
+    /// surface kernel, given its reflectance: its light request.
     fn diffuse_begin(
         &self,
         _s: &mut Self::State,
         _scratch: &mut Self::Scratch,
-        _surface: &SurfaceOut,
+        _lanes: &mut LaneVertices,
+        _k: usize,
         _r: SampledSpectrum,
         _sampler: &mut Sampler,
     ) -> LightRequest {
         unreachable!("diffuse_begin without lane_hit")
     }
 
-    /// The scatter kernel's input for such a vertex, given the answer to
-    /// its light request.
-    fn scatter_in(
-        _s: &Self::State,
-        _scratch: &Self::Scratch,
-        _light: Option<&LightAnswer>,
-    ) -> ScatterIn {
-        unreachable!("scatter_in without lane_hit")
-    }
-
-    /// The second half of such a vertex, given the scatter kernel's
-    /// answers.
+    /// The second half of such a vertex, after the scatter kernel, given
+    /// the answer to its light request.
     fn diffuse_finish(
         &self,
         _scene: &Scene,
         _s: &mut Self::State,
-        _scratch: &mut Self::Scratch,
-        _scatter: &ScatterOut,
+        _lanes: &LaneVertices,
+        _k: usize,
         _light: Option<&LightAnswer>,
         _sampler: &mut Sampler,
     ) -> VertexStep {

@@ -5,9 +5,7 @@
 //! emission, and subsurface scattering through the materials' BSSRDFs.
 
 use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
-use super::diffuse_lanes::{
-    lane_surface, DiffuseVertex, LaneShade, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut,
-};
+use super::diffuse_lanes::{lane_surface, LaneShade, LaneVertices, SurfaceOut};
 use super::direct::ShadowQuery;
 use super::direct::{light_request, LightAnswer, LightRequest};
 use super::direct::{light_sample_culled, surface_light_context};
@@ -567,7 +565,7 @@ impl VertexIntegrator for VolPathIntegrator {
         record: &HitRecord,
         lambda: &SampledWavelengths,
         gbuffer: bool,
-        out: &mut SurfaceIn,
+        out: &mut LaneVertices,
     ) -> Option<LaneShade> {
         // Only where `begin` asks for the light sample (no media, no
         // interfaces: the ray's medium is none and stays none), and not
@@ -622,30 +620,24 @@ impl VertexIntegrator for VolPathIntegrator {
         russian_roulette(s, sampler, None)
     }
 
+    // The BSDF sample leaves from ωo itself here (the path tracer negates
+    // the ray's direction).
+    const DIFFUSE_SAMPLE_FROM_WO: bool = true;
+
     #[inline(always)]
     fn diffuse_begin(
         &self,
         s: &mut VolPathState,
         scratch: &mut VolPathScratch,
-        surface: &SurfaceOut,
+        lanes: &mut LaneVertices,
+        k: usize,
         r: SampledSpectrum,
         sampler: &mut Sampler,
     ) -> LightRequest {
         s.depth += 1;
         scratch.hit = None;
         scratch.bsdf = None;
-        scratch.diffuse.begin(surface, s.ray.ray.time, r, sampler)
-    }
-
-    #[inline(always)]
-    fn scatter_in(
-        _s: &VolPathState,
-        scratch: &VolPathScratch,
-        light: Option<&LightAnswer>,
-    ) -> ScatterIn {
-        // The BSDF sample leaves from ωo itself here (the path tracer
-        // negates the ray's direction).
-        ScatterIn::new(&scratch.diffuse, -scratch.diffuse.wo, light)
+        lanes.begin(k, r, sampler)
     }
 
     /// `finish` for a diffuse vertex, given the BSDF's answers.
@@ -654,28 +646,28 @@ impl VertexIntegrator for VolPathIntegrator {
         &self,
         scene: &Scene,
         s: &mut VolPathState,
-        scratch: &mut VolPathScratch,
-        scatter: &ScatterOut,
+        lanes: &LaneVertices,
+        k: usize,
         light: Option<&LightAnswer>,
         sampler: &mut Sampler,
     ) -> VertexStep {
-        let v = &mut scratch.diffuse;
+        let time = s.ray.ray.time;
         // `surface_shadow_query`.
         let shadow = light.and_then(|a| {
-            let f_hat = scatter.f_light;
+            let (f_hat, pdf_light) = lanes.light_answers(k);
             if f_hat.is_black() {
                 return None;
             }
-            let (ray, t_max) = v.shadow_ray(a.ls.p_light, a.ls.n_light);
-            let ld = unoccluded_ld(scene, a, s, f_hat, scatter.pdf_light);
+            let (ray, t_max) = lanes.shadow_ray(k, time, a.ls.p_light, a.ls.n_light);
+            let ld = unoccluded_ld(scene, a, s, f_hat, pdf_light);
             Some(ShadowQuery { ray, t_max, ld })
         });
         let done = VertexStep { shadow, done: true };
-        v.write_context(&mut s.prev_ctx);
-        let Some((wi, pdf, cos_over_pdf)) = scatter.sample else {
+        lanes.write_context(k, &mut s.prev_ctx);
+        let Some((wi, pdf, cos_over_pdf)) = lanes.sample(k) else {
             return done;
         };
-        let f = v.r * INV_PI;
+        let f = lanes.r(k) * INV_PI;
         if f.is_black() {
             return done;
         }
@@ -684,7 +676,7 @@ impl VertexIntegrator for VolPathIntegrator {
         s.specular_bounce = false;
         s.any_non_specular = true;
         // Without media the next ray's medium is none, as the hit's.
-        s.ray = RayDifferential::new(v.spawn_ray(wi));
+        s.ray = RayDifferential::new(lanes.spawn_ray(k, wi, time));
         russian_roulette(s, sampler, shadow)
     }
 }
@@ -814,8 +806,6 @@ pub(crate) struct VolPathScratch {
     u2: Point2f,
     ray_medium: Option<MediumId>,
     answers: BsdfAnswers,
-    /// A vertex the wavefront takes in lanes (`diffuse_lanes.rs`).
-    diffuse: DiffuseVertex,
 }
 
 impl VolPathIntegrator {

@@ -47,9 +47,7 @@
 
 use super::bsdf_stage::{answer_bsdfs, BsdfAnswers, BsdfBatch, BsdfQuery};
 use super::camera_samples::{differential_scale, CameraBatch, CameraDraws, CameraRaySample};
-use super::diffuse_lanes::{
-    scatters, surfaces, LaneShade, ScatterIn, ScatterOut, SurfaceIn, SurfaceOut,
-};
+use super::diffuse_lanes::{scatters, surfaces, LaneShade, LaneVertices, LANE_SLOTS};
 use super::direct::{answer_lights, LightAnswer, LightBatch, LightRequest};
 use super::render::RenderOptions;
 use super::stages::{Stage, StageClock};
@@ -71,6 +69,7 @@ use std::ops::Range;
 /// slower on the killeroo scene at 64 spp, whose coated lane groups thin
 /// out.)
 const LANES: usize = 256;
+const _: () = assert!(LANES <= LANE_SLOTS, "a pass's lane vertices need a slot each");
 
 /// Finished samples the reorder buffer holds ahead of the oldest path
 /// still in flight (a power of two). A path can start only when its
@@ -244,12 +243,10 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let mut next_draws: Vec<Option<Float>> = Vec::with_capacity(LANES);
         let mut predrawn_next: Vec<Option<Float>> = Vec::new();
         let mut diffuse: Vec<usize> = Vec::with_capacity(LANES);
-        let mut surface_in: Vec<SurfaceIn> = Vec::with_capacity(LANES);
         let mut shades: Vec<LaneShade> = Vec::with_capacity(LANES);
-        let mut surface_out: Vec<SurfaceOut> = Vec::with_capacity(LANES);
+        // The lane vertices' columns, by slot (`diffuse_slot`: a lane's).
+        let mut vertices = LaneVertices::default();
         let mut diffuse_slot: Vec<usize> = Vec::new();
-        let mut scatter_in: Vec<ScatterIn> = Vec::with_capacity(LANES);
-        let mut scatter_out: Vec<ScatterOut> = Vec::with_capacity(LANES);
         let mut camera_batch = CameraBatch::new(scene);
         let mut camera_draws: Vec<(Point2i, CameraDraws)> = Vec::with_capacity(LANES);
         let mut camera_samples: Vec<CameraRaySample> = Vec::with_capacity(LANES);
@@ -396,7 +393,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             // The diffuse and specular vertices' surfaces, lane-parallel
             // (lanes the surface kernel leaves take the scalar vertex).
             diffuse.clear();
-            surface_in.clear();
+            vertices.clear();
             shades.clear();
             // Their meshes' indices, then vertices, requested for all
             // paths before any is read (large meshes miss the cache).
@@ -410,30 +407,22 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             for &i in &shade {
                 let lane = &lanes[i];
                 let Some(h) = &hits[i] else { continue };
-                // Written in place (see `SurfaceIn::fill`); a slot not
-                // taken is written over by the next.
-                let k = diffuse.len();
-                if surface_in.len() == k {
-                    surface_in.push(SurfaceIn::default());
-                }
-                let out = &mut surface_in[k];
                 if let Some(shade) =
                     self.0
-                        .lane_hit(scene, &lane.path, h, &lane.lambda, gbuffer, out)
+                        .lane_hit(scene, &lane.path, h, &lane.lambda, gbuffer, &mut vertices)
                 {
                     diffuse.push(i);
                     shades.push(shade);
                 }
             }
-            surface_in.truncate(diffuse.len());
-            surfaces(level, &surface_in, &mut surface_out);
+            surfaces(level, &mut vertices);
             diffuse_slot.resize(lanes.len(), 0);
             for &i in &active {
                 lanes[i].diffuse = false;
                 lanes[i].specular = false;
             }
             for (k, &i) in diffuse.iter().enumerate() {
-                if surface_out[k].ok {
+                if vertices.ok(k) {
                     match shades[k] {
                         LaneShade::Diffuse(_) => lanes[i].diffuse = true,
                         LaneShade::Specular(_) => lanes[i].specular = true,
@@ -451,14 +440,15 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     Some(LaneShade::Diffuse(r)) => Begin::Light(self.0.diffuse_begin(
                         &mut lane.path,
                         &mut scratch[i],
-                        &surface_out[k],
+                        &mut vertices,
+                        k,
                         r,
                         sampler,
                     )),
                     Some(LaneShade::Specular(b)) => Begin::Step(self.0.specular_step(
                         &mut lane.path,
                         &mut scratch[i],
-                        &surface_out[k],
+                        &vertices.surface_out(k),
                         b,
                         sampler,
                     )),
@@ -526,39 +516,39 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
 
             clock.enter(Stage::Scatters);
             // The diffuse vertices' BSDF values and samples, lane-parallel.
-            scatter_in.clear();
             for (&i, a) in request_lanes.iter().zip(&answers) {
                 if lanes[i].diffuse {
-                    scatter_in.push(I::scatter_in(&lanes[i].path, &scratch[i], a.as_ref()));
+                    let wi = a.as_ref().map_or(Vector3f::default(), |a| a.ls.wi);
+                    vertices.set_light_direction(diffuse_slot[i], wi);
                 }
             }
-            scatters(level, &scatter_in, &mut scatter_out);
+            scatters(level, &mut vertices, I::DIFFUSE_SAMPLE_FROM_WO);
 
             clock.enter(Stage::Finish);
             // Shade, second half: the light samples' shadow queries and the
             // next rays.
-            let mut scattered = scatter_out.iter();
             for (&i, answer) in request_lanes.iter().zip(&answers) {
                 let lane = &mut lanes[i];
                 sampler.set_cursor(&lane.cursor);
                 sampler.offer_1d(predrawn_next[i]);
-                let step = match lane.diffuse.then(|| scattered.next()).flatten() {
-                    Some(out) => self.0.diffuse_finish(
+                let step = if lane.diffuse {
+                    self.0.diffuse_finish(
                         scene,
                         &mut lane.path,
-                        &mut scratch[i],
-                        out,
+                        &vertices,
+                        diffuse_slot[i],
                         answer.as_ref(),
                         sampler,
-                    ),
-                    None => self.0.finish(
+                    )
+                } else {
+                    self.0.finish(
                         scene,
                         &mut lane.path,
                         &mut lane.lambda,
                         sampler,
                         &mut scratch[i],
                         answer.as_ref(),
-                    ),
+                    )
                 };
                 lane.cursor = sampler.cursor();
                 lane.done = step.done;
