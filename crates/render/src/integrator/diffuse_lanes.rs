@@ -356,16 +356,17 @@ impl LaneVertices {
     }
 
     /// The first half of the diffuse vertex at slot `k` (after the
-    /// integrator has counted it), of reflectance `r`: its sampler draws
-    /// taken (the BSDF's kept for the scatter kernel), its light request.
+    /// integrator has counted it), of reflectance `r`, given its sampler
+    /// draws (`Sampler::get_vertex_samples`; the BSDF's are kept for the
+    /// scatter kernel): its light request.
     #[inline(always)]
     pub(crate) fn begin(
         &mut self,
         k: usize,
         r: SampledSpectrum,
-        sampler: &mut Sampler,
+        draws: (Float, Point2f, Float, Point2f),
     ) -> LightRequest {
-        let (u_light, u_light_2d, _, u2) = sampler.get_vertex_samples();
+        let (u_light, u_light_2d, _, u2) = draws;
         for (w, &v) in r.values.iter().enumerate() {
             self.set(col::R + w, k, v);
         }
@@ -950,16 +951,11 @@ mod tests {
                 // direction here, normalized).
                 for from_wo in [false, true] {
                     for k in 0..v.len {
-                        let mut draws = Sampler::Independent(
-                            crate::sampler::IndependentSampler::new(1, k as i32),
-                        );
-                        v.begin(k, r, &mut draws);
+                        let u = Point2f::new(0.5, 0.5);
+                        let u2 = if k == 1 { u2 } else { u };
+                        v.begin(k, r, (0.5, u, 0.5, u2));
                         v.set_light_direction(k, wi);
                     }
-                    // `begin` took the BSDF's draws from the sampler: set
-                    // this case's at slot 1.
-                    v.set(col::U2, 1, u2.x);
-                    v.set(col::U2 + 1, 1, u2.y);
                     scatters(level, &mut v, from_wo);
                     let mode = TransportMode::Radiance;
                     let all = BxDFReflTransFlags::ALL;

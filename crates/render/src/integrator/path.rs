@@ -275,7 +275,7 @@ impl VertexIntegrator for PathIntegrator {
             s.eta_scale *= bs.eta * bs.eta;
         }
         s.ray = RayDifferential::new(origins.spawn_ray(bs.wi));
-        russian_roulette(s, sampler, shadow)
+        russian_roulette(s, || sampler.get_1d(), shadow)
     }
 
     #[inline(always)]
@@ -327,7 +327,7 @@ impl VertexIntegrator for PathIntegrator {
             s.eta_scale *= bs.eta * bs.eta;
         }
         s.ray = RayDifferential::new(next);
-        russian_roulette(s, sampler, None)
+        russian_roulette(s, || sampler.get_1d(), None)
     }
 
     /// `begin`'s steps for a diffuse vertex: the depth, the sampler draws,
@@ -341,12 +341,12 @@ impl VertexIntegrator for PathIntegrator {
         lanes: &mut LaneVertices,
         k: usize,
         r: SampledSpectrum,
-        sampler: &mut Sampler,
+        draws: (Float, Point2f, Float, Point2f),
     ) -> LightRequest {
         s.depth += 1;
         scratch.hit = None;
         scratch.bsdf = None;
-        lanes.begin(k, r, sampler)
+        lanes.begin(k, r, draws)
     }
 
     /// `finish` for a diffuse vertex, given the BSDF's answers.
@@ -358,7 +358,7 @@ impl VertexIntegrator for PathIntegrator {
         lanes: &LaneVertices,
         k: usize,
         light: Option<&LightAnswer>,
-        sampler: &mut Sampler,
+        draw: impl FnOnce() -> Float,
     ) -> VertexStep {
         let time = s.ray.ray.time;
         // `light_shadow_query`.
@@ -395,23 +395,24 @@ impl VertexIntegrator for PathIntegrator {
         s.specular_bounce = false;
         s.any_non_specular = true;
         s.ray = RayDifferential::new(lanes.spawn_ray(k, wi, time));
-        russian_roulette(s, sampler, shadow)
+        russian_roulette(s, draw, shadow)
     }
 }
 
 /// The end of a vertex: Russian roulette on the throughput (without the
-/// refraction scale), then the path ends where it is black.
+/// refraction scale; `draw` gives the vertex's next 1-D draw, taken only
+/// where the roulette runs), then the path ends where it is black.
 #[inline(always)]
 fn russian_roulette(
     s: &mut PathState,
-    sampler: &mut Sampler,
+    draw: impl FnOnce() -> Float,
     shadow: Option<ShadowQuery>,
 ) -> VertexStep {
     let rr_beta = s.beta * s.eta_scale;
     let m = rr_beta.max_component_value();
     if m < 1.0 && s.depth > 1 {
         let q = (1.0 - m).max(0.0);
-        if sampler.get_1d() < q {
+        if draw() < q {
             return VertexStep { shadow, done: true };
         }
         s.beta /= 1.0 - q;

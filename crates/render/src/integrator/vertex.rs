@@ -17,6 +17,7 @@ use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::ray::{Ray, RayDifferential};
+use rpbrt_geometry::tuple::Point2f;
 
 /// What a path vertex leaves to the caller: a shadow ray whose
 /// contribution counts if nothing blocks it, and whether the path ends
@@ -149,7 +150,8 @@ pub(crate) trait VertexIntegrator: Sync {
 
     /// The first half of a vertex that [`VertexIntegrator::lane_hit`]
     /// took as [`LaneShade::Diffuse`], at slot `k` of `lanes` after the
-    /// surface kernel, given its reflectance: its light request.
+    /// surface kernel, given its reflectance and its four sampler draws
+    /// ([`Sampler::get_vertex_samples`]): its light request.
     fn diffuse_begin(
         &self,
         _s: &mut Self::State,
@@ -157,13 +159,14 @@ pub(crate) trait VertexIntegrator: Sync {
         _lanes: &mut LaneVertices,
         _k: usize,
         _r: SampledSpectrum,
-        _sampler: &mut Sampler,
+        _draws: (Float, Point2f, Float, Point2f),
     ) -> LightRequest {
         unreachable!("diffuse_begin without lane_hit")
     }
 
     /// The second half of such a vertex, after the scatter kernel, given
-    /// the answer to its light request.
+    /// the answer to its light request; `draw` gives its next 1-D sampler
+    /// draw, called where the vertex draws (Russian roulette).
     fn diffuse_finish(
         &self,
         _scene: &Scene,
@@ -171,7 +174,7 @@ pub(crate) trait VertexIntegrator: Sync {
         _lanes: &LaneVertices,
         _k: usize,
         _light: Option<&LightAnswer>,
-        _sampler: &mut Sampler,
+        _draw: impl FnOnce() -> Float,
     ) -> VertexStep {
         unreachable!("diffuse_finish without lane_hit")
     }

@@ -554,7 +554,7 @@ impl VertexIntegrator for VolPathIntegrator {
             }
         }
 
-        russian_roulette(s, sampler, done.shadow)
+        russian_roulette(s, || sampler.get_1d(), done.shadow)
     }
 
     #[inline(always)]
@@ -617,7 +617,7 @@ impl VertexIntegrator for VolPathIntegrator {
         }
         // Without media or interfaces the next ray's medium stays none.
         s.ray = RayDifferential::new(next);
-        russian_roulette(s, sampler, None)
+        russian_roulette(s, || sampler.get_1d(), None)
     }
 
     // The BSDF sample leaves from ωo itself here (the path tracer negates
@@ -632,12 +632,12 @@ impl VertexIntegrator for VolPathIntegrator {
         lanes: &mut LaneVertices,
         k: usize,
         r: SampledSpectrum,
-        sampler: &mut Sampler,
+        draws: (Float, Point2f, Float, Point2f),
     ) -> LightRequest {
         s.depth += 1;
         scratch.hit = None;
         scratch.bsdf = None;
-        lanes.begin(k, r, sampler)
+        lanes.begin(k, r, draws)
     }
 
     /// `finish` for a diffuse vertex, given the BSDF's answers.
@@ -649,7 +649,7 @@ impl VertexIntegrator for VolPathIntegrator {
         lanes: &LaneVertices,
         k: usize,
         light: Option<&LightAnswer>,
-        sampler: &mut Sampler,
+        draw: impl FnOnce() -> Float,
     ) -> VertexStep {
         let time = s.ray.ray.time;
         // `surface_shadow_query`.
@@ -677,17 +677,18 @@ impl VertexIntegrator for VolPathIntegrator {
         s.any_non_specular = true;
         // Without media the next ray's medium is none, as the hit's.
         s.ray = RayDifferential::new(lanes.spawn_ray(k, wi, time));
-        russian_roulette(s, sampler, shadow)
+        russian_roulette(s, draw, shadow)
     }
 }
 
 /// The end of a surface vertex: Russian roulette on the throughput
 /// (without the refraction scale and the path's probability), after its
-/// draw; the path ends where the throughput is black.
+/// draw (`draw`, the vertex's next 1-D draw); the path ends where the
+/// throughput is black.
 #[inline(always)]
 fn russian_roulette(
     s: &mut VolPathState,
-    sampler: &mut Sampler,
+    draw: impl FnOnce() -> Float,
     shadow: Option<ShadowQuery>,
 ) -> VertexStep {
     let done = VertexStep { shadow, done: true };
@@ -695,7 +696,7 @@ fn russian_roulette(
         return done;
     }
     let rr_beta = s.beta * s.eta_scale / s.r_u.average();
-    let u_rr = sampler.get_1d();
+    let u_rr = draw();
     let m = rr_beta.max_component_value();
     if m < 1.0 && s.depth > 1 {
         let q = (1.0 - m).max(0.0);

@@ -69,7 +69,10 @@ use std::ops::Range;
 /// slower on the killeroo scene at 64 spp, whose coated lane groups thin
 /// out.)
 const LANES: usize = 256;
-const _: () = assert!(LANES <= LANE_SLOTS, "a pass's lane vertices need a slot each");
+const _: () = assert!(
+    LANES <= LANE_SLOTS,
+    "a pass's lane vertices need a slot each"
+);
 
 /// Finished samples the reorder buffer holds ahead of the oldest path
 /// still in flight (a power of two). A path can start only when its
@@ -433,18 +436,35 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             clock.enter(Stage::Begin);
             for &i in &active {
                 let lane = &mut lanes[i];
-                sampler.set_cursor(&lane.cursor);
-                sampler.offer_four_draws(predrawn[i]);
                 let k = diffuse_slot[i];
-                let begun = match (lane.diffuse || lane.specular).then(|| shades[k]) {
-                    Some(LaneShade::Diffuse(r)) => Begin::Light(self.0.diffuse_begin(
+                let shade = (lane.diffuse || lane.specular).then(|| shades[k]);
+                lane.camera = false;
+                if let Some(LaneShade::Diffuse(r)) = shade {
+                    // The draws computed ahead are taken at the lane's
+                    // cursor without the sampler.
+                    let draws = match predrawn[i] {
+                        Some(d) => lane.cursor.take_four_draws(d),
+                        None => {
+                            sampler.set_cursor(&lane.cursor);
+                            let draws = sampler.get_vertex_samples();
+                            lane.cursor = sampler.cursor();
+                            draws
+                        }
+                    };
+                    requests.push(self.0.diffuse_begin(
                         &mut lane.path,
                         &mut scratch[i],
                         &mut vertices,
                         k,
                         r,
-                        sampler,
-                    )),
+                        draws,
+                    ));
+                    request_lanes.push(i);
+                    continue;
+                }
+                sampler.set_cursor(&lane.cursor);
+                sampler.offer_four_draws(predrawn[i]);
+                let begun = match shade {
                     Some(LaneShade::Specular(b)) => Begin::Step(self.0.specular_step(
                         &mut lane.path,
                         &mut scratch[i],
@@ -452,7 +472,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                         b,
                         sampler,
                     )),
-                    None => self.0.begin(
+                    _ => self.0.begin(
                         scene,
                         &mut lane.path,
                         hits[i],
@@ -463,7 +483,6 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     ),
                 };
                 lane.cursor = sampler.cursor();
-                lane.camera = false;
                 match begun {
                     Begin::Step(step) => {
                         lane.done = step.done;
@@ -529,28 +548,42 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             // next rays.
             for (&i, answer) in request_lanes.iter().zip(&answers) {
                 let lane = &mut lanes[i];
-                sampler.set_cursor(&lane.cursor);
-                sampler.offer_1d(predrawn_next[i]);
                 let step = if lane.diffuse {
+                    // The Russian roulette draw, where computed ahead,
+                    // taken at the lane's cursor without the sampler.
+                    let cursor = &mut lane.cursor;
+                    let next = predrawn_next[i];
+                    let sampler = &mut *sampler;
                     self.0.diffuse_finish(
                         scene,
                         &mut lane.path,
                         &vertices,
                         diffuse_slot[i],
                         answer.as_ref(),
-                        sampler,
+                        || match next {
+                            Some(v) => cursor.take_1d(v),
+                            None => {
+                                sampler.set_cursor(cursor);
+                                let v = sampler.get_1d();
+                                *cursor = sampler.cursor();
+                                v
+                            }
+                        },
                     )
                 } else {
-                    self.0.finish(
+                    sampler.set_cursor(&lane.cursor);
+                    sampler.offer_1d(predrawn_next[i]);
+                    let step = self.0.finish(
                         scene,
                         &mut lane.path,
                         &mut lane.lambda,
                         sampler,
                         &mut scratch[i],
                         answer.as_ref(),
-                    )
+                    );
+                    lane.cursor = sampler.cursor();
+                    step
                 };
-                lane.cursor = sampler.cursor();
                 lane.done = step.done;
                 if let Some(q) = step.shadow {
                     shadow_rays.push((q.ray, q.t_max));

@@ -71,6 +71,34 @@ pub struct SamplerCursor {
     pub(crate) dimension: i32,
 }
 
+impl SamplerCursor {
+    /// Takes draws [`Sampler::four_draws_batch`] computed at this cursor
+    /// (its `out`), without the sampler: the values and the cursor after
+    /// them are those of [`Sampler::get_vertex_samples`] at this cursor
+    /// with the draws offered ([`Sampler::offer_four_draws`]). (Only
+    /// Z-Sobol' computes draws ahead; its four draws span six
+    /// dimensions.)
+    #[inline(always)]
+    pub(crate) fn take_four_draws(&mut self, d: [Float; 6]) -> (Float, Point2f, Float, Point2f) {
+        self.dimension += 6;
+        (
+            d[0],
+            Point2f::new(d[1], d[2]),
+            d[3],
+            Point2f::new(d[4], d[5]),
+        )
+    }
+
+    /// Takes the 1-D draw [`Sampler::four_draws_batch`] computed at this
+    /// cursor (its `next`), without the sampler: as
+    /// [`Sampler::get_1d`] with the draw offered ([`Sampler::offer_1d`]).
+    #[inline(always)]
+    pub(crate) fn take_1d(&mut self, v: Float) -> Float {
+        self.dimension += 1;
+        v
+    }
+}
+
 /// A sampler: a closed set of variants with one-line delegation (the
 /// Rust form of pbrt-v4's tagged `Sampler`).
 #[derive(Clone, Debug)]

@@ -1155,6 +1155,15 @@ mod tests {
                     s.offer_1d(*got_next);
                     assert_eq!(s.get_1d(), want[6]);
                     assert_eq!(s.dimension, c.dimension + 7);
+                    // Taken at the cursor without the sampler: the same
+                    // values, and the cursor the sampler's draws leave.
+                    if let (Some(v), Some(v_next)) = (got, got_next) {
+                        let mut taken = *c;
+                        let (a, b, cc, d) = taken.take_four_draws(*v);
+                        assert_eq!([a, b.x, b.y, cc, d.x, d.y], want[..6]);
+                        assert_eq!(taken.take_1d(*v_next), want[6]);
+                        assert_eq!(taken, s.cursor());
+                    }
                 }
                 // A 1-D offer is taken only at its own position: not by a
                 // 2-D draw there, nor after the cursor moves.
