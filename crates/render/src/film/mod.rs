@@ -482,6 +482,25 @@ impl Film {
         }
     }
 
+    /// [`Film::sample_wavelengths`] of each of `us`, into `out` (cleared
+    /// first): the same values, the visible range's computed
+    /// lane-parallel at `level` (`scratch` holds their buffers).
+    pub fn sample_wavelengths_many(
+        &self,
+        level: crate::simd::SimdLevel,
+        us: &[Float],
+        scratch: &mut Vec<Float>,
+        out: &mut Vec<SampledWavelengths>,
+    ) {
+        match &self.core().config.kind {
+            KindConfig::Spectral { .. } => {
+                out.clear();
+                out.extend(us.iter().map(|&u| self.sample_wavelengths(u)));
+            }
+            _ => SampledWavelengths::sample_visible_many(level, us, scratch, out),
+        }
+    }
+
     /// The film-plane area to sample: the pixel bounds grown by the filter
     /// radius less half a pixel (pbrt-v4 `FilmBase::SampleBounds`).
     pub fn sample_bounds(&self) -> Bounds2f {

@@ -32,7 +32,13 @@ impl CameraDraws {
     /// Takes the draws from `sampler`.
     #[inline]
     pub(crate) fn take(sampler: &mut Sampler) -> Self {
-        let (lu, u_pixel, time, p_lens) = sampler.get_camera_samples();
+        Self::from_four(sampler.get_camera_samples())
+    }
+
+    /// The draws from [`Sampler::get_camera_samples`]' four values (or
+    /// the same values computed ahead).
+    #[inline]
+    pub(crate) fn from_four((lu, u_pixel, time, p_lens): (Float, Point2f, Float, Point2f)) -> Self {
         CameraDraws {
             lu,
             u_pixel,
@@ -53,12 +59,18 @@ pub(crate) fn differential_scale(spp: i32) -> Float {
 /// wavelength jitter is off).
 #[inline]
 fn sample_wavelengths(scene: &Scene, opts: &RenderOptions, lu: Float) -> SampledWavelengths {
-    let lu = if opts.disable_wavelength_jitter {
+    scene.film.sample_wavelengths(wavelength_draw(opts, lu))
+}
+
+/// The draw the wavelengths take: `lu`, or 0.5 when wavelength jitter is
+/// off.
+#[inline]
+fn wavelength_draw(opts: &RenderOptions, lu: Float) -> Float {
+    if opts.disable_wavelength_jitter {
         0.5
     } else {
         lu
-    };
-    scene.film.sample_wavelengths(lu)
+    }
 }
 
 /// The camera sample in pixel `p_pixel` at filter offset `fs` (the pixel
@@ -225,6 +237,9 @@ pub(crate) struct CameraBatch {
     p_film: Vec<Point2f>,
     times: Vec<Float>,
     rays: Vec<Ray>,
+    lu: Vec<Float>,
+    lambda_scratch: Vec<Float>,
+    lambdas: Vec<SampledWavelengths>,
 }
 
 impl CameraBatch {
@@ -237,6 +252,9 @@ impl CameraBatch {
             p_film: Vec::new(),
             times: Vec::new(),
             rays: Vec::new(),
+            lu: Vec::new(),
+            lambda_scratch: Vec::new(),
+            lambdas: Vec::new(),
         }
     }
 
@@ -259,17 +277,23 @@ impl CameraBatch {
         self.u_pixel.extend(samples.iter().map(|(_, d)| d.u_pixel));
         self.filter.clear();
         scene.filter.sample_many(&self.u_pixel, &mut self.filter);
-        out.extend(
-            samples
-                .iter()
-                .zip(&self.filter)
-                .map(|(&(p_pixel, d), &fs)| CameraRaySample {
-                    p_pixel,
-                    lambda: sample_wavelengths(scene, opts, d.lu),
-                    cs: camera_sample(opts, p_pixel, fs, d.time, d.p_lens),
-                    ray: None,
-                }),
+        self.lu.clear();
+        self.lu
+            .extend(samples.iter().map(|(_, d)| wavelength_draw(opts, d.lu)));
+        scene.film.sample_wavelengths_many(
+            level,
+            &self.lu,
+            &mut self.lambda_scratch,
+            &mut self.lambdas,
         );
+        out.extend(samples.iter().zip(&self.filter).zip(&self.lambdas).map(
+            |((&(p_pixel, d), &fs), &lambda)| CameraRaySample {
+                p_pixel,
+                lambda,
+                cs: camera_sample(opts, p_pixel, fs, d.time, d.p_lens),
+                ray: None,
+            },
+        ));
         match self.pinhole.as_ref().filter(|_| !differentials) {
             Some(pinhole) => {
                 self.p_film.clear();

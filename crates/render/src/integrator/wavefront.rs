@@ -283,10 +283,17 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             sampler.four_draws_batch(level, &cursors, &mut draw_batch, &mut draws, None);
             camera_draws.clear();
             for ((&(_, p_pixel), cursor), &d) in starts.iter().zip(cursors.iter_mut()).zip(&draws) {
-                sampler.set_cursor(cursor);
-                sampler.offer_four_draws(d);
-                camera_draws.push((p_pixel, CameraDraws::take(sampler)));
-                *cursor = sampler.cursor();
+                let draws = match d {
+                    // Taken at the sample's cursor without the sampler.
+                    Some(d) => CameraDraws::from_four(cursor.take_four_draws(d)),
+                    None => {
+                        sampler.set_cursor(cursor);
+                        let draws = CameraDraws::take(sampler);
+                        *cursor = sampler.cursor();
+                        draws
+                    }
+                };
+                camera_draws.push((p_pixel, draws));
             }
             camera_batch.take(
                 scene,

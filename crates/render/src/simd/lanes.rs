@@ -84,6 +84,10 @@ pub trait F32Lanes: Copy {
     /// `to_bits() ± 1`: the step of [`rpbrt_geometry::float::next_float_up`]
     /// and `next_float_down`.
     fn step_bits(self, up: Self::Mask) -> Self;
+    /// Lane-wise bit pattern (`f32::to_bits`).
+    fn to_u32_bits(self) -> Self::U32;
+    /// Lane-wise float of a bit pattern (`f32::from_bits`).
+    fn from_u32_bits(u: Self::U32) -> Self;
     /// Lane-wise `self > o`.
     #[inline(always)]
     fn gt(self, o: Self) -> Self::Mask {
@@ -228,6 +232,14 @@ impl F32Lanes for Scalar1 {
     #[inline(always)]
     fn pow2i(n: Self) -> Self {
         Scalar1(f32::from_bits(((n.0 as i32 + 127) as u32) << 23))
+    }
+    #[inline(always)]
+    fn to_u32_bits(self) -> super::U32x1 {
+        super::U32x1(self.0.to_bits())
+    }
+    #[inline(always)]
+    fn from_u32_bits(u: super::U32x1) -> Self {
+        Scalar1(f32::from_bits(u.0))
     }
     #[inline(always)]
     fn step_bits(self, up: bool) -> Self {
@@ -421,6 +433,14 @@ mod x86 {
             }
         }
         #[inline(always)]
+        fn to_u32_bits(self) -> U32x16 {
+            unsafe { U32x16(_mm512_castps_si512(self.0)) }
+        }
+        #[inline(always)]
+        fn from_u32_bits(u: U32x16) -> Self {
+            unsafe { F32x16(_mm512_castsi512_ps(u.0)) }
+        }
+        #[inline(always)]
         fn step_bits(self, up: __mmask16) -> Self {
             unsafe {
                 let b = _mm512_castps_si512(self.0);
@@ -610,6 +630,14 @@ mod x86 {
                 let e = _mm256_add_epi32(_mm256_cvttps_epi32(n.0), _mm256_set1_epi32(127));
                 F32x8(_mm256_castsi256_ps(_mm256_slli_epi32::<23>(e)))
             }
+        }
+        #[inline(always)]
+        fn to_u32_bits(self) -> U32x8 {
+            unsafe { U32x8(_mm256_castps_si256(self.0)) }
+        }
+        #[inline(always)]
+        fn from_u32_bits(u: U32x8) -> Self {
+            unsafe { F32x8(_mm256_castsi256_ps(u.0)) }
         }
         #[inline(always)]
         fn step_bits(self, up: __m256) -> Self {
@@ -816,6 +844,14 @@ mod x86 {
                 let e = _mm_add_epi32(_mm_cvttps_epi32(n.0), _mm_set1_epi32(127));
                 F32x4(_mm_castsi128_ps(_mm_slli_epi32::<23>(e)))
             }
+        }
+        #[inline(always)]
+        fn to_u32_bits(self) -> U32x4 {
+            unsafe { U32x4(_mm_castps_si128(self.0)) }
+        }
+        #[inline(always)]
+        fn from_u32_bits(u: U32x4) -> Self {
+            unsafe { F32x4(_mm_castsi128_ps(u.0)) }
         }
         #[inline(always)]
         fn step_bits(self, up: __m128) -> Self {

@@ -10,7 +10,7 @@
 //! Both are within about two ulps of the correctly rounded result on the
 //! arguments rpbrt gives them (tested against `f64`).
 
-use super::F32Lanes;
+use super::{F32Lanes, U32Lanes};
 
 /// 4/π.
 const FOUR_OVER_PI: f32 = 1.273_239_5;
@@ -162,6 +162,62 @@ pub fn exp<L: F32Lanes>(x: L) -> L {
     let v = L::select(x.lt(L::splat(lo)), L::splat(0.0), v);
     let v = L::select(x.gt(L::splat(hi)), L::splat(f32::INFINITY), v);
     L::select(x.is_nan(), x, v)
+}
+
+/// √½, where the logarithm's reduction moves the mantissa from
+/// [½, √½) to [1, √2).
+const SQRT_HALF: f32 = std::f32::consts::FRAC_1_SQRT_2;
+/// ln(1 + r) ≈ r − r²/2 + r³ (L0 r⁸ … + L8) on [√½ − 1, √2 − 1]
+/// (highest power first).
+const LN_P: [f32; 9] = [
+    7.037_683_6e-2,
+    -1.151_461e-1,
+    1.167_699_9e-1,
+    -1.242_014_1e-1,
+    1.424_932_3e-1,
+    -1.666_805_8e-1,
+    2.000_071_4e-1,
+    -2.499_999_4e-1,
+    3.333_333_1e-1,
+];
+
+/// Lane-wise natural logarithm (the Cephes single-precision method:
+/// x = m·2ᵉ with m in [√½, √2), ln x = e ln 2 + ln m by a degree-9
+/// polynomial in m − 1, ln 2 in two parts). Within about one ulp of the
+/// correctly rounded value for positive normal and subnormal `x`; 0 gives
+/// −∞, +∞ gives +∞, negative numbers and NaN give NaN.
+#[inline(always)]
+pub fn ln<L: F32Lanes>(x: L) -> L {
+    type U<L> = <L as F32Lanes>::U32;
+    // Subnormals scaled into the normal range first (by 2²⁵).
+    let subnormal = x.lt(L::splat(f32::MIN_POSITIVE));
+    let xs = L::select(subnormal, x.mul(L::splat(33_554_432.0)), x);
+    let bias = L::select(subnormal, L::splat(126.0 + 25.0), L::splat(126.0));
+    // x = m·2ᵉ with m in [½, 1), from the bits.
+    let bits = xs.to_u32_bits();
+    let biased = <U<L> as U32Lanes>::and(bits.shr::<23>(), U::<L>::splat(0xff));
+    let m = L::from_u32_bits(<U<L> as U32Lanes>::or(
+        <U<L> as U32Lanes>::and(bits, U::<L>::splat(0x807f_ffff)),
+        U::<L>::splat(0x3f00_0000),
+    ));
+    let e = L::from_u32(biased).sub(bias);
+    // Below √½, m doubles and e drops by one.
+    let low = m.lt(L::splat(SQRT_HALF));
+    let e = L::select(low, e.sub(L::splat(1.0)), e);
+    let r = L::select(low, m.add(m), m).sub(L::splat(1.0));
+    let z = r.mul(r);
+    let mut y = L::splat(LN_P[0]);
+    for &c in &LN_P[1..] {
+        y = y.mul(r).add(L::splat(c));
+    }
+    let y = y.mul(r).mul(z);
+    let y = y.add(e.mul(L::splat(LN2_LO)));
+    let y = y.add(z.mul(L::splat(-0.5)));
+    let v = r.add(y).add(e.mul(L::splat(LN2_HI)));
+    let zero = L::splat(0.0);
+    let v = L::select(x.eq(zero), L::splat(f32::NEG_INFINITY), v);
+    let v = L::select(x.eq(L::splat(f32::INFINITY)), x, v);
+    L::select(L::or(x.lt(zero), x.is_nan()), L::splat(f32::NAN), v)
 }
 
 /// `clamp(v, lo, hi)` as [`rpbrt_geometry::float::clamp`] computes it

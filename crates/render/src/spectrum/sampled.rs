@@ -8,6 +8,8 @@ use std::ops::{
 use rpbrt_geometry::Float;
 
 use super::{LAMBDA_MAX, LAMBDA_MIN, N_SPECTRUM_SAMPLES};
+use crate::simd::math::ln;
+use crate::simd::{dispatch, F32Lanes, Kernel, Scalar1, SimdLevel};
 
 /// A spectral distribution point-sampled at the `N_SPECTRUM_SAMPLES`
 /// wavelengths of a [`SampledWavelengths`].
@@ -258,23 +260,47 @@ impl SampledWavelengths {
     pub fn sample_visible(u: Float) -> Self {
         let mut lambda = [0.0; N_SPECTRUM_SAMPLES];
         let mut pdf = [0.0; N_SPECTRUM_SAMPLES];
-        for i in 0..N_SPECTRUM_SAMPLES {
-            let mut up = u + i as Float / N_SPECTRUM_SAMPLES as Float;
-            if up > 1.0 {
-                up -= 1.0;
-            }
-            // λ = 538 − 138.888889·atanh(y) and the density is
-            // 0.0039398042 / cosh²(0.0072·(λ − 538)); as 0.0072 · 138.888889
-            // = 1, that is 0.0039398042 · (1 − y²), with no cosh to evaluate.
-            let y = 0.856_910_6 - 1.827_502 * up;
-            lambda[i] = 538.0 - 138.888_89 * atanh(y);
-            pdf[i] = if (360.0..=830.0).contains(&lambda[i]) {
-                0.003_939_804_2 * (1.0 - y * y)
-            } else {
-                0.0
-            };
+        for (i, (l, p)) in lambda.iter_mut().zip(&mut pdf).enumerate() {
+            let (vl, vp) = visible_lanes(Scalar1(stratum(u, i)));
+            (*l, *p) = (vl.0, vp.0);
         }
         SampledWavelengths { lambda, pdf }
+    }
+
+    /// [`SampledWavelengths::sample_visible`] of each of `us`, into `out`
+    /// (cleared first): the same values, computed lane-parallel at
+    /// `level`. `scratch` holds the draws and values between calls.
+    pub fn sample_visible_many(
+        level: SimdLevel,
+        us: &[Float],
+        scratch: &mut Vec<Float>,
+        out: &mut Vec<Self>,
+    ) {
+        const N: usize = N_SPECTRUM_SAMPLES;
+        let n = N * us.len();
+        scratch.clear();
+        scratch.extend(us.iter().flat_map(|&u| (0..N).map(move |i| stratum(u, i))));
+        scratch.resize(3 * n, 0.0);
+        let (strata, values) = scratch.split_at_mut(n);
+        let (lambda, pdf) = values.split_at_mut(n);
+        dispatch(
+            level,
+            VisibleBatch {
+                us: strata,
+                lambda,
+                pdf,
+            },
+        );
+        out.clear();
+        out.extend(
+            lambda
+                .chunks_exact(N)
+                .zip(pdf.chunks_exact(N))
+                .map(|(l, p)| SampledWavelengths {
+                    lambda: std::array::from_fn(|i| l[i]),
+                    pdf: std::array::from_fn(|i| p[i]),
+                }),
+        );
     }
 
     /// The sampling densities as a spectrum.
@@ -321,15 +347,64 @@ impl Index<usize> for SampledWavelengths {
 /// sensitive (pbrt-v4 `SampleVisibleWavelengths`).
 #[inline]
 pub fn sample_visible_wavelengths(u: Float) -> Float {
-    538.0 - 138.888_89 * atanh(0.856_910_6 - 1.827_502 * u)
+    visible_lanes(Scalar1(u)).0 .0
 }
 
-/// atanh(y) = ½ ln((1 + y) / (1 − y)) for |y| < 1, by one `ln` (the
-/// standard library's `atanh` goes through the slower `ln_1p`; the
-/// wavelengths need no more than f32 accuracy around y = 0).
-#[inline]
-fn atanh(y: Float) -> Float {
-    0.5 * ((1.0 + y) / (1.0 - y)).ln()
+/// The `i`th of [`SampledWavelengths::sample_visible`]'s stratified
+/// draws: `u + i / N`, wrapped to `[0, 1)`.
+#[inline(always)]
+fn stratum(u: Float, i: usize) -> Float {
+    let up = u + i as Float / N_SPECTRUM_SAMPLES as Float;
+    if up > 1.0 {
+        up - 1.0
+    } else {
+        up
+    }
+}
+
+/// [`sample_visible_wavelengths`] of each lane and its density. With
+/// y = 0.8569106 − 1.827502·u, λ = 538 − 138.888889·atanh(y) and the
+/// density 0.0039398042 / cosh²(0.0072·(λ − 538)); as 0.0072 · 138.888889
+/// = 1, that is 0.0039398042 · (1 − y²), with no cosh to evaluate. atanh
+/// is ½ ln((1 + y) / (1 − y)) (one logarithm; the wavelengths need no
+/// more than f32 accuracy around y = 0), by the lanes' [`ln`], so that
+/// the scalar and lane-parallel forms agree bit for bit.
+#[inline(always)]
+fn visible_lanes<L: F32Lanes>(u: L) -> (L, L) {
+    let one = L::splat(1.0);
+    let y = L::splat(0.856_910_6).sub(L::splat(1.827_502).mul(u));
+    let atanh = L::splat(0.5).mul(ln(one.add(y).div(one.sub(y))));
+    let lambda = L::splat(538.0).sub(L::splat(138.888_89).mul(atanh));
+    let inside = L::and(lambda.ge(L::splat(360.0)), lambda.le(L::splat(830.0)));
+    let pdf = L::splat(0.003_939_804_2).mul(one.sub(y.mul(y)));
+    (lambda, L::select(inside, pdf, L::splat(0.0)))
+}
+
+/// [`SampledWavelengths::sample_visible_many`]'s kernel: `lambda` and
+/// `pdf` (as long as `us`) of each draw in `us`.
+struct VisibleBatch<'a> {
+    us: &'a [Float],
+    lambda: &'a mut [Float],
+    pdf: &'a mut [Float],
+}
+
+impl Kernel for VisibleBatch<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<L: F32Lanes>(self) {
+        let n = self.us.len().min(self.lambda.len()).min(self.pdf.len());
+        let mut i = 0;
+        while i + L::N <= n {
+            let (l, p) = visible_lanes(L::load(&self.us[i..]));
+            l.store(&mut self.lambda[i..]);
+            p.store(&mut self.pdf[i..]);
+            i += L::N;
+        }
+        for j in i..n {
+            let (l, p) = visible_lanes(Scalar1(self.us[j]));
+            (self.lambda[j], self.pdf[j]) = (l.0, p.0);
+        }
+    }
 }
 
 /// The density of [`sample_visible_wavelengths`]; zero outside `[360, 830]`.

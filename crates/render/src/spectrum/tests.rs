@@ -135,6 +135,30 @@ fn visible_pdf_integrates_to_one_and_matches_sampling() {
     }
 }
 
+/// The camera batch's wavelengths are `sample_visible`'s, bit for bit, at
+/// every SIMD level and for a batch that does not fill the last vector.
+#[test]
+fn batched_visible_wavelengths_match_single_ones() {
+    let mut rng = Rng::with_sequence(5);
+    let mut us: Vec<Float> = (0..203).map(|_| rng.uniform_float()).collect();
+    us.extend([0.0, 0.5, 0.75, 1.0 - Float::EPSILON / 2.0]);
+    let expect: Vec<SampledWavelengths> = us
+        .iter()
+        .map(|&u| SampledWavelengths::sample_visible(u))
+        .collect();
+    let (mut scratch, mut got) = (Vec::new(), Vec::new());
+    for level in crate::simd::SimdLevel::available() {
+        SampledWavelengths::sample_visible_many(level, &us, &mut scratch, &mut got);
+        assert_eq!(got.len(), us.len());
+        for (g, e) in got.iter().zip(&expect) {
+            for j in 0..N_SPECTRUM_SAMPLES {
+                assert_eq!(g.get(j).to_bits(), e.get(j).to_bits(), "{level:?}");
+                assert_eq!(g.pdf()[j].to_bits(), e.pdf()[j].to_bits(), "{level:?}");
+            }
+        }
+    }
+}
+
 #[test]
 fn luminance_estimate_of_constant_is_one() {
     let mut rng = Rng::with_sequence(7);
