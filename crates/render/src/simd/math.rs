@@ -178,7 +178,7 @@ const LN_P: [f32; 9] = [
     -1.666_805_8e-1,
     2.000_071_4e-1,
     -2.499_999_4e-1,
-    3.333_333_1e-1,
+    3.333_333e-1,
 ];
 
 /// Lane-wise natural logarithm (the Cephes single-precision method:
