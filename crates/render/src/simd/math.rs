@@ -183,9 +183,9 @@ const LN_P: [f32; 9] = [
 
 /// Lane-wise natural logarithm (the Cephes single-precision method:
 /// x = m·2ᵉ with m in [√½, √2), ln x = e ln 2 + ln m by a degree-9
-/// polynomial in m − 1, ln 2 in two parts). Within about one ulp of the
-/// correctly rounded value for positive normal and subnormal `x`; 0 gives
-/// −∞, +∞ gives +∞, negative numbers and NaN give NaN.
+/// polynomial in m − 1, ln 2 in two parts). Within 2 ulps of the
+/// correctly rounded value for positive normal and subnormal `x` (in the
+/// tests); 0 gives −∞, +∞ gives +∞, negative numbers and NaN give NaN.
 #[inline(always)]
 pub fn ln<L: F32Lanes>(x: L) -> L {
     type U<L> = <L as F32Lanes>::U32;

@@ -251,8 +251,9 @@ impl Kernel for LnOp<'_> {
 }
 
 /// ln is within a few ulps of the correctly rounded value over the whole
-/// positive range (subnormals included), gives pbrt's special values at
-/// 0, ∞, negative numbers and NaN, and the same bits at every width.
+/// positive range (subnormals included), gives the C library's special
+/// values at 0, ∞, negative numbers and NaN, and the same bits at every
+/// width.
 #[test]
 fn ln_is_accurate_and_the_same_at_every_width() {
     let mut rng = Rng::with_sequence(12);
