@@ -755,6 +755,20 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    /// Values the product tests mix in: signed zeros, ones, a subnormal,
+    /// huge values of both signs, infinity and NaN (the last two).
+    const SPECIAL_VALUES: [Float; 9] = [
+        0.0,
+        -0.0,
+        1.0,
+        -1.0,
+        1e-40,
+        -3e38,
+        3e38,
+        Float::INFINITY,
+        Float::NAN,
+    ];
+
     /// Composing with a translation on either side (the short path of
     /// `Transform * Transform`) gives the full products' bits (fixed seed;
     /// signed zeros, tiny and huge values; infinities and NaNs on either
@@ -762,17 +776,7 @@ mod tests {
     #[test]
     fn translations_compose_to_the_full_products_bits() {
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let specials = [
-            0.0,
-            -0.0,
-            1.0,
-            -1.0,
-            1e-40,
-            -3e38,
-            3e38,
-            Float::INFINITY,
-            Float::NAN,
-        ];
+        let specials = SPECIAL_VALUES;
         let same = |a: &SquareMatrix4, b: &SquareMatrix4| {
             a.m.iter()
                 .flatten()
@@ -817,21 +821,12 @@ mod tests {
     #[test]
     fn products_are_the_inner_products_bit_for_bit() {
         let mut state = 0x2545_f491_4f6c_dd1du64;
-        let specials = [
-            0.0,
-            -0.0,
-            1.0,
-            -1.0,
-            1e-40,
-            3e38,
-            Float::INFINITY,
-            Float::NAN,
-        ];
+        let specials = SPECIAL_VALUES;
         for round in 0..20_000 {
             let mut entry = || {
                 let r = crate::float::xorshift64(&mut state);
                 match (r >> 60, round % 4) {
-                    (0..=1, _) => specials[(r % 8) as usize],
+                    (0..=1, _) => specials[(r % 9) as usize],
                     (_, 0) => Float::from_bits(r as u32),
                     _ => ((r % 20_001) as Float - 10_000.0) / 997.0,
                 }
