@@ -711,7 +711,7 @@ impl Mul for Transform {
     #[inline]
     fn mul(self, t2: Transform) -> Transform {
         // A translation (`Translate`, and the render space's offset from
-        // world space) composes in a quarter of the operations, to the
+        // world space) composes in under half the operations, to the
         // same bits.
         let finite = |t: &Transform| t.m.is_finite() && t.m_inv.is_finite();
         if let (Some(d), Some(di)) = (t2.m.translation(), t2.m_inv.translation()) {
@@ -788,7 +788,8 @@ mod tests {
             let mut entry = || {
                 let r = crate::float::xorshift64(&mut state);
                 match (r >> 58, round % 3) {
-                    // Non-finite specials in one matrix of 32 or so.
+                    // Any special, infinities and NaN included (about one
+                    // transform in ten holds a non-finite entry).
                     (0, _) => specials[(r % 9) as usize],
                     (1..=8, _) => specials[(r % 7) as usize],
                     (_, 0) => Float::from_bits(r as u32 & 0xbfff_ffff),
