@@ -27,7 +27,11 @@
 //! The surface kernel also serves the specular vertex of a smooth
 //! `dielectric` of constant index ([`lane_surface`]): on its surface
 //! the scalar BSDF's own sampling runs per lane, in the BSDF's frame the
-//! kernel built, with no general interaction built at all.
+//! kernel built, with no general interaction built at all. And it serves
+//! the staged vertex of a `conductor`, `dielectric` or coated material of
+//! constant textures: its BxDF, the same at every point, is put in that
+//! frame ([`LaneVertices::bsdf`]), and the BSDF stage answers its
+//! queries as it answers the scalar vertices'.
 //!
 //! Lanes where the scalar code takes a rare branch (a shading normal
 //! perpendicular to the tangent, derivatives rescaled) are flagged and
@@ -37,7 +41,7 @@ use super::bsdf_stage::BsdfAnswers;
 use super::direct::LightRequest;
 use super::Scene;
 use crate::bxdf::lanes::MAX_LANES;
-use crate::bxdf::{BSDFSample, BxDF, DielectricBxDF, BSDF};
+use crate::bxdf::{BSDFSample, BxDF, BxDFFlags, DielectricBxDF, BSDF};
 use crate::light::LightSampleContext;
 use crate::primitive::{HitRecord, TriangleHit};
 use crate::sampler::Sampler;
@@ -62,20 +66,27 @@ pub(crate) enum LaneShade {
     ///
     /// [`MaterialSet::constant_specular_dielectric`]: crate::material::MaterialSet::constant_specular_dielectric
     Specular(DielectricBxDF),
+    /// A staged vertex: a material of constant textures whose BSDF
+    /// queries the BSDF stage answers
+    /// ([`MaterialSet::is_constant_staged`]), this one.
+    ///
+    /// [`MaterialSet::is_constant_staged`]: crate::material::MaterialSet::is_constant_staged
+    Staged(u32),
 }
 
 /// How a hit `record` by a ray of direction `d` shades when it is a vertex
 /// the lanes take: a triangle without an area light, in a mesh without
-/// shading tangents, of a material [`LaneShade`] covers (its specular kind
-/// only where `specular` allows it); the surface kernel's input then
-/// takes the next slot of `out`. `None`: the scalar vertex takes it.
+/// shading tangents, of a material [`LaneShade`] covers (its specular and
+/// staged kinds only where `as_built`: the vertex shades with the BSDF as
+/// the material builds it, not regularized); the surface kernel's input
+/// then takes the next slot of `out`. `None`: the scalar vertex takes it.
 #[inline(always)]
 pub(crate) fn lane_surface(
     scene: &Scene,
     record: &HitRecord,
     d: Vector3f,
     lambda: &SampledWavelengths,
-    specular: bool,
+    as_built: bool,
     out: &mut LaneVertices,
 ) -> Option<LaneShade> {
     let hit = scene.aggregate.triangle_hit(record)?;
@@ -93,11 +104,14 @@ pub(crate) fn lane_surface(
             }
             LaneShade::Diffuse(r)
         }
-        None if specular => LaneShade::Specular(
-            scene
-                .materials
-                .constant_specular_dielectric(material, lambda)?,
-        ),
+        None if as_built => match scene
+            .materials
+            .constant_specular_dielectric(material, lambda)
+        {
+            Some(bxdf) => LaneShade::Specular(bxdf),
+            None if scene.materials.is_constant_staged(material) => LaneShade::Staged(material),
+            None => return None,
+        },
         None => return None,
     };
     out.push(&hit, d).then_some(shade)
@@ -372,24 +386,76 @@ impl LaneVertices {
         }
         self.set(col::U2, k, u2.x);
         self.set(col::U2 + 1, k, u2.y);
-        // The light-sampling context: the point offset toward ωo (the
-        // BSDF only reflects), the normals.
-        let (n, ns, wo) = (
-            self.normal(col::N_OUT, k),
-            self.normal(col::NS, k),
-            self.vector(col::WO, k),
-        );
+        // A Lambertian BSDF only reflects and is zero across hemispheres.
+        self.request(k, BxDFFlags::DIFFUSE_REFLECTION, true, u_light, u_light_2d)
+    }
+
+    /// The BSDF of the staged vertex at slot `k`: `bxdf` in the frame the
+    /// surface kernel built (`BSDF::new`'s).
+    #[inline(always)]
+    pub(crate) fn bsdf(&self, k: usize, bxdf: BxDF) -> BSDF {
+        BSDF {
+            bxdf,
+            shading_frame: Frame {
+                x: self.vector(col::X, k),
+                y: self.vector(col::Y, k),
+                z: Vector3f::from(self.ns(k)),
+            },
+        }
+    }
+
+    /// The light request of the staged vertex at slot `k`, of BSDF `bsdf`
+    /// (`light_request`'s), given its light's draws.
+    #[inline(always)]
+    pub(crate) fn light_request(
+        &self,
+        k: usize,
+        bsdf: &BSDF,
+        u: Float,
+        u_light: Point2f,
+    ) -> LightRequest {
+        let zero_across = bsdf.bxdf.zero_across_hemispheres();
+        self.request(k, bsdf.flags(), zero_across, u, u_light)
+    }
+
+    /// The light request at slot `k` of a BSDF of `flags` whose frame's z
+    /// axis is the shading normal (`surface_light_context`'s point: offset
+    /// toward ωo where the BSDF only reflects, away where it only
+    /// transmits); `zero_across`: the BSDF is zero across hemispheres.
+    #[inline(always)]
+    fn request(
+        &self,
+        k: usize,
+        flags: BxDFFlags,
+        zero_across: bool,
+        u: Float,
+        u_light: Point2f,
+    ) -> LightRequest {
+        let (n, ns, wo) = (self.normal(col::N_OUT, k), self.ns(k), self.wo(k));
+        let pi = match (flags.is_reflective(), flags.is_transmissive()) {
+            (true, false) => Point3fi::from(self.toward(k, wo)),
+            (false, true) => Point3fi::from(self.toward(k, -wo)),
+            _ => self.pi(k),
+        };
         let z = Vector3f::from(ns);
         LightRequest {
-            ctx: LightSampleContext {
-                pi: Point3fi::from(self.toward(k, wo)),
-                n,
-                ns,
-            },
-            u: u_light,
-            u_light: u_light_2d,
-            hemisphere: Some((z, dot(wo, z))),
+            ctx: LightSampleContext { pi, n, ns },
+            u,
+            u_light,
+            hemisphere: zero_across.then(|| (z, dot(wo, z))),
         }
+    }
+
+    /// ωo at slot `k`.
+    #[inline(always)]
+    pub(crate) fn wo(&self, k: usize) -> Vector3f {
+        self.vector(col::WO, k)
+    }
+
+    /// The shading normal at slot `k`.
+    #[inline(always)]
+    pub(crate) fn ns(&self, k: usize) -> Normal3f {
+        self.normal(col::NS, k)
     }
 
     /// Sets the light sample's direction at slot `k` for the scatter

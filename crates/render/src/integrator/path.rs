@@ -100,6 +100,8 @@ pub(crate) struct SurfaceScratch {
     u: Float,
     u2: Point2f,
     answers: BsdfAnswers,
+    /// ωo of a staged vertex (which has no `hit`).
+    wo: Vector3f,
 }
 
 impl VertexIntegrator for PathIntegrator {
@@ -127,12 +129,10 @@ impl VertexIntegrator for PathIntegrator {
         scratch: &'a SurfaceScratch,
         light: Option<&LightAnswer>,
     ) -> Option<BsdfQuery<'a>> {
-        let (Some(hit), Some(bsdf)) = (scratch.hit.as_ref(), scratch.bsdf.as_ref()) else {
-            return None;
-        };
+        let bsdf = scratch.bsdf.as_ref()?;
         Some(BsdfQuery {
             bsdf,
-            wo_light: hit.si.wo,
+            wo_light: scratch.hit.as_ref().map_or(scratch.wo, |h| h.si.wo),
             wi_light: light.map(|a| a.ls.wi),
             wo: -s.ray.ray.d,
             u: scratch.u,
@@ -294,8 +294,8 @@ impl VertexIntegrator for PathIntegrator {
         if s.depth >= self.max_depth || scene.force_diffuse || (gbuffer && s.depth == 0) {
             return None;
         }
-        let specular = !(self.regularize && s.any_non_specular);
-        lane_surface(scene, record, s.ray.ray.d, lambda, specular, out)
+        let as_built = !(self.regularize && s.any_non_specular);
+        lane_surface(scene, record, s.ray.ray.d, lambda, as_built, out)
     }
 
     /// `begin` and `finish` for a specular vertex: the depth, the BSDF's
@@ -361,26 +361,9 @@ impl VertexIntegrator for PathIntegrator {
         draw: impl FnOnce() -> Float,
     ) -> VertexStep {
         let time = s.ray.ray.time;
-        // `light_shadow_query`.
         let shadow = light.and_then(|a| {
             let (f, pdf_light) = lanes.light_answers(k);
-            if f.is_black() {
-                return None;
-            }
-            let ls = &a.ls;
-            let (ray, t_max) = lanes.shadow_ray(k, time, ls.p_light, ls.n_light);
-            let p_l = a.p * ls.pdf;
-            let ld = if scene.lights[a.light as usize].light_type().is_delta() {
-                ls.l * f / p_l
-            } else {
-                let w_l = power_heuristic(1.0, p_l, 1.0, pdf_light);
-                ls.l * f * (w_l / p_l)
-            };
-            Some(ShadowQuery {
-                ray,
-                t_max,
-                ld: s.beta * ld,
-            })
+            lane_shadow_query(scene, s, lanes, k, a, f, pdf_light)
         });
         lanes.write_context(k, &mut s.prev_ctx);
         let Some((wi, pdf, cos_over_pdf)) = lanes.sample(k) else {
@@ -397,6 +380,100 @@ impl VertexIntegrator for PathIntegrator {
         s.ray = RayDifferential::new(lanes.spawn_ray(k, wi, time));
         russian_roulette(s, draw, shadow)
     }
+
+    #[inline(always)]
+    fn staged_begin(
+        &self,
+        s: &mut PathState,
+        scratch: &mut SurfaceScratch,
+        lanes: &LaneVertices,
+        k: usize,
+        bsdf: BSDF,
+        draws: (Float, Point2f, Float, Point2f),
+    ) -> LightRequest {
+        s.depth += 1;
+        scratch.hit = None;
+        let (u_light, u_light_2d, u, u2) = draws;
+        (scratch.u, scratch.u2) = (u, u2);
+        scratch.wo = lanes.wo(k);
+        let req = lanes.light_request(k, &bsdf, u_light, u_light_2d);
+        scratch.bsdf = Some(bsdf);
+        req
+    }
+
+    /// `finish` for a staged vertex.
+    #[inline(always)]
+    fn staged_finish(
+        &self,
+        scene: &Scene,
+        s: &mut PathState,
+        scratch: &mut SurfaceScratch,
+        lanes: &LaneVertices,
+        k: usize,
+        light: Option<&LightAnswer>,
+        draw: impl FnOnce() -> Float,
+    ) -> VertexStep {
+        let Some(bsdf) = scratch.bsdf.as_ref() else {
+            return VertexStep::DONE;
+        };
+        let pre = std::mem::take(&mut scratch.answers);
+        let (wo, ns, time) = (scratch.wo, lanes.ns(k), s.ray.ray.time);
+        // `light_shadow_query`.
+        let shadow = light.and_then(|a| {
+            let wi = a.ls.wi;
+            let f = pre.light_f(bsdf, wo, wi) * abs_dot(wi, ns);
+            if f.is_black() {
+                return None;
+            }
+            let pdf_light = pre.light_pdf(bsdf, wo, wi);
+            lane_shadow_query(scene, s, lanes, k, a, f, pdf_light)
+        });
+        lanes.write_context(k, &mut s.prev_ctx);
+        let Some((bs, p_b)) = pre.sample(bsdf, -s.ray.ray.d, scratch.u, scratch.u2) else {
+            return VertexStep { shadow, done: true };
+        };
+        s.beta *= bs.f * (abs_dot(bs.wi, ns) / bs.pdf);
+        s.p_b = p_b;
+        s.specular_bounce = bs.is_specular();
+        s.any_non_specular |= !bs.is_specular();
+        if bs.is_transmission() {
+            s.eta_scale *= bs.eta * bs.eta;
+        }
+        s.ray = RayDifferential::new(lanes.spawn_ray(k, bs.wi, time));
+        russian_roulette(s, draw, shadow)
+    }
+}
+
+/// `light_shadow_query` at slot `k` of the lane vertices, given the
+/// BSDF's value (times the cosine) and density toward light sample `a`,
+/// its contribution multiplied by the path's throughput.
+#[inline(always)]
+fn lane_shadow_query(
+    scene: &Scene,
+    s: &PathState,
+    lanes: &LaneVertices,
+    k: usize,
+    a: &LightAnswer,
+    f: SampledSpectrum,
+    pdf_light: Float,
+) -> Option<ShadowQuery> {
+    if f.is_black() {
+        return None;
+    }
+    let ls = &a.ls;
+    let (ray, t_max) = lanes.shadow_ray(k, s.ray.ray.time, ls.p_light, ls.n_light);
+    let p_l = a.p * ls.pdf;
+    let ld = if scene.lights[a.light as usize].light_type().is_delta() {
+        ls.l * f / p_l
+    } else {
+        let w_l = power_heuristic(1.0, p_l, 1.0, pdf_light);
+        ls.l * f * (w_l / p_l)
+    };
+    Some(ShadowQuery {
+        ray,
+        t_max,
+        ld: s.beta * ld,
+    })
 }
 
 /// The end of a vertex: Russian roulette on the throughput (without the

@@ -10,7 +10,7 @@ use super::bsdf_stage::{BsdfAnswers, BsdfQuery};
 use super::diffuse_lanes::{LaneShade, LaneVertices, SurfaceOut};
 use super::direct::{answer_light, LightAnswer, LightRequest, ShadowQuery};
 use super::Scene;
-use crate::bxdf::DielectricBxDF;
+use crate::bxdf::{DielectricBxDF, BSDF};
 use crate::film::VisibleSurface;
 use crate::primitive::HitRecord;
 use crate::sampler::Sampler;
@@ -177,6 +177,41 @@ pub(crate) trait VertexIntegrator: Sync {
         _draw: impl FnOnce() -> Float,
     ) -> VertexStep {
         unreachable!("diffuse_finish without lane_hit")
+    }
+
+    /// The first half of a vertex that [`VertexIntegrator::lane_hit`]
+    /// took as [`LaneShade::Staged`], at slot `k` of `lanes` after the
+    /// surface kernel, given its BSDF (non-specular, in the kernel's
+    /// frame: [`LaneVertices::bsdf`]) and its four sampler draws: its
+    /// light request. The BSDF stage then answers its queries
+    /// ([`VertexIntegrator::bsdf_query`]).
+    fn staged_begin(
+        &self,
+        _s: &mut Self::State,
+        _scratch: &mut Self::Scratch,
+        _lanes: &LaneVertices,
+        _k: usize,
+        _bsdf: BSDF,
+        _draws: (Float, Point2f, Float, Point2f),
+    ) -> LightRequest {
+        unreachable!("staged_begin without lane_hit")
+    }
+
+    /// The second half of such a vertex, given the answer to its light
+    /// request and the BSDF stage's answers in `scratch`; `draw` as for
+    /// [`VertexIntegrator::diffuse_finish`].
+    #[allow(clippy::too_many_arguments)]
+    fn staged_finish(
+        &self,
+        _scene: &Scene,
+        _s: &mut Self::State,
+        _scratch: &mut Self::Scratch,
+        _lanes: &LaneVertices,
+        _k: usize,
+        _light: Option<&LightAnswer>,
+        _draw: impl FnOnce() -> Float,
+    ) -> VertexStep {
+        unreachable!("staged_finish without lane_hit")
     }
 }
 

@@ -259,14 +259,13 @@ impl VertexIntegrator for VolPathIntegrator {
         scratch: &'a VolPathScratch,
         light: Option<&LightAnswer>,
     ) -> Option<BsdfQuery<'a>> {
-        let (Some(hit), Some(bsdf)) = (scratch.hit.as_ref(), scratch.bsdf.as_ref()) else {
-            return None;
-        };
+        let bsdf = scratch.bsdf.as_ref()?;
+        let wo = scratch.hit.as_ref().map_or(scratch.wo, |h| h.si.wo);
         Some(BsdfQuery {
             bsdf,
-            wo_light: hit.si.wo,
+            wo_light: wo,
             wi_light: light.map(|a| a.ls.wi),
-            wo: hit.si.wo,
+            wo,
             u: scratch.u,
             u2: scratch.u2,
         })
@@ -580,8 +579,8 @@ impl VertexIntegrator for VolPathIntegrator {
         }
         // Specular vertices too, but where regularization would roughen
         // the BSDF.
-        let specular = !(self.regularize && s.any_non_specular);
-        lane_surface(scene, record, s.ray.ray.d, lambda, specular, out)
+        let as_built = !(self.regularize && s.any_non_specular);
+        lane_surface(scene, record, s.ray.ray.d, lambda, as_built, out)
     }
 
     /// `begin` and `finish` for a specular vertex in a scene without
@@ -652,15 +651,9 @@ impl VertexIntegrator for VolPathIntegrator {
         draw: impl FnOnce() -> Float,
     ) -> VertexStep {
         let time = s.ray.ray.time;
-        // `surface_shadow_query`.
         let shadow = light.and_then(|a| {
             let (f_hat, pdf_light) = lanes.light_answers(k);
-            if f_hat.is_black() {
-                return None;
-            }
-            let (ray, t_max) = lanes.shadow_ray(k, time, a.ls.p_light, a.ls.n_light);
-            let ld = unoccluded_ld(scene, a, s, f_hat, pdf_light);
-            Some(ShadowQuery { ray, t_max, ld })
+            lane_shadow_query(scene, s, lanes, k, a, f_hat, pdf_light)
         });
         let done = VertexStep { shadow, done: true };
         lanes.write_context(k, &mut s.prev_ctx);
@@ -679,6 +672,90 @@ impl VertexIntegrator for VolPathIntegrator {
         s.ray = RayDifferential::new(lanes.spawn_ray(k, wi, time));
         russian_roulette(s, draw, shadow)
     }
+
+    #[inline(always)]
+    fn staged_begin(
+        &self,
+        s: &mut VolPathState,
+        scratch: &mut VolPathScratch,
+        lanes: &LaneVertices,
+        k: usize,
+        bsdf: BSDF,
+        draws: (Float, Point2f, Float, Point2f),
+    ) -> LightRequest {
+        s.depth += 1;
+        scratch.hit = None;
+        let (u_light, u_light_2d, u, u2) = draws;
+        (scratch.u, scratch.u2) = (u, u2);
+        scratch.wo = lanes.wo(k);
+        let req = lanes.light_request(k, &bsdf, u_light, u_light_2d);
+        scratch.bsdf = Some(bsdf);
+        req
+    }
+
+    /// `finish` for a staged vertex (no media: its next ray's medium is
+    /// none; no subsurface scattering: its materials have none).
+    #[inline(always)]
+    fn staged_finish(
+        &self,
+        scene: &Scene,
+        s: &mut VolPathState,
+        scratch: &mut VolPathScratch,
+        lanes: &LaneVertices,
+        k: usize,
+        light: Option<&LightAnswer>,
+        draw: impl FnOnce() -> Float,
+    ) -> VertexStep {
+        let Some(bsdf) = scratch.bsdf.as_ref() else {
+            return VertexStep::DONE;
+        };
+        let pre = std::mem::take(&mut scratch.answers);
+        let (wo, ns, time) = (scratch.wo, lanes.ns(k), s.ray.ray.time);
+        // `surface_shadow_query`.
+        let shadow = light.and_then(|a| {
+            let wi = a.ls.wi;
+            let f_hat = pre.light_f(bsdf, wo, wi) * abs_dot(wi, ns);
+            if f_hat.is_black() {
+                return None;
+            }
+            let scatter_pdf = pre.light_pdf(bsdf, wo, wi);
+            lane_shadow_query(scene, s, lanes, k, a, f_hat, scatter_pdf)
+        });
+        let done = VertexStep { shadow, done: true };
+        lanes.write_context(k, &mut s.prev_ctx);
+        let Some((bs, p_b)) = pre.sample(bsdf, wo, scratch.u, scratch.u2) else {
+            return done;
+        };
+        s.beta *= bs.f * (abs_dot(bs.wi, ns) / bs.pdf);
+        s.r_l = s.r_u / p_b;
+        s.specular_bounce = bs.is_specular();
+        s.any_non_specular |= !bs.is_specular();
+        if bs.is_transmission() {
+            s.eta_scale *= bs.eta * bs.eta;
+        }
+        s.ray = RayDifferential::new(lanes.spawn_ray(k, bs.wi, time));
+        russian_roulette(s, draw, done.shadow)
+    }
+}
+
+/// `surface_shadow_query` at slot `k` of the lane vertices, given the
+/// BSDF's value (times the cosine) and density toward light sample `a`.
+#[inline(always)]
+fn lane_shadow_query(
+    scene: &Scene,
+    s: &VolPathState,
+    lanes: &LaneVertices,
+    k: usize,
+    a: &LightAnswer,
+    f_hat: SampledSpectrum,
+    scatter_pdf: Float,
+) -> Option<ShadowQuery> {
+    if f_hat.is_black() {
+        return None;
+    }
+    let (ray, t_max) = lanes.shadow_ray(k, s.ray.ray.time, a.ls.p_light, a.ls.n_light);
+    let ld = unoccluded_ld(scene, a, s, f_hat, scatter_pdf);
+    Some(ShadowQuery { ray, t_max, ld })
 }
 
 /// The end of a surface vertex: Russian roulette on the throughput
@@ -807,6 +884,8 @@ pub(crate) struct VolPathScratch {
     u2: Point2f,
     ray_medium: Option<MediumId>,
     answers: BsdfAnswers,
+    /// ωo of a staged vertex (which has no `hit`).
+    wo: Vector3f,
 }
 
 impl VolPathIntegrator {

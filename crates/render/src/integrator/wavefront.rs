@@ -23,7 +23,10 @@
 //!    before the first half, their BSDF's answers together before the
 //!    second; so do the specular vertices of smooth glass under `path`,
 //!    whose whole vertex (no light sample) is the scalar BSDF's sample in
-//!    the frame the surface kernel built. Before the surfaces, the hit
+//!    the frame the surface kernel built, and the staged vertices of
+//!    constant conductor, rough dielectric and coated materials, whose
+//!    BSDF is built in that frame and answered by the BSDF stage, without
+//!    the general interaction. Before the surfaces, the hit
 //!    meshes' data is prefetched for every path at once where the scene
 //!    is too large for the cache;
 //! 3. **light**: the requests' lights chosen and sampled together
@@ -106,6 +109,15 @@ struct Lane<S> {
     diffuse: bool,
     /// The vertex being shaded is a specular vertex taken in lanes.
     specular: bool,
+    /// The vertex being shaded is a staged vertex taken in lanes.
+    staged: bool,
+}
+
+/// A lane vertex that asks for a light sample: a diffuse vertex of this
+/// reflectance, or a staged vertex of this BSDF.
+enum LaneLight {
+    Diffuse(SampledSpectrum),
+    Staged(crate::bxdf::BSDF),
 }
 
 /// A finished sample waiting for its turn to be added to the tile.
@@ -329,6 +341,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     camera: true,
                     diffuse: false,
                     specular: false,
+                    staged: false,
                 };
                 let slot = match free.pop() {
                     Some(slot) => {
@@ -430,12 +443,14 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             for &i in &active {
                 lanes[i].diffuse = false;
                 lanes[i].specular = false;
+                lanes[i].staged = false;
             }
             for (k, &i) in diffuse.iter().enumerate() {
                 if vertices.ok(k) {
                     match shades[k] {
                         LaneShade::Diffuse(_) => lanes[i].diffuse = true,
                         LaneShade::Specular(_) => lanes[i].specular = true,
+                        LaneShade::Staged(_) => lanes[i].staged = true,
                     }
                     diffuse_slot[i] = k;
                 }
@@ -444,9 +459,29 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             for &i in &active {
                 let lane = &mut lanes[i];
                 let k = diffuse_slot[i];
-                let shade = (lane.diffuse || lane.specular).then(|| shades[k]);
+                let shade = (lane.diffuse || lane.specular || lane.staged).then(|| shades[k]);
                 lane.camera = false;
-                if let Some(LaneShade::Diffuse(r)) = shade {
+                // A staged vertex's BSDF, built first (it draws nothing):
+                // one that turns out specular only is left to the scalar
+                // vertex, which draws otherwise.
+                let lane_light = match shade {
+                    Some(LaneShade::Diffuse(r)) => Some(LaneLight::Diffuse(r)),
+                    Some(LaneShade::Staged(m)) => {
+                        let mut lambda = lane.lambda;
+                        let bsdf = scene
+                            .materials
+                            .constant_bxdf(m, &mut lambda)
+                            .map(|bxdf| vertices.bsdf(k, bxdf))
+                            .filter(|b| b.flags().is_non_specular());
+                        lane.staged = bsdf.is_some();
+                        bsdf.map(|b| {
+                            lane.lambda = lambda;
+                            LaneLight::Staged(b)
+                        })
+                    }
+                    _ => None,
+                };
+                if let Some(lane_light) = lane_light {
                     // The draws computed ahead are taken at the lane's
                     // cursor without the sampler.
                     let draws = match predrawn[i] {
@@ -458,14 +493,16 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                             draws
                         }
                     };
-                    requests.push(self.0.diffuse_begin(
-                        &mut lane.path,
-                        &mut scratch[i],
-                        &mut vertices,
-                        k,
-                        r,
-                        draws,
-                    ));
+                    let (path, scratch) = (&mut lane.path, &mut scratch[i]);
+                    requests.push(match lane_light {
+                        LaneLight::Diffuse(r) => {
+                            self.0
+                                .diffuse_begin(path, scratch, &mut vertices, k, r, draws)
+                        }
+                        LaneLight::Staged(bsdf) => self
+                            .0
+                            .staged_begin(path, scratch, &vertices, k, bsdf, draws),
+                    });
                     request_lanes.push(i);
                     continue;
                 }
@@ -555,28 +592,31 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             // next rays.
             for (&i, answer) in request_lanes.iter().zip(&answers) {
                 let lane = &mut lanes[i];
-                let step = if lane.diffuse {
+                let step = if lane.diffuse || lane.staged {
                     // The Russian roulette draw, where computed ahead,
                     // taken at the lane's cursor without the sampler.
                     let cursor = &mut lane.cursor;
                     let next = predrawn_next[i];
                     let sampler = &mut *sampler;
-                    self.0.diffuse_finish(
-                        scene,
-                        &mut lane.path,
-                        &vertices,
-                        diffuse_slot[i],
-                        answer.as_ref(),
-                        || match next {
-                            Some(v) => cursor.take_1d(v),
-                            None => {
-                                sampler.set_cursor(cursor);
-                                let v = sampler.get_1d();
-                                *cursor = sampler.cursor();
-                                v
-                            }
-                        },
-                    )
+                    let draw = || match next {
+                        Some(v) => cursor.take_1d(v),
+                        None => {
+                            sampler.set_cursor(cursor);
+                            let v = sampler.get_1d();
+                            *cursor = sampler.cursor();
+                            v
+                        }
+                    };
+                    let (k, answer) = (diffuse_slot[i], answer.as_ref());
+                    if lane.diffuse {
+                        let path = &mut lane.path;
+                        self.0
+                            .diffuse_finish(scene, path, &vertices, k, answer, draw)
+                    } else {
+                        let (path, scratch) = (&mut lane.path, &mut scratch[i]);
+                        self.0
+                            .staged_finish(scene, path, scratch, &vertices, k, answer, draw)
+                    }
                 } else {
                     sampler.set_cursor(&lane.cursor);
                     sampler.offer_1d(predrawn_next[i]);

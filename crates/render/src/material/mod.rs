@@ -480,6 +480,41 @@ impl MaterialSet {
         }
     }
 
+    /// True when `material` is a plain `conductor`, `dielectric`,
+    /// `coateddiffuse` or `coatedconductor` (no mix, no bump or normal
+    /// map) whose textures are all constants: its BxDF is the same at
+    /// every point ([`MaterialSet::constant_bxdf`]), and the wavefront's
+    /// BSDF stage answers its queries (the wavefront's staged vertex).
+    #[inline]
+    pub(crate) fn is_constant_staged(&self, material: u32) -> bool {
+        matches!(
+            self.materials.get(material as usize),
+            Some(
+                Material::Conductor(_)
+                    | Material::Dielectric(_)
+                    | Material::CoatedDiffuse(_)
+                    | Material::CoatedConductor(_)
+            )
+        ) && !self.needs_differentials(material)
+    }
+
+    /// The BxDF of a material that [`MaterialSet::is_constant_staged`]
+    /// accepts, as [`MaterialSet::get_bsdf`] builds it at any hit
+    /// (nothing it reads varies over the surface); it may terminate the
+    /// secondary wavelengths of `lambda`, as there.
+    pub(crate) fn constant_bxdf(
+        &self,
+        material: u32,
+        lambda: &mut SampledWavelengths,
+    ) -> Option<BxDF> {
+        debug_assert!(self.is_constant_staged(material));
+        self.materials.get(material as usize)?.get_bxdf(
+            &MaterialEvalContext::default(),
+            lambda,
+            self.seed,
+        )
+    }
+
     /// True when shading material `material` may read the hit's
     /// screen-space differentials: a texture that filters over its
     /// footprint, or bump or normal mapping. Only materials proven to read

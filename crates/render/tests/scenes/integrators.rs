@@ -611,6 +611,34 @@ AttributeBegin
       "integer indices" [ 0 1 2  0 3 1  1 3 2  2 3 0 ]
 AttributeEnd
 AttributeBegin
+  # Glossy meshes of constant materials, flat and with vertex normals:
+  # the wavefront's staged vertex (a smooth conductor's BSDF is specular
+  # and falls back to the scalar vertex).
+  Translate 1.6 0.05 -1.8
+  Material "coatedconductor" "float interface.roughness" 0.1
+      "float conductor.roughness" 0.2
+  Shape "trianglemesh" "point3 P" [ 0 0 0  0.7 0 0.1  0.3 0.8 0.3  0.35 0.1 0.7 ]
+      "normal N" [ -0.5 -0.3 -0.6  0.6 -0.2 -0.5  0 1 0  0.1 -0.2 0.9 ]
+      "integer indices" [ 0 1 2  0 3 1  1 3 2  2 3 0 ]
+  Translate -0.9 0 0.5
+  Material "coateddiffuse" "rgb reflectance" [ 0.2 0.5 0.7 ] "float roughness" 0.1
+  Shape "trianglemesh" "point3 P" [ 0 0 0  0.7 0 0.1  0.3 0.8 0.3  0.35 0.1 0.7 ]
+      "integer indices" [ 0 1 2  0 3 1  1 3 2  2 3 0 ]
+  Translate -3.4 0 0.4
+  Material "conductor" "float roughness" 0.25
+  Shape "trianglemesh" "point3 P" [ 0 0 0  0.7 0 0.1  0.3 0.8 0.3  0.35 0.1 0.7 ]
+      "normal N" [ -0.5 -0.3 -0.6  0.6 -0.2 -0.5  0 1 0  0.1 -0.2 0.9 ]
+      "integer indices" [ 0 1 2  0 3 1  1 3 2  2 3 0 ]
+  Translate 0 0 1.2
+  Material "dielectric" "float eta" 1.4 "float roughness" 0.15
+  Shape "trianglemesh" "point3 P" [ 0 0 0  0.7 0 0.1  0.3 0.8 0.3  0.35 0.1 0.7 ]
+      "integer indices" [ 0 1 2  0 3 1  1 3 2  2 3 0 ]
+  Translate 4.2 0 0.6
+  Material "conductor" "float roughness" 0
+  Shape "trianglemesh" "point3 P" [ 0 0 0  0.7 0 0.1  0.3 0.8 0.3  0.35 0.1 0.7 ]
+      "integer indices" [ 0 1 2  0 3 1  1 3 2  2 3 0 ]
+AttributeEnd
+AttributeBegin
   Translate 0.2 0.5 0.8
   Material "conductor" "float roughness" 0.1
   Shape "sphere" "float radius" 0.5
