@@ -404,18 +404,38 @@ impl LaneVertices {
         }
     }
 
-    /// The light request of the staged vertex at slot `k`, of BSDF `bsdf`
-    /// (`light_request`'s), given its light's draws.
+    /// The first half of the staged vertex at slot `k`, of BSDF `bsdf`,
+    /// given its four sampler draws: its light request
+    /// (`light_request`'s), and what its second half keeps: ωo and the
+    /// BSDF sample's two draws.
     #[inline(always)]
-    pub(crate) fn light_request(
+    pub(crate) fn staged_begin(
         &self,
         k: usize,
         bsdf: &BSDF,
-        u: Float,
-        u_light: Point2f,
-    ) -> LightRequest {
+        draws: (Float, Point2f, Float, Point2f),
+    ) -> (LightRequest, Vector3f, Float, Point2f) {
+        let (u_light, u_light_2d, u, u2) = draws;
         let zero_across = bsdf.bxdf.zero_across_hemispheres();
-        self.request(k, bsdf.flags(), zero_across, u, u_light)
+        let req = self.request(k, bsdf.flags(), zero_across, u_light, u_light_2d);
+        (req, self.wo(k), u, u2)
+    }
+
+    /// The staged vertex at slot `k`'s BSDF `bsdf` toward a light sample's
+    /// direction `wi` (from ωo `wo`), from the BSDF stage's answers `pre`:
+    /// its value times `|wi · ns|` and its density; `None` where the value
+    /// is black (no shadow ray).
+    #[inline(always)]
+    pub(crate) fn staged_light(
+        &self,
+        k: usize,
+        bsdf: &BSDF,
+        pre: &BsdfAnswers,
+        wo: Vector3f,
+        wi: Vector3f,
+    ) -> Option<(SampledSpectrum, Float)> {
+        let f = pre.light_f(bsdf, wo, wi) * abs_dot(wi, self.ns(k));
+        (!f.is_black()).then(|| (f, pre.light_pdf(bsdf, wo, wi)))
     }
 
     /// The light request at slot `k` of a BSDF of `flags` whose frame's z

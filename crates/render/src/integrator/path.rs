@@ -393,10 +393,8 @@ impl VertexIntegrator for PathIntegrator {
     ) -> LightRequest {
         s.depth += 1;
         scratch.hit = None;
-        let (u_light, u_light_2d, u, u2) = draws;
-        (scratch.u, scratch.u2) = (u, u2);
-        scratch.wo = lanes.wo(k);
-        let req = lanes.light_request(k, &bsdf, u_light, u_light_2d);
+        let req;
+        (req, scratch.wo, scratch.u, scratch.u2) = lanes.staged_begin(k, &bsdf, draws);
         scratch.bsdf = Some(bsdf);
         req
     }
@@ -420,12 +418,7 @@ impl VertexIntegrator for PathIntegrator {
         let (wo, ns, time) = (scratch.wo, lanes.ns(k), s.ray.ray.time);
         // `light_shadow_query`.
         let shadow = light.and_then(|a| {
-            let wi = a.ls.wi;
-            let f = pre.light_f(bsdf, wo, wi) * abs_dot(wi, ns);
-            if f.is_black() {
-                return None;
-            }
-            let pdf_light = pre.light_pdf(bsdf, wo, wi);
+            let (f, pdf_light) = lanes.staged_light(k, bsdf, &pre, wo, a.ls.wi)?;
             lane_shadow_query(scene, s, lanes, k, a, f, pdf_light)
         });
         lanes.write_context(k, &mut s.prev_ctx);

@@ -685,10 +685,8 @@ impl VertexIntegrator for VolPathIntegrator {
     ) -> LightRequest {
         s.depth += 1;
         scratch.hit = None;
-        let (u_light, u_light_2d, u, u2) = draws;
-        (scratch.u, scratch.u2) = (u, u2);
-        scratch.wo = lanes.wo(k);
-        let req = lanes.light_request(k, &bsdf, u_light, u_light_2d);
+        let req;
+        (req, scratch.wo, scratch.u, scratch.u2) = lanes.staged_begin(k, &bsdf, draws);
         scratch.bsdf = Some(bsdf);
         req
     }
@@ -713,12 +711,7 @@ impl VertexIntegrator for VolPathIntegrator {
         let (wo, ns, time) = (scratch.wo, lanes.ns(k), s.ray.ray.time);
         // `surface_shadow_query`.
         let shadow = light.and_then(|a| {
-            let wi = a.ls.wi;
-            let f_hat = pre.light_f(bsdf, wo, wi) * abs_dot(wi, ns);
-            if f_hat.is_black() {
-                return None;
-            }
-            let scatter_pdf = pre.light_pdf(bsdf, wo, wi);
+            let (f_hat, scatter_pdf) = lanes.staged_light(k, bsdf, &pre, wo, a.ls.wi)?;
             lane_shadow_query(scene, s, lanes, k, a, f_hat, scatter_pdf)
         });
         let done = VertexStep { shadow, done: true };
