@@ -487,19 +487,46 @@ impl MIPMap {
         self.filter::<[f32; 3]>(st, dst0, dst1)
     }
 
+    /// The fractional level whose texel spacing matches the footprint
+    /// spanned by `dst0` and `dst1`, for the filters other than EWA.
+    #[inline]
+    fn footprint_level(&self, dst0: Vector2f, dst1: Vector2f) -> f32 {
+        let width = 2.0
+            * dst0
+                .x
+                .abs()
+                .max(dst0.y.abs())
+                .max(dst1.x.abs())
+                .max(dst1.y.abs());
+        (self.levels() - 1) as f32 + width.max(1e-8).log2()
+    }
+
+    /// Starts loading the texels that a filtered lookup at `st` over the
+    /// footprint spanned by `dst0` and `dst1` reads at its finer level,
+    /// for a lookup soon after (bilinear and trilinear lookups of levels
+    /// in memory; nothing otherwise): a hint with no effect on results.
+    pub fn prefetch(&self, st: Point2f, dst0: Vector2f, dst1: Vector2f) {
+        if self.tiled.is_some()
+            || !matches!(
+                self.options.filter,
+                FilterFunction::Bilinear | FilterFunction::Trilinear
+            )
+        {
+            return;
+        }
+        let level = self.footprint_level(dst0, dst1);
+        if level < (self.levels() - 1) as f32 {
+            let ilevel = level.floor().max(0.0) as usize;
+            self.pyramid[ilevel].prefetch_bilerp(st, self.wrap2d());
+        }
+    }
+
     fn filter<T: MipValue>(&self, st: Point2f, mut dst0: Vector2f, mut dst1: Vector2f) -> T {
         let n_levels = self.levels();
         if self.options.filter != FilterFunction::EWA {
-            let width = 2.0
-                * dst0
-                    .x
-                    .abs()
-                    .max(dst0.y.abs())
-                    .max(dst1.x.abs())
-                    .max(dst1.y.abs());
             // Level whose texel spacing matches the filter width; very wide filters use
             // the single top texel.
-            let level = (n_levels - 1) as f32 + width.max(1e-8).log2();
+            let level = self.footprint_level(dst0, dst1);
             if level >= (n_levels - 1) as f32 {
                 return T::texel(self, n_levels - 1, Point2i { x: 0, y: 0 });
             }

@@ -732,6 +732,23 @@ impl Image {
     /// four texels found once for all channels.
     #[inline]
     pub fn bilerp_channels_into(&self, p: Point2f, wrap: WrapMode2D, out: &mut [f32]) {
+        let (at, dx, dy) = self.bilerp_corners(p, wrap);
+        let n = self.n_channels().min(out.len());
+        // The storage type matched once for all twelve-odd reads (each
+        // read is `value_at`'s).
+        let out = &mut out[..n];
+        match &self.data {
+            PixelData::U256(v) => bilerp_texels(at, dx, dy, out, |i| self.encoding.to_linear(v[i])),
+            PixelData::Half(v) => bilerp_texels(at, dx, dy, out, |i| v[i].to_f32()),
+            PixelData::Float(v) => bilerp_texels(at, dx, dy, out, |i| v[i]),
+        }
+    }
+
+    /// The storage offsets of the four texels a bilinear lookup at `p`
+    /// reads (`None` outside the image under `Black` wrapping), and the
+    /// lookup's weights along x and y.
+    #[inline(always)]
+    fn bilerp_corners(&self, p: Point2f, wrap: WrapMode2D) -> ([Option<usize>; 4], f32, f32) {
         let x = p.x * self.resolution.x as f32 - 0.5;
         let y = p.y * self.resolution.y as f32 - 0.5;
         let (xf, yf) = (x.floor(), y.floor());
@@ -747,14 +764,28 @@ impl Image {
             corner(xi, yi + 1),
             corner(xi + 1, yi + 1),
         ];
-        let n = self.n_channels().min(out.len());
-        // The storage type matched once for all twelve-odd reads (each
-        // read is `value_at`'s).
-        let out = &mut out[..n];
-        match &self.data {
-            PixelData::U256(v) => bilerp_texels(at, dx, dy, out, |i| self.encoding.to_linear(v[i])),
-            PixelData::Half(v) => bilerp_texels(at, dx, dy, out, |i| v[i].to_f32()),
-            PixelData::Float(v) => bilerp_texels(at, dx, dy, out, |i| v[i]),
+        (at, dx, dy)
+    }
+
+    /// Starts loading the texels a bilinear lookup at `p` reads
+    /// ([`Image::bilerp_channels_into`]), for a lookup soon after: a hint
+    /// with no effect on results.
+    #[inline]
+    pub fn prefetch_bilerp(&self, p: Point2f, wrap: WrapMode2D) {
+        let (at, _, _) = self.bilerp_corners(p, wrap);
+        let (base, size): (*const u8, usize) = match &self.data {
+            PixelData::U256(v) => (v.as_ptr(), 1),
+            PixelData::Half(v) => (v.as_ptr().cast(), 2),
+            PixelData::Float(v) => (v.as_ptr().cast(), 4),
+        };
+        // Each cache line once: a row's two texels usually share one.
+        let mut last = usize::MAX;
+        for i in at.into_iter().flatten() {
+            let p = base.wrapping_add(i * size);
+            if p.addr() >> 6 != last {
+                crate::simd::prefetch_ptr(p);
+                last = p.addr() >> 6;
+            }
         }
     }
 

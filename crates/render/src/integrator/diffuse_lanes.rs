@@ -1,9 +1,9 @@
 //! The wavefront's diffuse vertex: the commonest path vertex of all, a
-//! hit on a triangle of a plain `diffuse` material with a constant
-//! reflectance, taken lane-parallel from the hit to the next ray, without
-//! building the general surface interaction and BSDF the scalar vertex
-//! builds (about 400 bytes a vertex, most of which this vertex never
-//! reads).
+//! hit on a triangle of a plain `diffuse` material, its reflectance a
+//! constant or a texture, taken lane-parallel from the hit to the next
+//! ray, without building the general surface interaction and BSDF the
+//! scalar vertex builds (about 400 bytes a vertex, most of which this
+//! vertex never reads).
 //!
 //! Two kernels, each a fixed sequence of the IEEE operations the scalar
 //! code performs, so that every width gives the scalar vertex's bits:
@@ -13,7 +13,10 @@
 //!    and the BSDF's frame (pbrt-v4's `Triangle::InteractionFromIntersection`
 //!    and `BSDF` constructor). What follows per lane (the point's
 //!    interval, the reflectance, the sampler draws and the light
-//!    request) runs the scalar code itself.
+//!    request) runs the scalar code itself. A textured reflectance is
+//!    looked up there too, in the context the scalar interaction would
+//!    give the texture (its differentials computed by the same code), the
+//!    pass's lookups prepared first and their image texels prefetched.
 //! 2. [`scatters`], after the light stage: the Lambertian BSDF's value and
 //!    density toward the light sample, and its cosine-weighted sample of
 //!    the next direction (pbrt-v4's `DiffuseBxDF` through `BSDF::f`,
@@ -43,16 +46,18 @@ use super::Scene;
 use crate::bxdf::lanes::MAX_LANES;
 use crate::bxdf::{BSDFSample, BxDF, BxDFFlags, DielectricBxDF, BSDF};
 use crate::light::LightSampleContext;
-use crate::primitive::{HitRecord, TriangleHit};
+use crate::primitive::{HitRecord, TextureParts, TriangleHit};
 use crate::sampler::Sampler;
 use crate::simd::math::{self, V3};
 use crate::simd::{dispatch, F32Lanes, Kernel, SimdLevel};
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::TextureEvalContext;
 use rpbrt_geometry::float::{gamma, Float, INV_PI, PI_OVER_4};
 use rpbrt_geometry::frame::Frame;
+use rpbrt_geometry::interaction::SurfaceInteraction;
 use rpbrt_geometry::interval::Interval;
 use rpbrt_geometry::pointfi::Point3fi;
-use rpbrt_geometry::ray::{spawn_ray_from_origin_to_surface, Ray, SHADOW_EPSILON};
+use rpbrt_geometry::ray::{spawn_ray_from_origin_to_surface, Ray, RayDifferential, SHADOW_EPSILON};
 use rpbrt_geometry::tuple::*;
 
 /// What a vertex that the surface kernel builds shades with.
@@ -61,6 +66,13 @@ pub(crate) enum LaneShade {
     /// A diffuse vertex: a plain `diffuse` material of constant, not
     /// black, reflectance (this, at the path's wavelengths).
     Diffuse(SampledSpectrum),
+    /// A diffuse vertex of a plain `diffuse` material whose reflectance
+    /// is a texture ([`MaterialSet::textured_diffuse`]), this one: the
+    /// texture is looked up after the surface kernel
+    /// ([`LaneVertices::textured_reflectance`]).
+    ///
+    /// [`MaterialSet::textured_diffuse`]: crate::material::MaterialSet::textured_diffuse
+    Textured(u32),
     /// A specular vertex: a constant specular `dielectric` material
     /// ([`MaterialSet::constant_specular_dielectric`]), its BxDF.
     ///
@@ -104,6 +116,9 @@ pub(crate) fn lane_surface(
             }
             LaneShade::Diffuse(r)
         }
+        None if scene.materials.textured_diffuse(material).is_some() => {
+            LaneShade::Textured(material)
+        }
         None if as_built => match scene
             .materials
             .constant_specular_dielectric(material, lambda)
@@ -114,7 +129,13 @@ pub(crate) fn lane_surface(
         },
         None => return None,
     };
-    out.push(&hit, d).then_some(shade)
+    if !out.push(&hit, d) {
+        return None;
+    }
+    if let LaneShade::Textured(_) = shade {
+        out.texture[out.len - 1] = hit.texture_parts();
+    }
+    Some(shade)
 }
 
 /// The components of a point, vector or normal.
@@ -192,6 +213,10 @@ pub(crate) struct LaneVertices {
     shading: [bool; STRIDE],
     ok: [bool; STRIDE],
     sampled: [bool; STRIDE],
+    /// Per textured diffuse slot: the hit's parameterization, and the
+    /// texture lookup's context.
+    texture: Box<[TextureParts; STRIDE]>,
+    contexts: Box<[TextureEvalContext; STRIDE]>,
 }
 
 impl Default for LaneVertices {
@@ -202,6 +227,8 @@ impl Default for LaneVertices {
             shading: [false; STRIDE],
             ok: [false; STRIDE],
             sampled: [false; STRIDE],
+            texture: Box::new([TextureParts::default(); STRIDE]),
+            contexts: Box::new([TextureEvalContext::default(); STRIDE]),
         }
     }
 }
@@ -388,6 +415,56 @@ impl LaneVertices {
         self.set(col::U2 + 1, k, u2.y);
         // A Lambertian BSDF only reflects and is zero across hemispheres.
         self.request(k, BxDFFlags::DIFFUSE_REFLECTION, true, u_light, u_light_2d)
+    }
+
+    /// Prepares the texture lookup of the textured diffuse vertex at slot
+    /// `k`, of material `material`, hit by `ray`: its context, the scalar
+    /// vertex's (from the interaction's point, normal, ∂p/∂u, ∂p/∂v and
+    /// (u, v), with the screen-space differentials computed from them),
+    /// and a prefetch of the image texels it reads, so that the lookups
+    /// of a pass wait on memory together rather than one after another.
+    #[inline(always)]
+    pub(crate) fn texture_lookup(
+        &mut self,
+        scene: &Scene,
+        k: usize,
+        material: u32,
+        ray: &RayDifferential,
+    ) {
+        let Some(m) = scene.materials.textured_diffuse(material) else {
+            return;
+        };
+        let t = &self.texture[k];
+        let mut si = SurfaceInteraction {
+            pi: self.pi(k),
+            n: self.normal(col::N_OUT, k),
+            uv: t.uv,
+            dpdu: t.dpdu,
+            dpdv: t.dpdv,
+            face_index: t.face_index,
+            ..Default::default()
+        };
+        scene.texture_differentials(material, &mut si, ray);
+        let ctx = TextureEvalContext::from_si(&si);
+        m.reflectance.prefetch(&ctx);
+        self.contexts[k] = ctx;
+    }
+
+    /// The reflectance of the textured diffuse vertex at slot `k`, of
+    /// material `material`, looked up in the context
+    /// [`LaneVertices::texture_lookup`] prepared; `None` where it is
+    /// black (a BSDF without flags, which the scalar vertex handles).
+    #[inline(always)]
+    pub(crate) fn textured_reflectance(
+        &self,
+        scene: &Scene,
+        k: usize,
+        material: u32,
+        lambda: &SampledWavelengths,
+    ) -> Option<SampledSpectrum> {
+        let m = scene.materials.textured_diffuse(material)?;
+        let r = m.reflectance_at(&self.contexts[k], lambda);
+        (!r.is_black()).then_some(r)
     }
 
     /// The BSDF of the staged vertex at slot `k`: `bxdf` in the frame the

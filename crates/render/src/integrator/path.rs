@@ -16,7 +16,7 @@ use crate::sampler::Sampler;
 use crate::sampling::power_heuristic;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::{Float, INV_PI};
-use rpbrt_geometry::ray::{Ray, RayDifferential};
+use rpbrt_geometry::ray::RayDifferential;
 use rpbrt_geometry::tuple::*;
 
 /// The state of a path being traced: the locals of pbrt-v4's
@@ -114,8 +114,8 @@ impl VertexIntegrator for PathIntegrator {
     }
 
     #[inline(always)]
-    fn ray(s: &PathState) -> &Ray {
-        &s.ray.ray
+    fn ray(s: &PathState) -> &RayDifferential {
+        &s.ray
     }
 
     #[inline(always)]

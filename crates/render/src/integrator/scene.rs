@@ -244,17 +244,7 @@ impl Scene {
         sampler: &mut S,
     ) -> Option<BSDF> {
         let material = hit.material?;
-        // The differentials only feed texture filtering and bump mapping;
-        // materials that do neither get the same BSDF without them.
-        if self.materials.needs_differentials(material) {
-            let spp_scale = (1.0 / (self.samples_per_pixel.max(1) as Float).sqrt()).max(0.125);
-            hit.si.compute_differentials(
-                ray,
-                Some(&self.camera_differentials),
-                spp_scale,
-                self.disable_texture_filtering,
-            );
-        }
+        self.texture_differentials(material, &mut hit.si, ray);
         // Returned as is (not unwrapped and rewrapped): the BSDF is large
         // and this lets it be built in the caller's slot.
         let bsdf = self.materials.get_bsdf(material, &mut hit.si, lambda);
@@ -267,6 +257,28 @@ impl Scene {
             return Some(MaterialSet::force_diffuse(&bsdf, &hit.si, uc, u));
         }
         bsdf
+    }
+
+    /// The screen-space differentials of `si` (hit by `ray`) where
+    /// `material` reads them: they only feed texture filtering and bump
+    /// mapping, and materials that do neither get the same BSDF without
+    /// them.
+    #[inline]
+    pub(crate) fn texture_differentials(
+        &self,
+        material: u32,
+        si: &mut SurfaceInteraction,
+        ray: &RayDifferential,
+    ) {
+        if self.materials.needs_differentials(material) {
+            let spp_scale = (1.0 / (self.samples_per_pixel.max(1) as Float).sqrt()).max(0.125);
+            si.compute_differentials(
+                ray,
+                Some(&self.camera_differentials),
+                spp_scale,
+                self.disable_texture_filtering,
+            );
+        }
     }
 
     /// The first visible surface of a camera path, for G-buffer films

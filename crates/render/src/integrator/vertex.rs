@@ -16,7 +16,7 @@ use crate::primitive::HitRecord;
 use crate::sampler::Sampler;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::Float;
-use rpbrt_geometry::ray::{Ray, RayDifferential};
+use rpbrt_geometry::ray::RayDifferential;
 use rpbrt_geometry::tuple::Point2f;
 
 /// What a path vertex leaves to the caller: a shadow ray whose
@@ -66,8 +66,9 @@ pub(crate) trait VertexIntegrator: Sync {
     /// The state of a path starting with a camera ray.
     fn start(&self, ray: RayDifferential) -> Self::State;
 
-    /// The ray whose closest hit the next vertex needs.
-    fn ray(s: &Self::State) -> &Ray;
+    /// The ray whose closest hit the next vertex needs, with its
+    /// differentials.
+    fn ray(s: &Self::State) -> &RayDifferential;
 
     /// The radiance the path has gathered.
     fn radiance(s: &mut Self::State) -> &mut SampledSpectrum;
@@ -229,7 +230,7 @@ pub(crate) fn li_by_vertices<I: VertexIntegrator>(
     let mut s = integrator.start(ray);
     let mut scratch = I::Scratch::default();
     loop {
-        let record = scene.intersect_record(I::ray(&s), Float::INFINITY);
+        let record = scene.intersect_record(&I::ray(&s).ray, Float::INFINITY);
         let step = match integrator.begin(
             scene,
             &mut s,

@@ -244,8 +244,8 @@ impl VertexIntegrator for VolPathIntegrator {
     }
 
     #[inline(always)]
-    fn ray(s: &VolPathState) -> &Ray {
-        &s.ray.ray
+    fn ray(s: &VolPathState) -> &RayDifferential {
+        &s.ray
     }
 
     #[inline(always)]

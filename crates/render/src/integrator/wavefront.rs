@@ -18,8 +18,9 @@
 //!    (delta tracking through media, emission, the BSDF, the sampler
 //!    draws) up to the vertex's light-sample request, and, after the
 //!    light stage, [`VertexIntegrator::finish`] (the BSDF toward the
-//!    light sample, the next ray). Diffuse vertices (`diffuse_lanes.rs`)
-//!    take both halves in lanes instead: their surfaces built together
+//!    light sample, the next ray). Diffuse vertices (`diffuse_lanes.rs`,
+//!    of constant or textured reflectance) take both halves in lanes
+//!    instead: their surfaces built together
 //!    before the first half, their BSDF's answers together before the
 //!    second; so do the specular vertices of smooth glass under `path`,
 //!    whose whole vertex (no light sample) is the scalar BSDF's sample in
@@ -373,7 +374,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             let coherent = order.len();
             order.extend(active.iter().filter(|&&i| !lanes[i].camera));
             rays.clear();
-            rays.extend(order.iter().map(|&i| *I::ray(&lanes[i].path)));
+            rays.extend(order.iter().map(|&i| I::ray(&lanes[i].path).ray));
             scene.intersect_records(&rays, coherent, level, &mut traced);
             hits.resize(lanes.len(), None);
             for (&i, &h) in order.iter().zip(&traced) {
@@ -450,11 +451,18 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             for (k, &i) in diffuse.iter().enumerate() {
                 if vertices.ok(k) {
                     match shades[k] {
-                        LaneShade::Diffuse(_) => lanes[i].diffuse = true,
+                        LaneShade::Diffuse(_) | LaneShade::Textured(_) => lanes[i].diffuse = true,
                         LaneShade::Specular(_) => lanes[i].specular = true,
                         LaneShade::Staged(_) => lanes[i].staged = true,
                     }
                     diffuse_slot[i] = k;
+                }
+            }
+            // The textured vertices' lookups prepared together, their
+            // texels prefetched.
+            for (k, &i) in diffuse.iter().enumerate() {
+                if let (true, LaneShade::Textured(m)) = (vertices.ok(k), shades[k]) {
+                    vertices.texture_lookup(scene, k, m, I::ray(&lanes[i].path));
                 }
             }
             clock.enter(Stage::Begin);
@@ -468,6 +476,12 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 // vertex, which draws otherwise.
                 let lane_light = match shade {
                     Some(LaneShade::Diffuse(r)) => Some(LaneLight::Diffuse(r)),
+                    // A black reflectance is left to the scalar vertex.
+                    Some(LaneShade::Textured(m)) => {
+                        let r = vertices.textured_reflectance(scene, k, m, &lane.lambda);
+                        lane.diffuse = r.is_some();
+                        r.map(LaneLight::Diffuse)
+                    }
                     Some(LaneShade::Staged(m)) => {
                         let mut lambda = lane.lambda;
                         let bsdf = scene

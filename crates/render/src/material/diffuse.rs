@@ -2,8 +2,8 @@
 //! `DiffuseMaterial`, `DiffuseTransmissionMaterial`).
 
 use crate::bxdf::{BxDF, DiffuseBxDF, DiffuseTransmissionBxDF};
-use crate::spectrum::SampledWavelengths;
-use crate::texture::SpectrumTextureRef;
+use crate::spectrum::{SampledSpectrum, SampledWavelengths};
+use crate::texture::{SpectrumTextureRef, TextureEvalContext};
 use rpbrt_geometry::float::Float;
 
 use super::{MaterialEvalContext, ShadingPerturbation};
@@ -20,8 +20,17 @@ pub struct DiffuseMaterial {
 impl DiffuseMaterial {
     /// The BxDF at a point.
     pub fn get_bxdf(&self, ctx: &MaterialEvalContext, lambda: &mut SampledWavelengths) -> BxDF {
-        let r = self.reflectance.evaluate(&ctx.tex, lambda).clamp(0.0, 1.0);
-        BxDF::Diffuse(DiffuseBxDF::new(r))
+        BxDF::Diffuse(DiffuseBxDF::new(self.reflectance_at(&ctx.tex, lambda)))
+    }
+
+    /// The reflectance at a point, clamped to [0, 1] (the BxDF's).
+    #[inline]
+    pub fn reflectance_at(
+        &self,
+        ctx: &TextureEvalContext,
+        lambda: &SampledWavelengths,
+    ) -> SampledSpectrum {
+        self.reflectance.evaluate(ctx, lambda).clamp(0.0, 1.0)
     }
 }
 

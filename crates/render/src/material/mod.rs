@@ -447,6 +447,24 @@ impl MaterialSet {
         }
     }
 
+    /// The plain `diffuse` material `material` (no mix, no normal or
+    /// bump map) when its reflectance is a texture other than a constant:
+    /// its reflectance varies over the surface but depends on nothing
+    /// else of the hit than the texture lookup's context (the wavefront's
+    /// lane-parallel diffuse vertex, textured).
+    #[inline]
+    pub(crate) fn textured_diffuse(&self, material: u32) -> Option<&DiffuseMaterial> {
+        match self.materials.get(material as usize) {
+            Some(Material::Diffuse(m))
+                if !m.perturbation.is_some()
+                    && !matches!(*m.reflectance, crate::texture::SpectrumTexture::Constant(_)) =>
+            {
+                Some(m)
+            }
+            _ => None,
+        }
+    }
+
     /// The BxDF of `material` when it is a plain `dielectric` (no mix, no
     /// normal or bump map) of constant index of refraction and constant
     /// roughness, and that BxDF is specular: the same at every point and

@@ -17,7 +17,7 @@ use rpbrt_geometry::float::Float;
 use rpbrt_geometry::interaction::SurfaceInteraction;
 use rpbrt_geometry::ray::{MediumId, Ray};
 use rpbrt_geometry::transform::Transform;
-use rpbrt_geometry::tuple::{Normal3f, Point3f, Vector3f};
+use rpbrt_geometry::tuple::{Normal3f, Point2f, Point3f, Vector3f};
 use rpbrt_geometry::Bounds3f;
 use std::sync::Arc;
 
@@ -483,6 +483,37 @@ impl TriangleHit<'_> {
             }
         }
     }
+
+    /// What texture lookups read of the hit besides the point and its
+    /// normal, as the interaction holds it.
+    #[inline(always)]
+    pub(crate) fn texture_parts(&self) -> TextureParts {
+        let [b0, b1, b2] = self.b;
+        let (dpdu, dpdv) = match self.frame {
+            Some(f) => (f.dpdu, f.dpdv),
+            None => {
+                let f = self.tri.frame();
+                (f.dpdu, f.dpdv)
+            }
+        };
+        TextureParts {
+            uv: self.tri.uv_at(b0, b1, b2),
+            dpdu,
+            dpdv,
+            face_index: self.tri.face_index(),
+        }
+    }
+}
+
+/// A triangle hit's surface parameterization at the point hit
+/// ([`TriangleHit::texture_parts`]): (u, v), the geometric ∂p/∂u and
+/// ∂p/∂v, and the face index.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct TextureParts {
+    pub uv: Point2f,
+    pub dpdu: Vector3f,
+    pub dpdv: Vector3f,
+    pub face_index: i32,
 }
 
 /// How [`PrimitiveAggregate::interaction`] builds a hit's interaction.

@@ -578,6 +578,26 @@ impl<M: Deref<Target = TriangleMesh>> TriangleOf<M> {
         }
     }
 
+    /// The texture coordinates at barycentrics (b0, b1, b2), as the
+    /// interaction interpolates them.
+    #[inline(always)]
+    pub(crate) fn uv_at(&self, b0: Float, b1: Float, b2: Float) -> Point2f {
+        let uv = self.uvs();
+        Point2f::new(
+            b0 * uv[0].x + b1 * uv[1].x + b2 * uv[2].x,
+            b0 * uv[0].y + b1 * uv[1].y + b2 * uv[2].y,
+        )
+    }
+
+    /// The triangle's face index (ptex), 0 when the mesh has none.
+    #[inline(always)]
+    pub(crate) fn face_index(&self) -> i32 {
+        self.mesh
+            .face_indices
+            .as_ref()
+            .map_or(0, |f| f[self.tri_index as usize])
+    }
+
     /// The solid angle the triangle subtends from `p`.
     pub fn solid_angle(&self, p: Point3f) -> Float {
         let [a, b, c] = self.directions_from(p);
@@ -799,7 +819,6 @@ impl<M: Deref<Target = TriangleMesh>> TriangleOf<M> {
         let mesh = &*self.mesh;
         let v = self.vertex_indices();
         let [p0, p1, p2] = self.vertices();
-        let uv = self.uvs();
         let TriangleFrame {
             n,
             dpdu,
@@ -809,10 +828,7 @@ impl<M: Deref<Target = TriangleMesh>> TriangleOf<M> {
         } = *frame;
 
         let p_hit = p0 * b0 + p1 * b1 + p2 * b2;
-        let uv_hit = Point2f::new(
-            b0 * uv[0].x + b1 * uv[1].x + b2 * uv[2].x,
-            b0 * uv[0].y + b1 * uv[1].y + b2 * uv[2].y,
-        );
+        let uv_hit = self.uv_at(b0, b1, b2);
         let abs_sum = (p0 * b0).abs() + (p1 * b1).abs() + (p2 * b2).abs();
         let p_error = Vector3f::from(abs_sum) * gamma(7);
 
@@ -837,10 +853,7 @@ impl<M: Deref<Target = TriangleMesh>> TriangleOf<M> {
             },
             ..Default::default()
         };
-        isect.face_index = mesh
-            .face_indices
-            .as_ref()
-            .map_or(0, |f| f[self.tri_index as usize]);
+        isect.face_index = self.face_index();
 
         if mesh.n.is_some() || mesh.s.is_some() {
             // Shading normal: interpolated vertex normals when usable.

@@ -43,6 +43,14 @@ impl ImageTextureBase {
             Vector2f::new(c.dsdy, c.dtdy),
         )
     }
+
+    /// Starts loading the texels a lookup at `ctx` reads
+    /// ([`MIPMap::prefetch`]).
+    #[inline]
+    pub fn prefetch(&self, ctx: &TextureEvalContext) {
+        let (st, d0, d1) = self.lookup_coords(ctx);
+        self.mipmap.prefetch(st, d0, d1);
+    }
 }
 
 /// A float texture read from an image (pbrt-v4 `FloatImageTexture`).

@@ -133,6 +133,29 @@ impl FloatTexture {
         }
     }
 
+    /// Starts loading the image texels that [`FloatTexture::evaluate`]
+    /// at `ctx` reads, through scales and blends, for an evaluation soon
+    /// after: a hint with no effect on results.
+    pub fn prefetch(&self, ctx: &TextureEvalContext) {
+        match self {
+            FloatTexture::Image(t) => t.base.prefetch(ctx),
+            FloatTexture::Scaled(t) => {
+                t.tex.prefetch(ctx);
+                t.scale.prefetch(ctx);
+            }
+            FloatTexture::Mix(t) => {
+                t.tex1.prefetch(ctx);
+                t.tex2.prefetch(ctx);
+                t.amount.prefetch(ctx);
+            }
+            FloatTexture::DirectionMix(t) => {
+                t.tex1.prefetch(ctx);
+                t.tex2.prefetch(ctx);
+            }
+            _ => {}
+        }
+    }
+
     /// The value if the texture is a constant.
     #[inline]
     pub fn constant_value(&self) -> Option<Float> {
@@ -198,6 +221,34 @@ impl SpectrumTexture {
             SpectrumTexture::Ptex(t) => t.evaluate(ctx, lambda),
             SpectrumTexture::Uv(t) => t.evaluate(ctx, lambda),
             SpectrumTexture::Grey(t) => SampledSpectrum::new(t.evaluate(ctx)),
+        }
+    }
+
+    /// Starts loading the image texels that [`SpectrumTexture::evaluate`]
+    /// at `ctx` reads, through scales, products and blends, for an
+    /// evaluation soon after: a hint with no effect on results.
+    pub fn prefetch(&self, ctx: &TextureEvalContext) {
+        match self {
+            SpectrumTexture::Image(t) => t.base.prefetch(ctx),
+            SpectrumTexture::Scaled(t) => {
+                t.tex.prefetch(ctx);
+                t.scale.prefetch(ctx);
+            }
+            SpectrumTexture::Product(t) => {
+                t.tex.prefetch(ctx);
+                t.tex2.prefetch(ctx);
+            }
+            SpectrumTexture::Mix(t) => {
+                t.tex1.prefetch(ctx);
+                t.tex2.prefetch(ctx);
+                t.amount.prefetch(ctx);
+            }
+            SpectrumTexture::DirectionMix(t) => {
+                t.tex1.prefetch(ctx);
+                t.tex2.prefetch(ctx);
+            }
+            SpectrumTexture::Grey(t) => t.prefetch(ctx),
+            _ => {}
         }
     }
 }

@@ -582,6 +582,7 @@ LightSource "spot" "point3 from" [ 2 4 -2 ] "point3 to" [ 0 0 0 ] "rgb I" [ 20 1
 Texture "checks" "spectrum" "checkerboard" "float uscale" 8 "float vscale" 8
     "rgb tex1" [ 0.8 0.8 0.8 ] "rgb tex2" [ 0.1 0.2 0.1 ]
 Texture "bumps" "float" "scale" "float tex" 0.02 "float scale" 1
+Texture "scaled-checks" "spectrum" "scale" "texture tex" "checks" "float scale" 0.7
 AttributeBegin
   Material "diffuse" "texture reflectance" "checks" "texture displacement" "bumps"
   Shape "trianglemesh" "point3 P" [ -4 0 -4  4 0 -4  4 0 4  -4 0 4 ]
@@ -695,15 +696,26 @@ fn wavefront_matches_scalar_bit_for_bit() {
     ] {
         let tag = format!("wavefront-varied-{sampler}-{integrator}");
         let varied = varied_scene(&tag, sampler, spp, integrator);
-        // And without the G-buffer and the texture that need ray
-        // differentials: the camera's pinhole rays generated lane-parallel.
-        let plain = varied.replace("Film \"gbuffer\"", "Film \"rgb\"").replace(
-            "\"texture reflectance\" \"checks\" \"texture displacement\" \"bumps\"",
-            "\"rgb reflectance\" [ 0.4 0.5 0.3 ]",
-        );
-        assert_ne!(plain, varied);
+        let rgb = varied.replace("Film \"gbuffer\"", "Film \"rgb\"");
+        let floor = "\"texture reflectance\" \"checks\" \"texture displacement\" \"bumps\"";
+        // Without the G-buffer and the bump map: the textured diffuse
+        // vertex, taken in lanes (on the floor, and on the mesh with
+        // vertex normals and no uv, under a scaled texture), its texture
+        // filtered with the camera ray's differentials and with the
+        // camera's approximate ones.
+        let textured = rgb
+            .replace(floor, "\"texture reflectance\" \"checks\"")
+            .replace(
+                "\"rgb reflectance\" [ 0.3 0.6 0.5 ]",
+                "\"texture reflectance\" \"scaled-checks\"",
+            );
+        // And without any texture that needs ray differentials: the
+        // camera's pinhole rays generated lane-parallel.
+        let plain = rgb.replace(floor, "\"rgb reflectance\" [ 0.4 0.5 0.3 ]");
+        assert!(!textured.contains("\"texture displacement\""));
+        assert!(textured.contains("\"texture reflectance\" \"scaled-checks\""));
         assert!(!plain.contains("gbuffer") && !plain.contains("texture reflectance"));
-        for text in [varied, plain] {
+        for text in [varied, textured, plain] {
             check_wavefront_bits(&text);
         }
     }
