@@ -1,16 +1,18 @@
 //! Camera rays many at a time: the common camera (a pinhole perspective
 //! camera whose transform does not move during the shutter) generating
 //! the rays of a batch of film points lane-parallel, at the SIMD level's
-//! width.
+//! width, with or without their differentials.
 //!
 //! Each lane performs the scalar code's operations in its order (no fused
 //! multiply-adds: Rust does not contract them), so the rays are those of
 //! [`PerspectiveCamera::generate_ray`](super::PerspectiveCamera::generate_ray)
+//! and [`PerspectiveCamera::generate_ray_differential`](super::PerspectiveCamera::generate_ray_differential)
 //! bit for bit, at every width.
 
 use super::Camera;
 use crate::simd::{self, F32Lanes, Kernel, SimdLevel, MAX_LANES};
 use rpbrt_geometry::pointfi::Point3fi;
+use rpbrt_geometry::ray::RayDifferential;
 use rpbrt_geometry::{Float, MediumId, Point2f, Point3f, Ray, Vector3f};
 
 /// A pinhole perspective camera with a fixed render-from-camera
@@ -28,6 +30,24 @@ pub struct PinholeRays {
     origin: Point3f,
     origin_error: Vector3f,
     medium: Option<MediumId>,
+    /// The camera-space origin taken to render space as a point (the
+    /// offset rays' origin, before scaling), and one raster pixel's
+    /// camera-space offsets along x and y.
+    origin_point: Point3f,
+    dx_camera: Vector3f,
+    dy_camera: Vector3f,
+}
+
+/// The offset rays [`PinholeRays::rays`] gives its rays.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum OffsetRays {
+    /// None (nothing reads them).
+    None,
+    /// One pixel's offsets, as the camera makes them.
+    Unscaled,
+    /// Those offsets scaled by this factor toward the main ray
+    /// (`RayDifferential::scale_differentials`).
+    Scaled(Float),
 }
 
 impl Camera {
@@ -49,15 +69,27 @@ impl Camera {
             origin: o.midpoint(),
             origin_error: o.error(),
             medium: c.base.medium,
+            origin_point: render.apply_point(Point3f::new(0.0, 0.0, 0.0)),
+            dx_camera: c.dx_camera,
+            dy_camera: c.dy_camera,
         })
     }
 }
 
 impl PinholeRays {
     /// The rays through raster points `p_film` at times `times` (as
-    /// long), appended to `out`: [`Camera::generate_ray`]'s rays, computed
-    /// [`SimdLevel::lanes`] at a time at `level`.
-    pub fn rays(&self, level: SimdLevel, p_film: &[Point2f], times: &[Float], out: &mut Vec<Ray>) {
+    /// long), with the offset rays `offsets` asks for, appended to `out`:
+    /// [`Camera::generate_ray`]'s rays (without offset rays) or
+    /// [`Camera::generate_ray_differential`]'s (then scaled as asked),
+    /// computed [`SimdLevel::lanes`] at a time at `level`.
+    pub fn rays(
+        &self,
+        level: SimdLevel,
+        p_film: &[Point2f],
+        times: &[Float],
+        offsets: OffsetRays,
+        out: &mut Vec<RayDifferential>,
+    ) {
         debug_assert_eq!(p_film.len(), times.len());
         simd::dispatch(
             level,
@@ -65,6 +97,7 @@ impl PinholeRays {
                 cam: self,
                 p_film,
                 times,
+                offsets,
                 out,
             },
         );
@@ -86,7 +119,40 @@ struct RaysKernel<'a> {
     cam: &'a PinholeRays,
     p_film: &'a [Point2f],
     times: &'a [Float],
-    out: &'a mut Vec<Ray>,
+    offsets: OffsetRays,
+    out: &'a mut Vec<RayDifferential>,
+}
+
+/// `v` normalized as `Vector3f::normalize` does it (each component
+/// divided by the length).
+#[inline(always)]
+fn normalize<L: F32Lanes>(v: [L; 3]) -> [L; 3] {
+    let len = v[0]
+        .mul(v[0])
+        .add(v[1].mul(v[1]))
+        .add(v[2].mul(v[2]))
+        .sqrt();
+    [v[0].div(len), v[1].div(len), v[2].div(len)]
+}
+
+/// `p + o`, component by component.
+#[inline(always)]
+fn plus<L: F32Lanes>(p: [L; 3], o: Vector3f) -> [L; 3] {
+    [
+        p[0].add(L::splat(o.x)),
+        p[1].add(L::splat(o.y)),
+        p[2].add(L::splat(o.z)),
+    ]
+}
+
+/// `render_from_camera.apply_vector(v)`.
+#[inline(always)]
+fn to_render<L: F32Lanes>(r: &[[Float; 4]; 4], v: [L; 3]) -> [L; 3] {
+    [
+        row(&r[0], v[0], v[1], v[2]),
+        row(&r[1], v[0], v[1], v[2]),
+        row(&r[2], v[0], v[1], v[2]),
+    ]
 }
 
 impl Kernel for RaysKernel<'_> {
@@ -98,6 +164,7 @@ impl Kernel for RaysKernel<'_> {
             cam,
             p_film,
             times,
+            offsets,
             out,
         } = self;
         let n = L::N;
@@ -125,19 +192,10 @@ impl Kernel for RaysKernel<'_> {
                 L::select(affine, zp, zp.div(wp)),
             ];
             // The camera-space direction, normalized.
-            let len = pc[0]
-                .mul(pc[0])
-                .add(pc[1].mul(pc[1]))
-                .add(pc[2].mul(pc[2]))
-                .sqrt();
-            let dc = [pc[0].div(len), pc[1].div(len), pc[2].div(len)];
+            let dc = normalize(pc);
             // render_from_camera.apply_ray: the direction's image, and the
             // origin pushed past its error bound along it.
-            let d = [
-                row(&r[0], dc[0], dc[1], dc[2]),
-                row(&r[1], dc[0], dc[1], dc[2]),
-                row(&r[2], dc[0], dc[1], dc[2]),
-            ];
+            let d = to_render(r, dc);
             let len2 = d[0].mul(d[0]).add(d[1].mul(d[1])).add(d[2].mul(d[2]));
             let e = cam.origin_error;
             let dt = d[0]
@@ -153,15 +211,56 @@ impl Kernel for RaysKernel<'_> {
                 L::select(offset, s(o.y).add(d[1].mul(dt)), s(o.y)),
                 L::select(offset, s(o.z).add(d[2].mul(dt)), s(o.z)),
             ];
-            let mut lanes = [[0.0; MAX_LANES]; 6];
+            let mut lanes = [[0.0; MAX_LANES]; 18];
             for (v, dst) in os.iter().chain(&d).zip(lanes.iter_mut()) {
                 v.store(dst);
             }
-            out.extend(times.iter().enumerate().map(|(k, &time)| Ray {
-                o: Point3f::new(lanes[0][k], lanes[1][k], lanes[2][k]),
-                d: Vector3f::new(lanes[3][k], lanes[4][k], lanes[5][k]),
-                time,
-                medium: cam.medium,
+            if offsets != OffsetRays::None {
+                // The offset rays (`generate_ray_differential`): from the
+                // camera-space origin, through the point one pixel over,
+                // taken to render space (`apply_ray_differential`), then
+                // scaled toward the main ray (`scale_differentials`).
+                let op = cam.origin_point;
+                let mut rx = [s(op.x), s(op.y), s(op.z)];
+                let mut ry = rx;
+                let mut dxr = to_render(r, normalize(plus(pc, cam.dx_camera)));
+                let mut dyr = to_render(r, normalize(plus(pc, cam.dy_camera)));
+                if let OffsetRays::Scaled(f) = offsets {
+                    let f = s(f);
+                    for a in 0..3 {
+                        rx[a] = os[a].add(rx[a].sub(os[a]).mul(f));
+                        ry[a] = os[a].add(ry[a].sub(os[a]).mul(f));
+                        dxr[a] = d[a].add(dxr[a].sub(d[a]).mul(f));
+                        dyr[a] = d[a].add(dyr[a].sub(d[a]).mul(f));
+                    }
+                }
+                let rest = rx.iter().chain(&ry).chain(&dxr).chain(&dyr);
+                for (v, dst) in rest.zip(lanes[6..].iter_mut()) {
+                    v.store(dst);
+                }
+            }
+            let has_differentials = offsets != OffsetRays::None;
+            out.extend(times.iter().enumerate().map(|(k, &time)| {
+                let p = |c: usize| Point3f::new(lanes[c][k], lanes[c + 1][k], lanes[c + 2][k]);
+                let v = |c: usize| Vector3f::new(lanes[c][k], lanes[c + 1][k], lanes[c + 2][k]);
+                let ray = Ray {
+                    o: p(0),
+                    d: v(3),
+                    time,
+                    medium: cam.medium,
+                };
+                if has_differentials {
+                    RayDifferential {
+                        ray,
+                        has_differentials,
+                        rx_origin: p(6),
+                        ry_origin: p(9),
+                        rx_direction: v(12),
+                        ry_direction: v(15),
+                    }
+                } else {
+                    RayDifferential::new(ray)
+                }
             }));
         }
     }

@@ -33,7 +33,7 @@ use rpbrt_geometry::{
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 pub use create::{create_camera, read_lens_file, CAMERA_NAMES};
-pub use lanes::PinholeRays;
+pub use lanes::{OffsetRays, PinholeRays};
 pub use projective::{OrthographicCamera, PerspectiveCamera, ProjectiveTransforms};
 pub use realistic::{ApertureImage, LensElementInterface, RealisticCamera};
 pub use spherical::{SphericalCamera, SphericalMapping};

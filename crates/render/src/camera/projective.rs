@@ -199,8 +199,10 @@ pub struct PerspectiveCamera {
     /// corner grown by the filter radius: directions further off axis
     /// carry no importance (pbrt-v4 `cosTotalWidth`).
     pub cos_total_width: Float,
-    dx_camera: Vector3f,
-    dy_camera: Vector3f,
+    /// The camera-space offsets of one raster pixel along x and y (the
+    /// ray differentials' film offsets).
+    pub(crate) dx_camera: Vector3f,
+    pub(crate) dy_camera: Vector3f,
 }
 
 impl PerspectiveCamera {

@@ -890,6 +890,7 @@ fn aperture_image_from_a_file() {
 #[test]
 fn pinhole_lanes_match_single_rays() {
     use crate::simd::SimdLevel;
+    use rpbrt_geometry::ray::RayDifferential;
     let moved = Transform::translate(Vector3f::new(3.0, -1.5, 250.0))
         * Transform::rotate(37.0, Vector3f::new(0.3, 1.0, -0.2))
         * Transform::scale(1.0, 1.0, -1.0);
@@ -942,20 +943,39 @@ fn pinhole_lanes_match_single_rays() {
             Point2f::new(w / 2.0, h / 2.0),
         ]);
         let times: Vec<Float> = p_film.iter().map(|_| rng.uniform_float()).collect();
+        let bits = |r: &RayDifferential| {
+            let (o, d) = (r.ray.o, r.ray.d);
+            let (ox, oy, dx, dy) = (r.rx_origin, r.ry_origin, r.rx_direction, r.ry_direction);
+            [
+                o.x, o.y, o.z, d.x, d.y, d.z, r.ray.time, ox.x, ox.y, ox.z, oy.x, oy.y, oy.z, dx.x,
+                dx.y, dx.z, dy.x, dy.y, dy.z,
+            ]
+            .map(Float::to_bits)
+        };
         for level in SimdLevel::available() {
-            let mut out = vec![];
-            lanes.rays(level, &p_film, &times, &mut out);
-            assert_eq!(out.len(), p_film.len());
-            for ((p, &t), r) in p_film.iter().zip(&times).zip(&out) {
-                let mut s = sample(p.x, p.y);
-                s.time = t;
-                let mut e = c.generate_ray(&s).unwrap().ray;
-                e.time = t;
-                let bits = |r: &Ray| {
-                    [r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, r.time].map(Float::to_bits)
-                };
-                assert_eq!(bits(r), bits(&e), "{level:?} at {p:?}");
-                assert_eq!(r.medium, Some(2));
+            for offsets in [
+                OffsetRays::None,
+                OffsetRays::Unscaled,
+                OffsetRays::Scaled(0.125),
+            ] {
+                let mut out = vec![];
+                lanes.rays(level, &p_film, &times, offsets, &mut out);
+                assert_eq!(out.len(), p_film.len());
+                for ((p, &t), r) in p_film.iter().zip(&times).zip(&out) {
+                    let mut s = sample(p.x, p.y);
+                    s.time = t;
+                    let mut e = match offsets {
+                        OffsetRays::None => RayDifferential::new(c.generate_ray(&s).unwrap().ray),
+                        _ => c.generate_ray_differential(&s).unwrap().ray,
+                    };
+                    if let OffsetRays::Scaled(f) = offsets {
+                        e.scale_differentials(f);
+                    }
+                    e.ray.time = t;
+                    assert_eq!(r.has_differentials, offsets != OffsetRays::None);
+                    assert_eq!(bits(r), bits(&e), "{level:?} {offsets:?} at {p:?}");
+                    assert_eq!(r.ray.medium, Some(2));
+                }
             }
         }
     }

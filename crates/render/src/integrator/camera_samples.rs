@@ -8,14 +8,14 @@
 use super::render::RenderOptions;
 use super::tile::add_estimate;
 use super::Scene;
-use crate::camera::{CameraSample, PinholeRays};
+use crate::camera::{CameraSample, OffsetRays, PinholeRays};
 use crate::film::{FilmTile, VisibleSurface};
 use crate::filter::FilterSample;
 use crate::sampler::Sampler;
 use crate::simd::SimdLevel;
 use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 use rpbrt_geometry::float::Float;
-use rpbrt_geometry::ray::{Ray, RayDifferential};
+use rpbrt_geometry::ray::RayDifferential;
 use rpbrt_geometry::tuple::*;
 
 /// A camera sample's draws, in pbrt-v4's order: the wavelengths' 1-D,
@@ -228,15 +228,16 @@ impl CameraRaySample {
 /// The camera samples of many pixel samples at once: what
 /// [`CameraRaySample::take`] gives for each, bit for bit, with the filter
 /// table's searches interleaved ([`crate::filter::Filter::sample_many`])
-/// and, for a pinhole camera without differentials, the rays generated
-/// lane-parallel ([`PinholeRays`]). Holds the buffers between batches.
+/// and, for a pinhole camera, the rays (with their differentials where
+/// asked) generated lane-parallel ([`PinholeRays`]). Holds the buffers
+/// between batches.
 pub(crate) struct CameraBatch {
     pinhole: Option<PinholeRays>,
     u_pixel: Vec<Point2f>,
     filter: Vec<FilterSample>,
     p_film: Vec<Point2f>,
     times: Vec<Float>,
-    rays: Vec<Ray>,
+    rays: Vec<RayDifferential>,
     lu: Vec<Float>,
     lambda_scratch: Vec<Float>,
     lambdas: Vec<SampledWavelengths>,
@@ -294,17 +295,23 @@ impl CameraBatch {
                 ray: None,
             },
         ));
-        match self.pinhole.as_ref().filter(|_| !differentials) {
+        match self.pinhole.as_ref() {
             Some(pinhole) => {
                 self.p_film.clear();
                 self.p_film.extend(out.iter().map(|s| s.cs.p_film));
                 self.times.clear();
                 self.times
                     .extend(out.iter().map(|s| scene.camera.sample_time(s.cs.time)));
+                // `ray_for`'s offset rays.
+                let offsets = match (differentials, opts.disable_pixel_jitter) {
+                    (false, _) => OffsetRays::None,
+                    (true, true) => OffsetRays::Unscaled,
+                    (true, false) => OffsetRays::Scaled(diff_scale),
+                };
                 self.rays.clear();
-                pinhole.rays(level, &self.p_film, &self.times, &mut self.rays);
+                pinhole.rays(level, &self.p_film, &self.times, offsets, &mut self.rays);
                 for (s, &r) in out.iter_mut().zip(&self.rays) {
-                    s.ray = Some((RayDifferential::new(r), 1.0));
+                    s.ray = Some((r, 1.0));
                 }
             }
             None => {
