@@ -128,6 +128,13 @@ fn levels_parse_and_order() {
     assert!(SimdLevel::Avx2 < SimdLevel::Avx512 && SimdLevel::Avx512.lanes() == 16);
     // Asking for more than the processor has runs what it has.
     assert!(level() <= SimdLevel::detected());
+    // The default is the best level but for Intel's AVX-512, where it is
+    // AVX2.
+    let (preferred, best) = (SimdLevel::preferred(), SimdLevel::detected());
+    assert!(
+        preferred == best || (best == SimdLevel::Avx512 && preferred == SimdLevel::Avx2),
+        "{preferred:?} of {best:?}"
+    );
     let sum = dispatch(
         SimdLevel::Avx512,
         AllOps {
