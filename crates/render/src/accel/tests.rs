@@ -271,6 +271,36 @@ fn check_levels<const W: usize, H>(
                 bvh.intersect_p_slots_at(level, ray, *t_max, |_, p, r, t| hit(p, r, t).is_some());
             assert_eq!(any, got.is_some(), "{name}: {level:?}: ray {k}: occlusion");
         }
+        // The interleaved search of a batch: the same occlusion, each
+        // candidate handed with its own ray's index (batches of several
+        // lengths, so that tracks are refilled mid-batch or left idle).
+        for chunk in [1, 5, 8, 13, rays.len().max(1)] {
+            for (c, batch) in rays.chunks(chunk).enumerate() {
+                let mut out = vec![true; batch.len()];
+                let mut tested = 0;
+                bvh.intersect_ps_stream_at(
+                    level,
+                    batch,
+                    &mut out,
+                    |k, s, p, r, t| {
+                        assert_eq!(bvh.prim_indices()[s as usize], p, "{name}: slot {s}");
+                        assert_eq!((*r, t), batch[k], "{name}: ray {k} of the batch");
+                        tested += 1;
+                        hit(p, r, t).is_some()
+                    },
+                    |_, _| {},
+                );
+                for (j, &blocked) in out.iter().enumerate() {
+                    let k = c * chunk + j;
+                    let want = singles[k].is_some();
+                    assert_eq!(
+                        blocked, want,
+                        "{name}: {level:?}: batch of {chunk}: ray {k}"
+                    );
+                }
+                assert!(tested > 0 || out.iter().all(|b| !b), "{name}");
+            }
+        }
     }
 }
 

@@ -166,14 +166,22 @@ impl Scene {
     }
 
     /// Whether anything blocks each ray of `rays` in (0, its t_max), into
-    /// `out` (cleared first): [`Scene::intersect_p`] of a batch of rays.
-    pub fn intersect_ps(&self, rays: &[(Ray, Float)], out: &mut Vec<bool>) {
+    /// `out` (cleared first): [`Scene::intersect_p`] of a batch of rays,
+    /// `interleave`d or not ([`PrimitiveAggregate::intersect_ps`]).
+    ///
+    /// [`PrimitiveAggregate::intersect_ps`]: crate::primitive::PrimitiveAggregate::intersect_ps
+    pub fn intersect_ps(
+        &self,
+        rays: &[(Ray, Float)],
+        level: crate::simd::SimdLevel,
+        interleave: bool,
+        out: &mut Vec<bool>,
+    ) {
         LOCAL_RAY_COUNTS.with(|c| {
             let (closest, shadow) = c.get();
             c.set((closest, shadow + rays.len() as u64));
         });
-        out.clear();
-        out.extend(rays.iter().map(|(r, t)| self.aggregate.intersect_p(r, *t)));
+        self.aggregate.intersect_ps(rays, level, interleave, out);
     }
 
     /// Whether anything blocks `ray` in (0, t_max).

@@ -273,6 +273,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let level = opts.simd.unwrap_or_else(crate::simd::level);
         let mut clock = StageClock::new(opts.stage_times.as_deref());
         let prefetch = scene.aggregate.prefetch_pays();
+        let mut interleave_shadows = false;
         loop {
             clock.enter(Stage::Camera);
             // Refill the pool in the tile's sample order. Once
@@ -656,7 +657,10 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
 
             clock.enter(Stage::Shadow);
             // Shadow: the light samples' visibility.
-            scene.intersect_ps(&shadow_rays, &mut blocked);
+            scene.intersect_ps(&shadow_rays, level, interleave_shadows, &mut blocked);
+            // Interleaved where most of the last batch was blocked (see
+            // `PrimitiveAggregate::intersect_ps`).
+            interleave_shadows = 2 * blocked.iter().filter(|&&b| b).count() > blocked.len();
             for (&(i, ld), &b) in shadow_lanes.iter().zip(&blocked) {
                 if !b {
                     *I::radiance(&mut lanes[i].path) += ld;

@@ -1131,14 +1131,73 @@ impl PrimitiveAggregate {
     /// Whether anything is hit in (0, t_max).
     pub fn intersect_p(&self, ray: &Ray, t_max: Float) -> bool {
         let tr = TriangleRay::new(ray);
-        self.accel.intersect_p_slots(ray, t_max, |slot, i, r, t| {
-            match self.triangle_vertices.get(slot as usize) {
-                Some(Some([p0, p1, p2])) => {
-                    intersect_prepared_triangle(&tr, t, *p0, *p1, *p2).is_some()
-                }
-                _ => self.intersect_p_other(i, r, &tr, t),
+        self.accel
+            .intersect_p_slots(ray, t_max, |slot, i, r, t| self.blocks(slot, i, r, &tr, t))
+    }
+
+    /// [`PrimitiveAggregate::intersect_p`] of each of a batch of shadow
+    /// rays `(ray, t_max)`, into `out`. With `interleave`, under a wide
+    /// BVH too large for a core's cache
+    /// ([`PrimitiveAggregate::prefetch_pays`]), the rays are searched a
+    /// few at a time, taking turns ([`WideBvh::intersect_ps_stream_at`]):
+    /// that pays where the rays end at blockers deep in the tree, whose
+    /// nodes are rarely in cache (the water caustic's shadow rays from
+    /// under the water: 20% faster), and costs where most rays are
+    /// unblocked, seeing mostly the top of the tree, which stays in cache
+    /// (the killeroo crop's, 93% unblocked: 20% slower). The answers are
+    /// the same either way.
+    pub fn intersect_ps(
+        &self,
+        rays: &[(Ray, Float)],
+        level: SimdLevel,
+        interleave: bool,
+        out: &mut Vec<bool>,
+    ) {
+        out.clear();
+        match &self.accel {
+            Accelerator::Bvh4(bvh) if interleave && self.prefetch_pays() => {
+                self.intersect_ps_stream(bvh, rays, level, out)
             }
-        })
+            Accelerator::Bvh8(bvh) if interleave && self.prefetch_pays() => {
+                self.intersect_ps_stream(bvh, rays, level, out)
+            }
+            _ => out.extend(rays.iter().map(|(r, t)| self.intersect_p(r, *t))),
+        }
+    }
+
+    fn intersect_ps_stream<const W: usize>(
+        &self,
+        bvh: &WideBvh<W>,
+        rays: &[(Ray, Float)],
+        level: SimdLevel,
+        out: &mut Vec<bool>,
+    ) {
+        let trs: Vec<TriangleRay> = rays.iter().map(|(r, _)| TriangleRay::new(r)).collect();
+        out.resize(rays.len(), false);
+        let vertices = &self.triangle_vertices;
+        bvh.intersect_ps_stream_at(
+            level,
+            rays,
+            out,
+            |k, slot, i, r, t| self.blocks(slot, i, r, &trs[k], t),
+            |first, count| {
+                let base = vertices.as_ptr().wrapping_add(first as usize);
+                for j in 0..count as usize {
+                    crate::simd::prefetch_ptr(base.wrapping_add(j));
+                }
+            },
+        );
+    }
+
+    /// Whether the entry `i` in slot `slot` blocks `ray` in (0, t_max).
+    #[inline(always)]
+    fn blocks(&self, slot: u32, i: u32, ray: &Ray, tr: &TriangleRay, t_max: Float) -> bool {
+        match self.triangle_vertices.get(slot as usize) {
+            Some(Some([p0, p1, p2])) => {
+                intersect_prepared_triangle(tr, t_max, *p0, *p1, *p2).is_some()
+            }
+            _ => self.intersect_p_other(i, ray, tr, t_max),
+        }
     }
 
     /// The shadow test of an entry that is not in the vertex cache.

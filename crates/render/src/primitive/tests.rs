@@ -450,3 +450,69 @@ fn a_lone_mesh_primitive_is_its_closest_triangle() {
     }
     assert!(hits > 300, "{hits}");
 }
+
+/// A batch of shadow rays gets the single rays' answers, searched
+/// interleaved or one ray at a time, at every SIMD level, in batches of
+/// several lengths, through the vertex cache or without it, with spheres
+/// and alpha-masked triangles among the entries.
+#[test]
+fn shadow_ray_batches_answer_as_single_rays() {
+    let mut rng = Rng::new(21, 0);
+    // More entries than `PREFETCH_MIN_ENTRIES`: the interleaved search's
+    // condition.
+    let big = random_mesh(&mut rng, 9000);
+    let masked = random_mesh(&mut rng, 200);
+    let prims = || -> Vec<Primitive> {
+        let mut prims = vec![
+            Primitive::Mesh(MeshPrimitive {
+                mesh: big.clone(),
+                material: Some(1),
+                medium_interface: None,
+                alpha: Alpha::Opaque,
+            }),
+            Primitive::Mesh(MeshPrimitive {
+                mesh: masked.clone(),
+                material: Some(2),
+                medium_interface: None,
+                alpha: Alpha::Constant(0.5),
+            }),
+        ];
+        for k in 0..3 {
+            let at = Vector3f::new(k as Float - 1.0, 0.5, -2.5);
+            prims.push(sphere_prim(Transform::translate(at), 0.4));
+        }
+        prims
+    };
+    let params = AccelParams::default();
+    let cached = PrimitiveAggregate::new(prims(), &params);
+    let uncached = PrimitiveAggregate::with_cache_limits(prims(), &params, 0, 0);
+    // Rays from outside the cube of triangles: the shorter ones stop
+    // before it, the longer ones end inside it or pass through.
+    let rays: Vec<(Ray, Float)> = (0..3000)
+        .map(|k| {
+            let t_max = [0.6, 0.8, 0.85, 1.0, Float::INFINITY][k % 5];
+            (random_ray(&mut rng), t_max)
+        })
+        .collect();
+    for agg in [&cached, &uncached] {
+        assert!(agg.prefetch_pays());
+        let want: Vec<bool> = rays.iter().map(|(r, t)| agg.intersect_p(r, *t)).collect();
+        let blocked = want.iter().filter(|&&b| b).count();
+        assert!((300..2700).contains(&blocked), "{blocked} of 3000 blocked");
+        for level in SimdLevel::available() {
+            for interleave in [false, true] {
+                for chunk in [7, 256, rays.len()] {
+                    let (mut out, mut got) = (Vec::new(), Vec::new());
+                    for batch in rays.chunks(chunk) {
+                        agg.intersect_ps(batch, level, interleave, &mut out);
+                        got.extend_from_slice(&out);
+                    }
+                    assert!(
+                        got == want,
+                        "{level:?}, interleaved {interleave}, batches of {chunk}"
+                    );
+                }
+            }
+        }
+    }
+}
