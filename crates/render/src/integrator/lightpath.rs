@@ -25,6 +25,8 @@ pub struct LightPathIntegrator {
 }
 
 impl TileIntegrator for LightPathIntegrator {
+    type Buffers = ();
+
     fn evaluate_pixel_sample(
         &self,
         scene: &Scene,

@@ -78,6 +78,11 @@ fn tiles(bounds: Bounds2i) -> Vec<Bounds2i> {
 /// in the tile's [`SplatBuffer`], which the loop applies to the film in
 /// tile order.
 pub trait TileIntegrator: Sync {
+    /// What a worker thread keeps from one [`TileIntegrator::render_tile`]
+    /// to the next (the wavefront's pool of paths and its columns, whose
+    /// allocation per tile cost page faults and zero-filling).
+    type Buffers: Default;
+
     /// Takes sample `sampler` (already started for this pixel and sample
     /// index) of pixel `p_pixel`: adds to `tile` and/or records splats.
     /// `differentials`: whether camera rays need their differentials.
@@ -118,7 +123,9 @@ pub trait TileIntegrator: Sync {
         tile: &mut FilmTile,
         splats: &mut SplatBuffer,
         differentials: bool,
+        buffers: &mut Self::Buffers,
     ) -> u64 {
+        let _ = buffers;
         let mut taken = 0;
         for p in bounds.iter() {
             for s in samples.clone() {
@@ -139,6 +146,8 @@ pub trait TileIntegrator: Sync {
 pub(crate) struct RayTiles<'a, I>(pub &'a I);
 
 impl<I: RayIntegrator> TileIntegrator for RayTiles<'_, I> {
+    type Buffers = ();
+
     #[inline]
     fn evaluate_pixel_sample(
         &self,
@@ -245,6 +254,7 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
                 let targets = &targets;
                 let work = || {
                     let mut sampler = scene_ref.sampler.clone();
+                    let mut buffers = I::Buffers::default();
                     loop {
                         let index = next_tile.fetch_add(1, Ordering::Relaxed);
                         let Some(&b) = tile_list.get(index) else {
@@ -262,6 +272,7 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
                             &mut tile,
                             &mut tile_splats,
                             differentials,
+                            &mut buffers,
                         );
                         scene_ref.counters.flush_local();
                         scene_ref

@@ -131,6 +131,35 @@ struct Finished {
     filter_weight: Float,
 }
 
+/// What a worker thread keeps from one tile to the next
+/// ([`TileIntegrator::Buffers`]): the pool's paths and their scratch, the
+/// lane vertices' columns, the reorder buffer and the stages' batches,
+/// whose allocation for each tile cost page faults and zero-filling
+/// (about 450 KB a tile).
+pub(crate) struct PassBuffers<S, C> {
+    lanes: Vec<Lane<S>>,
+    scratch: Vec<C>,
+    vertices: LaneVertices,
+    reorder: Option<ReorderBuffer>,
+    light_batch: LightBatch,
+    bsdf_batch: BsdfBatch,
+    draw_batch: FourDrawBatch,
+}
+
+impl<S, C> Default for PassBuffers<S, C> {
+    fn default() -> Self {
+        PassBuffers {
+            lanes: Vec::new(),
+            scratch: Vec::new(),
+            vertices: LaneVertices::default(),
+            reorder: None,
+            light_batch: LightBatch::default(),
+            bsdf_batch: BsdfBatch::default(),
+            draw_batch: FourDrawBatch::default(),
+        }
+    }
+}
+
 /// Finished samples, added to the tile in sequence order.
 struct ReorderBuffer {
     slots: Vec<Option<Finished>>,
@@ -150,6 +179,18 @@ impl ReorderBuffer {
                 .collect(),
             next: 0,
         }
+    }
+
+    /// The buffer of [`ReorderBuffer::new`]`(gbuffer)`, made from one a
+    /// tile left (every sample it started finished, so every slot is
+    /// empty again).
+    fn reuse(mut self, gbuffer: bool) -> Self {
+        debug_assert!(self.slots.iter().all(Option::is_none));
+        if self.visible.is_empty() == gbuffer {
+            return ReorderBuffer::new(gbuffer);
+        }
+        self.next = 0;
+        self
     }
 
     /// Whether sample `seq` may start: its slot is free.
@@ -191,6 +232,8 @@ impl ReorderBuffer {
 }
 
 impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
+    type Buffers = PassBuffers<I::State, I::Scratch>;
+
     fn evaluate_pixel_sample(
         &self,
         scene: &Scene,
@@ -222,18 +265,32 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         tile: &mut FilmTile,
         _splats: &mut SplatBuffer,
         differentials: bool,
+        buffers: &mut Self::Buffers,
     ) -> u64 {
         let pixels: Vec<Point2i> = bounds.iter().collect();
         let per_pixel = (samples.end - samples.start).max(0) as usize;
         let total = pixels.len() * per_pixel;
         let gbuffer = scene.film.uses_visible_surface();
-        let mut reorder = ReorderBuffer::new(gbuffer);
+        let PassBuffers {
+            lanes,
+            scratch,
+            vertices,
+            reorder,
+            light_batch,
+            bsdf_batch,
+            draw_batch,
+        } = buffers;
+        let fresh = match reorder.take() {
+            Some(r) => r.reuse(gbuffer),
+            None => ReorderBuffer::new(gbuffer),
+        };
+        let reorder = reorder.insert(fresh);
+        lanes.clear();
         // The paths' first visible surfaces, by slot (G-buffer films only).
         let mut visibles: Vec<VisibleSurface> = Vec::new();
-        // The paths in flight stay in their slots from start to end (a
-        // lane is a few hundred bytes: moving lanes around costs more
-        // than indexing them).
-        let mut lanes: Vec<Lane<I::State>> = Vec::with_capacity(LANES);
+        // The paths in flight (`lanes`) stay in their slots from start to
+        // end (a lane is a few hundred bytes: moving lanes around costs
+        // more than indexing them).
         let mut active: Vec<usize> = Vec::with_capacity(LANES);
         let mut free: Vec<usize> = Vec::with_capacity(LANES);
         let mut order: Vec<usize> = Vec::with_capacity(LANES);
@@ -243,17 +300,13 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let mut shadow_rays: Vec<(Ray, Float)> = Vec::with_capacity(LANES);
         let mut shadow_lanes: Vec<(usize, SampledSpectrum)> = Vec::with_capacity(LANES);
         let mut blocked: Vec<bool> = Vec::with_capacity(LANES);
-        let mut scratch: Vec<I::Scratch> = Vec::new();
         let mut requests: Vec<LightRequest> = Vec::with_capacity(LANES);
         let mut request_lanes: Vec<usize> = Vec::with_capacity(LANES);
-        let mut light_batch = LightBatch::default();
         let mut answers: Vec<Option<LightAnswer>> = Vec::with_capacity(LANES);
-        let mut bsdf_batch = BsdfBatch::default();
         let mut bsdf_answers: Vec<BsdfAnswers> = Vec::with_capacity(LANES);
         let mut bsdf_lanes: Vec<usize> = Vec::with_capacity(LANES);
         let mut starts: Vec<(usize, Point2i)> = Vec::with_capacity(LANES);
         let mut cursors: Vec<SamplerCursor> = Vec::with_capacity(LANES);
-        let mut draw_batch = FourDrawBatch::default();
         let mut draws: Vec<Option<[Float; 6]>> = Vec::with_capacity(LANES);
         let mut shade: Vec<usize> = Vec::with_capacity(LANES);
         let mut predrawn: Vec<Option<[Float; 6]>> = Vec::new();
@@ -262,8 +315,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let mut predrawn_next: Vec<Option<Float>> = Vec::new();
         let mut diffuse: Vec<usize> = Vec::with_capacity(LANES);
         let mut shades: Vec<LaneShade> = Vec::with_capacity(LANES);
-        // The lane vertices' columns, by slot (`diffuse_slot`: a lane's).
-        let mut vertices = LaneVertices::default();
+        // A lane's slot in the lane vertices' columns.
         let mut diffuse_slot: Vec<usize> = Vec::new();
         let mut camera_batch = CameraBatch::new(scene);
         let mut camera_draws: Vec<(Point2i, CameraDraws)> = Vec::with_capacity(LANES);
@@ -296,7 +348,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             // The camera samples' draws, computed together and taken by
             // each sample in turn (leaving each cursor past them), then
             // their filter offsets, wavelengths and rays together.
-            sampler.four_draws_batch(level, &cursors, &mut draw_batch, &mut draws, None);
+            sampler.four_draws_batch(level, &cursors, draw_batch, &mut draws, None);
             camera_draws.clear();
             for ((&(_, p_pixel), cursor), &d) in starts.iter().zip(cursors.iter_mut()).zip(&draws) {
                 let draws = match d {
@@ -404,7 +456,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             sampler.four_draws_batch(
                 level,
                 &cursors,
-                &mut draw_batch,
+                draw_batch,
                 &mut draws,
                 Some(&mut next_draws),
             );
@@ -436,13 +488,13 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 let Some(h) = &hits[i] else { continue };
                 if let Some(shade) =
                     self.0
-                        .lane_hit(scene, &lane.path, h, &lane.lambda, gbuffer, &mut vertices)
+                        .lane_hit(scene, &lane.path, h, &lane.lambda, gbuffer, vertices)
                 {
                     diffuse.push(i);
                     shades.push(shade);
                 }
             }
-            surfaces(level, &mut vertices);
+            surfaces(level, vertices);
             diffuse_slot.resize(lanes.len(), 0);
             for &i in &active {
                 lanes[i].diffuse = false;
@@ -513,8 +565,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     let (path, scratch) = (&mut lane.path, &mut scratch[i]);
                     requests.push(match lane_light {
                         LaneLight::Diffuse(r) => {
-                            self.0
-                                .diffuse_begin(path, scratch, &mut vertices, k, r, draws)
+                            self.0.diffuse_begin(path, scratch, vertices, k, r, draws)
                         }
                         LaneLight::Staged(bsdf) => self
                             .0
@@ -567,7 +618,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 level,
                 &requests,
                 |k| &lanes[request_lanes[k]].lambda,
-                &mut light_batch,
+                light_batch,
                 &mut answers,
             );
 
@@ -586,7 +637,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     Some(Some(q))
                 })
                 .collect();
-            answer_bsdfs(level, &bsdf_queries, &mut bsdf_batch, &mut bsdf_answers);
+            answer_bsdfs(level, &bsdf_queries, bsdf_batch, &mut bsdf_answers);
             drop(bsdf_queries);
             for (&i, a) in bsdf_lanes.iter().zip(&bsdf_answers) {
                 if a.light.is_some() || a.sample.is_some() {
@@ -602,7 +653,7 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     vertices.set_light_direction(diffuse_slot[i], wi);
                 }
             }
-            scatters(level, &mut vertices, I::DIFFUSE_SAMPLE_FROM_WO);
+            scatters(level, vertices, I::DIFFUSE_SAMPLE_FROM_WO);
 
             clock.enter(Stage::Finish);
             // Shade, second half: the light samples' shadow queries and the

@@ -136,6 +136,8 @@ struct BdptRun<'a> {
 }
 
 impl TileIntegrator for BdptRun<'_> {
+    type Buffers = ();
+
     fn evaluate_pixel_sample(
         &self,
         scene: &Scene,
