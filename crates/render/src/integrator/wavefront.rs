@@ -567,9 +567,9 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                         LaneLight::Diffuse(r) => {
                             self.0.diffuse_begin(path, scratch, vertices, k, r, draws)
                         }
-                        LaneLight::Staged(bsdf) => self
-                            .0
-                            .staged_begin(path, scratch, &vertices, k, bsdf, draws),
+                        LaneLight::Staged(bsdf) => {
+                            self.0.staged_begin(path, scratch, vertices, k, bsdf, draws)
+                        }
                     });
                     request_lanes.push(i);
                     continue;
@@ -679,11 +679,11 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                     if lane.diffuse {
                         let path = &mut lane.path;
                         self.0
-                            .diffuse_finish(scene, path, &vertices, k, answer, draw)
+                            .diffuse_finish(scene, path, vertices, k, answer, draw)
                     } else {
                         let (path, scratch) = (&mut lane.path, &mut scratch[i]);
                         self.0
-                            .staged_finish(scene, path, scratch, &vertices, k, answer, draw)
+                            .staged_finish(scene, path, scratch, vertices, k, answer, draw)
                     }
                 } else {
                     sampler.set_cursor(&lane.cursor);
