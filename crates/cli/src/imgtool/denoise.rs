@@ -150,6 +150,9 @@ pub(crate) fn denoise_file(job: &Job, budget: &MemoryBudget) -> Result<(), Strin
             ));
         }
     }
+    if let Some(a) = albedo.as_deref_mut() {
+        clamp_albedo(a);
+    }
     charge_output(budget, res.x.into(), res.y.into(), 3, "the denoised image")?;
     let oidn = Oidn::load()?;
     let out = oidn
@@ -164,6 +167,21 @@ pub(crate) fn denoise_file(job: &Job, budget: &MemoryBudget) -> Result<(), Strin
         .map_err(|e| format!("{infile}: {e}"))?;
     let image = Image::from_f32(out, res, &["R", "G", "B"]).map_err(|e| e.to_string())?;
     save(&image, job.outfile, &input.metadata)
+}
+
+/// Clamps albedo values to [0, 1], the range Open Image Denoise requires
+/// of them ("must be always between 0 and 1"): pbrt-v4's `gbuffer` film
+/// records a Monte Carlo estimate of each surface's reflectance, which
+/// overshoots 1 a little at some pixels (1.01 on veach-mis at 16 spp).
+/// Returns how many values were changed.
+fn clamp_albedo(albedo: &mut [f32]) -> usize {
+    let mut changed = 0;
+    for x in albedo.iter_mut() {
+        let c = x.clamp(0.0, 1.0);
+        changed += usize::from(c != *x);
+        *x = c;
+    }
+    changed
 }
 
 /// The first of `sets` of three channels that `image` has, as interleaved
@@ -204,6 +222,35 @@ mod tests {
         let mut v = vec![1.0, 2.0, 3.0, f32::NAN, 0.5, 0.5, 0.1, f32::INFINITY, 0.2];
         assert_eq!(zero_non_finite(&mut v), 2);
         assert_eq!(v, vec![1.0, 2.0, 3.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+    }
+
+    /// Albedos outside [0, 1] are clamped, the rest kept bit for bit.
+    #[test]
+    fn albedo_is_clamped_to_the_unit_range() {
+        let mut a = [
+            0.0,
+            0.5,
+            1.0,
+            1.0107,
+            -0.25,
+            0.999_999_9,
+            f32::MIN_POSITIVE,
+            7.0,
+            -0.0,
+        ];
+        assert_eq!(clamp_albedo(&mut a), 3);
+        let want = [
+            0.0,
+            0.5,
+            1.0,
+            1.0,
+            0.0,
+            0.999_999_9,
+            f32::MIN_POSITIVE,
+            1.0,
+            -0.0,
+        ];
+        assert!(a.iter().zip(&want).all(|(x, y)| x.to_bits() == y.to_bits()));
     }
 
     #[test]
