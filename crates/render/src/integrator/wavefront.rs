@@ -144,6 +144,11 @@ pub(crate) struct PassBuffers<S, C> {
     light_batch: LightBatch,
     bsdf_batch: BsdfBatch,
     draw_batch: FourDrawBatch,
+    /// The camera stage's buffers (made for the scene's camera on the
+    /// first tile: a worker's buffers serve one scene).
+    camera_batch: Option<CameraBatch>,
+    camera_draws: Vec<(Point2i, CameraDraws)>,
+    camera_samples: Vec<CameraRaySample>,
 }
 
 impl<S, C> Default for PassBuffers<S, C> {
@@ -156,6 +161,9 @@ impl<S, C> Default for PassBuffers<S, C> {
             light_batch: LightBatch::default(),
             bsdf_batch: BsdfBatch::default(),
             draw_batch: FourDrawBatch::default(),
+            camera_batch: None,
+            camera_draws: Vec::new(),
+            camera_samples: Vec::new(),
         }
     }
 }
@@ -279,7 +287,11 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
             light_batch,
             bsdf_batch,
             draw_batch,
+            camera_batch,
+            camera_draws,
+            camera_samples,
         } = buffers;
+        let camera_batch = camera_batch.get_or_insert_with(|| CameraBatch::new(scene));
         let fresh = match reorder.take() {
             Some(r) => r.reuse(gbuffer),
             None => ReorderBuffer::new(gbuffer),
@@ -317,9 +329,6 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
         let mut shades: Vec<LaneShade> = Vec::with_capacity(LANES);
         // A lane's slot in the lane vertices' columns.
         let mut diffuse_slot: Vec<usize> = Vec::new();
-        let mut camera_batch = CameraBatch::new(scene);
-        let mut camera_draws: Vec<(Point2i, CameraDraws)> = Vec::with_capacity(LANES);
-        let mut camera_samples: Vec<CameraRaySample> = Vec::with_capacity(LANES);
         let diff_scale = differential_scale(sampler.samples_per_pixel());
         let mut started = 0;
         let level = opts.simd.unwrap_or_else(crate::simd::level);
@@ -367,10 +376,10 @@ impl<I: VertexIntegrator + RayIntegrator> TileIntegrator for Wavefront<'_, I> {
                 scene,
                 opts,
                 level,
-                &camera_draws,
+                camera_draws,
                 differentials,
                 diff_scale,
-                &mut camera_samples,
+                camera_samples,
             );
             for ((&(seq, p_pixel), cursor), cs) in
                 starts.iter().zip(&cursors).zip(camera_samples.drain(..))
