@@ -434,6 +434,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
             albedo_file: None,
             normal_file: None,
             color_only: false,
+            noisy_aux: false,
             quality: oidn::Quality::High,
         };
         if let Err(e) = imgtool::denoise::denoise_file(&job, &budget) {

@@ -72,6 +72,11 @@ pub struct Inputs<'a> {
     /// Prefiltered in place.
     pub normal: Option<&'a mut [f32]>,
     pub quality: Quality,
+    /// Whether the albedo and normal are prefiltered first and then
+    /// passed as clean (`cleanAux`: OIDN's recommended final-frame
+    /// workflow, three filter runs), or passed as they are (its mode for
+    /// noisy auxiliary images, one run).
+    pub prefilter: bool,
 }
 
 /// A loaded OIDN library and its functions.
@@ -212,6 +217,7 @@ impl Oidn {
             albedo,
             normal,
             quality,
+            prefilter,
         } = inputs;
         let n = width
             .checked_mul(height)
@@ -232,14 +238,14 @@ impl Oidn {
         // it.
         let mut color = color.to_vec();
         let mut output = vec![0.0f32; n];
-        let clean = albedo.is_some();
+        let clean = albedo.is_some() && prefilter;
         let mut albedo = albedo;
         let mut normal = normal;
         for (name, image) in [
             ("albedo", albedo.as_deref_mut()),
             ("normal", normal.as_deref_mut()),
         ] {
-            if let Some(image) = image {
+            if let Some(image) = image.filter(|_| prefilter) {
                 let f = device.filter()?;
                 f.image(name, image, width, height)?;
                 f.image("output", image, width, height)?;

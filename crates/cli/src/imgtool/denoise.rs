@@ -16,7 +16,8 @@ usage: rpbrt imgtool denoise [options] <filename>
     image's R, G, B channels. A `gbuffer` film's image also holds the
     first visible surface's albedo (Albedo.R/G/B) and shading normal
     (Ns.X/Y/Z): they are used as auxiliary images, prefiltered first
-    (OIDN's recommended workflow), unless --color-only is given.
+    (OIDN's recommended workflow; albedos clamped to [0, 1]), unless
+    --color-only or --noisy-aux is given.
     Non-finite colour pixels are counted, reported and set to zero.
     The library is loaded at run time: `pip install pyoidn` provides it
     (or set OIDN_DIR to a folder holding libOpenImageDenoise.so.2).
@@ -24,6 +25,9 @@ options:
     --albedo <file>    Albedo image (its Albedo.R/G/B channels, else R, G, B),
                        in place of the input's own.
     --color-only       Denoise from the colour alone.
+    --noisy-aux        Pass the albedo and normal as they are, not
+                       prefiltered (OIDN's mode for noisy auxiliary images:
+                       one filter run instead of three).
     --normal <file>    Normal image (its Ns.X/Y/Z or N.X/Y/Z channels, else
                        R, G, B), in place of the input's own; needs an albedo.
     --outfile <name>   Output image filename (required): R, G, B, with the
@@ -35,7 +39,7 @@ options:
 pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
     let mut a = Args::new("denoise", argv);
     let (mut infile, mut outfile, mut albedo_file, mut normal_file) = (None, None, None, None);
-    let mut color_only = false;
+    let (mut color_only, mut noisy_aux) = (false, false);
     let mut quality = Quality::High;
     while let Some(arg) = a.next_arg() {
         match arg {
@@ -44,6 +48,7 @@ pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
                 "albedo" => albedo_file = Some(a.value(&f)?),
                 "normal" => normal_file = Some(a.value(&f)?),
                 "color-only" | "coloronly" => color_only = a.bool(&f)?,
+                "noisy-aux" | "noisyaux" => noisy_aux = a.bool(&f)?,
                 "quality" => {
                     let q = a.value(&f)?;
                     quality = Quality::parse(&q).ok_or_else(|| {
@@ -61,12 +66,18 @@ pub fn run(argv: &[String], budget: &MemoryBudget) -> Result<(), String> {
     if color_only && (albedo_file.is_some() || normal_file.is_some()) {
         return Err(a.err("--color-only takes no --albedo or --normal"));
     }
+    if color_only && noisy_aux {
+        return Err(
+            a.err("--noisy-aux is how the auxiliary images are passed; --color-only uses none")
+        );
+    }
     let job = Job {
         infile: &infile,
         outfile: &outfile,
         albedo_file: albedo_file.as_deref(),
         normal_file: normal_file.as_deref(),
         color_only,
+        noisy_aux,
         quality,
     };
     denoise_file(&job, budget).map_err(|e| a.err(e))
@@ -80,6 +91,8 @@ pub(crate) struct Job<'a> {
     pub albedo_file: Option<&'a str>,
     pub normal_file: Option<&'a str>,
     pub color_only: bool,
+    /// The auxiliary images passed as they are (`--noisy-aux`).
+    pub noisy_aux: bool,
     pub quality: Quality,
 }
 
@@ -163,6 +176,7 @@ pub(crate) fn denoise_file(job: &Job, budget: &MemoryBudget) -> Result<(), Strin
             albedo: albedo.as_deref_mut(),
             normal: normal.as_deref_mut(),
             quality: job.quality,
+            prefilter: !job.noisy_aux,
         })
         .map_err(|e| format!("{infile}: {e}"))?;
     let image = Image::from_f32(out, res, &["R", "G", "B"]).map_err(|e| e.to_string())?;

@@ -226,6 +226,7 @@ impl Shared {
             albedo: None,
             normal: None,
             quality: crate::oidn::Quality::High,
+            prefilter: false,
         });
         let rgb = match out {
             Ok(v) => v,

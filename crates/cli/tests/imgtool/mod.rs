@@ -714,6 +714,17 @@ fn denoise_bad_inputs_are_clear_errors() {
         "--color-only takes no --albedo or --normal",
     );
     fails_with(
+        &imgtool(&[
+            "denoise",
+            &color,
+            "--color-only",
+            "--noisy-aux",
+            "--outfile",
+            &out,
+        ]),
+        "--color-only uses none",
+    );
+    fails_with(
         &imgtool(&["denoise", &color]),
         "--outfile must be specified",
     );
@@ -733,8 +744,8 @@ fn denoise_bad_inputs_are_clear_errors() {
 }
 
 /// A noisy gradient with a NaN pixel, denoised from its colour alone and
-/// with a `gbuffer` film's albedo and normal channels: both come much
-/// closer to the clean image, the NaN is reported and zeroed, and the
+/// with a `gbuffer` film's albedo and normal channels (prefiltered, and as
+/// they are): each comes much closer to the clean image, the NaN is reported and zeroed, and the
 /// metadata is kept. Skipped, with a message, where there is no OIDN.
 #[test]
 fn denoise_removes_noise_with_and_without_auxiliary_images() {
@@ -788,7 +799,11 @@ fn denoise_removes_noise_with_and_without_auxiliary_images() {
             / (rgb.len() - 3) as f64
     };
     let noisy_mse = mse(&vals);
-    for (name, extra) in [("aux", None), ("color", Some("--color-only"))] {
+    for (name, extra) in [
+        ("aux", None),
+        ("noisy-aux", Some("--noisy-aux")),
+        ("color", Some("--color-only")),
+    ] {
         let out = d.join(format!("{name}.exr"));
         let out_s = out.to_string_lossy().into_owned();
         let mut args = vec!["denoise", &input, "--outfile", &out_s, "--quality", "fast"];
