@@ -745,8 +745,9 @@ fn denoise_bad_inputs_are_clear_errors() {
 
 /// A noisy gradient with a NaN pixel, denoised from its colour alone and
 /// with a `gbuffer` film's albedo and normal channels (prefiltered, and as
-/// they are): each comes much closer to the clean image, the NaN is reported and zeroed, and the
-/// metadata is kept. Skipped, with a message, where there is no OIDN.
+/// they are): each comes much closer to the clean image, the NaN is
+/// reported and zeroed, and the metadata is kept. Skipped, with a message,
+/// where there is no OIDN.
 #[test]
 fn denoise_removes_noise_with_and_without_auxiliary_images() {
     let d = dir("denoise");
