@@ -66,6 +66,9 @@ pub struct Options {
     /// `--preview [ADDR]`: serve a live view of the render over HTTP
     /// (`127.0.0.1:0`, a free loopback port, when no address is given).
     pub preview: Option<std::net::SocketAddr>,
+    /// `--interactive`: move the camera from the preview page; implies
+    /// `--preview` (on a free loopback port unless given an address).
+    pub interactive: bool,
     /// `--display-server host:port`: stream the image to tev.
     pub display_server: Option<String>,
     /// `--max-memory <size>`: the memory budget, in bytes (default: from
@@ -116,6 +119,10 @@ Rendering options:
   --disable-wavelength-jitter  Always sample the same four wavelengths of light.
   --display-server <host:port> Stream the image as it renders to the tev viewer.
   --force-diffuse              Replace every material with a diffuse one.
+  --interactive                Move the camera from the browser (implies --preview):
+                               W/S A/D Q/E move, arrows turn, drag orbits, the wheel
+                               dollies; the render restarts on each change and the
+                               page shows the camera as LookAt/Camera text.
   --max-memory <size>          The most memory the input may claim (e.g. 6G): scene
                                text, meshes, images and textures, the film and the
                                integrator's buffers. Past it, an error names the
@@ -364,6 +371,7 @@ pub fn parse_args(args: &[String]) -> Result<Options, ArgError> {
             "serveparts" => o.serve_parts = true,
             "quick" => o.quick = true,
             "quiet" => o.quiet = true,
+            "interactive" => o.interactive = true,
             "stats" => o.stats = true,
             "writepartialimages" => o.write_partial_images = true,
             "wavefront" => o.wavefront = Some(true),

@@ -157,7 +157,26 @@ fn peak_memory_bytes() -> Option<u64> {
 /// with its location, and the exit status is 1 on any error.
 fn render_command(opts: &args::Options) -> ExitCode {
     let t0 = Instant::now();
-    let watching = opts.preview.is_some() || opts.display_server.is_some();
+    // `--interactive` implies `--preview` (a free loopback port by default).
+    let preview_addr = opts.preview.or_else(|| {
+        opts.interactive
+            .then(|| std::net::SocketAddr::from(([127, 0, 0, 1], 0)))
+    });
+    if opts.interactive {
+        let clash = [
+            (opts.serve_parts, "--serve-parts"),
+            (opts.spp_range.is_some(), "--spp-range"),
+            (opts.tile.is_some(), "--tile"),
+            (opts.denoise, "--denoise"),
+            (opts.write_partial_images, "--write-partial-images"),
+            (opts.mse_reference_image.is_some(), "--mse-reference-image"),
+        ];
+        if let Some((_, flag)) = clash.iter().find(|(on, _)| *on) {
+            diagln!("rpbrt: error: --interactive renders the whole image until stopped; it does not go with {flag}");
+            return ExitCode::FAILURE;
+        }
+    }
+    let watching = preview_addr.is_some() || opts.display_server.is_some();
     if watching && opts.serve_parts {
         diagln!("rpbrt: error: --preview and --display-server watch one render, not --serve-parts");
         return ExitCode::FAILURE;
@@ -165,7 +184,7 @@ fn render_command(opts: &args::Options) -> ExitCode {
     // Watching: the server binds before the scene loads, so that a port
     // in use fails at once.
     let watch = watching.then(|| Arc::new(watch::Watch::new()));
-    let server = match (opts.preview, &watch) {
+    let server = match (preview_addr, &watch) {
         (Some(addr), Some(w)) => match preview::Preview::start(addr, Arc::clone(w)) {
             Ok(p) => {
                 let everywhere = if p.addr().ip().is_unspecified() {
@@ -247,6 +266,32 @@ fn render_command(opts: &args::Options) -> ExitCode {
     let mut scene = created.scene;
     let integrator = created.integrator;
     let t_create = t0.elapsed() - t_parse;
+    if opts.interactive {
+        if !integrator.renders_interactively() {
+            diagln!(
+                "rpbrt: error: --interactive: the \"{}\" integrator cannot render interactively (path, volpath, simplepath, simplevolpath, ambientocclusion, randomwalk and whitted can)",
+                integrator.name()
+            );
+            return ExitCode::FAILURE;
+        }
+        if let Some(p) = &server {
+            let b = scene.film.pixel_bounds();
+            let d = b.diagonal();
+            p.set_camera_control(preview::CameraControl::new(
+                scene.camera.clone(),
+                preview::CameraDirective::of(&desc.camera.base),
+                Arc::clone(&scene.aggregate),
+                (b.p_min.x, b.p_min.y),
+                (d.x, d.y),
+            ));
+            if !opts.quiet {
+                diagln!(
+                    "rpbrt: interactive: move the camera at {}; Ctrl-C writes the image and ends",
+                    p.url()
+                );
+            }
+        }
+    }
     if let Some((start, end)) = opts.spp_range {
         if !integrator.renders_pixel_samples() {
             diagln!(

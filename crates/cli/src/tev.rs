@@ -348,6 +348,7 @@ mod tests {
                 rgb: (0..3 * width * height).map(f).collect(),
                 spp: 1,
                 done: false,
+                camera: 0,
             },
         })
     }
@@ -503,6 +504,7 @@ mod tests {
                 rgb: vec![1.0; 3 * width * height],
                 spp: 1,
                 done: false,
+                camera: 0,
             },
         });
         let e = client.try_display(&frame).unwrap_err();

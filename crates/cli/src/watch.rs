@@ -10,7 +10,7 @@
 //! than when the next tile of a long wave finishes (minutes at high
 //! sample counts).
 
-use rpbrt_render::integrator::{Progress, RenderObserver, Snapshot};
+use rpbrt_render::integrator::{CameraChange, Progress, RenderObserver, Snapshot};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
@@ -60,6 +60,13 @@ pub struct Watch {
     always: AtomicBool,
     /// Snapshots at the ends of waves are wanted even with nobody watching.
     wave_ends: AtomicBool,
+    /// `--interactive`: the render takes cameras from [`Watch::propose_camera`].
+    interactive: AtomicBool,
+    /// The camera proposed and not yet taken (the latest wins), and
+    /// whether there is one (read by the render every few milliseconds).
+    camera: Mutex<Option<CameraChange>>,
+    camera_waiting: AtomicBool,
+    camera_changed: Condvar,
 }
 
 impl Default for Watch {
@@ -79,6 +86,10 @@ impl Watch {
             last_viewer_ms: AtomicU64::new(u64::MAX),
             always: AtomicBool::new(false),
             wave_ends: AtomicBool::new(false),
+            interactive: AtomicBool::new(false),
+            camera: Mutex::new(None),
+            camera_waiting: AtomicBool::new(false),
+            camera_changed: Condvar::new(),
         }
     }
 
@@ -113,6 +124,26 @@ impl Watch {
     /// latest at once. A wave's end is rare and its snapshot a film read.
     pub fn keep_wave_ends(&self) {
         self.wave_ends.store(true, Ordering::Relaxed);
+    }
+
+    /// Makes the render interactive ([`RenderObserver::interactive`]).
+    pub fn set_interactive(&self) {
+        self.interactive.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether the render is interactive.
+    pub fn is_interactive(&self) -> bool {
+        self.interactive.load(Ordering::Relaxed)
+    }
+
+    /// Asks the render to go on from `change`, replacing a camera proposed
+    /// and not yet taken.
+    pub fn propose_camera(&self, change: CameraChange) {
+        let mut c = self.camera.lock().unwrap_or_else(|e| e.into_inner());
+        *c = Some(change);
+        self.camera_waiting.store(true, Ordering::Release);
+        drop(c);
+        self.camera_changed.notify_all();
     }
 
     /// Names the image (the file it is written to).
@@ -174,6 +205,25 @@ impl RenderObserver for Watch {
         drop(s);
         self.changed.notify_all();
     }
+
+    fn interactive(&self) -> bool {
+        self.is_interactive()
+    }
+
+    fn camera_pending(&self) -> bool {
+        self.camera_waiting.load(Ordering::Acquire)
+    }
+
+    fn take_camera(&self, timeout: Duration) -> Option<CameraChange> {
+        let guard = self.camera.lock().unwrap_or_else(|e| e.into_inner());
+        let (mut guard, _) = self
+            .camera_changed
+            .wait_timeout_while(guard, timeout, |c| c.is_none())
+            .unwrap_or_else(|e| e.into_inner());
+        let taken = guard.take();
+        self.camera_waiting.store(false, Ordering::Release);
+        taken
+    }
 }
 
 #[cfg(test)]
@@ -187,6 +237,7 @@ mod tests {
             rgb: vec![0.5; 3],
             spp: 1,
             done,
+            camera: 0,
         }
     }
 

@@ -33,6 +33,10 @@
 //! has the final image, then exits: the page keeps showing it and can
 //! still save it.
 
+mod camera;
+
+pub use camera::{CameraControl, CameraDirective};
+
 use crate::watch::{Frame, Watch};
 use std::collections::HashMap;
 use std::io::{BufRead, BufReader, Read, Write};
@@ -60,6 +64,10 @@ const CLIENT_TIMEOUT: Duration = Duration::from_secs(10);
 /// another copy, so memory stays at the frame plus this many encodings
 /// however many clients read slowly.
 const MAX_IMAGE_BUFFERS: usize = 2;
+/// Longest `/camera` request body.
+const MAX_BODY: usize = 4096;
+/// Longest a `/status?after=N` request waits for a newer snapshot.
+const LONG_POLL: Duration = Duration::from_secs(1);
 /// What a request head that missed [`Limits::head_deadline`] is told.
 const HEAD_TOO_SLOW: &str = "request head not received in time";
 
@@ -129,6 +137,11 @@ struct Shared {
     /// the latest denoised snapshot (denoised once per version; requests
     /// wait on the lock, so one denoise runs at a time).
     denoiser: Mutex<Denoiser>,
+    /// `--interactive`: the camera the page moves (`None` until the scene
+    /// is loaded, and in a render that is not interactive).
+    control: Mutex<Option<CameraControl>>,
+    /// The reasons camera requests were refused for, each logged once.
+    refused: Mutex<std::collections::HashSet<String>>,
 }
 
 /// What `/denoised` keeps between requests.
@@ -143,6 +156,8 @@ struct Denoiser {
 struct Encoded {
     version: u64,
     done: bool,
+    /// The camera the snapshot was rendered from.
+    camera: u64,
     bytes: Arc<Vec<u8>>,
 }
 
@@ -199,6 +214,36 @@ fn client_key(ip: IpAddr) -> IpAddr {
 }
 
 impl Shared {
+    fn control(&self) -> std::sync::MutexGuard<'_, Option<CameraControl>> {
+        self.control.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Logs a refused camera request's reason, the first time it is seen.
+    fn refuse(&self, why: &str) {
+        let mut seen = self.refused.lock().unwrap_or_else(|e| e.into_inner());
+        if seen.len() < 100 && seen.insert(why.to_string()) {
+            diagln!("rpbrt: refused a camera request: {why}");
+        }
+    }
+
+    /// `POST /camera`: applies the request's change to the camera and
+    /// hands the camera to the render; the camera's JSON, or the status
+    /// and reason of a refusal.
+    fn camera_request(&self, body: &[u8]) -> Result<String, (&'static str, String)> {
+        let bad = |why: String| ("400 Bad Request", why);
+        let mut control = self.control();
+        let Some(c) = control.as_mut() else {
+            return Err((
+                "404 Not Found",
+                "not an interactive render (start rpbrt with --interactive)".into(),
+            ));
+        };
+        let op = camera::parse_op(body).map_err(bad)?;
+        let change = c.apply(op).map_err(bad)?;
+        self.watch.propose_camera(change);
+        Ok(c.json())
+    }
+
     fn clients(&self) -> std::sync::MutexGuard<'_, Clients> {
         self.clients.lock().unwrap_or_else(|e| e.into_inner())
     }
@@ -240,11 +285,13 @@ impl Shared {
                 rgb,
                 spp: s.spp,
                 done: s.done,
+                camera: s.camera,
             },
         };
         let e = Encoded {
             version: frame.version,
             done: frame.snapshot.done,
+            camera: frame.snapshot.camera,
             bytes: Arc::new(encode_image(&denoised)),
         };
         d.latest = Some(e.clone());
@@ -268,6 +315,7 @@ impl Shared {
         let e = Encoded {
             version: frame.version,
             done: frame.snapshot.done,
+            camera: frame.snapshot.camera,
             bytes: Arc::new(encode_image(&frame)),
         };
         im.encodes += 1;
@@ -333,10 +381,20 @@ impl Preview {
             clients: Mutex::new(Clients::default()),
             denoiser: Mutex::new(Denoiser::default()),
             images: Mutex::new(Images::default()),
+            control: Mutex::new(None),
+            refused: Mutex::new(Default::default()),
         });
         let s = Arc::clone(&shared);
         std::thread::spawn(move || accept_loop(listener, s));
         Ok(Preview { addr, shared })
+    }
+
+    /// Lets the page move the camera (`--interactive`): requests to
+    /// `/camera` change `control`, and the render takes the cameras from
+    /// the watch.
+    pub fn set_camera_control(&self, control: CameraControl) {
+        self.shared.watch.set_interactive();
+        *self.shared.control() = Some(control);
     }
 
     /// The address served.
@@ -410,11 +468,17 @@ impl Read for DeadlineReader<'_> {
 }
 
 /// A parsed request head.
-#[derive(Debug, PartialEq)]
+#[derive(Debug, Default, PartialEq)]
 struct Request {
     method: String,
     path: String,
+    /// What follows `?` in the target (without the fragment).
+    query: String,
     host: Option<String>,
+    /// `Origin`, `Content-Type` and `Content-Length`, when sent.
+    origin: Option<String>,
+    content_type: Option<String>,
+    content_length: Option<String>,
 }
 
 /// Reads a request head (request line and headers) of at most
@@ -451,18 +515,30 @@ fn read_request(r: &mut impl BufRead) -> Result<Request, &'static str> {
     if !version.starts_with("HTTP/1.") {
         return Err("unsupported HTTP version");
     }
-    let host = lines.find_map(|l| {
-        let (name, value) = l.split_once(':')?;
-        name.trim()
-            .eq_ignore_ascii_case("host")
-            .then(|| value.trim().to_string())
-    });
-    let path = target.split(['?', '#']).next().unwrap_or("/").to_string();
-    Ok(Request {
+    let mut req = Request {
         method: method.to_string(),
-        path,
-        host,
-    })
+        ..Request::default()
+    };
+    for l in lines {
+        let Some((name, value)) = l.split_once(':') else {
+            continue;
+        };
+        let slot = match name.trim().to_ascii_lowercase().as_str() {
+            "host" => &mut req.host,
+            "origin" => &mut req.origin,
+            "content-type" => &mut req.content_type,
+            "content-length" => &mut req.content_length,
+            _ => continue,
+        };
+        if slot.is_none() {
+            *slot = Some(value.trim().to_string());
+        }
+    }
+    let target = target.split('#').next().unwrap_or("/");
+    let (path, query) = target.split_once('?').unwrap_or((target, ""));
+    req.path = path.to_string();
+    req.query = query.to_string();
+    Ok(req)
 }
 
 /// Whether a `Host` header names this machine's loopback at `port`.
@@ -495,10 +571,22 @@ fn respond(
     body: &[u8],
     head_only: bool,
 ) -> std::io::Result<()> {
+    respond_with(w, status, content_type, body, head_only, "")
+}
+
+/// [`respond`] with `extra` header lines (each ending in CRLF).
+fn respond_with(
+    w: &mut impl Write,
+    status: &str,
+    content_type: &str,
+    body: &[u8],
+    head_only: bool,
+    extra: &str,
+) -> std::io::Result<()> {
     write!(
         w,
         "HTTP/1.1 {status}\r\nContent-Type: {content_type}\r\nContent-Length: {}\r\n\
-         Cache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\nConnection: close\r\n\r\n",
+         Cache-Control: no-store\r\nX-Content-Type-Options: nosniff\r\n{extra}Connection: close\r\n\r\n",
         body.len()
     )?;
     if !head_only {
@@ -511,11 +599,12 @@ fn respond(
 /// `deadline`.
 fn serve(stream: TcpStream, deadline: Instant, shared: &Shared) -> std::io::Result<()> {
     stream.set_write_timeout(Some(CLIENT_TIMEOUT))?;
-    let req = read_request(&mut BufReader::new(DeadlineReader {
+    let mut reader = BufReader::new(DeadlineReader {
         stream: &stream,
         deadline,
-    }));
-    let mut out = std::io::BufWriter::new(stream);
+    });
+    let req = read_request(&mut reader);
+    let mut out = std::io::BufWriter::new(&stream);
     let text = "text/plain; charset=utf-8";
     let req = match req {
         Ok(r) => r,
@@ -534,6 +623,21 @@ fn serve(stream: TcpStream, deadline: Instant, shared: &Shared) -> std::io::Resu
         let why = b"this server answers only requests addressed to the loopback interface";
         return respond(&mut out, "403 Forbidden", text, why, false);
     }
+    if req.method == "POST" && req.path == "/camera" {
+        return match camera_post(&req, &mut reader, shared) {
+            Ok(json) => respond(
+                &mut out,
+                "200 OK",
+                "application/json",
+                json.as_bytes(),
+                false,
+            ),
+            Err((status, why)) => {
+                shared.refuse(&why);
+                respond(&mut out, status, text, why.as_bytes(), false)
+            }
+        };
+    }
     let head_only = req.method == "HEAD";
     if req.method != "GET" && !head_only {
         return respond(&mut out, "405 Method Not Allowed", text, b"GET only", false);
@@ -548,9 +652,27 @@ fn serve(stream: TcpStream, deadline: Instant, shared: &Shared) -> std::io::Resu
         ),
         "/status" => {
             shared.watch.viewer_seen();
+            // `?after=N`: answered once there is a snapshot newer than N
+            // (or the render ended), or after LONG_POLL.
+            let after = req
+                .query
+                .split('&')
+                .find_map(|kv| kv.strip_prefix("after="))
+                .and_then(|v| v.parse::<u64>().ok());
+            let camera = shared.control().as_ref().map(CameraControl::json);
             let (json, finished) = {
-                let s = shared.watch.state();
-                (status_json(&s, std::process::id()), s.finished)
+                let s = match after {
+                    Some(v) => shared.watch.wait_newer(v, LONG_POLL),
+                    None => shared.watch.state(),
+                };
+                let mut json = status_json(&s, std::process::id());
+                if let Some(c) = camera {
+                    // The camera and the one the snapshot was rendered from.
+                    let from = s.frame.as_ref().map_or(0, |f| f.snapshot.camera);
+                    json.pop();
+                    json += &format!(",\"camera\":{c},\"frame_camera\":{from}}}");
+                }
+                (json, s.finished)
             };
             respond(
                 &mut out,
@@ -569,12 +691,13 @@ fn serve(stream: TcpStream, deadline: Instant, shared: &Shared) -> std::io::Resu
             match shared.image() {
                 Some(e) => {
                     let body = e.bytes.as_slice();
-                    respond(
+                    respond_with(
                         &mut out,
                         "200 OK",
                         "application/octet-stream",
                         body,
                         head_only,
+                        &format!("X-Rpbrt-Camera: {}\r\n", e.camera),
                     )?;
                     if e.done && !head_only {
                         shared.final_image_served.store(true, Ordering::Relaxed);
@@ -607,6 +730,59 @@ fn serve(stream: TcpStream, deadline: Instant, shared: &Shared) -> std::io::Resu
         "/favicon.ico" => respond(&mut out, "204 No Content", text, b"", true),
         _ => respond(&mut out, "404 Not Found", text, b"not found", head_only),
     }
+}
+
+/// Checks and reads a `POST /camera` request: same origin only (a page
+/// from elsewhere may not move the camera: its `Origin` differs, and its
+/// JSON content type needs a CORS preflight this server never grants), a
+/// JSON body of at most [`MAX_BODY`] bytes within the head's deadline.
+fn camera_post(
+    req: &Request,
+    reader: &mut impl Read,
+    shared: &Shared,
+) -> Result<String, (&'static str, String)> {
+    if let Some(origin) = &req.origin {
+        let own = req.host.as_deref().map(|h| format!("http://{h}"));
+        if own.as_deref() != Some(origin.as_str()) {
+            return Err((
+                "403 Forbidden",
+                format!("requests from {origin} may not move the camera"),
+            ));
+        }
+    }
+    let json = req.content_type.as_deref().is_some_and(|t| {
+        t.split(';')
+            .next()
+            .is_some_and(|m| m.trim().eq_ignore_ascii_case("application/json"))
+    });
+    if !json {
+        return Err((
+            "415 Unsupported Media Type",
+            "the body must be application/json".into(),
+        ));
+    }
+    let len = req
+        .content_length
+        .as_deref()
+        .and_then(|v| v.parse::<usize>().ok())
+        .ok_or((
+            "411 Length Required",
+            "Content-Length is missing or not a number".to_string(),
+        ))?;
+    if len > MAX_BODY {
+        return Err((
+            "413 Payload Too Large",
+            format!("the body is over {MAX_BODY} bytes"),
+        ));
+    }
+    let mut body = vec![0; len];
+    reader.read_exact(&mut body).map_err(|_| {
+        (
+            "408 Request Timeout",
+            "the body did not arrive in time".to_string(),
+        )
+    })?;
+    shared.camera_request(&body)
 }
 
 /// `/image`'s bytes for a frame: the [`IMAGE_HEADER`]-byte header, then

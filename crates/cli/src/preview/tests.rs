@@ -36,7 +36,9 @@ fn request_heads_are_parsed_with_limits() {
         Ok(Request {
             method: "GET".into(),
             path: "/status".into(),
+            query: "x=1".into(),
             host: Some("127.0.0.1:80".into()),
+            ..Request::default()
         })
     );
     assert!(read_request(&mut "GET / HTTP/1.1\r\nHost: x".as_bytes()).is_err());
@@ -83,6 +85,7 @@ fn frame(version: u64, done: bool) -> Frame {
             rgb: vec![0.0, 0.5, 1.0, 2.0, -1.0, f32::INFINITY],
             spp: 16,
             done,
+            camera: 0,
         },
     }
 }
@@ -407,6 +410,7 @@ fn preview_slow_image_readers_share_one_encoding() {
         rgb: vec![0.25; 3 * w * h],
         spp,
         done: false,
+        camera: 0,
     };
     let stalled_reader = || {
         let mut s = TcpStream::connect(addr).unwrap();
@@ -510,6 +514,7 @@ fn denoised_route_serves_the_snapshot_denoised() {
         rgb,
         spp: 4,
         done: false,
+        camera: 0,
     });
     let (head, body) = get(addr, "/denoised", &host);
     if head.starts_with("HTTP/1.1 503") {

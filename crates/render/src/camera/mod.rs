@@ -16,6 +16,7 @@
 
 mod create;
 mod lanes;
+mod place;
 mod projective;
 mod realistic;
 mod spherical;
@@ -34,6 +35,7 @@ use crate::spectrum::{SampledSpectrum, SampledWavelengths};
 
 pub use create::{create_camera, read_lens_file, CAMERA_NAMES};
 pub use lanes::{OffsetRays, PinholeRays};
+pub use place::{LensChange, LensSettings};
 pub use projective::{OrthographicCamera, PerspectiveCamera, ProjectiveTransforms};
 pub use realistic::{ApertureImage, LensElementInterface, RealisticCamera};
 pub use spherical::{SphericalCamera, SphericalMapping};

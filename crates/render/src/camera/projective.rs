@@ -79,6 +79,9 @@ pub struct OrthographicCamera {
     pub lens_radius: Float,
     /// Distance to the plane in focus.
     pub focal_distance: Float,
+    /// The screen window the raster maps to (kept to build the camera
+    /// again elsewhere: [`super::Camera::placed`]).
+    pub screen_window: Bounds2f,
     dx_camera: Vector3f,
     dy_camera: Vector3f,
 }
@@ -108,6 +111,7 @@ impl OrthographicCamera {
             xf,
             lens_radius,
             focal_distance,
+            screen_window,
             dx_camera,
             dy_camera,
         })
@@ -193,6 +197,12 @@ pub struct PerspectiveCamera {
     pub lens_radius: Float,
     /// Distance to the plane in focus.
     pub focal_distance: Float,
+    /// The field of view in degrees across the screen window's [−1, 1]
+    /// extent, and the window (kept to build the camera again elsewhere:
+    /// [`super::Camera::placed`]).
+    pub fov: Float,
+    /// The screen window the raster maps to.
+    pub screen_window: Bounds2f,
     /// Area of the image rectangle on the plane z = 1 (for importance).
     pub image_plane_area: Float,
     /// Cosine of the angle between the viewing direction and the film's
@@ -234,6 +244,8 @@ impl PerspectiveCamera {
             xf,
             lens_radius,
             focal_distance,
+            fov,
+            screen_window,
             image_plane_area,
             cos_total_width: 0.0,
             dx_camera,

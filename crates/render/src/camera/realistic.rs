@@ -353,6 +353,16 @@ impl RealisticCamera {
         Ok((cam, warnings))
     }
 
+    /// Finds the minimum differentials again, after the placement changed
+    /// ([`super::Camera::placed`]).
+    pub(crate) fn refind_minimum_differentials(&mut self) {
+        let mut base = self.base.clone();
+        base.find_minimum_differentials(|b, s| {
+            differential_by_offset(s, |s| self.ray_with_base(b, s))
+        });
+        self.base = base;
+    }
+
     /// The z of the rear element (the lens–film distance).
     #[inline]
     pub fn lens_rear_z(&self) -> Float {

@@ -549,6 +549,28 @@ impl Film {
         c.splat_rgb = pixels::AtomicF64s::new(c.splat_rgb.len());
         c.splat_buckets = pixels::AtomicF64s::new(c.splat_buckets.len());
     }
+    /// Expresses G-buffer positions and normals kept in camera space in
+    /// the space of a camera placed by `ct` from now on (a camera moved by
+    /// an interactive render); other films are unchanged.
+    pub fn place_camera(&mut self, ct: &crate::camera::CameraTransform) {
+        let c = self.core_mut();
+        if let KindConfig::GBuffer {
+            apply_inverse: true,
+            color_space,
+            ..
+        } = c.config.kind
+        {
+            c.config = Arc::new(SampleConfig {
+                sensor: c.config.sensor.clone(),
+                max_component_value: c.config.max_component_value,
+                kind: KindConfig::GBuffer {
+                    output_from_render: ct.render_from_camera,
+                    apply_inverse: true,
+                    color_space,
+                },
+            });
+        }
+    }
     /// Writes to `name` from now on (format by extension).
     pub fn set_filename(&mut self, name: String) {
         self.core_mut().filename = name;

@@ -36,6 +36,7 @@ mod create;
 mod diffuse_lanes;
 mod direct;
 mod function;
+mod interactive;
 mod lightpath;
 mod mlt;
 mod path;
@@ -55,11 +56,13 @@ mod whitted;
 pub use bdpt::BdptIntegrator;
 pub use create::{create_integrator, IntegratorOptions, INTEGRATOR_NAMES};
 pub use function::{FunctionIntegrator, TestFunction};
+pub use interactive::{pick, Pick};
 pub use lightpath::LightPathIntegrator;
 pub use mlt::MltIntegrator;
 pub use path::PathIntegrator;
 pub use render::{
-    Progress, ProgressFn, RenderError, RenderObserver, RenderOptions, RenderStats, Snapshot,
+    CameraChange, Progress, ProgressFn, RenderError, RenderObserver, RenderOptions, RenderStats,
+    Snapshot,
 };
 pub use scene::{RayCounters, Scene};
 pub use simple::{AmbientOcclusionIntegrator, RandomWalkIntegrator, SimplePathIntegrator};
@@ -123,6 +126,13 @@ impl Integrator {
                 "the \"{}\" integrator does not take samples pixel by pixel, so it cannot render sample ranges or parts of its film",
                 self.name()
             ))));
+        }
+        if opts.observer.as_ref().is_some_and(|o| o.interactive()) && !self.renders_interactively()
+        {
+            return Err(RenderError::Unsupported(format!(
+                "the \"{}\" integrator cannot render interactively (path, volpath, simplepath, simplevolpath, ambientocclusion, randomwalk and whitted can)",
+                self.name()
+            )));
         }
         // One match per render: each arm runs a loop built for its
         // integrator (no dispatch per ray).
@@ -248,6 +258,22 @@ impl Integrator {
         !matches!(
             self,
             Integrator::Mlt(_) | Integrator::Sppm(_) | Integrator::Function(_)
+        )
+    }
+
+    /// True for integrators that can render interactively (`--interactive`):
+    /// those that estimate each camera ray's radiance alone, so that a
+    /// moved camera needs only a cleared film.
+    pub fn renders_interactively(&self) -> bool {
+        matches!(
+            self,
+            Integrator::Path(_)
+                | Integrator::VolPath(_)
+                | Integrator::SimplePath(_)
+                | Integrator::SimpleVolPath(_)
+                | Integrator::AmbientOcclusion(_)
+                | Integrator::RandomWalk(_)
+                | Integrator::Whitted(_)
         )
     }
 

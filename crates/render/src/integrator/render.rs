@@ -64,8 +64,23 @@ pub struct Snapshot {
     /// Samples per pixel (SPPM: iterations) that every pixel has; pixels
     /// of tiles finished in the running wave have more.
     pub spp: i32,
-    /// True for the final image, the one written to the file.
+    /// True for the final image, the one written to the file (in an
+    /// interactive render: the image with all its samples for a camera).
     pub done: bool,
+    /// The camera it was rendered from: 0, the scene's; in an interactive
+    /// render, the number of the [`CameraChange`] since.
+    pub camera: u64,
+}
+
+/// A camera an interactive render goes on with ([`RenderObserver::take_camera`]).
+#[derive(Clone, Debug)]
+pub struct CameraChange {
+    /// Its number, which the snapshots rendered from it carry (greater than
+    /// those before it; 0 is the scene's own camera).
+    pub number: u64,
+    /// The camera: the scene's, placed elsewhere
+    /// ([`crate::camera::Camera::placed`]), or the scene's own again.
+    pub camera: crate::camera::Camera,
 }
 
 /// Watches a render as it runs (the command line's live view and tev
@@ -79,6 +94,24 @@ pub trait RenderObserver: Send + Sync {
     fn wants_image(&self, wave_end: bool) -> bool;
     /// A new snapshot.
     fn image(&self, snapshot: Snapshot);
+    /// Whether the render is interactive (`--interactive`): it goes on
+    /// until interrupted, starts again from the first sample whenever
+    /// [`RenderObserver::take_camera`] has a camera, and waits for one once
+    /// the image has all its samples. Default: no.
+    fn interactive(&self) -> bool {
+        false
+    }
+    /// Whether a camera waits to be taken (asked every few milliseconds
+    /// while an interactive render runs: keep it cheap).
+    fn camera_pending(&self) -> bool {
+        false
+    }
+    /// The latest camera asked for since the last one taken, waiting at
+    /// most `timeout` for one.
+    fn take_camera(&self, timeout: Duration) -> Option<CameraChange> {
+        let _ = timeout;
+        None
+    }
 }
 
 impl std::fmt::Debug for dyn RenderObserver {
@@ -125,6 +158,7 @@ pub(crate) fn snapshot<'t>(
         rgb: film.rgb_snapshot(tiles, splat_scale),
         spp,
         done,
+        camera: 0,
     }
 }
 
@@ -183,6 +217,8 @@ pub enum RenderError {
     },
     /// A partial render (`--spp-range`) cannot be made as asked.
     Partial(crate::film::PartialError),
+    /// The integrator cannot render this way (interactively).
+    Unsupported(String),
 }
 
 impl std::fmt::Display for RenderError {
@@ -197,6 +233,7 @@ impl std::fmt::Display for RenderError {
             },
             RenderError::WriteFile { path, source } => write!(f, "{path}: {source}"),
             RenderError::Partial(e) => write!(f, "{e}"),
+            RenderError::Unsupported(m) => f.write_str(m),
         }
     }
 }
@@ -209,6 +246,7 @@ impl std::error::Error for RenderError {
             RenderError::WriteImage { source, .. } => Some(source),
             RenderError::WriteFile { source, .. } => Some(source),
             RenderError::Partial(e) => Some(e),
+            RenderError::Unsupported(_) => None,
         }
     }
 }

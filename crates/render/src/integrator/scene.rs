@@ -68,8 +68,9 @@ pub struct Scene {
     pub sampler: Sampler,
     /// The pixel filter.
     pub filter: Filter,
-    /// All geometry under its acceleration structure.
-    pub aggregate: PrimitiveAggregate,
+    /// All geometry under its acceleration structure (shared: an
+    /// interactive render's viewers pick points with it while it renders).
+    pub aggregate: std::sync::Arc<PrimitiveAggregate>,
     /// All lights; area lights are referenced by index from primitives.
     pub lights: Vec<Light>,
     /// Indices of the infinite lights in `lights`.
@@ -101,6 +102,16 @@ pub struct Scene {
 }
 
 impl Scene {
+    /// Renders from `camera` from now on (a camera moved by an interactive
+    /// render: [`crate::camera::Camera::placed`]), with what depends on it:
+    /// the minimum differentials and a G-buffer film's camera space. The
+    /// geometry, lights and media stay where the scene put them.
+    pub fn set_camera(&mut self, camera: Camera) {
+        self.camera_differentials = camera.camera_differentials();
+        self.film.place_camera(&camera.base().camera_transform);
+        self.camera = camera;
+    }
+
     /// The bounds of the geometry.
     pub fn bounds(&self) -> Bounds3f {
         self.aggregate.bounds()

@@ -51,7 +51,7 @@ pub trait RayIntegrator: Sync {
 /// Side of the square tiles the image is split into.
 const TILE_SIZE: i32 = 16;
 
-fn tiles(bounds: Bounds2i) -> Vec<Bounds2i> {
+pub(crate) fn tiles(bounds: Bounds2i) -> Vec<Bounds2i> {
     let mut out = Vec::new();
     let mut y = bounds.p_min.y;
     while y < bounds.p_max.y {
@@ -214,6 +214,9 @@ pub(crate) fn render_tiles<I: TileIntegrator>(
     metadata: &mut ImageMetadata,
     progress: ProgressFn,
 ) -> Result<RenderStats, RenderError> {
+    if let Some(o) = opts.observer.as_deref().filter(|o| o.interactive()) {
+        return super::interactive::render(integrator, scene, opts, metadata, progress, o);
+    }
     let start = Instant::now();
     let pool = thread_pool(opts)?;
     let spp = scene.sampler.samples_per_pixel().max(1);

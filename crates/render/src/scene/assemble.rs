@@ -785,7 +785,7 @@ fn create(
         film,
         sampler,
         filter,
-        aggregate,
+        aggregate: std::sync::Arc::new(aggregate),
         light_cull: lights.iter().map(LightCull::for_light).collect(),
         lights,
         infinite_lights,

@@ -522,6 +522,7 @@ pub(crate) fn render(
                         rgb: image.as_f32().map(<[f32]>::to_vec).unwrap_or_default(),
                         spp: iterations_done,
                         done: last,
+                        camera: 0,
                     });
                 }
                 if writes {
