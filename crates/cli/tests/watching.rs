@@ -780,10 +780,12 @@ fn interactive_camera_in_a_real_browser() {
     let back = converged(&mut page, "the file's camera again, converged");
     assert_eq!(back["hash"], first["hash"], "{back} {first}");
 
-    // Changes reach the page quickly (the figure is measured by the
-    // ignored `interactive_latency` below; here only a loose bound).
-    let l = latencies(&mut page, 10);
-    assert!(median(&l) < 2000.0, "{l:?}");
+    // Changes reach the page within the budget, 150 ms (the
+    // figure for the bundled scene and the Cornell box comes from the
+    // ignored `interactive_latency` below; this 48 × 36 image takes
+    // about 15 ms, so the bound holds on a loaded machine).
+    let l = latencies(&mut page, 15);
+    assert!(median(&l) < 150.0, "{l:?}");
     // Ctrl-C once the image is complete: a clean exit, the image written.
     converged(&mut page, "the last camera, converged");
     let status = interrupt(child);

@@ -9,10 +9,11 @@
 //! What a pass shows, and why:
 //! - first a **coarse image**: sample 0 of one pixel in each block of
 //!   `block × block`, spread over its block. The block side is chosen so
-//!   that this takes about [`COARSE_BUDGET`] (from the last pass's time per
-//!   sample; before any, from the pixel count): a full pixel sample of a
-//!   400×400 path-traced image takes about 0.4 s on two cores, too long
-//!   to wait for after each key press. Its samples are thrown away.
+//!   that this takes about [`COARSE_BUDGET`] (from the last coarse image's
+//!   time per pixel, or the last full sample's; before any, from the pixel
+//!   count): a full pixel sample of a 400×400 path-traced image takes
+//!   about 0.4 s on two cores, too long to wait for after each key press.
+//!   Its samples are thrown away.
 //! - then **waves** of 1, 1, 2, 4 and then at most [`MAX_WAVE`] samples
 //!   per pixel, each shown when it completes: the whole image refines
 //!   together rather than tile by tile.
@@ -244,7 +245,7 @@ fn first_block(pixels: u64) -> i32 {
 
 /// The block side (a power of two, at most 64) whose coarse image takes
 /// about [`COARSE_BUDGET`] when a full pixel sample of `pixels` pixels
-/// took `wave0`; 1 when the full sample is itself that quick.
+/// takes `wave0`; 1 when the full sample is itself that quick.
 fn block_for(pixels: u64, wave0: Duration) -> i32 {
     let ratio = wave0.as_secs_f64() / COARSE_BUDGET.as_secs_f64();
     let mut b = 1;
@@ -259,13 +260,19 @@ impl<I: TileIntegrator> Pass<'_, I> {
         self.opts.interrupted()
     }
 
-    /// Renders the pass into the cleared film; returns how it ended and
-    /// how long sample 0 of every pixel took (when it was all taken).
+    /// Renders the pass into the cleared film; returns how it ended and an
+    /// estimate of how long sample 0 of every pixel takes: from the coarse
+    /// image's time per pixel when there was one (what the estimate sizes),
+    /// else from the wave that took them all.
     fn run(&self, scene: &mut Scene, spp: i32, block: i32) -> (PassEnd, Option<Duration>) {
+        let tc = Instant::now();
+        // The time of the coarse image, over the pixels it stands for.
+        let mut estimate = None;
         if block > 1 {
             let Some(rgb) = self.coarse(scene, block) else {
                 return (PassEnd::Stopped { spp: 0 }, None);
             };
+            estimate = Some(tc.elapsed() * (block * block) as u32);
             let d = scene.film.active_bounds().diagonal();
             self.observer.image(Snapshot {
                 width: d.x.max(0) as usize,
@@ -291,9 +298,9 @@ impl<I: TileIntegrator> Pass<'_, I> {
                 .merge_tile(&t.into_inner().unwrap_or_else(|e| e.into_inner()));
         }
         if self.stopped() {
-            return (PassEnd::Stopped { spp: 0 }, None);
+            return (PassEnd::Stopped { spp: 0 }, estimate);
         }
-        let wave0 = t0.elapsed();
+        let wave0 = estimate.unwrap_or_else(|| t0.elapsed());
         self.show(scene, &[], 1, spp);
         // Samples 1.. of each pixel, in tiles kept across the waves.
         let rest = fresh(scene);
