@@ -659,12 +659,13 @@ fn serve(stream: TcpStream, deadline: Instant, shared: &Shared) -> std::io::Resu
                 .split('&')
                 .find_map(|kv| kv.strip_prefix("after="))
                 .and_then(|v| v.parse::<u64>().ok());
-            let camera = shared.control().as_ref().map(CameraControl::json);
             let (json, finished) = {
                 let s = match after {
                     Some(v) => shared.watch.wait_newer(v, LONG_POLL),
                     None => shared.watch.state(),
                 };
+                // Read after the wait: the camera as of the answer.
+                let camera = shared.control().as_ref().map(CameraControl::json);
                 let mut json = status_json(&s, std::process::id());
                 if let Some(c) = camera {
                     // The camera and the one the snapshot was rendered from.

@@ -42,8 +42,12 @@ pub struct Browser {
 impl Browser {
     /// Starts `chromium` headless on `url`, with a fresh profile.
     pub fn launch(chromium: &Path, url: &str) -> Browser {
-        // One browser per test process.
-        let profile = std::env::temp_dir().join(format!("rpbrt-chromium-{}", std::process::id()));
+        // A profile per browser: tests of one process run at once, and a
+        // profile in use by another browser keeps this one from starting.
+        static LAUNCHED: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let n = LAUNCHED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let profile =
+            std::env::temp_dir().join(format!("rpbrt-chromium-{}-{n}", std::process::id()));
         let mut child = Command::new(chromium)
             .args([
                 "--headless",
