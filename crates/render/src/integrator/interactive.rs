@@ -198,6 +198,10 @@ pub(crate) fn render<I: TileIntegrator>(
             PassEnd::Stopped { spp } if opts.interrupted() => {
                 write(scene, metadata, spp)?;
                 complete = false;
+                // The image written is the last one: a watching page gets it.
+                let mut s = snapshot(&scene.film, std::iter::empty(), spp, splat_scale(spp), true);
+                s.camera = camera;
+                observer.image(s);
                 None
             }
             PassEnd::Stopped { .. } => observer.take_camera(Duration::ZERO),
