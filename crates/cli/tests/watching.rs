@@ -89,6 +89,19 @@ fn exr_pixel(path: &Path, x: usize, y: usize) -> [f32; 3] {
     [v[i], v[i + 1], v[i + 2]]
 }
 
+/// The image canvas's left, top, width and height in the viewport.
+fn view_rect(page: &mut cdp::Page) -> Vec<f64> {
+    let rect = page.eval(
+        r#"(() => { const r = document.getElementById("view").getBoundingClientRect();
+                    return [r.left, r.top, r.width, r.height]; })()"#,
+    );
+    rect.as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect()
+}
+
 /// What the page shows, as JSON, for the test to read.
 const PAGE_STATE: &str = r#"(() => {
   const c = document.getElementById("view");
@@ -209,16 +222,7 @@ fn preview_in_a_real_browser() {
 
     // The readout under the cursor is the film's float value.
     let (x, y) = (30usize, 17usize);
-    let rect = page.eval(
-        r#"(() => { const r = document.getElementById("view").getBoundingClientRect();
-                    return [r.left, r.top, r.width, r.height]; })()"#,
-    );
-    let r: Vec<f64> = rect
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let r = view_rect(&mut page);
     page.mouse_move(
         r[0] + (x as f64 + 0.5) * r[2] / W as f64,
         r[1] + (y as f64 + 0.5) * r[3] / H as f64,
@@ -668,16 +672,7 @@ fn interactive_camera_in_a_real_browser() {
 
     // A drag to the right orbits the camera to the left about the point
     // under the cursor.
-    let rect = page.eval(
-        r#"(() => { const r = document.getElementById("view").getBoundingClientRect();
-                    return [r.left, r.top, r.width, r.height]; })()"#,
-    );
-    let r: Vec<f64> = rect
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
+    let r = view_rect(&mut page);
     let (cx, cy) = (r[0] + r[2] / 2.0, r[1] + r[3] / 2.0);
     let before = look_at(&text);
     for (ty, x) in [

@@ -424,26 +424,17 @@ impl CameraControl {
                     Key::Left => translate(&mut view, screen_right * -d),
                     Key::Up => translate(&mut view, screen_up * d),
                     Key::Down => translate(&mut view, screen_up * -d),
-                    Key::TurnLeft | Key::TurnRight => {
-                        let toward = if key == Key::TurnRight {
-                            screen_right
-                        } else {
-                            -screen_right
+                    Key::TurnLeft | Key::TurnRight | Key::TurnUp | Key::TurnDown => {
+                        // Yaw about the up vector, pitch about the right axis.
+                        let (axis, toward) = match key {
+                            Key::TurnRight => (up_axis, screen_right),
+                            Key::TurnLeft => (up_axis, -screen_right),
+                            Key::TurnUp => (right, screen_up),
+                            _ => (right, -screen_up),
                         };
-                        let sign = dot(cross(up_axis, dir), toward).signum();
+                        let sign = dot(cross(axis, dir), toward).signum();
                         for l in &mut view.looks {
-                            l.look = l.eye + rotate(l.look - l.eye, up_axis, sign * turn);
-                        }
-                    }
-                    Key::TurnUp | Key::TurnDown => {
-                        let toward = if key == Key::TurnUp {
-                            screen_up
-                        } else {
-                            -screen_up
-                        };
-                        let sign = dot(cross(right, dir), toward).signum();
-                        for l in &mut view.looks {
-                            l.look = l.eye + rotate(l.look - l.eye, right, sign * turn);
+                            l.look = l.eye + rotate(l.look - l.eye, axis, sign * turn);
                         }
                         if !pitch_ok(&view) {
                             return Err(
