@@ -8,9 +8,15 @@
 //!   film's float value under the cursor, progress and ETA, and saves the
 //!   image (PNG as shown, PFM as the film's floats) without the server;
 //! - `/status`: JSON: the snapshot's number, size and samples per pixel,
-//!   whether it is the final image, the progress and the ETA;
+//!   whether it is the final image, the progress and the ETA (with
+//!   `?after=N`, answered once a snapshot newer than N is there, or after
+//!   [`LONG_POLL`]; `--interactive` adds the camera);
 //! - `/image`: the latest snapshot, [`IMAGE_HEADER`] bytes of header then
-//!   RGB `f32` values (see [`encode_image`]).
+//!   RGB `f32` values (see [`encode_image`]), and in an `X-Rpbrt-Camera`
+//!   header the number of the camera it was rendered from;
+//! - `POST /camera` (`--interactive` only): a JSON change to the camera
+//!   ([`camera::parse_op`]), from the page's own origin; answered with the
+//!   camera's JSON, or a 4xx and the reason.
 //!
 //! Connections are limited so that slow or many clients cannot lock the
 //! page out (see [`Limits`]): the whole request head must arrive within
@@ -20,7 +26,7 @@
 //! sending it, and slow readers hold at most [`MAX_IMAGE_BUFFERS`]
 //! encodings alive.
 //!
-//! It stays std-only on purpose: three GET routes, plus the limits above.
+//! It stays std-only on purpose: a few small routes, plus the limits above.
 //! tiny_http offers neither a head deadline nor per-client shares, and
 //! hyper (which has a head timeout) would bring an async runtime along;
 //! either would still need the per-client accounting written here.
