@@ -60,11 +60,9 @@ impl LookAt {
     /// Whether the numbers make a camera: finite, bounded, the eye off the
     /// look point and the up vector off the view direction.
     fn valid(&self) -> bool {
-        let coords = [self.eye.x, self.eye.y, self.eye.z, self.look.x, self.look.y]
-            .into_iter()
-            .chain([self.look.z, self.up.x, self.up.y, self.up.z]);
-        let bounded = coords
-            .into_iter()
+        let (e, l, u) = (self.eye, self.look, self.up);
+        let bounded = [e.x, e.y, e.z, l.x, l.y, l.z, u.x, u.y, u.z]
+            .iter()
             .all(|v| v.is_finite() && v.abs() <= MAX_COORD);
         let d = self.look - self.eye;
         bounded
@@ -341,14 +339,10 @@ impl CameraControl {
         if rfc.is_animated() {
             transforms.push(world_from_camera(&rfc.end_transform));
         }
-        let m = transforms[0].matrix().m;
-        let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
         let looks = transforms.iter().map(derive_look_at).collect();
         let lens = camera.lens();
         let view = View {
-            flip: det < 0.0,
+            flip: transforms[0].swaps_handedness(),
             looks,
             lens: LensChange {
                 fov: lens.fov,
