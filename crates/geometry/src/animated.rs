@@ -75,30 +75,48 @@ pub fn decompose(m: &SquareMatrix4) -> Decomposition {
 }
 
 /// A transformation that varies over time between two keyframes.
-#[derive(Clone, Copy, Debug, PartialEq)]
+///
+/// Stored compactly: a pair of translations (what `ActiveTransform`
+/// lines around `Translate` give every moving shape of a scene) is kept
+/// as its two offsets, 36 bytes in all, since everything about it (the
+/// keyframes, their decompositions, the interpolation) follows from them
+/// bit for bit; any other pair keeps its keyframes and decompositions
+/// behind one pointer.
+#[derive(Clone, Debug, PartialEq)]
 pub struct AnimatedTransform {
-    /// The transformation at `start_time`.
-    pub start_transform: Transform,
-    /// The transformation at `end_time`.
-    pub end_transform: Transform,
     /// Start of the animation.
     pub start_time: Float,
     /// End of the animation.
     pub end_time: Float,
+    keys: Keys,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+enum Keys {
+    /// Both keyframes are, to the bit, `Transform::translate` of these
+    /// offsets (the start's, then the end's). Their decompositions are
+    /// the offsets with no rotation and unit scale, and the interpolation
+    /// is the translation by the interpolated offset.
+    Translations([Vector3f; 2]),
+    /// Any other pair of keyframes.
+    General(Box<GeneralKeys>),
+}
+
+#[derive(Clone, Debug, PartialEq)]
+struct GeneralKeys {
+    start: Transform,
+    end: Transform,
     actually_animated: bool,
     d0: Decomposition,
     d1: Decomposition,
     has_rotation: bool,
-    /// Both keyframes are translations (no rotation, unit scale): the
-    /// interpolation is the translation by the interpolated offset.
-    translation_only: bool,
 }
 
-/// A decomposition with no rotation (a quaternion whose vector part is
-/// +0) and no scale: a translation.
-fn is_translation(d: &Decomposition) -> bool {
-    let v = d.r.v;
-    [v.x, v.y, v.z].iter().all(|c| c.to_bits() == 0) && d.s == SquareMatrix4::identity()
+/// The offset of `t` when `t` is, to the bit, the translation by it.
+fn translation_offset(t: &Transform) -> Option<Vector3f> {
+    let m = t.matrix();
+    let d = Vector3f::new(m.m[0][3], m.m[1][3], m.m[2][3]);
+    Transform::translate(d).same_bits(t).then_some(d)
 }
 
 impl AnimatedTransform {
@@ -109,6 +127,19 @@ impl AnimatedTransform {
 
     /// Interpolates between `start` at `start_time` and `end` at `end_time`.
     pub fn new(start: Transform, start_time: Float, end: Transform, end_time: Float) -> Self {
+        if let (Some(a), Some(b)) = (translation_offset(&start), translation_offset(&end)) {
+            return AnimatedTransform {
+                start_time,
+                end_time,
+                keys: Keys::Translations([a, b]),
+            };
+        }
+        AnimatedTransform::general(start, start_time, end, end_time)
+    }
+
+    /// [`AnimatedTransform::new`] keeping the keyframes and their
+    /// decompositions whatever they are.
+    fn general(start: Transform, start_time: Float, end: Transform, end_time: Float) -> Self {
         let actually_animated = start != end;
         let d0 = decompose(start.matrix());
         let mut d1 = decompose(end.matrix());
@@ -117,33 +148,54 @@ impl AnimatedTransform {
             d1.r = -d1.r;
         }
         let has_rotation = d0.r.dot(d1.r) < 0.9995;
-        let translation_only = is_translation(&d0) && is_translation(&d1);
         AnimatedTransform {
-            start_transform: start,
-            end_transform: end,
             start_time,
             end_time,
-            actually_animated,
-            d0,
-            d1,
-            has_rotation,
-            translation_only,
+            keys: Keys::General(Box::new(GeneralKeys {
+                start,
+                end,
+                actually_animated,
+                d0,
+                d1,
+                has_rotation,
+            })),
         }
     }
 
     /// True when the two keyframes differ.
     #[inline]
     pub fn is_animated(&self) -> bool {
-        self.actually_animated
+        match &self.keys {
+            Keys::Translations([a, b]) => a != b,
+            Keys::General(g) => g.actually_animated,
+        }
+    }
+
+    /// The transformation at `start_time`.
+    #[inline]
+    pub fn start_transform(&self) -> Transform {
+        match &self.keys {
+            Keys::Translations([a, _]) => Transform::translate(*a),
+            Keys::General(g) => g.start,
+        }
+    }
+
+    /// The transformation at `end_time`.
+    #[inline]
+    pub fn end_transform(&self) -> Transform {
+        match &self.keys {
+            Keys::Translations([_, b]) => Transform::translate(*b),
+            Keys::General(g) => g.end,
+        }
     }
 
     /// The transformation at `time` (clamped to the keyframe interval).
     pub fn interpolate(&self, time: Float) -> Transform {
-        if !self.actually_animated || time <= self.start_time {
-            return self.start_transform;
+        if !self.is_animated() || time <= self.start_time {
+            return self.start_transform();
         }
         if time >= self.end_time {
-            return self.end_transform;
+            return self.end_transform();
         }
         let dt = (time - self.start_time) / (self.end_time - self.start_time);
         self.at_fraction(dt)
@@ -152,21 +204,24 @@ impl AnimatedTransform {
     /// The decompositions' interpolation at `dt` of the keyframe interval
     /// (0 at its start, 1 at its end).
     fn at_fraction(&self, dt: Float) -> Transform {
-        let trans = Vector3f::lerp(dt, self.d0.t, self.d1.t);
-        if self.translation_only {
-            // What the composition below gives, bit for bit: a rotation
-            // with a +0 vector part is the identity matrix (whatever the
-            // interpolated real part), and products with the identity are
-            // exact (tested), so this is the translation alone, without
-            // its four matrix products and an inverse (per ray, for a
-            // ray meeting a moving shape).
-            return Transform::translate(trans);
-        }
-        let rotate = Quaternion::slerp(dt, self.d0.r, self.d1.r);
+        let g = match &self.keys {
+            Keys::Translations([a, b]) => {
+                // What the composition below gives, bit for bit: a
+                // rotation with a +0 vector part is the identity matrix
+                // (whatever the interpolated real part), and products with
+                // the identity are exact (tested), so this is the
+                // translation alone, without its four matrix products and
+                // an inverse (per ray, for a ray meeting a moving shape).
+                return Transform::translate(Vector3f::lerp(dt, *a, *b));
+            }
+            Keys::General(g) => g,
+        };
+        let trans = Vector3f::lerp(dt, g.d0.t, g.d1.t);
+        let rotate = Quaternion::slerp(dt, g.d0.r, g.d1.r);
         let mut scale = SquareMatrix4::identity();
         for i in 0..3 {
             for j in 0..3 {
-                scale.m[i][j] = lerp(dt, self.d0.s.m[i][j], self.d1.s.m[i][j]);
+                scale.m[i][j] = lerp(dt, g.d0.s.m[i][j], g.d1.s.m[i][j]);
             }
         }
         let st = Transform::from_matrix(scale).unwrap_or_default();
@@ -176,41 +231,26 @@ impl AnimatedTransform {
     /// Applies the transformation at `time` to a point.
     #[inline]
     pub fn apply_point(&self, p: Point3f, time: Float) -> Point3f {
-        if !self.actually_animated {
-            return self.start_transform.apply_point(p);
-        }
         self.interpolate(time).apply_point(p)
     }
     /// Applies the transformation at `time` to a vector.
     #[inline]
     pub fn apply_vector(&self, v: Vector3f, time: Float) -> Vector3f {
-        if !self.actually_animated {
-            return self.start_transform.apply_vector(v);
-        }
         self.interpolate(time).apply_vector(v)
     }
     /// Applies the transformation at `time` to a normal.
     #[inline]
     pub fn apply_normal(&self, n: Normal3f, time: Float) -> Normal3f {
-        if !self.actually_animated {
-            return self.start_transform.apply_normal(n);
-        }
         self.interpolate(time).apply_normal(n)
     }
     /// Applies the transformation at the ray's time to the ray.
     #[inline]
     pub fn apply_ray(&self, r: &Ray, t_max: Float) -> (Ray, Float) {
-        if !self.actually_animated {
-            return self.start_transform.apply_ray(r, t_max);
-        }
         self.interpolate(r.time).apply_ray(r, t_max)
     }
     /// Applies the inverse of the transformation at the ray's time.
     #[inline]
     pub fn apply_inverse_ray(&self, r: &Ray, t_max: Float) -> (Ray, Float) {
-        if !self.actually_animated {
-            return self.start_transform.apply_inverse_ray(r, t_max);
-        }
         self.interpolate(r.time).apply_inverse_ray(r, t_max)
     }
 
@@ -231,18 +271,22 @@ impl AnimatedTransform {
         if b.is_empty() {
             return *b;
         }
-        if !self.actually_animated {
-            return self.start_transform.apply_bounds(b);
+        if !self.is_animated() {
+            return self.start_transform().apply_bounds(b);
         }
-        if self.d0.r == self.d1.r {
+        let rotating = match &self.keys {
+            Keys::General(g) if g.d0.r != g.d1.r => Some(g),
+            _ => None,
+        };
+        let Some(g) = rotating else {
             // The keyframes themselves and the decompositions' ends (which
             // the interpolation uses inside the interval and may differ
             // from the keyframes in the last bits), padded for the
             // rounding of the interpolation in between.
             let r = self
-                .start_transform
+                .start_transform()
                 .apply_bounds(b)
-                .union(&self.end_transform.apply_bounds(b))
+                .union(&self.end_transform().apply_bounds(b))
                 .union(&self.at_fraction(0.0).apply_bounds(b))
                 .union(&self.at_fraction(1.0).apply_bounds(b));
             let magnitude = [r.p_min, r.p_max]
@@ -250,20 +294,20 @@ impl AnimatedTransform {
                 .flat_map(|p| [p.x.abs(), p.y.abs(), p.z.abs()])
                 .fold(0.0, Float::max);
             return r.expand(1e-6 * ((b.p_max - b.p_min).length() + magnitude));
-        }
+        };
         let delta = (self.end_time - self.start_time).max(Float::MIN_POSITIVE);
-        let theta = self.d0.r.angle_between(self.d1.r) * 2.0;
-        let omega = if self.has_rotation || theta > 0.0 {
+        let theta = g.d0.r.angle_between(g.d1.r) * 2.0;
+        let omega = if g.has_rotation || theta > 0.0 {
             theta / delta
         } else {
             0.0
         };
-        let trans_speed = (self.d1.t - self.d0.t).length() / delta;
+        let trans_speed = (g.d1.t - g.d0.t).length() / delta;
         let mut speed: Float = 0.0;
         for c in 0..8 {
             let p = Vector3f::from(b.corner(c));
-            let sp0 = mat3_apply(&self.d0.s, p);
-            let sp1 = mat3_apply(&self.d1.s, p);
+            let sp0 = mat3_apply(&g.d0.s, p);
+            let sp1 = mat3_apply(&g.d1.s, p);
             let s =
                 trans_speed + omega * sp0.length().max(sp1.length()) + (sp1 - sp0).length() / delta;
             speed = speed.max(s);
@@ -352,11 +396,8 @@ mod tests {
             let a = Transform::translate(Vector3f::new(next(), next(), next()));
             let b = Transform::translate(Vector3f::new(next(), next(), next()));
             let at = AnimatedTransform::new(a, 0.0, b, 1.0);
-            assert!(at.translation_only);
-            let general = AnimatedTransform {
-                translation_only: false,
-                ..at
-            };
+            assert!(matches!(at.keys, Keys::Translations(_)));
+            let general = AnimatedTransform::general(a, 0.0, b, 1.0);
             // Times in [0, 1], where `interpolate` takes them: the ends,
             // sixteenths and arbitrary floats.
             for k in 0..=32 {
@@ -392,10 +433,38 @@ mod tests {
             }
         }
         // A scale or a rotation in either keyframe takes the composition.
+        let general = |a: Transform, b: Transform| {
+            matches!(AnimatedTransform::new(a, 0.0, b, 1.0).keys, Keys::General(_))
+        };
         let s = Transform::scale(2.0, 1.0, 1.0);
-        assert!(!AnimatedTransform::new(s, 0.0, Transform::identity(), 1.0).translation_only);
+        assert!(general(s, Transform::identity()));
         let r = Transform::rotate(10.0, Vector3f::new(0.0, 1.0, 0.0));
-        assert!(!AnimatedTransform::new(Transform::identity(), 0.0, r, 1.0).translation_only);
+        assert!(general(Transform::identity(), r));
+        // So does a translation matrix whose inverse is not, to the bit,
+        // the negated offset's.
+        let t = Transform::translate(Vector3f::new(1.0, 2.0, 3.0));
+        let mut inv = *t.inverse_matrix();
+        inv.m[0][3] = -0.999_999_9;
+        let odd = Transform::from_matrices(*t.matrix(), inv);
+        assert!(general(odd, t));
+        assert!(!general(t, t));
+        // The compact pair answers as the general one does.
+        let (a, b) = (t, Transform::translate(Vector3f::new(-0.0, 2.5, 3.0)));
+        let (at, g) = (
+            AnimatedTransform::new(a, 0.25, b, 0.75),
+            AnimatedTransform::general(a, 0.25, b, 0.75),
+        );
+        assert!(at.start_transform().same_bits(&g.start_transform()));
+        assert!(at.end_transform().same_bits(&g.end_transform()));
+        assert_eq!(at.is_animated(), g.is_animated());
+        for time in [0.0, 0.25, 0.3, 0.5, 0.75, 1.0] {
+            assert!(at.interpolate(time).same_bits(&g.interpolate(time)), "{time}");
+        }
+        let bx = Bounds3f::new(Point3f::new(-1.0, -0.5, -0.2), Point3f::new(1.0, 0.5, 2.0));
+        assert_eq!(at.motion_bounds(&bx), g.motion_bounds(&bx));
+        let still = AnimatedTransform::new(a, 0.0, a, 1.0);
+        assert!(!still.is_animated());
+        assert!(still.interpolate(0.5).same_bits(&a));
     }
 
     /// A translation's decomposition skips the iteration; it must be what
@@ -447,7 +516,10 @@ mod tests {
         let b =
             Transform::translate(Vector3f::new(10.5, -2.0, -4.0)) * Transform::scale(1.0, 2.0, 0.5);
         let at = AnimatedTransform::new(a, 0.0, b, 1.0);
-        assert_eq!(at.d0.r, at.d1.r, "the straight-motion case");
+        let Keys::General(g) = &at.keys else {
+            panic!("scales are general")
+        };
+        assert_eq!(g.d0.r, g.d1.r, "the straight-motion case");
         let bx = Bounds3f::new(Point3f::new(-1.0, -0.5, -0.2), Point3f::new(1.0, 0.5, 2.0));
         let mb = at.motion_bounds(&bx);
         let ends = a.apply_bounds(&bx).union(&b.apply_bounds(&bx));

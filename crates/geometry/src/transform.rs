@@ -271,14 +271,11 @@ impl Transform {
     /// −0 for 0 and no NaN for itself): then any computation gives the
     /// same result for either.
     pub fn same_bits(&self, o: &Transform) -> bool {
-        let bits = |t: &Transform| {
-            let (m, mi) = (&t.m.m, &t.m_inv.m);
-            std::array::from_fn::<u32, 32, _>(|k| {
-                let src = if k < 16 { m } else { mi };
-                src[(k % 16) / 4][k % 4].to_bits()
-            })
-        };
-        bits(self) == bits(o)
+        fn bits(t: &Transform) -> impl Iterator<Item = u32> + '_ {
+            let rows = t.m.m.iter().chain(&t.m_inv.m);
+            rows.flatten().map(|v| v.to_bits())
+        }
+        bits(self).eq(bits(o))
     }
 
     /// The identity transformation.

@@ -376,7 +376,7 @@ impl ParameterDictionary {
         &self,
         name: &str,
         accept: &[&str],
-        expected: &str,
+        expected: &dyn std::fmt::Display,
     ) -> Result<Option<&ParsedParameter>, ParamError> {
         let mut other: Option<&ParsedParameter> = None;
         for p in self.named(name) {
@@ -423,7 +423,7 @@ impl ParameterDictionary {
         name: &str,
         ty: &str,
     ) -> Result<Option<[f32; N]>, ParamError> {
-        let Some(p) = self.find(name, &[ty], &format!("\"{ty}\""))? else {
+        let Some(p) = self.find(name, &[ty], &Quoted(ty))? else {
             return Ok(None);
         };
         if p.floats.len() != N || p.value_count() != N {
@@ -440,7 +440,7 @@ impl ParameterDictionary {
         name: &str,
         ty: &str,
     ) -> Result<Vec<[f32; N]>, ParamError> {
-        let Some(p) = self.find(name, &[ty], &format!("\"{ty}\""))? else {
+        let Some(p) = self.find(name, &[ty], &Quoted(ty))? else {
             return Ok(Vec::new());
         };
         if p.floats.is_empty() || p.floats.len() % N != 0 || p.value_count() != p.floats.len() {
@@ -471,7 +471,7 @@ impl ParameterDictionary {
 
     /// The single `integer` named `name`, or `default` if absent.
     pub fn get_one_int(&self, name: &str, default: i32) -> Result<i32, ParamError> {
-        let Some(p) = self.find(name, &["integer"], "\"integer\"")? else {
+        let Some(p) = self.find(name, &["integer"], &"\"integer\"")? else {
             return Ok(default);
         };
         if p.ints.len() != 1 || p.value_count() != 1 {
@@ -483,7 +483,7 @@ impl ParameterDictionary {
 
     /// The single `bool` named `name`, or `default` if absent.
     pub fn get_one_bool(&self, name: &str, default: bool) -> Result<bool, ParamError> {
-        let Some(p) = self.find(name, &["bool"], "\"bool\"")? else {
+        let Some(p) = self.find(name, &["bool"], &"\"bool\"")? else {
             return Ok(default);
         };
         if p.bools.len() != 1 || p.value_count() != 1 {
@@ -502,7 +502,7 @@ impl ParameterDictionary {
 
     /// The single `string` named `name`, if present.
     pub fn get_one_string_opt(&self, name: &str) -> Result<Option<String>, ParamError> {
-        let Some(p) = self.find(name, &["string"], "\"string\"")? else {
+        let Some(p) = self.find(name, &["string"], &"\"string\"")? else {
             return Ok(None);
         };
         if p.strings.len() != 1 || p.value_count() != 1 {
@@ -569,7 +569,7 @@ impl ParameterDictionary {
 
     /// All values of the `integer` named `name` (empty if absent).
     pub fn get_int_array(&self, name: &str) -> Result<Vec<i32>, ParamError> {
-        let Some(p) = self.find(name, &["integer"], "\"integer\"")? else {
+        let Some(p) = self.find(name, &["integer"], &"\"integer\"")? else {
             return Ok(Vec::new());
         };
         if p.ints.is_empty() || p.value_count() != p.ints.len() {
@@ -581,7 +581,7 @@ impl ParameterDictionary {
 
     /// All values of the `bool` named `name` (empty if absent).
     pub fn get_bool_array(&self, name: &str) -> Result<Vec<bool>, ParamError> {
-        let Some(p) = self.find(name, &["bool"], "\"bool\"")? else {
+        let Some(p) = self.find(name, &["bool"], &"\"bool\"")? else {
             return Ok(Vec::new());
         };
         if p.bools.is_empty() || p.value_count() != p.bools.len() {
@@ -593,7 +593,7 @@ impl ParameterDictionary {
 
     /// All values of the `string` named `name` (empty if absent).
     pub fn get_string_array(&self, name: &str) -> Result<Vec<String>, ParamError> {
-        let Some(p) = self.find(name, &["string"], "\"string\"")? else {
+        let Some(p) = self.find(name, &["string"], &"\"string\"")? else {
             return Ok(Vec::new());
         };
         if p.strings.is_empty() || p.value_count() != p.strings.len() {
@@ -632,7 +632,7 @@ impl ParameterDictionary {
     /// A non-texture parameter of that name is not an error here: callers
     /// try the texture first, then a constant.
     pub fn get_texture(&self, name: &str) -> Result<Option<String>, ParamError> {
-        let Some(p) = self.find(name, &[FLOAT_TEX], "\"texture\"")? else {
+        let Some(p) = self.find(name, &[FLOAT_TEX], &"\"texture\"")? else {
             return Ok(None);
         };
         if p.strings.len() != 1 || p.value_count() != 1 {
@@ -646,7 +646,7 @@ impl ParameterDictionary {
     /// name), if present.
     pub fn get_one_spectrum(&self, name: &str) -> Result<Option<SpectrumValue>, ParamError> {
         let accept = ["rgb", "blackbody", "spectrum"];
-        let Some(p) = self.find(name, &accept, "\"rgb\", \"spectrum\" or \"blackbody\"")? else {
+        let Some(p) = self.find(name, &accept, &"\"rgb\", \"spectrum\" or \"blackbody\"")? else {
             return Ok(None);
         };
         let v = match p.canonical_type() {
@@ -750,6 +750,17 @@ fn check_rgb(d: &ParameterDictionary, name: &str, c: [f32; 3]) -> Result<(), Par
         });
     }
     Ok(())
+}
+
+/// A parameter type as an error message names it, `"float"`, written
+/// only when the error is (the lookups of every parameter would otherwise
+/// format it each time).
+struct Quoted<'a>(&'a str);
+
+impl std::fmt::Display for Quoted<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "\"{}\"", self.0)
+    }
 }
 
 #[cfg(test)]
@@ -969,3 +980,4 @@ mod tests {
         assert_eq!(d.into_params().len(), 1);
     }
 }
+

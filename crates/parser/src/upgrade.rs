@@ -59,8 +59,10 @@ impl Edit {
     }
 
     fn finish(self) -> Upgraded {
-        let mut params = self.front;
-        params.extend(self.params);
+        let mut params = self.params;
+        if !self.front.is_empty() {
+            params.splice(0..0, self.front);
+        }
         // Kept with the scene's entity: a directive of one parameter would
         // otherwise hold room for four (a Vec's smallest growth), 500 bytes
         // more per shape in a scene of many small shapes.

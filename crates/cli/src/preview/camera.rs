@@ -335,9 +335,9 @@ impl CameraControl {
         let ct = &base.camera_transform;
         let world_from_camera = |t: &Transform| ct.world_from_render * *t;
         let rfc = &ct.render_from_camera;
-        let mut transforms = vec![world_from_camera(&rfc.start_transform)];
+        let mut transforms = vec![world_from_camera(&rfc.start_transform())];
         if rfc.is_animated() {
-            transforms.push(world_from_camera(&rfc.end_transform));
+            transforms.push(world_from_camera(&rfc.end_transform()));
         }
         let looks = transforms.iter().map(derive_look_at).collect();
         let lens = camera.lens();

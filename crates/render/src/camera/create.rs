@@ -60,9 +60,9 @@ pub fn create_camera(
             ),
         );
     }
-    let ct = *camera_transform;
+    let ct = camera_transform.clone();
     let rfc = &ct.render_from_camera;
-    if rfc.start_transform.has_scale(1e-3) || rfc.end_transform.has_scale(1e-3) {
+    if rfc.start_transform().has_scale(1e-3) || rfc.end_transform().has_scale(1e-3) {
         cp.warn(
             "scaling detected in the camera-from-render transformation; the renderer \
              assumes it has none, so the image may be wrong",

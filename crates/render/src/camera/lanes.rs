@@ -61,7 +61,7 @@ impl Camera {
         if c.lens_radius > 0.0 || rfc.is_animated() {
             return None;
         }
-        let render = &rfc.start_transform;
+        let render = &rfc.start_transform();
         let o = render.apply_point_fi(Point3fi::from(Point3f::new(0.0, 0.0, 0.0)));
         Some(PinholeRays {
             raster: c.xf.camera_from_raster.matrix().m,

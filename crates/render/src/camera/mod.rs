@@ -227,7 +227,7 @@ impl CameraBase {
         let xf = if rfc.is_animated() {
             rfc.interpolate(r.ray.time)
         } else {
-            rfc.start_transform
+            rfc.start_transform()
         };
         xf.apply_ray_differential(r, Float::INFINITY).0
     }

@@ -80,9 +80,9 @@ impl Camera {
         let wfc = world_from_camera;
         let camera_transform = CameraTransform {
             render_from_camera: AnimatedTransform::new(
-                render_from_world * wfc.start_transform,
+                render_from_world * wfc.start_transform(),
                 wfc.start_time,
-                render_from_world * wfc.end_transform,
+                render_from_world * wfc.end_transform(),
                 wfc.end_time,
             ),
             world_from_render,

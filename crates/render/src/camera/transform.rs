@@ -41,7 +41,7 @@ impl RenderingCoordinateSystem {
 
 /// The camera's placement (pbrt-v4 `CameraTransform`): where render space
 /// is with respect to the world, and the camera with respect to it.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct CameraTransform {
     /// From camera space to render space, over the shutter interval.
     pub render_from_camera: AnimatedTransform,
@@ -74,9 +74,9 @@ impl CameraTransform {
         };
         let render_from_world = world_from_render.inverse();
         let render_from_camera = AnimatedTransform::new(
-            render_from_world * world_from_camera.start_transform,
+            render_from_world * world_from_camera.start_transform(),
             world_from_camera.start_time,
-            render_from_world * world_from_camera.end_transform,
+            render_from_world * world_from_camera.end_transform(),
             world_from_camera.end_time,
         );
         CameraTransform {
@@ -112,10 +112,10 @@ mod tests {
         assert!((Vector3f::from(p) - Vector3f::new(1.0, 2.0, 3.0)).length() < 1e-5);
         let ct = CameraTransform::new(&a, RenderingCoordinateSystem::Camera);
         assert!(
-            ct.render_from_camera.start_transform.is_identity()
+            ct.render_from_camera.start_transform().is_identity()
                 || ct
                     .render_from_camera
-                    .start_transform
+                    .start_transform()
                     .matrix()
                     .m
                     .iter()

@@ -290,7 +290,7 @@ pub fn create_film(
         "gbuffer" => {
             let cs = fp.string("coordinatesystem", "camera")?;
             let (output_from_render, apply_inverse) = match cs.as_str() {
-                "camera" => (camera_transform.render_from_camera, true),
+                "camera" => (camera_transform.render_from_camera.clone(), true),
                 "world" => (AnimatedTransform::fixed(camera_transform.world_from_render), false),
                 _ => {
                     return Err(Diagnostic::error(

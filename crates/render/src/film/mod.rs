@@ -564,7 +564,7 @@ impl Film {
                 sensor: c.config.sensor.clone(),
                 max_component_value: c.config.max_component_value,
                 kind: KindConfig::GBuffer {
-                    output_from_render: ct.render_from_camera,
+                    output_from_render: ct.render_from_camera.clone(),
                     apply_inverse: true,
                     color_space,
                 },

@@ -207,7 +207,7 @@ pub fn create_light(
     if render_from_light.is_animated() {
         lp.warn("animated lights aren't supported; using the start transform");
     }
-    let render_from_light = render_from_light.start_transform;
+    let render_from_light = render_from_light.start_transform();
 
     let light = match name {
         "point" => {

@@ -241,13 +241,16 @@ pub enum Moving {
 
 impl Moving {
     /// `prims` as one moving primitive, under `accel` when they need an
-    /// aggregate; `None` when there are none.
-    pub fn of(mut prims: Vec<Primitive>, accel: &AccelParams) -> Option<Moving> {
+    /// aggregate; `None` when there are none. Takes them all, leaving
+    /// `prims` empty (and, for a single shape, its room kept for the next
+    /// one: a scene of many moving shapes makes them one after another).
+    pub fn of(prims: &mut Vec<Primitive>, accel: &AccelParams) -> Option<Moving> {
         match prims.len() {
             0 => None,
             1 if matches!(prims[0], Primitive::Geometric(_)) => prims.pop().map(Moving::One),
             _ => Some(Moving::Many(Arc::new(PrimitiveAggregate::new(
-                prims, accel,
+                std::mem::take(prims),
+                accel,
             )))),
         }
     }

@@ -115,7 +115,7 @@ fn moving_sphere(own_aggregate: bool) -> PrimitiveAggregate {
             &AccelParams::default(),
         )))
     } else {
-        Moving::of(vec![sphere], &AccelParams::default()).expect("one primitive")
+        Moving::of(&mut vec![sphere], &AccelParams::default()).expect("one primitive")
     };
     assert_eq!(matches!(primitive, Moving::One(_)), !own_aggregate);
     PrimitiveAggregate::new(

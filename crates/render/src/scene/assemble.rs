@@ -186,7 +186,7 @@ fn create_media(desc: &SceneDescription, p: &mut Problems) -> (Vec<Medium>, Hash
         let medium = r
             .charge(m.base.params.memory_bytes() as u64, "this medium's data")
             .and_then(|()| r.string("type", &m.base.name))
-            .and_then(|ty| create_medium(&ty, &r, &m.render_from_object.start_transform));
+            .and_then(|ty| create_medium(&ty, &r, &m.render_from_object.start_transform()));
         if let Some(medium) = p.finish(r, medium) {
             ids.insert(m.name.clone(), media.len() as u32);
             media.push(medium);
@@ -424,7 +424,7 @@ fn place_instances(
             })),
             InstanceTransform::Animated(a) => Primitive::Animated(Box::new(AnimatedPrimitive {
                 primitive: Moving::Many(def.clone()),
-                render_from_primitive: **a,
+                render_from_primitive: (**a).clone(),
             })),
         })
     };
@@ -611,10 +611,11 @@ fn create(
         create_primitives(&cx, s, &mut lights, p, &mut prims);
     }
     // One primitive for each animated shape (they carry no lights).
-    let animated = |s: &AnimatedShapeSceneEntity,
-                    lights: &mut Vec<Light>,
-                    p: &mut Problems,
-                    prims: &mut Vec<Primitive>| {
+    let mut inner = Vec::new();
+    let mut animated = |s: AnimatedShapeSceneEntity,
+                        lights: &mut Vec<Light>,
+                        p: &mut Problems,
+                        prims: &mut Vec<Primitive>| {
         if s.attributes.light_index.is_some() {
             p.errors.push(Diagnostic::error(
                 s.base.loc.clone(),
@@ -622,19 +623,19 @@ fn create(
             ));
             return;
         }
-        let mut inner = Vec::new();
-        create_primitives(&cx, &at_origin(s), lights, p, &mut inner);
-        if let Some(moving) = Moving::of(inner, &default_accel) {
+        let (shape, render_from_primitive) = at_origin(s);
+        create_primitives(&cx, &shape, lights, p, &mut inner);
+        if let Some(moving) = Moving::of(&mut inner, &default_accel) {
             prims.push(Primitive::Animated(Box::new(AnimatedPrimitive {
                 primitive: moving,
-                render_from_primitive: s.render_from_object,
+                render_from_primitive,
             })));
         }
     };
     match taken.animated_shapes {
         None => {
             for s in &desc.animated_shapes {
-                animated(s, &mut lights, p, &mut prims);
+                animated(s.clone(), &mut lights, p, &mut prims);
             }
         }
         Some(list) => {
@@ -645,7 +646,7 @@ fn create(
             let mut reported = Vec::new();
             take_from_end(list, |s| {
                 let mut own = Problems::default();
-                animated(&s, &mut lights, &mut own, &mut prims);
+                animated(s, &mut lights, &mut own, &mut prims);
                 if !own.errors.is_empty() || !own.warnings.is_empty() {
                     reported.push(own);
                 }
@@ -674,11 +675,12 @@ fn create(
         }
         for s in &def.animated_shapes {
             let mut shapes = Vec::new();
-            create_primitives(&cx, &at_origin(s), &mut lights, p, &mut shapes);
-            if let Some(moving) = Moving::of(shapes, &default_accel) {
+            let (shape, render_from_primitive) = at_origin(s.clone());
+            create_primitives(&cx, &shape, &mut lights, p, &mut shapes);
+            if let Some(moving) = Moving::of(&mut shapes, &default_accel) {
                 inner.push(Primitive::Animated(Box::new(AnimatedPrimitive {
                     primitive: moving,
-                    render_from_primitive: s.render_from_object,
+                    render_from_primitive,
                 })));
             }
         }

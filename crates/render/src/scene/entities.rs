@@ -526,11 +526,11 @@ impl Dump {
     fn animated(&mut self, what: &str, a: &AnimatedTransform) {
         self.transform(
             &format!("{what} t0={}", Self::num(a.start_time)),
-            &a.start_transform,
+            &a.start_transform(),
         );
         self.transform(
             &format!("{what} t1={}", Self::num(a.end_time)),
-            &a.end_transform,
+            &a.end_transform(),
         );
     }
 

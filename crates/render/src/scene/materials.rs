@@ -31,7 +31,7 @@ fn texture_def(e: &TextureSceneEntity) -> TextureDef<'_> {
     TextureDef {
         name: &e.name,
         class: &e.base.name,
-        render_from_texture: e.render_from_object.start_transform,
+        render_from_texture: e.render_from_object.start_transform(),
     }
 }
 

@@ -22,6 +22,7 @@ use crate::shape::Shape;
 use crate::texture::{FloatTexture, NamedTextures, TextureEvalContext, TextureParams};
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::transform::Transform;
+use rpbrt_geometry::animated::AnimatedTransform;
 use rpbrt_geometry::tuple::{Point2f, Point3f};
 
 /// What shapes are turned into primitives with.
@@ -66,15 +67,17 @@ fn alpha_of(tp: &TextureParams) -> Result<Alpha, Diagnostic> {
     }
 }
 
-/// The fixed-transformation view of an animated shape: its shapes are
-/// made in its own space and moved by an animated primitive.
-pub(super) fn at_origin(s: &AnimatedShapeSceneEntity) -> ShapeSceneEntity {
-    ShapeSceneEntity {
-        base: s.base.clone(),
+/// The fixed-transformation view of an animated shape, and its motion:
+/// its shapes are made in its own space and moved by an animated
+/// primitive.
+pub(super) fn at_origin(s: AnimatedShapeSceneEntity) -> (ShapeSceneEntity, AnimatedTransform) {
+    let shape = ShapeSceneEntity {
+        base: s.base,
         render_from_object: Transform::identity(),
         object_from_render: Transform::identity(),
-        attributes: s.attributes.clone(),
-    }
+        attributes: s.attributes,
+    };
+    (shape, s.render_from_object)
 }
 
 /// The scene's `displacementedgescale` option (pbrt-v4's
@@ -353,7 +356,7 @@ pub fn create_scene_shapes(desc: &SceneDescription) -> SceneShapes {
     for s in animated {
         add(
             &s.base,
-            &s.render_from_object.start_transform,
+            &s.render_from_object.start_transform(),
             s.attributes.reverse_orientation,
         );
     }

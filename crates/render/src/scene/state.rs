@@ -123,15 +123,29 @@ pub(super) enum Block {
 /// A cheap summary of a parameter list: enough to tell whether an upgrade
 /// mapping changed anything (it renames, retypes, adds and removes
 /// parameters or changes their value counts; it never edits a value in place).
-pub(super) fn fingerprint(params: &[ParsedParameter]) -> Vec<(String, String, [usize; 4])> {
-    params
-        .iter()
-        .map(|p| {
-            (
-                p.name.clone(),
-                p.ty.clone(),
-                [p.floats.len(), p.ints.len(), p.strings.len(), p.bools.len()],
-            )
-        })
-        .collect()
+pub(super) fn fingerprint(params: &[ParsedParameter]) -> u64 {
+    // A hash (64-bit FNV-1a) rather than a copy of the names: this runs
+    // twice for every directive, and copying would allocate for each
+    // parameter. Two lists that differ hash alike about once in 2^64; then
+    // an upgrade's warnings go unreported (the upgrade itself is applied
+    // either way).
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |bytes: &[u8]| {
+        for &b in bytes {
+            h = (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    };
+    for p in params {
+        // Each name ends with a byte no name holds, so that ("ab", "c")
+        // and ("a", "bc") differ.
+        for text in [&p.name, &p.ty] {
+            eat(text.as_bytes());
+            eat(&[0xff]);
+        }
+        for n in [p.floats.len(), p.ints.len(), p.strings.len(), p.bools.len()] {
+            eat(&(n as u64).to_le_bytes());
+        }
+    }
+    eat(&(params.len() as u64).to_le_bytes());
+    h
 }

@@ -25,7 +25,7 @@ fn create(text: &str) -> Result<(Medium, Vec<Diagnostic>), Diagnostic> {
     let e = &desc.media[0];
     let cs = RgbColorSpace::get(&e.base.color_space).unwrap();
     let r = ParamReader::with_color_space(&e.base.params, &e.base.loc, cs);
-    let m = create_medium(&e.base.name, &r, &e.render_from_object.start_transform)?;
+    let m = create_medium(&e.base.name, &r, &e.render_from_object.start_transform())?;
     // The scene's medium loop reads the type the builder put back.
     let _ = r.string("type", "");
     Ok((m, r.finish()))
