@@ -259,9 +259,12 @@ fn lookup_directive(word: &[u8]) -> Option<Directive> {
     if !word.first().is_some_and(u8::is_ascii_uppercase) {
         return None;
     }
+    // The length and last byte first: most names differ there, and the
+    // comparison of whole names would call `memcmp` for every one.
+    let last = word.last();
     DIRECTIVES
         .iter()
-        .find(|(n, _)| n.as_bytes() == word)
+        .find(|(n, _)| n.len() == word.len() && n.as_bytes().last() == last && n.as_bytes() == word)
         .map(|&(_, d)| d)
 }
 

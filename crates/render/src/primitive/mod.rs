@@ -209,13 +209,114 @@ impl MeshPrimitive {
     }
 }
 
-/// An object instance: a shared aggregate placed by a fixed transformation.
-#[derive(Clone, Debug)]
-pub struct TransformedPrimitive {
-    /// The instanced aggregate, in its own space.
-    pub primitive: Arc<PrimitiveAggregate>,
-    /// From the instance's space to rendering space.
-    pub render_from_primitive: Transform,
+/// Object instances: shared aggregates (object definitions), each placed
+/// by a fixed transformation. An aggregate gives each instance an entry
+/// of its own, as it gives a mesh's triangles, so a run of instances is
+/// one primitive: per instance a transformation and the index of its
+/// object in flat arrays (132 bytes), where a primitive of its own would
+/// also take a 72-byte enum and a separately allocated box.
+#[derive(Clone, Debug, Default)]
+pub struct InstanceSet {
+    /// The instanced aggregates, each in its own space.
+    objects: Vec<Arc<PrimitiveAggregate>>,
+    /// Per instance: the index of its object in `objects`.
+    object_of: Vec<u32>,
+    /// Per instance: from its object's space to rendering space.
+    render_from_object: Vec<Transform>,
+}
+
+impl InstanceSet {
+    /// No instances.
+    pub fn new() -> InstanceSet {
+        InstanceSet::default()
+    }
+
+    /// One instance of `object`.
+    pub fn one(object: Arc<PrimitiveAggregate>, render_from_object: Transform) -> InstanceSet {
+        let mut set = InstanceSet::new();
+        let k = set.add_object(object);
+        set.push(k, render_from_object);
+        set
+    }
+
+    /// Adds an object that instances may place; returns its index for
+    /// [`InstanceSet::push`].
+    pub fn add_object(&mut self, object: Arc<PrimitiveAggregate>) -> u32 {
+        self.objects.push(object);
+        (self.objects.len() - 1) as u32
+    }
+
+    /// Adds an instance of the object `object` (an index that
+    /// [`InstanceSet::add_object`] returned).
+    pub fn push(&mut self, object: u32, render_from_object: Transform) {
+        debug_assert!((object as usize) < self.objects.len());
+        self.object_of.push(object);
+        self.render_from_object.push(render_from_object);
+    }
+
+    /// Room for `n` more instances.
+    pub fn reserve_exact(&mut self, n: usize) {
+        self.object_of.reserve_exact(n);
+        self.render_from_object.reserve_exact(n);
+    }
+
+    /// The number of instances.
+    pub fn len(&self) -> usize {
+        self.object_of.len()
+    }
+
+    /// True when there are no instances.
+    pub fn is_empty(&self) -> bool {
+        self.object_of.is_empty()
+    }
+
+    /// Instance `i`: its object and transformation.
+    #[inline]
+    fn get(&self, i: u32) -> (&PrimitiveAggregate, &Transform) {
+        let i = i as usize;
+        (
+            &self.objects[self.object_of[i] as usize],
+            &self.render_from_object[i],
+        )
+    }
+
+    /// The bounds of instance `i` in rendering space.
+    fn bounds_of(&self, i: u32) -> Bounds3f {
+        let (object, xf) = self.get(i);
+        xf.apply_bounds(&object.bounds())
+    }
+
+    /// The closest hit on instance `i` in (0, t_max).
+    fn intersect_one(&self, i: u32, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
+        let (object, xf) = self.get(i);
+        let (r, t) = xf.apply_inverse_ray(ray, t_max);
+        let pi = object.intersect(&r, t)?;
+        Some(transform_hit(pi, xf))
+    }
+
+    /// Whether instance `i` blocks the ray in (0, t_max).
+    fn intersect_p_one(&self, i: u32, ray: &Ray, t_max: Float) -> bool {
+        let (object, xf) = self.get(i);
+        let (r, t) = xf.apply_inverse_ray(ray, t_max);
+        object.intersect_p(&r, t)
+    }
+
+    /// Reverses the order of the instances.
+    pub fn reverse(&mut self) {
+        self.object_of.reverse();
+        self.render_from_object.reverse();
+    }
+
+    /// Gives back the room reserved beyond the instances.
+    pub fn shrink_to_fit(&mut self) {
+        self.object_of.shrink_to_fit();
+        self.render_from_object.shrink_to_fit();
+    }
+
+    /// The instances' indices.
+    fn indices(&self) -> impl Iterator<Item = u32> {
+        0..self.len() as u32
+    }
 }
 
 /// Primitives whose transformation changes over the shutter interval.
@@ -301,9 +402,10 @@ pub enum Primitive {
     /// The triangles of a mesh with common properties (an aggregate gives
     /// each triangle an entry).
     Mesh(MeshPrimitive),
-    /// An object instance (boxed: two matrices would make every
-    /// primitive large).
-    Transformed(Box<TransformedPrimitive>),
+    /// Object instances under fixed transformations (an aggregate gives
+    /// each an entry; boxed: three vectors would make every primitive
+    /// larger).
+    Instances(Box<InstanceSet>),
     /// Motion-blurred primitives (boxed: an animated transform is large).
     Animated(Box<AnimatedPrimitive>),
 }
@@ -323,11 +425,13 @@ impl Primitive {
                     f(m)
                 }
             }
-            Primitive::Transformed(p) => p
-                .primitive
-                .prims
-                .iter()
-                .for_each(|q| q.for_each_material(f)),
+            Primitive::Instances(set) => {
+                for &k in &set.object_of {
+                    for q in &set.objects[k as usize].prims {
+                        q.for_each_material(f);
+                    }
+                }
+            }
             Primitive::Animated(p) => p.primitive.for_each_material(f),
         }
     }
@@ -339,9 +443,9 @@ impl Primitive {
             Primitive::Mesh(p) => p
                 .valid_triangles()
                 .fold(Bounds3f::empty(), |b, i| b.union(&p.triangle_bounds(i))),
-            Primitive::Transformed(p) => {
-                p.render_from_primitive.apply_bounds(&p.primitive.bounds())
-            }
+            Primitive::Instances(set) => set
+                .indices()
+                .fold(Bounds3f::empty(), |b, i| b.union(&set.bounds_of(i))),
             Primitive::Animated(p) => p.render_from_primitive.motion_bounds(&p.primitive.bounds()),
         }
     }
@@ -364,10 +468,18 @@ impl Primitive {
                 }
                 closest
             }
-            Primitive::Transformed(p) => {
-                let (r, t) = p.render_from_primitive.apply_inverse_ray(ray, t_max);
-                let pi = p.primitive.intersect(&r, t)?;
-                Some(transform_hit(pi, &p.render_from_primitive))
+            Primitive::Instances(set) => {
+                // (Aggregates test each instance as an entry; this is for
+                // a set met on its own.)
+                let mut closest = None;
+                let mut t_max = t_max;
+                for i in set.indices() {
+                    if let Some(pi) = set.intersect_one(i, ray, t_max) {
+                        t_max = pi.t_hit;
+                        closest = Some(pi);
+                    }
+                }
+                closest
             }
             Primitive::Animated(p) => {
                 let xf = p.render_from_primitive.interpolate(ray.time);
@@ -386,9 +498,8 @@ impl Primitive {
             Primitive::Mesh(p) => p
                 .valid_triangles()
                 .any(|i| p.intersect_p_triangle(i, ray, t_max)),
-            Primitive::Transformed(p) => {
-                let (r, t) = p.render_from_primitive.apply_inverse_ray(ray, t_max);
-                p.primitive.intersect_p(&r, t)
+            Primitive::Instances(set) => {
+                set.indices().any(|i| set.intersect_p_one(i, ray, t_max))
             }
             Primitive::Animated(p) => {
                 let (r, t) = p
@@ -535,8 +646,9 @@ enum HitKind {
 
 /// Where the entries of an aggregate's primitives lie in the acceleration
 /// structure: one entry per primitive, except a [`MeshPrimitive`], which
-/// has one per triangle (degenerate ones included, with empty bounds).
-/// Entries keep the primitives' order.
+/// has one per triangle (degenerate ones included, with empty bounds), and
+/// an [`InstanceSet`], which has one per instance. Entries keep the
+/// primitives' order.
 #[derive(Clone, Debug, Default)]
 struct EntryMap {
     /// The first entry of each primitive, then the number of entries;
@@ -554,6 +666,7 @@ impl EntryMap {
     fn new(prims: &[Primitive]) -> EntryMap {
         let entries = |p: &Primitive| match p {
             Primitive::Mesh(m) => m.mesh.n_triangles(),
+            Primitive::Instances(set) => set.len(),
             _ => 1,
         };
         let len: usize = prims.iter().map(entries).sum();
@@ -665,6 +778,7 @@ impl PrimitiveAggregate {
                 let (p, i) = entries.locate(e);
                 match &prims[p] {
                     Primitive::Mesh(m) => m.triangle_bounds(i),
+                    Primitive::Instances(set) => set.bounds_of(i),
                     prim => prim.bounds(),
                 }
             },
@@ -1054,6 +1168,7 @@ impl PrimitiveAggregate {
         let (p, i) = self.entries.locate(e);
         match &self.prims[p] {
             Primitive::Mesh(m) => m.intersect_triangle(i, ray, t_max),
+            Primitive::Instances(set) => set.intersect_one(i, ray, t_max),
             prim => prim.intersect(ray, t_max),
         }
     }
@@ -1212,6 +1327,7 @@ impl PrimitiveAggregate {
         let (p, e) = self.entries.locate(i);
         match &self.prims[p] {
             Primitive::Mesh(m) => m.intersect_p_triangle(e, ray, t_max),
+            Primitive::Instances(set) => set.intersect_p_one(e, ray, t_max),
             prim => prim.intersect_p(ray, t_max),
         }
     }

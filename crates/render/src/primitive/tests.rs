@@ -69,10 +69,7 @@ fn instances_match_direct_geometry() {
         &AccelParams::default(),
     ));
     let inst = PrimitiveAggregate::new(
-        vec![Primitive::Transformed(Box::new(TransformedPrimitive {
-            primitive: inner,
-            render_from_primitive: xf,
-        }))],
+        vec![Primitive::Instances(Box::new(InstanceSet::one(inner, xf)))],
         &AccelParams::default(),
     );
     let mut rng = Rng::new(2, 0);
@@ -273,11 +270,10 @@ fn intersect_is_record_then_interaction() {
         random_triangles(&mut rng, 50, &Transform::identity()),
         &AccelParams::default(),
     ));
-    prims.push(Primitive::Transformed(Box::new(TransformedPrimitive {
-        primitive: inner,
-        render_from_primitive: Transform::translate(Vector3f::new(0.0, 2.0, 2.0))
-            * Transform::scale(0.5, 0.5, 0.5),
-    })));
+    prims.push(Primitive::Instances(Box::new(InstanceSet::one(
+        inner,
+        Transform::translate(Vector3f::new(0.0, 2.0, 2.0)) * Transform::scale(0.5, 0.5, 0.5),
+    ))));
     let Primitive::Geometric(mut masked) =
         sphere_prim(Transform::translate(Vector3f::new(0.0, -2.0, -2.0)), 1.0)
     else {

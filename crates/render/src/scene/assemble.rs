@@ -27,13 +27,14 @@ use crate::material::MaterialSet;
 use crate::medium::{create_medium, create_region, Medium, RegionMedium};
 use crate::params::{unknown_type, ParamReader};
 use crate::primitive::{
-    AnimatedPrimitive, Moving, Primitive, PrimitiveAggregate, TransformedPrimitive,
+    AnimatedPrimitive, InstanceSet, Moving, Primitive, PrimitiveAggregate,
 };
 use crate::sampler::{create_sampler, Sampler};
 use crate::texture::TextureOptions;
 
 /// What an object instance adds when the scene is created, in bytes: its
-/// primitive (boxed with its transformation) and accelerator entry.
+/// transformation and object in an [`InstanceSet`], and its accelerator
+/// entry.
 const INSTANCE_BYTES: u64 = 256;
 
 /// Command-line settings that change how the scene is created.
@@ -412,31 +413,86 @@ fn place_instances(
         }
         placed += 1;
     }
-    let mut primitive = |inst: &InstanceSceneEntity| {
-        let def = definition.get(&inst.name)?;
-        if def.primitives().is_empty() {
-            return None;
-        }
-        Some(match &inst.render_from_instance {
-            InstanceTransform::Fixed(t) => Primitive::Transformed(Box::new(TransformedPrimitive {
-                primitive: def.clone(),
-                render_from_primitive: *t,
-            })),
-            InstanceTransform::Animated(a) => Primitive::Animated(Box::new(AnimatedPrimitive {
-                primitive: Moving::Many(def.clone()),
-                render_from_primitive: (**a).clone(),
-            })),
-        })
-    };
-    prims.reserve_exact(placed);
+    let mut runs = InstanceRuns::default();
+    // Room for every instance in the first run (typically the only one):
+    // growing by doubling would hold two copies of its transformations.
+    runs.set.reserve_exact(placed);
     match taken {
-        None => prims.extend(list[..end].iter().filter_map(&mut primitive)),
+        None => {
+            for inst in &list[..end] {
+                runs.add(inst, definition.get(&inst.name), prims);
+            }
+        }
         Some(mut list) => {
+            // From the last instance to the first; the order is put back
+            // below.
             list.truncate(end);
             let base = prims.len();
-            take_from_end(list, |inst| prims.extend(primitive(&inst)));
+            take_from_end(list, |inst| runs.add(&inst, definition.get(&inst.name), prims));
+            runs.close(prims);
+            for prim in &mut prims[base..] {
+                if let Primitive::Instances(set) = prim {
+                    set.reverse();
+                }
+            }
             prims[base..].reverse();
         }
+    }
+    runs.close(prims);
+}
+
+/// Consecutive instances under fixed transformations, gathered into one
+/// [`InstanceSet`] each run (an entry per instance in the aggregate, as
+/// separate primitives had, in the same order).
+#[derive(Default)]
+struct InstanceRuns {
+    set: InstanceSet,
+    /// The set's objects, by their aggregate's address.
+    objects: HashMap<usize, u32>,
+}
+
+impl InstanceRuns {
+    /// Adds the instance `inst` of `def` (nothing for an undefined or
+    /// empty object): to the open run, or as a primitive of its own after
+    /// the run when it moves.
+    fn add(
+        &mut self,
+        inst: &InstanceSceneEntity,
+        def: Option<&Arc<PrimitiveAggregate>>,
+        prims: &mut Vec<Primitive>,
+    ) {
+        let Some(def) = def else { return };
+        if def.primitives().is_empty() {
+            return;
+        }
+        match &inst.render_from_instance {
+            InstanceTransform::Fixed(t) => {
+                let set = &mut self.set;
+                let k = *self
+                    .objects
+                    .entry(Arc::as_ptr(def) as usize)
+                    .or_insert_with(|| set.add_object(def.clone()));
+                set.push(k, *t);
+            }
+            InstanceTransform::Animated(a) => {
+                self.close(prims);
+                prims.push(Primitive::Animated(Box::new(AnimatedPrimitive {
+                    primitive: Moving::Many(def.clone()),
+                    render_from_primitive: (**a).clone(),
+                })));
+            }
+        }
+    }
+
+    /// Ends the open run, appending its set to `prims`.
+    fn close(&mut self, prims: &mut Vec<Primitive>) {
+        if !self.set.is_empty() {
+            let mut set = std::mem::take(&mut self.set);
+            set.shrink_to_fit();
+            prims.push(Primitive::Instances(Box::new(set)));
+        }
+        self.set = InstanceSet::new();
+        self.objects.clear();
     }
 }
 
