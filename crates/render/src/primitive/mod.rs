@@ -16,7 +16,7 @@ use rpbrt_geometry::animated::AnimatedTransform;
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::interaction::SurfaceInteraction;
 use rpbrt_geometry::ray::{MediumId, Ray};
-use rpbrt_geometry::transform::Transform;
+use rpbrt_geometry::transform::{SquareMatrix4, Transform};
 use rpbrt_geometry::tuple::{Normal3f, Point2f, Point3f, Vector3f};
 use rpbrt_geometry::Bounds3f;
 use std::sync::Arc;
@@ -222,7 +222,111 @@ pub struct InstanceSet {
     /// Per instance: the index of its object in `objects`.
     object_of: Vec<u32>,
     /// Per instance: from its object's space to rendering space.
-    render_from_object: Vec<Transform>,
+    render_from_object: Placements,
+}
+
+/// The instances' transformations.
+#[derive(Clone, Debug)]
+enum Placements {
+    /// All affine: without the matrices' last rows (96 bytes each).
+    Affine(Vec<AffinePair>),
+    /// Some not affine: whole.
+    Full(Vec<Transform>),
+}
+
+impl Default for Placements {
+    fn default() -> Placements {
+        Placements::Affine(Vec::new())
+    }
+}
+
+/// An affine transformation and its inverse without their last rows, which
+/// are, to the bit, (0, 0, 0, 1) (`+0`s): the transformation it gives back
+/// is bit for bit the one it was made from.
+#[derive(Clone, Copy, Debug)]
+struct AffinePair {
+    m: [[Float; 4]; 3],
+    m_inv: [[Float; 4]; 3],
+}
+
+impl AffinePair {
+    const LAST_ROW: [Float; 4] = [0.0, 0.0, 0.0, 1.0];
+
+    /// `t` without its last rows, when they are (0, 0, 0, 1) to the bit.
+    fn of(t: &Transform) -> Option<AffinePair> {
+        let (m, mi) = (&t.matrix().m, &t.inverse_matrix().m);
+        let last = |row: &[Float; 4]| {
+            row.iter()
+                .zip(AffinePair::LAST_ROW)
+                .all(|(a, b)| a.to_bits() == b.to_bits())
+        };
+        (last(&m[3]) && last(&mi[3])).then(|| AffinePair {
+            m: [m[0], m[1], m[2]],
+            m_inv: [mi[0], mi[1], mi[2]],
+        })
+    }
+
+    fn transform(&self) -> Transform {
+        let full = |r: &[[Float; 4]; 3]| {
+            SquareMatrix4::new([r[0], r[1], r[2], AffinePair::LAST_ROW])
+        };
+        Transform::from_matrices(full(&self.m), full(&self.m_inv))
+    }
+}
+
+impl Placements {
+    fn len(&self) -> usize {
+        match self {
+            Placements::Affine(v) => v.len(),
+            Placements::Full(v) => v.len(),
+        }
+    }
+
+    fn get(&self, i: usize) -> Transform {
+        match self {
+            Placements::Affine(v) => v[i].transform(),
+            Placements::Full(v) => v[i],
+        }
+    }
+
+    fn push(&mut self, t: Transform) {
+        if let Placements::Affine(v) = self {
+            match AffinePair::of(&t) {
+                Some(a) => return v.push(a),
+                None => {
+                    // The first that is not affine: every one whole from
+                    // here on.
+                    let mut full = Vec::with_capacity(v.capacity());
+                    full.extend(v.iter().map(AffinePair::transform));
+                    *self = Placements::Full(full);
+                }
+            }
+        }
+        if let Placements::Full(v) = self {
+            v.push(t);
+        }
+    }
+
+    fn reserve_exact(&mut self, n: usize) {
+        match self {
+            Placements::Affine(v) => v.reserve_exact(n),
+            Placements::Full(v) => v.reserve_exact(n),
+        }
+    }
+
+    fn shrink_to_fit(&mut self) {
+        match self {
+            Placements::Affine(v) => v.shrink_to_fit(),
+            Placements::Full(v) => v.shrink_to_fit(),
+        }
+    }
+
+    fn reverse(&mut self) {
+        match self {
+            Placements::Affine(v) => v.reverse(),
+            Placements::Full(v) => v.reverse(),
+        }
+    }
 }
 
 impl InstanceSet {
@@ -252,6 +356,7 @@ impl InstanceSet {
         debug_assert!((object as usize) < self.objects.len());
         self.object_of.push(object);
         self.render_from_object.push(render_from_object);
+        debug_assert_eq!(self.object_of.len(), self.render_from_object.len());
     }
 
     /// Room for `n` more instances.
@@ -272,11 +377,11 @@ impl InstanceSet {
 
     /// Instance `i`: its object and transformation.
     #[inline]
-    fn get(&self, i: u32) -> (&PrimitiveAggregate, &Transform) {
+    fn get(&self, i: u32) -> (&PrimitiveAggregate, Transform) {
         let i = i as usize;
         (
             &self.objects[self.object_of[i] as usize],
-            &self.render_from_object[i],
+            self.render_from_object.get(i),
         )
     }
 
@@ -291,7 +396,7 @@ impl InstanceSet {
         let (object, xf) = self.get(i);
         let (r, t) = xf.apply_inverse_ray(ray, t_max);
         let pi = object.intersect(&r, t)?;
-        Some(transform_hit(pi, xf))
+        Some(transform_hit(pi, &xf))
     }
 
     /// Whether instance `i` blocks the ray in (0, t_max).
