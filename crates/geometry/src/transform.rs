@@ -271,11 +271,16 @@ impl Transform {
     /// −0 for 0 and no NaN for itself): then any computation gives the
     /// same result for either.
     pub fn same_bits(&self, o: &Transform) -> bool {
-        fn bits(t: &Transform) -> impl Iterator<Item = u32> + '_ {
-            let rows = t.m.m.iter().chain(&t.m_inv.m);
-            rows.flatten().map(|v| v.to_bits())
-        }
-        bits(self).eq(bits(o))
+        let same = |a: &SquareMatrix4, b: &SquareMatrix4| {
+            let mut differ = 0;
+            for (ra, rb) in a.m.iter().zip(&b.m) {
+                for (x, y) in ra.iter().zip(rb) {
+                    differ |= x.to_bits() ^ y.to_bits();
+                }
+            }
+            differ == 0
+        };
+        same(&self.m, &o.m) && same(&self.m_inv, &o.m_inv)
     }
 
     /// The identity transformation.

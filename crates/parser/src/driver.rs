@@ -253,18 +253,35 @@ const DIRECTIVES: &[(&str, Directive)] = &[
     ("WorldEnd", Directive::WorldEnd),
 ];
 
+/// For each upper-case first letter, the range of [`DIRECTIVES`] (sorted)
+/// whose names start with it.
+const BY_FIRST_LETTER: [(u8, u8); 26] = {
+    let mut t = [(0u8, 0u8); 26];
+    let mut k = 0;
+    while k < DIRECTIVES.len() {
+        let c = (DIRECTIVES[k].0.as_bytes()[0] - b'A') as usize;
+        if t[c].1 == 0 {
+            t[c].0 = k as u8;
+        }
+        t[c].1 = k as u8 + 1;
+        k += 1;
+    }
+    t
+};
+
 fn lookup_directive(word: &[u8]) -> Option<Directive> {
     // Directive names start with an upper-case letter; numbers (the common
-    // case inside meshes) are rejected by the first byte.
-    if !word.first().is_some_and(u8::is_ascii_uppercase) {
+    // case inside meshes) are rejected by the first byte. Then only the
+    // names with that first letter (at most six) are compared, length
+    // first: this runs for every word of a scene.
+    let first = *word.first()?;
+    if !first.is_ascii_uppercase() {
         return None;
     }
-    // The length and last byte first: most names differ there, and the
-    // comparison of whole names would call `memcmp` for every one.
-    let last = word.last();
-    DIRECTIVES
+    let (a, b) = BY_FIRST_LETTER[(first - b'A') as usize];
+    DIRECTIVES[a as usize..b as usize]
         .iter()
-        .find(|(n, _)| n.len() == word.len() && n.as_bytes().last() == last && n.as_bytes() == word)
+        .find(|(n, _)| n.len() == word.len() && n.as_bytes() == word)
         .map(|&(_, d)| d)
 }
 

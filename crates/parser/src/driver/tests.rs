@@ -866,3 +866,26 @@ fn gzip_bomb_scene_stops_at_the_size_limit() {
     );
     let _ = std::fs::remove_dir_all(&d);
 }
+
+/// The lookup by first letter needs the table sorted (so that names with
+/// one first letter are together); every name is found, and words that
+/// differ from a name in length or a letter are not.
+#[test]
+fn every_directive_is_looked_up() {
+    let names: Vec<&str> = directive_names().collect();
+    let mut sorted = names.clone();
+    sorted.sort_unstable();
+    assert_eq!(names, sorted);
+    for &(name, d) in DIRECTIVES {
+        assert_eq!(lookup_directive(name.as_bytes()), Some(d), "{name}");
+        let longer = format!("{name}s");
+        assert_eq!(lookup_directive(longer.as_bytes()), None, "{longer}");
+        let mut changed = name.as_bytes().to_vec();
+        let last = changed.len() - 1;
+        changed[last] ^= 0x20;
+        assert_eq!(lookup_directive(&changed), None, "{name}");
+    }
+    for word in ["", "A", "Z", "1", "attributeBegin", "Zebra", "Transforms"] {
+        assert_eq!(lookup_directive(word.as_bytes()), None, "{word}");
+    }
+}

@@ -351,14 +351,14 @@ fn ray_differentials_match_rays_one_pixel_over() {
             P::F("focaldistance", &[4.0]),
         ],
     ] {
-        let c = create_camera(&entity_with("perspective", &params, ct), &film).unwrap();
+        let c = create_camera(&entity_with("perspective", &params, ct.clone()), &film).unwrap();
         check_differentials(&c, &s, 1e-5, 1e-5);
     }
     for params in [
         vec![],
         vec![P::F("lensradius", &[0.1]), P::F("focaldistance", &[4.0])],
     ] {
-        let c = create_camera(&entity_with("orthographic", &params, ct), &film).unwrap();
+        let c = create_camera(&entity_with("orthographic", &params, ct.clone()), &film).unwrap();
         check_differentials(&c, &s, 1e-5, 1e-5);
     }
     // Offset-based differentials are linearisations: close, not exact.
