@@ -45,7 +45,7 @@ pub(super) struct ShapeContext<'a> {
 const ACCEL_BYTES_PER_PRIMITIVE: usize = 64;
 
 /// What a shape other than a mesh triangle takes, in bytes: its box
-/// (quadrics keep two transformations and their parameters) and the enum
+/// (quadrics keep a transformation and their parameters) and the enum
 /// that holds it.
 const SHAPE_BYTES: usize = 320;
 

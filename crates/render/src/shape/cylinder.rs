@@ -20,10 +20,9 @@ use rpbrt_geometry::Bounds3f;
 /// A cylinder about the object-space z axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cylinder {
-    /// Object-to-render transformation.
+    /// Object-to-render transformation (its inverse, which it holds too,
+    /// is the render-to-object one: one transformation, not two, per shape).
     pub render_from_object: Transform,
-    /// Render-to-object transformation.
-    pub object_from_render: Transform,
     /// Whether normals point inward.
     pub reverse_orientation: bool,
     /// Whether `render_from_object` changes handedness.
@@ -62,10 +61,9 @@ impl Cylinder {
             )));
         }
         let phi_max = phi_max_radians(S, phi_max)?;
-        let (render_from_object, object_from_render, swaps) = transforms(S, render_from_object)?;
+        let (render_from_object, _, swaps) = transforms(S, render_from_object)?;
         Ok(Cylinder {
             render_from_object,
-            object_from_render,
             reverse_orientation,
             transform_swaps_handedness: swaps,
             radius,
@@ -91,7 +89,7 @@ impl Cylinder {
     }
 
     fn basic_intersect(&self, r: &Ray, t_max: Float) -> Option<(Float, Point3f, Float)> {
-        let (oi, di) = object_ray(&self.object_from_render, r);
+        let (oi, di) = object_ray(&self.render_from_object.inverse(), r);
         let a = di.x.sqr() + di.y.sqr();
         let b = (di.x * oi.x + di.y * oi.y) * 2.0;
         let rad = Interval::new(self.radius);
@@ -155,7 +153,7 @@ impl ShapeMethods for Cylinder {
 
     fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
         let (t_hit, p, phi) = self.basic_intersect(ray, t_max)?;
-        let wo = object_wo(&self.object_from_render, ray);
+        let wo = object_wo(&self.render_from_object.inverse(), ray);
         Some(ShapeIntersection {
             intr: self.interaction(p, phi, wo, ray.time),
             t_hit,

@@ -18,10 +18,9 @@ use rpbrt_geometry::Bounds3f;
 /// A disk (or annulus) perpendicular to the object-space z axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Disk {
-    /// Object-to-render transformation.
+    /// Object-to-render transformation (its inverse, which it holds too,
+    /// is the render-to-object one: one transformation, not two, per shape).
     pub render_from_object: Transform,
-    /// Render-to-object transformation.
-    pub object_from_render: Transform,
     /// Whether the normal points toward −z.
     pub reverse_orientation: bool,
     /// Whether `render_from_object` changes handedness.
@@ -60,10 +59,9 @@ impl Disk {
             )));
         }
         let phi_max = phi_max_radians(S, phi_max)?;
-        let (render_from_object, object_from_render, swaps) = transforms(S, render_from_object)?;
+        let (render_from_object, _, swaps) = transforms(S, render_from_object)?;
         Ok(Disk {
             render_from_object,
-            object_from_render,
             reverse_orientation,
             transform_swaps_handedness: swaps,
             height,
@@ -78,7 +76,7 @@ impl Disk {
     }
 
     fn basic_intersect(&self, r: &Ray, t_max: Float) -> Option<(Float, Point3f, Float)> {
-        let (oi, di) = object_ray(&self.object_from_render, r);
+        let (oi, di) = object_ray(&self.render_from_object.inverse(), r);
         let (o, d) = (oi.midpoint(), di.midpoint());
         // Rays parallel to the plane never hit it.
         if d.z == 0.0 {
@@ -158,7 +156,7 @@ impl ShapeMethods for Disk {
 
     fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
         let (t_hit, p, phi) = self.basic_intersect(ray, t_max)?;
-        let wo = object_wo(&self.object_from_render, ray);
+        let wo = object_wo(&self.render_from_object.inverse(), ray);
         Some(ShapeIntersection {
             intr: self.interaction(p, phi, wo, ray.time),
             t_hit,

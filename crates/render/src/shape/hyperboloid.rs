@@ -31,10 +31,9 @@ use rpbrt_geometry::Bounds3f;
 /// A hyperboloid of one sheet (or cone, or cylinder) swept by a segment.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hyperboloid {
-    /// Object-to-render transformation.
+    /// Object-to-render transformation (its inverse, which it holds too,
+    /// is the render-to-object one: one transformation, not two, per shape).
     pub render_from_object: Transform,
-    /// Render-to-object transformation.
-    pub object_from_render: Transform,
     /// Whether normals point the other way.
     pub reverse_orientation: bool,
     /// Whether `render_from_object` changes handedness.
@@ -92,7 +91,7 @@ impl Hyperboloid {
             )));
         }
         let phi_max = phi_max_radians(S, phi_max)?;
-        let (render_from_object, object_from_render, swaps) = transforms(S, render_from_object)?;
+        let (render_from_object, _, swaps) = transforms(S, render_from_object)?;
         let (dx, dy, dz) = (
             (p2.x - p1.x) as f64,
             (p2.y - p1.y) as f64,
@@ -118,7 +117,6 @@ impl Hyperboloid {
         let r2 = (p2.x * p2.x + p2.y * p2.y).sqrt();
         Ok(Hyperboloid {
             render_from_object,
-            object_from_render,
             reverse_orientation,
             transform_swaps_handedness: swaps,
             p1,
@@ -156,7 +154,7 @@ impl Hyperboloid {
         r: &Ray,
         t_max: Float,
     ) -> Option<(Interval, Point3f, Float, Float, Point3fi)> {
-        let (oi, di) = object_ray(&self.object_from_render, r);
+        let (oi, di) = object_ray(&self.render_from_object.inverse(), r);
         let dz = self.p2.z - self.p1.z;
         // v along the ray: v0 + t·vd.
         let v0 = (oi.z - self.p1.z) / dz;
@@ -275,7 +273,7 @@ impl ShapeMethods for Hyperboloid {
 
     fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
         let (t, p, phi, v, p_fi) = self.basic_intersect(ray, t_max)?;
-        let wo = object_wo(&self.object_from_render, ray);
+        let wo = object_wo(&self.render_from_object.inverse(), ray);
         Some(ShapeIntersection {
             intr: self.interaction(p, phi, v, p_fi, wo, ray.time),
             t_hit: t.midpoint(),

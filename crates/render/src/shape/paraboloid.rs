@@ -20,10 +20,9 @@ use rpbrt_geometry::Bounds3f;
 /// A paraboloid of revolution about the object-space z axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Paraboloid {
-    /// Object-to-render transformation.
+    /// Object-to-render transformation (its inverse, which it holds too,
+    /// is the render-to-object one: one transformation, not two, per shape).
     pub render_from_object: Transform,
-    /// Render-to-object transformation.
-    pub object_from_render: Transform,
     /// Whether normals point inward.
     pub reverse_orientation: bool,
     /// Whether `render_from_object` changes handedness.
@@ -65,10 +64,9 @@ impl Paraboloid {
             )));
         }
         let phi_max = phi_max_radians(S, phi_max)?;
-        let (render_from_object, object_from_render, swaps) = transforms(S, render_from_object)?;
+        let (render_from_object, _, swaps) = transforms(S, render_from_object)?;
         Ok(Paraboloid {
             render_from_object,
-            object_from_render,
             reverse_orientation,
             transform_swaps_handedness: swaps,
             radius,
@@ -92,7 +90,7 @@ impl Paraboloid {
         r: &Ray,
         t_max: Float,
     ) -> Option<(Interval, Point3f, Float, Point3fi)> {
-        let (oi, di) = object_ray(&self.object_from_render, r);
+        let (oi, di) = object_ray(&self.render_from_object.inverse(), r);
         let k = Interval::new(self.z_max) / Interval::new(self.radius).sqr();
         let a = k * (di.x.sqr() + di.y.sqr());
         let b = k * (di.x * oi.x + di.y * oi.y) * 2.0 - di.z;
@@ -155,7 +153,7 @@ impl ShapeMethods for Paraboloid {
 
     fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
         let (t, p, phi, p_fi) = self.basic_intersect(ray, t_max)?;
-        let wo = object_wo(&self.object_from_render, ray);
+        let wo = object_wo(&self.render_from_object.inverse(), ray);
         Some(ShapeIntersection {
             intr: self.interaction(p, phi, p_fi, wo, ray.time),
             t_hit: t.midpoint(),

@@ -247,10 +247,9 @@ pub(super) fn transforms(
 /// `z_min ≤ z ≤ z_max` and `φ ≤ φ_max`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sphere {
-    /// Object-to-render transformation.
+    /// Object-to-render transformation (its inverse, which it holds too,
+    /// is the render-to-object one: one transformation, not two, per shape).
     pub render_from_object: Transform,
-    /// Render-to-object transformation.
-    pub object_from_render: Transform,
     /// Whether normals point inward.
     pub reverse_orientation: bool,
     /// Whether `render_from_object` changes handedness.
@@ -296,7 +295,7 @@ impl Sphere {
             )));
         }
         let phi_max = phi_max_radians(S, phi_max)?;
-        let (render_from_object, object_from_render, swaps) = transforms(S, render_from_object)?;
+        let (render_from_object, _, swaps) = transforms(S, render_from_object)?;
         let full = zlo <= -radius && zhi >= radius && phi_max >= 2.0 * PI;
         let cone_radius = if full {
             uniform_scale(&render_from_object).map(|s| s * radius)
@@ -305,7 +304,6 @@ impl Sphere {
         };
         Ok(Sphere {
             render_from_object,
-            object_from_render,
             reverse_orientation,
             transform_swaps_handedness: swaps,
             radius,
@@ -348,7 +346,7 @@ impl Sphere {
 
     /// pbrt-v4's `BasicIntersect`: the object-space hit, its φ and `t`.
     fn basic_intersect(&self, r: &Ray, t_max: Float) -> Option<(Float, Point3f, Float)> {
-        let (oi, di) = object_ray(&self.object_from_render, r);
+        let (oi, di) = object_ray(&self.render_from_object.inverse(), r);
         let a = sum_sq(di.x, di.y, di.z);
         let b = (di.x * oi.x + di.y * oi.y + di.z * oi.z) * 2.0;
         let rad = Interval::new(self.radius);
@@ -457,7 +455,7 @@ impl ShapeMethods for Sphere {
 
     fn intersect(&self, ray: &Ray, t_max: Float) -> Option<ShapeIntersection> {
         let (t_hit, p, phi) = self.basic_intersect(ray, t_max)?;
-        let wo = object_wo(&self.object_from_render, ray);
+        let wo = object_wo(&self.render_from_object.inverse(), ray);
         Some(ShapeIntersection {
             intr: self.interaction(p, phi, wo, ray.time),
             t_hit,
@@ -541,7 +539,7 @@ impl ShapeMethods for Sphere {
         let p_error = Vector3f::from(p).abs() * gamma(5);
         let n = Normal3f::from(nv);
         let n = if self.flip() { -n } else { n };
-        let p_obj = self.object_from_render.apply_point(p);
+        let p_obj = self.render_from_object.apply_inverse_point(p);
         let uv = self.uv_of(p_obj, positive_atan2(p_obj.y, p_obj.x));
         if one_minus_cos_theta_max <= 0.0 {
             return None;
