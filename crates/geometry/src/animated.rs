@@ -434,7 +434,10 @@ mod tests {
         }
         // A scale or a rotation in either keyframe takes the composition.
         let general = |a: Transform, b: Transform| {
-            matches!(AnimatedTransform::new(a, 0.0, b, 1.0).keys, Keys::General(_))
+            matches!(
+                AnimatedTransform::new(a, 0.0, b, 1.0).keys,
+                Keys::General(_)
+            )
         };
         let s = Transform::scale(2.0, 1.0, 1.0);
         assert!(general(s, Transform::identity()));
@@ -458,7 +461,10 @@ mod tests {
         assert!(at.end_transform().same_bits(&g.end_transform()));
         assert_eq!(at.is_animated(), g.is_animated());
         for time in [0.0, 0.25, 0.3, 0.5, 0.75, 1.0] {
-            assert!(at.interpolate(time).same_bits(&g.interpolate(time)), "{time}");
+            assert!(
+                at.interpolate(time).same_bits(&g.interpolate(time)),
+                "{time}"
+            );
         }
         let bx = Bounds3f::new(Point3f::new(-1.0, -0.5, -0.2), Point3f::new(1.0, 0.5, 2.0));
         assert_eq!(at.motion_bounds(&bx), g.motion_bounds(&bx));

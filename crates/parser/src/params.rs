@@ -980,4 +980,3 @@ mod tests {
         assert_eq!(d.into_params().len(), 1);
     }
 }
-

@@ -267,9 +267,8 @@ impl AffinePair {
     }
 
     fn transform(&self) -> Transform {
-        let full = |r: &[[Float; 4]; 3]| {
-            SquareMatrix4::new([r[0], r[1], r[2], AffinePair::LAST_ROW])
-        };
+        let full =
+            |r: &[[Float; 4]; 3]| SquareMatrix4::new([r[0], r[1], r[2], AffinePair::LAST_ROW]);
         Transform::from_matrices(full(&self.m), full(&self.m_inv))
     }
 }
@@ -603,9 +602,7 @@ impl Primitive {
             Primitive::Mesh(p) => p
                 .valid_triangles()
                 .any(|i| p.intersect_p_triangle(i, ray, t_max)),
-            Primitive::Instances(set) => {
-                set.indices().any(|i| set.intersect_p_one(i, ray, t_max))
-            }
+            Primitive::Instances(set) => set.indices().any(|i| set.intersect_p_one(i, ray, t_max)),
             Primitive::Animated(p) => {
                 let (r, t) = p
                     .render_from_primitive

@@ -26,9 +26,7 @@ use crate::lightsampler::create_light_sampler;
 use crate::material::MaterialSet;
 use crate::medium::{create_medium, create_region, Medium, RegionMedium};
 use crate::params::{unknown_type, ParamReader};
-use crate::primitive::{
-    AnimatedPrimitive, InstanceSet, Moving, Primitive, PrimitiveAggregate,
-};
+use crate::primitive::{AnimatedPrimitive, InstanceSet, Moving, Primitive, PrimitiveAggregate};
 use crate::sampler::{create_sampler, Sampler};
 use crate::texture::TextureOptions;
 
@@ -428,7 +426,9 @@ fn place_instances(
             // below.
             list.truncate(end);
             let base = prims.len();
-            take_from_end(list, |inst| runs.add(&inst, definition.get(&inst.name), prims));
+            take_from_end(list, |inst| {
+                runs.add(&inst, definition.get(&inst.name), prims)
+            });
             runs.close(prims);
             for prim in &mut prims[base..] {
                 if let Primitive::Instances(set) = prim {

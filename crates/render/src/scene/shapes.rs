@@ -20,9 +20,9 @@ use crate::primitive::{Alpha, GeometricPrimitive, MediumInterface, MeshPrimitive
 use crate::shape::create::{create_shape_set, create_shapes, Displacement};
 use crate::shape::Shape;
 use crate::texture::{FloatTexture, NamedTextures, TextureEvalContext, TextureParams};
+use rpbrt_geometry::animated::AnimatedTransform;
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::transform::Transform;
-use rpbrt_geometry::animated::AnimatedTransform;
 use rpbrt_geometry::tuple::{Point2f, Point3f};
 
 /// What shapes are turned into primitives with.

@@ -72,7 +72,11 @@ fn parts(c: &Camera) -> (Float, Float, Float) {
 /// points.
 fn integrate_importance(c: &Camera, k: usize, seed: u64) -> Float {
     let (_, lens_radius, _) = parts(c);
-    let xf = c.base().camera_transform.render_from_camera.start_transform();
+    let xf = c
+        .base()
+        .camera_transform
+        .render_from_camera
+        .start_transform();
     let view = xf.apply_vector(Vector3f::new(0.0, 0.0, 1.0)).normalize();
     let lens_area = if lens_radius > 0.0 {
         PI * lens_radius * lens_radius

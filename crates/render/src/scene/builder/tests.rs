@@ -100,7 +100,9 @@ fn look_at_and_camera_define_camera_space() {
         -5.0
     ));
     // Camera looks down +z in camera space; towards the world origin here.
-    let ahead = rfc.start_transform().apply_point(Point3f::new(0.0, 0.0, 1.0));
+    let ahead = rfc
+        .start_transform()
+        .apply_point(Point3f::new(0.0, 0.0, 1.0));
     assert!(close(ahead, 0.0, 0.0, -4.0));
     // "camera" coordinate system: objects placed at the camera.
     assert!(close(
@@ -129,7 +131,11 @@ fn rendering_coordinate_systems() {
     ));
     // camera: render space is camera space.
     let s = build_with(text, RenderingCoordinateSystem::Camera);
-    let rfc = s.camera.camera_transform.render_from_camera.start_transform();
+    let rfc = s
+        .camera
+        .camera_transform
+        .render_from_camera
+        .start_transform();
     assert!(close(
         rfc.apply_point(Point3f::new(0.5, 0.25, 2.0)),
         0.5,
@@ -178,10 +184,20 @@ fn active_transform_makes_animated_shapes() {
         0.0,
         0.0
     ));
-    assert!(close(a.end_transform().apply_point(origin()), 1.0, 0.0, 0.0));
+    assert!(close(
+        a.end_transform().apply_point(origin()),
+        1.0,
+        0.0,
+        0.0
+    ));
     assert!(close(a.apply_point(origin(), 1.0), 0.5, 0.0, 0.0));
     let b = &s.animated_shapes[1].render_from_object;
-    assert!(close(b.end_transform().apply_point(origin()), 1.0, 1.0, 0.0));
+    assert!(close(
+        b.end_transform().apply_point(origin()),
+        1.0,
+        1.0,
+        0.0
+    ));
     // Only the start moved: both keyframes now agree.
     assert_eq!(s.shapes.len(), 1);
     assert_eq!(s.shapes[0].base.name, "cylinder");
@@ -970,13 +986,21 @@ fn pbrt_v1_defaults_materials_and_camera() {
     assert_eq!(s.materials[2].name, "clay");
     // pbrt-v1's LookAt mirrored the camera frame in x: camera +x looks
     // toward world −x.
-    let rfc = s.camera.camera_transform.render_from_camera.start_transform();
+    let rfc = s
+        .camera
+        .camera_transform
+        .render_from_camera
+        .start_transform();
     let x = rfc.apply_vector(Vector3f::new(1.0, 0.0, 0.0));
     assert!((x.x + 1.0).abs() < 1e-5, "{x:?}");
     // Read as pbrt-v2 (no pbrt-v1 construct), the same camera is not
     // mirrored.
     let s = build("SurfaceIntegrator \"path\"\nLookAt 0 0 0  0 0 1  0 1 0\nCamera \"perspective\"\nWorldBegin\n");
-    let rfc = s.camera.camera_transform.render_from_camera.start_transform();
+    let rfc = s
+        .camera
+        .camera_transform
+        .render_from_camera
+        .start_transform();
     let x = rfc.apply_vector(Vector3f::new(1.0, 0.0, 0.0));
     assert!((x.x - 1.0).abs() < 1e-5, "{x:?}");
     assert_error(
