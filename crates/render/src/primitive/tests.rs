@@ -99,6 +99,111 @@ fn instances_match_direct_geometry() {
     assert!(hits > 500);
 }
 
+/// A run of instances as one set gives the entries, hits and shadow
+/// answers that each instance as a primitive of its own gives, bit for
+/// bit: affine placements kept without their last rows, a projective one
+/// turning the set's placements whole, a set built backwards and
+/// reversed.
+#[test]
+fn instance_set_matches_separate_instances() {
+    let mut rng = Rng::new(5, 0);
+    let objects = [
+        Arc::new(PrimitiveAggregate::new(
+            random_triangles(&mut rng, 40, &Transform::identity()),
+            &AccelParams::default(),
+        )),
+        Arc::new(PrimitiveAggregate::new(
+            vec![sphere_prim(Transform::identity(), 0.8)],
+            &AccelParams::default(),
+        )),
+    ];
+    let mut placements = Vec::new();
+    for k in 0..30 {
+        let v = |rng: &mut Rng| rng.uniform_float() * 8.0 - 4.0;
+        let xf = Transform::translate(Vector3f::new(v(&mut rng), v(&mut rng), v(&mut rng)))
+            * Transform::rotate(360.0 * rng.uniform_float(), Vector3f::new(0.3, 1.0, 0.2))
+            * Transform::scale(0.3, 0.25 + 0.1 * rng.uniform_float(), 0.3);
+        placements.push((k % 2, xf));
+    }
+    let mut projective = *Transform::scale(0.3, 0.3, 0.3).matrix();
+    projective.m[3] = [0.01, 0.0, 0.0, 1.0];
+    let projective = match Transform::from_matrix(projective) {
+        Ok(t) => t,
+        Err(e) => panic!("{e}"),
+    };
+    assert!(AffinePair::of(&projective).is_none());
+    for (kind, placed) in [
+        ("affine", placements.clone()),
+        ("projective", {
+            let mut p = placements.clone();
+            p.insert(17, (0, projective));
+            p
+        }),
+    ] {
+        let mut set = InstanceSet::new();
+        let ids = objects.clone().map(|o| set.add_object(o));
+        for &(k, xf) in &placed {
+            set.push(ids[k], xf);
+        }
+        assert_eq!(
+            matches!(set.render_from_object, Placements::Affine(_)),
+            kind == "affine"
+        );
+        for (i, &(_, xf)) in placed.iter().enumerate() {
+            assert!(set.render_from_object.get(i).same_bits(&xf), "{kind} {i}");
+        }
+        let mut backwards = InstanceSet::new();
+        let ids = objects.clone().map(|o| backwards.add_object(o));
+        for &(k, xf) in placed.iter().rev() {
+            backwards.push(ids[k], xf);
+        }
+        backwards.reverse();
+        let one_set = PrimitiveAggregate::new(
+            vec![Primitive::Instances(Box::new(set))],
+            &AccelParams::default(),
+        );
+        let reversed = PrimitiveAggregate::new(
+            vec![Primitive::Instances(Box::new(backwards))],
+            &AccelParams::default(),
+        );
+        let separate = PrimitiveAggregate::new(
+            placed
+                .iter()
+                .map(|&(k, xf)| {
+                    Primitive::Instances(Box::new(InstanceSet::one(objects[k].clone(), xf)))
+                })
+                .collect(),
+            &AccelParams::default(),
+        );
+        assert_eq!(one_set.entry_count(), placed.len());
+        assert_eq!(one_set.bounds(), separate.bounds());
+        let mut hits = 0;
+        for _ in 0..2000 {
+            let r = random_ray(&mut rng);
+            let a = separate.intersect_record(&r, Float::INFINITY);
+            for agg in [&one_set, &reversed] {
+                assert_eq!(agg.intersect_record(&r, Float::INFINITY), a, "{kind}");
+                assert_eq!(
+                    agg.intersect_p(&r, Float::INFINITY),
+                    separate.intersect_p(&r, Float::INFINITY)
+                );
+                let (x, y) = (
+                    agg.intersect(&r, Float::INFINITY),
+                    separate.intersect(&r, Float::INFINITY),
+                );
+                assert_eq!(x.is_some(), y.is_some());
+                if let (Some(x), Some(y)) = (x, y) {
+                    assert_eq!(x.t_hit.to_bits(), y.t_hit.to_bits());
+                    assert_eq!(x.si.p(), y.si.p());
+                    assert_eq!(x.material, y.material);
+                }
+            }
+            hits += usize::from(a.is_some());
+        }
+        assert!(hits > 200, "{kind}: {hits}");
+    }
+}
+
 /// An aggregate holding one sphere moving along x from −2 to 2, held
 /// directly (`Moving::One`) or under an aggregate of its own.
 fn moving_sphere(own_aggregate: bool) -> PrimitiveAggregate {

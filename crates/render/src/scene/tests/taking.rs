@@ -6,6 +6,9 @@
 use super::super::assemble::{create_scene, create_scene_taking_entities, CreateOptions};
 use super::{build_scene_from_str, BuildOptions};
 use crate::scene::entities::SceneDescription;
+use rpbrt_geometry::float::Float;
+use rpbrt_geometry::ray::Ray;
+use rpbrt_geometry::tuple::{Point3f, Vector3f};
 
 fn described(text: &str) -> SceneDescription {
     match build_scene_from_str(text, &BuildOptions::default()) {
@@ -43,6 +46,46 @@ fn taken_entities_give_the_same_scene_and_problems_in_order() {
     assert_eq!(read, taken);
     assert!(desc.instances.is_empty() && desc.animated_shapes.is_empty());
     assert!(read.contains("bogus"), "{read}");
+
+    // Fixed and moving instances interleaved: runs of fixed ones become
+    // sets; taken from the end, the runs and their instances are put back
+    // in order (the same entries, so the same hits).
+    let mut text = HEAD.to_string();
+    text += "ObjectBegin \"o\"\nShape \"sphere\" \"float radius\" 0.3\nObjectEnd\n";
+    for x in 0..7 {
+        for y in 0..3 {
+            text += &format!(
+                "AttributeBegin\nTranslate {x} {y} 3\nObjectInstance \"o\"\nAttributeEnd\n"
+            );
+        }
+        text += &format!(
+            "AttributeBegin\nActiveTransform StartTime\nTranslate {x} 4 3\nActiveTransform EndTime\nTranslate {x} 5 3\nActiveTransform All\nObjectInstance \"o\"\nAttributeEnd\n"
+        );
+    }
+    let scene =
+        |r: Result<crate::scene::assemble::CreatedScene, Vec<rpbrt_parser::Diagnostic>>| match r {
+            Ok(c) => c.scene,
+            Err(e) => panic!("{e:?}"),
+        };
+    let read = scene(create_scene(&described(&text), &CreateOptions::default()));
+    let taken = scene(create_scene_taking_entities(
+        &mut described(&text),
+        &CreateOptions::default(),
+    ));
+    assert_eq!(read.aggregate.primitives().len(), 14);
+    assert_eq!(read.aggregate.entry_count(), 28);
+    assert_eq!(taken.aggregate.entry_count(), 28);
+    let mut hits = 0;
+    for i in 0..40 {
+        for j in 0..40 {
+            let o = Point3f::new(i as Float * 0.2 - 1.0, j as Float * 0.2 - 1.0, -5.0);
+            let ray = Ray::with_time(o, Vector3f::new(0.3, 0.2, 1.0), 0.5, None);
+            let a = read.aggregate.intersect_record(&ray, Float::INFINITY);
+            assert_eq!(a, taken.aggregate.intersect_record(&ray, Float::INFINITY));
+            hits += usize::from(a.is_some());
+        }
+    }
+    assert!(hits > 30, "{hits}");
 
     // Errors: two broken moving meshes, reported in the files' order
     // either way.
