@@ -353,7 +353,8 @@ impl InstanceSet {
     /// Adds an instance of the object `object` (an index that
     /// [`InstanceSet::add_object`] returned).
     pub fn push(&mut self, object: u32, render_from_object: Transform) {
-        debug_assert!((object as usize) < self.objects.len());
+        // A bad index would otherwise panic at the first ray to meet it.
+        assert!((object as usize) < self.objects.len(), "no object {object}");
         self.object_of.push(object);
         self.render_from_object.push(render_from_object);
         debug_assert_eq!(self.object_of.len(), self.render_from_object.len());
