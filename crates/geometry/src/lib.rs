@@ -16,6 +16,7 @@ pub mod quaternion;
 pub mod ray;
 pub mod spherical;
 pub mod transform;
+pub mod transform_list;
 pub mod tuple;
 
 pub use animated::AnimatedTransform;
@@ -28,6 +29,7 @@ pub use quaternion::Quaternion;
 pub use ray::{offset_ray_origin, spawn_ray, spawn_ray_to, MediumId, Ray, RayDifferential};
 pub use spherical::*;
 pub use transform::{SquareMatrix4, Transform, TransformError};
+pub use transform_list::TransformList;
 pub use tuple::*;
 
 /// A uniform-sphere warp, exposed only for the crate's integration tests

@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 use crate::input;
 use crate::loc::FileLoc;
+use crate::tokenizer::SourceText;
 
 /// How serious a [`Diagnostic`] is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -177,7 +178,7 @@ impl std::error::Error for Diagnostic {}
 /// with their source line after parsing has finished.
 #[derive(Clone, Debug, Default)]
 pub struct SourceMap {
-    files: HashMap<Arc<str>, Arc<[u8]>>,
+    files: HashMap<Arc<str>, SourceText>,
 }
 
 impl SourceMap {
@@ -187,7 +188,7 @@ impl SourceMap {
     }
 
     /// Records the contents of `file`.
-    pub fn insert(&mut self, file: Arc<str>, contents: Arc<[u8]>) {
+    pub fn insert(&mut self, file: Arc<str>, contents: SourceText) {
         self.files.insert(file, contents);
     }
 
@@ -207,7 +208,7 @@ impl SourceMap {
     }
 
     /// The recorded files and their contents.
-    pub fn into_files(self) -> impl Iterator<Item = (Arc<str>, Arc<[u8]>)> {
+    pub fn into_files(self) -> impl Iterator<Item = (Arc<str>, SourceText)> {
         self.files.into_iter()
     }
 }
@@ -373,7 +374,7 @@ mod tests {
     fn diagnostics_counts_and_renders_from_sources() {
         let mut ds = Diagnostics::new();
         ds.sources
-            .insert(Arc::from("a.pbrt"), Arc::from(&b"Foo\n"[..]));
+            .insert(Arc::from("a.pbrt"), Arc::new(b"Foo\n".to_vec()));
         ds.push(Diagnostic::warning(loc(1, 1), "w"));
         assert!(!ds.has_errors());
         ds.push(Diagnostic::error(loc(1, 2), "e"));

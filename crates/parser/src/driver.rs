@@ -18,6 +18,7 @@ use crate::input;
 use crate::loc::FileLoc;
 use crate::params::{split_declaration, value_kind, ParsedParameter, ValueKind};
 use crate::target::{IncludeKind, ParserTarget};
+use crate::tokenizer::SourceText;
 use crate::tokenizer::{escape_string, Token, TokenKind, Tokenizer};
 
 /// Limits and settings for one parse.
@@ -79,7 +80,7 @@ pub fn parse_files<P: AsRef<Path>>(
 pub fn parse_string(text: &str, target: &mut dyn ParserTarget) -> Result<Diagnostics, Diagnostics> {
     Parser::new(ParseOptions::default()).parse_bytes(
         "<string>",
-        text.as_bytes().into(),
+        Arc::new(text.as_bytes().to_vec()),
         Path::new("."),
         target,
     )
@@ -128,7 +129,7 @@ impl Parser {
     pub fn parse_bytes(
         &self,
         name: &str,
-        data: Arc<[u8]>,
+        data: SourceText,
         dir: &Path,
         target: &mut dyn ParserTarget,
     ) -> Result<Diagnostics, Diagnostics> {
@@ -349,7 +350,7 @@ struct Run<'a> {
     /// Files read whose directives are delivered later (deferred, or parsed
     /// for an import): kept until it is known whether a diagnostic points
     /// into them.
-    held: Vec<(Arc<str>, Arc<[u8]>)>,
+    held: Vec<(Arc<str>, SourceText)>,
     /// Bytes of scene text charged to the budget, given back when the
     /// parse ends.
     text_charged: u64,
@@ -541,7 +542,7 @@ impl<'a> Run<'a> {
             _ => PathBuf::from("."),
         };
         Ok(Source {
-            tok: Tokenizer::new(Arc::from(path.display().to_string()), Arc::from(data)),
+            tok: Tokenizer::new(Arc::from(path.display().to_string()), Arc::new(data)),
             dir,
             canon: std::fs::canonicalize(path).ok(),
         })

@@ -37,4 +37,4 @@ pub use format::FormattingTarget;
 pub use loc::FileLoc;
 pub use params::{ParamError, ParameterDictionary, ParsedParameter, SpectrumValue, ValueKind};
 pub use target::{DirectiveResult, IncludeKind, ParamList, ParserTarget};
-pub use tokenizer::{Token, TokenKind, Tokenizer};
+pub use tokenizer::{SourceText, Token, TokenKind, Tokenizer};

@@ -54,11 +54,16 @@ impl Token {
     }
 }
 
+/// A scene file's text, shared by its tokenizer and the diagnostics that
+/// point into it. A `Vec` behind the `Arc` (not an `Arc<[u8]>`), so that a
+/// file read into a vector is shared as it is, without a copy.
+pub type SourceText = Arc<Vec<u8>>;
+
 /// Tokenizer over one file's contents.
 #[derive(Clone, Debug)]
 pub struct Tokenizer {
     name: Arc<str>,
-    data: Arc<[u8]>,
+    data: SourceText,
     pos: usize,
     line: u32,
     line_start: usize,
@@ -94,7 +99,7 @@ fn saturating_u32(v: usize) -> u32 {
 impl Tokenizer {
     /// Creates a tokenizer over `data`, reported as file `name`. A UTF-8
     /// byte-order mark is skipped.
-    pub fn new(name: Arc<str>, data: Arc<[u8]>) -> Self {
+    pub fn new(name: Arc<str>, data: SourceText) -> Self {
         let pos = if data.starts_with(&[0xef, 0xbb, 0xbf]) {
             3
         } else {
@@ -137,7 +142,7 @@ impl Tokenizer {
 
     /// Creates a tokenizer over a string (handy for tests and `parse_string`).
     pub fn from_str(name: &str, text: &str) -> Self {
-        Self::new(Arc::from(name), Arc::from(text.as_bytes()))
+        Self::new(Arc::from(name), Arc::new(text.as_bytes().to_vec()))
     }
 
     /// An error if the file is UTF-16 encoded (which pbrt does not support).
@@ -159,7 +164,7 @@ impl Tokenizer {
     }
 
     /// The whole buffer.
-    pub fn data(&self) -> &Arc<[u8]> {
+    pub fn data(&self) -> &SourceText {
         &self.data
     }
 
@@ -278,7 +283,7 @@ impl Tokenizer {
     /// error for a malformed string (after which tokenizing can continue).
     #[inline]
     pub fn next_token(&mut self) -> Result<Option<Token>, Diagnostic> {
-        let data = &*self.data;
+        let data = self.data.as_slice();
         let len = data.len();
         let mut pos = self.pos;
         // Skip whitespace and comments.
@@ -350,7 +355,7 @@ impl Tokenizer {
         line: u32,
         column: u32,
     ) -> Result<Option<Token>, Diagnostic> {
-        let data = &*self.data;
+        let data = self.data.as_slice();
         let len = data.len();
         let start_loc = || FileLoc::new(self.name.clone(), line, column);
         let mut i = quote + 1;
@@ -770,9 +775,9 @@ mod tests {
 
     #[test]
     fn utf16_is_rejected_and_utf8_bom_skipped() {
-        let t = Tokenizer::new(Arc::from("u"), Arc::from(&[0xff, 0xfe, b'a', 0][..]));
+        let t = Tokenizer::new(Arc::from("u"), Arc::new([0xff, 0xfe, b'a', 0].to_vec()));
         assert!(t.check_encoding().is_some());
-        let mut t = Tokenizer::new(Arc::from("u"), Arc::from(&[0xef, 0xbb, 0xbf, b'A'][..]));
+        let mut t = Tokenizer::new(Arc::from("u"), Arc::new([0xef, 0xbb, 0xbf, b'A'].to_vec()));
         assert!(t.check_encoding().is_none());
         let tok = t.next_token().unwrap().unwrap();
         assert_eq!(t.raw(&tok), b"A");
@@ -780,7 +785,7 @@ mod tests {
 
     #[test]
     fn invalid_utf8_string_is_an_error_not_a_panic() {
-        let mut t = Tokenizer::new(Arc::from("u"), Arc::from(&b"\"\xff\xfe\" \xc3"[..]));
+        let mut t = Tokenizer::new(Arc::from("u"), Arc::new(b"\"\xff\xfe\" \xc3".to_vec()));
         let tok = t.next_token().unwrap().unwrap();
         assert!(t.string_value(&tok).is_err());
         let tok = t.next_token().unwrap().unwrap();

@@ -16,7 +16,8 @@ use rpbrt_geometry::animated::AnimatedTransform;
 use rpbrt_geometry::float::Float;
 use rpbrt_geometry::interaction::SurfaceInteraction;
 use rpbrt_geometry::ray::{MediumId, Ray};
-use rpbrt_geometry::transform::{SquareMatrix4, Transform};
+use rpbrt_geometry::transform::Transform;
+use rpbrt_geometry::transform_list::TransformList;
 use rpbrt_geometry::tuple::{Normal3f, Point2f, Point3f, Vector3f};
 use rpbrt_geometry::Bounds3f;
 use std::sync::Arc;
@@ -223,110 +224,7 @@ pub struct InstanceSet {
     /// Per instance: the index of its object in `objects`.
     object_of: Vec<u32>,
     /// Per instance: from its object's space to rendering space.
-    render_from_object: Placements,
-}
-
-/// The instances' transformations.
-#[derive(Clone, Debug)]
-enum Placements {
-    /// All affine: without the matrices' last rows (96 bytes each).
-    Affine(Vec<AffinePair>),
-    /// Some not affine: whole.
-    Full(Vec<Transform>),
-}
-
-impl Default for Placements {
-    fn default() -> Placements {
-        Placements::Affine(Vec::new())
-    }
-}
-
-/// An affine transformation and its inverse without their last rows, which
-/// are, to the bit, (0, 0, 0, 1) (`+0`s): the transformation it gives back
-/// is bit for bit the one it was made from.
-#[derive(Clone, Copy, Debug)]
-struct AffinePair {
-    m: [[Float; 4]; 3],
-    m_inv: [[Float; 4]; 3],
-}
-
-impl AffinePair {
-    const LAST_ROW: [Float; 4] = [0.0, 0.0, 0.0, 1.0];
-
-    /// `t` without its last rows, when they are (0, 0, 0, 1) to the bit.
-    fn of(t: &Transform) -> Option<AffinePair> {
-        let (m, mi) = (&t.matrix().m, &t.inverse_matrix().m);
-        let last = |row: &[Float; 4]| {
-            row.iter()
-                .zip(AffinePair::LAST_ROW)
-                .all(|(a, b)| a.to_bits() == b.to_bits())
-        };
-        (last(&m[3]) && last(&mi[3])).then(|| AffinePair {
-            m: [m[0], m[1], m[2]],
-            m_inv: [mi[0], mi[1], mi[2]],
-        })
-    }
-
-    fn transform(&self) -> Transform {
-        let full =
-            |r: &[[Float; 4]; 3]| SquareMatrix4::new([r[0], r[1], r[2], AffinePair::LAST_ROW]);
-        Transform::from_matrices(full(&self.m), full(&self.m_inv))
-    }
-}
-
-impl Placements {
-    fn len(&self) -> usize {
-        match self {
-            Placements::Affine(v) => v.len(),
-            Placements::Full(v) => v.len(),
-        }
-    }
-
-    fn get(&self, i: usize) -> Transform {
-        match self {
-            Placements::Affine(v) => v[i].transform(),
-            Placements::Full(v) => v[i],
-        }
-    }
-
-    fn push(&mut self, t: Transform) {
-        if let Placements::Affine(v) = self {
-            match AffinePair::of(&t) {
-                Some(a) => return v.push(a),
-                None => {
-                    // The first that is not affine: every one whole from
-                    // here on.
-                    let mut full = Vec::with_capacity(v.capacity());
-                    full.extend(v.iter().map(AffinePair::transform));
-                    *self = Placements::Full(full);
-                }
-            }
-        }
-        if let Placements::Full(v) = self {
-            v.push(t);
-        }
-    }
-
-    fn reserve_exact(&mut self, n: usize) {
-        match self {
-            Placements::Affine(v) => v.reserve_exact(n),
-            Placements::Full(v) => v.reserve_exact(n),
-        }
-    }
-
-    fn shrink_to_fit(&mut self) {
-        match self {
-            Placements::Affine(v) => v.shrink_to_fit(),
-            Placements::Full(v) => v.shrink_to_fit(),
-        }
-    }
-
-    fn reverse(&mut self) {
-        match self {
-            Placements::Affine(v) => v.reverse(),
-            Placements::Full(v) => v.reverse(),
-        }
-    }
+    render_from_object: TransformList,
 }
 
 impl InstanceSet {
@@ -341,6 +239,26 @@ impl InstanceSet {
         let k = set.add_object(object);
         set.push(k, render_from_object);
         set
+    }
+
+    /// Instances of `objects`: instance `i` places `objects[object_of[i]]`
+    /// by `render_from_object.get(i)` (the lists moved in, not copied).
+    /// Panics unless the lists are as long and every index is in range.
+    pub fn from_parts(
+        objects: Vec<Arc<PrimitiveAggregate>>,
+        object_of: Vec<u32>,
+        render_from_object: TransformList,
+    ) -> InstanceSet {
+        assert_eq!(object_of.len(), render_from_object.len());
+        assert!(
+            object_of.iter().all(|&k| (k as usize) < objects.len()),
+            "an instance of no object"
+        );
+        InstanceSet {
+            objects,
+            object_of,
+            render_from_object,
+        }
     }
 
     /// Adds an object that instances may place; returns its index for

@@ -131,7 +131,6 @@ fn instance_set_matches_separate_instances() {
         Ok(t) => t,
         Err(e) => panic!("{e}"),
     };
-    assert!(AffinePair::of(&projective).is_none());
     for (kind, placed) in [
         ("affine", placements.clone()),
         ("projective", {
@@ -145,10 +144,7 @@ fn instance_set_matches_separate_instances() {
         for &(k, xf) in &placed {
             set.push(ids[k], xf);
         }
-        assert_eq!(
-            matches!(set.render_from_object, Placements::Affine(_)),
-            kind == "affine"
-        );
+        assert_eq!(set.render_from_object.bytes_each() == 96, kind == "affine");
         for (i, &(_, xf)) in placed.iter().enumerate() {
             assert!(set.render_from_object.get(i).same_bits(&xf), "{kind} {i}");
         }

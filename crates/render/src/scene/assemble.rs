@@ -8,9 +8,11 @@
 use std::collections::HashMap;
 use std::sync::Arc;
 
+use rpbrt_geometry::Transform;
 use rpbrt_parser::{Diagnostic, MemoryBudget};
 
 use super::entities::*;
+use super::instances::InstanceList;
 use super::materials::{create_materials, create_textures};
 use super::shapes::{at_origin, create_primitives, ShapeContext};
 use crate::accel::{AccelParams, ParamValue};
@@ -326,9 +328,10 @@ pub fn create_scene(
 }
 
 /// [`create_scene`], taking the description's object instances and
-/// animated shapes (left empty): their memory (about 180 and 700 bytes
-/// each) is freed as they become render primitives, before the scene's
-/// accelerator is built, instead of being held whole beside them.
+/// animated shapes (left empty): the instances' transformations become
+/// the scene's instance set as they are, and the animated shapes are
+/// freed as they become render primitives, instead of being held whole
+/// beside them.
 pub fn create_scene_taking_entities(
     desc: &mut SceneDescription,
     opts: &CreateOptions,
@@ -344,106 +347,124 @@ pub fn create_scene_taking_entities(
 /// (`None`: read from the description).
 #[derive(Default)]
 struct Taken {
-    instances: Option<Vec<InstanceSceneEntity>>,
+    instances: Option<InstanceList>,
     animated_shapes: Option<Vec<AnimatedShapeSceneEntity>>,
 }
 
-/// The object definitions by name, remembering the last name looked up
-/// (consecutive instances mostly share their object's name, an `Arc` the
-/// definition's instances share: a pointer comparison instead of hashing
-/// the name).
-struct Definitions<'a> {
-    map: &'a HashMap<&'a str, Arc<PrimitiveAggregate>>,
-    last: Option<(Arc<str>, Option<&'a Arc<PrimitiveAggregate>>)>,
-}
-
-impl<'a> Definitions<'a> {
-    fn get(&mut self, name: &Arc<str>) -> Option<&'a Arc<PrimitiveAggregate>> {
-        match &self.last {
-            Some((n, def)) if Arc::ptr_eq(n, name) => *def,
-            _ => {
-                let def = self.map.get(&**name);
-                self.last = Some((name.clone(), def));
-                def
-            }
-        }
-    }
-}
-
-/// Appends the primitives of `instances` to `prims`, in order: each
-/// instance of a defined, non-empty object, until the memory budget runs
-/// out (reported at the first instance over it, as every error here is).
-/// Instances taken from the description are placed from the last, their
-/// list shrunk as it goes, so that the description's copy and the
-/// primitives are not both held whole.
+/// Appends the primitives of the description's object instances to
+/// `prims`, in order (`taken`: the instances taken from it, whose lists
+/// are moved into the primitives instead of copied). Instances of an
+/// undefined object are errors (at its first instance); those of an empty
+/// one are left out.
 fn place_instances(
     desc: &SceneDescription,
-    taken: Option<Vec<InstanceSceneEntity>>,
+    taken: Option<InstanceList>,
     definitions: &HashMap<&str, Arc<PrimitiveAggregate>>,
     prims: &mut Vec<Primitive>,
     p: &mut Problems,
 ) {
-    let mut definition = Definitions {
-        map: definitions,
-        last: None,
+    let list = taken.as_ref().unwrap_or(&desc.instances);
+    // Per name: its object, where defined and not empty.
+    let objects: Vec<Option<&Arc<PrimitiveAggregate>>> = list
+        .names
+        .iter()
+        .map(|(name, loc)| match definitions.get(&**name) {
+            None => {
+                p.errors.push(Diagnostic::error(
+                    loc.clone(),
+                    format!("object \"{name}\" is not defined"),
+                ));
+                None
+            }
+            Some(def) => (!def.primitives().is_empty()).then_some(def),
+        })
+        .collect();
+    let placed = list
+        .name_of
+        .iter()
+        .filter(|&&k| objects[k as usize].is_some())
+        .count();
+    // The instances' primitives and accelerator entries, charged at the
+    // first instance.
+    if let Some((_, loc)) = list.names.first() {
+        let bytes = INSTANCE_BYTES.saturating_mul(placed as u64);
+        if let Err(e) = desc.budget.charge(bytes, "these object instances") {
+            p.errors.push(Diagnostic::error(loc.clone(), e.to_string()));
+            return;
+        }
+    }
+    if placed == 0 {
+        return;
+    }
+    if !list.animated.is_empty() {
+        place_runs(list, &objects, prims);
+        return;
+    }
+    // No instance moves: all of them are one set, its lists the
+    // description's (copied only when it is borrowed), each name's index
+    // turned into its object's.
+    let mut set_objects = Vec::new();
+    let index: Vec<u32> = objects
+        .iter()
+        .map(|o| match o {
+            Some(def) => {
+                set_objects.push(Arc::clone(def));
+                set_objects.len() as u32 - 1
+            }
+            None => u32::MAX,
+        })
+        .collect();
+    let (mut object_of, mut fixed) = match taken {
+        Some(list) => (list.name_of, list.fixed),
+        None => (list.name_of.clone(), list.fixed.clone()),
     };
-    // Errors and the budget first, in order.
-    let list = taken.as_deref().unwrap_or(&desc.instances);
-    let mut end = list.len();
-    let mut placed = 0;
-    for (k, inst) in list.iter().enumerate() {
-        let Some(def) = definition.get(&inst.name) else {
-            p.errors.push(Diagnostic::error(
-                inst.loc.clone(),
-                format!("object \"{}\" is not defined", inst.name),
-            ));
+    if placed < object_of.len() {
+        fixed.retain_indices(|i| index[object_of[i] as usize] != u32::MAX);
+        object_of.retain(|&k| index[k as usize] != u32::MAX);
+    }
+    for k in &mut object_of {
+        *k = index[*k as usize];
+    }
+    object_of.shrink_to_fit();
+    fixed.shrink_to_fit();
+    prims.push(Primitive::Instances(Box::new(InstanceSet::from_parts(
+        set_objects,
+        object_of,
+        fixed,
+    ))));
+}
+
+/// [`place_instances`] where some instances move: each run of fixed ones
+/// is a set, each moving one a primitive of its own, in order.
+fn place_runs(
+    list: &InstanceList,
+    objects: &[Option<&Arc<PrimitiveAggregate>>],
+    prims: &mut Vec<Primitive>,
+) {
+    let mut runs = InstanceRuns::default();
+    let mut moving = list.animated.iter().peekable();
+    for (i, &k) in list.name_of.iter().enumerate() {
+        let animated = moving.next_if(|(j, _)| *j as usize == i).map(|(_, a)| &**a);
+        let Some(def) = objects[k as usize] else {
             continue;
         };
-        if def.primitives().is_empty() {
-            continue;
-        }
-        // The instance's primitive and its accelerator entry.
-        if let Err(e) = desc.budget.charge(INSTANCE_BYTES, "this object instance") {
-            p.errors
-                .push(Diagnostic::error(inst.loc.clone(), e.to_string()));
-            end = k;
-            break;
-        }
-        placed += 1;
-    }
-    let mut runs = InstanceRuns::default();
-    // Room for every instance in the first run (typically the only one):
-    // growing by doubling would hold two copies of its transformations.
-    runs.set.reserve_exact(placed);
-    match taken {
-        None => {
-            for inst in &list[..end] {
-                runs.add(inst, definition.get(&inst.name), prims);
+        match animated {
+            Some(a) => {
+                runs.close(prims);
+                prims.push(Primitive::Animated(Box::new(AnimatedPrimitive {
+                    primitive: Moving::Many(def.clone()),
+                    render_from_primitive: a.clone(),
+                })));
             }
-        }
-        Some(mut list) => {
-            // From the last instance to the first; the order is put back
-            // below.
-            list.truncate(end);
-            let base = prims.len();
-            take_from_end(list, |inst| {
-                runs.add(&inst, definition.get(&inst.name), prims)
-            });
-            runs.close(prims);
-            for prim in &mut prims[base..] {
-                if let Primitive::Instances(set) = prim {
-                    set.reverse();
-                }
-            }
-            prims[base..].reverse();
+            None => runs.add(def, list.fixed.get(i)),
         }
     }
     runs.close(prims);
 }
 
 /// Consecutive instances under fixed transformations, gathered into one
-/// [`InstanceSet`] each run (an entry per instance in the aggregate, as
-/// separate primitives had, in the same order).
+/// [`InstanceSet`] each run (an entry per instance in the aggregate, in
+/// order).
 #[derive(Default)]
 struct InstanceRuns {
     set: InstanceSet,
@@ -452,36 +473,14 @@ struct InstanceRuns {
 }
 
 impl InstanceRuns {
-    /// Adds the instance `inst` of `def` (nothing for an undefined or
-    /// empty object): to the open run, or as a primitive of its own after
-    /// the run when it moves.
-    fn add(
-        &mut self,
-        inst: &InstanceSceneEntity,
-        def: Option<&Arc<PrimitiveAggregate>>,
-        prims: &mut Vec<Primitive>,
-    ) {
-        let Some(def) = def else { return };
-        if def.primitives().is_empty() {
-            return;
-        }
-        match &inst.render_from_instance {
-            InstanceTransform::Fixed(t) => {
-                let set = &mut self.set;
-                let k = *self
-                    .objects
-                    .entry(Arc::as_ptr(def) as usize)
-                    .or_insert_with(|| set.add_object(def.clone()));
-                set.push(k, *t);
-            }
-            InstanceTransform::Animated(a) => {
-                self.close(prims);
-                prims.push(Primitive::Animated(Box::new(AnimatedPrimitive {
-                    primitive: Moving::Many(def.clone()),
-                    render_from_primitive: (**a).clone(),
-                })));
-            }
-        }
+    /// Adds an instance of `def` placed by `t` to the open run.
+    fn add(&mut self, def: &Arc<PrimitiveAggregate>, t: Transform) {
+        let set = &mut self.set;
+        let k = *self
+            .objects
+            .entry(Arc::as_ptr(def) as usize)
+            .or_insert_with(|| set.add_object(def.clone()));
+        set.push(k, t);
     }
 
     /// Ends the open run, appending its set to `prims`.
@@ -491,7 +490,6 @@ impl InstanceRuns {
             set.shrink_to_fit();
             prims.push(Primitive::Instances(Box::new(set)));
         }
-        self.set = InstanceSet::new();
         self.objects.clear();
     }
 }

@@ -1457,20 +1457,8 @@ impl ParserTarget for SceneBuilder {
         } else {
             InstanceTransform::Fixed(self.render_from_object_at(0) * world_from_render)
         };
-        // The object's name, shared with its definition (a million
-        // instances of one object hold one copy of its name, not a million).
-        let (name, name_bytes) = match self.instance_names.get(name) {
-            Some(shared) => (shared.clone(), 0),
-            None => (Arc::from(name), heap(name.len())),
-        };
-        let bytes = vec_element::<InstanceSceneEntity>() + name_bytes;
-        self.charge(bytes, "ObjectInstance", &loc)?;
-        self.scene.instances.push(InstanceSceneEntity {
-            name,
-            loc,
-            render_from_instance,
-        });
-        Ok(())
+        let bytes = self.scene.instances.push(name, &loc, render_from_instance);
+        self.charge(bytes, "ObjectInstance", &loc)
     }
 
     fn end_of_files(&mut self) -> DirectiveResult {
@@ -1512,11 +1500,11 @@ impl ParserTarget for SceneBuilder {
                 }
             }
         }
-        for inst in &self.scene.instances {
-            if !self.instance_names.contains(&*inst.name) {
+        for (name, loc) in self.scene.instances.names() {
+            if !self.instance_names.contains(name) {
                 self.pending.push(Diagnostic::error(
-                    inst.loc.clone(),
-                    format!("\"{}\": object instance not defined", inst.name),
+                    loc.clone(),
+                    format!("\"{name}\": object instance not defined"),
                 ));
             }
         }

@@ -14,6 +14,7 @@ use std::sync::Arc;
 use rpbrt_geometry::{AnimatedTransform, Float, Transform};
 use rpbrt_parser::{Diagnostic, FileLoc, MemoryBudget, ParameterDictionary, ParsedParameter};
 
+use super::instances::InstanceList;
 use crate::camera::{CameraTransform, RenderingCoordinateSystem};
 
 /// The location given to entities that stand for a default (no directive).
@@ -211,17 +212,6 @@ pub enum InstanceTransform {
     Animated(Box<AnimatedTransform>),
 }
 
-/// An `ObjectInstance`.
-#[derive(Clone, Debug)]
-pub struct InstanceSceneEntity {
-    /// The instanced object's name (shared with its definition's).
-    pub name: Arc<str>,
-    /// Where the directive was.
-    pub loc: FileLoc,
-    /// From instance space (the definition's render space) to render space.
-    pub render_from_instance: InstanceTransform,
-}
-
 /// The value of an `Option` setting.
 #[derive(Clone, Debug, PartialEq)]
 pub enum OptionValue {
@@ -290,7 +280,7 @@ pub struct SceneDescription {
     /// Object definitions in order.
     pub instance_definitions: Vec<InstanceDefinitionSceneEntity>,
     /// Object instances in order.
-    pub instances: Vec<InstanceSceneEntity>,
+    pub instances: InstanceList,
     /// `Option` settings in order (a later one overrides an earlier one).
     pub options: Vec<SceneOption>,
     /// Warnings (and, for a failed build, errors) produced.
@@ -347,7 +337,7 @@ impl Default for SceneDescription {
             volume_regions: Vec::new(),
             regions_scatter: true,
             instance_definitions: Vec::new(),
-            instances: Vec::new(),
+            instances: InstanceList::new(),
             options: Vec::new(),
             diagnostics: Vec::new(),
             pbrt_v3: None,
@@ -455,10 +445,14 @@ impl SceneDescription {
             }
             d.line("objectend");
         }
-        for i in &self.instances {
-            match &i.render_from_instance {
-                InstanceTransform::Fixed(t) => d.transform(&format!("instance {:?}", i.name), t),
-                InstanceTransform::Animated(a) => d.animated(&format!("instance {:?}", i.name), a),
+        for i in 0..self.instances.len() {
+            match self.instances.get(i) {
+                (name, InstanceTransform::Fixed(t)) => {
+                    d.transform(&format!("instance {name:?}"), &t)
+                }
+                (name, InstanceTransform::Animated(a)) => {
+                    d.animated(&format!("instance {name:?}"), &a)
+                }
             }
         }
         for o in &self.options {

@@ -11,6 +11,7 @@ pub mod assemble;
 pub mod builder;
 pub mod entities;
 pub mod files;
+pub mod instances;
 mod materials;
 pub mod names;
 pub mod options;
@@ -28,6 +29,7 @@ use crate::camera::RenderingCoordinateSystem;
 
 pub use builder::SceneBuilder;
 pub use entities::*;
+pub use instances::InstanceList;
 pub use names::EntityKind;
 
 /// Settings for [`build_scene`]. The memory budget is the parser's
@@ -101,7 +103,7 @@ pub fn build_scene_from_str(
         SceneBuilder::new(options.render_coord_sys).with_budget(options.parse.budget.clone());
     let result = Parser::new(options.parse.clone()).parse_bytes(
         "<string>",
-        Arc::from(text.as_bytes()),
+        Arc::new(text.as_bytes().to_vec()),
         Path::new("."),
         &mut builder,
     );
@@ -119,7 +121,11 @@ pub fn build_scene_from_bytes(
 ) -> Result<(SceneDescription, Diagnostics), Diagnostics> {
     let mut builder =
         SceneBuilder::new(options.render_coord_sys).with_budget(options.parse.budget.clone());
-    let result =
-        Parser::new(options.parse.clone()).parse_bytes(name, Arc::from(bytes), dir, &mut builder);
+    let result = Parser::new(options.parse.clone()).parse_bytes(
+        name,
+        Arc::new(bytes.to_vec()),
+        dir,
+        &mut builder,
+    );
     finish(builder, result, options)
 }

@@ -2,6 +2,7 @@
 //! the RGB to spectrum tables (pbrt-v4 book sections 4.6.3 and 4.6.6;
 //! pbrt-v4 `util/colorspace.h`).
 
+use std::borrow::Cow;
 use std::sync::{Arc, OnceLock};
 
 use rpbrt_geometry::Float;
@@ -16,41 +17,58 @@ pub const RGB_TO_SPECTRUM_RES: usize = 64;
 /// Sigmoid-polynomial coefficients over a grid of RGB colours: indexed by
 /// the largest component, that component's value (on the nonuniform z
 /// nodes) and the other two divided by it (Jakob and Hanika 2019).
+///
+/// The coefficients are read where they lie: in the bytes embedded in the
+/// program for the built-in colour spaces (9.4 MB each, of which a scene
+/// touches the few pages its colours need), not decoded into a copy.
 #[derive(Clone, Debug)]
 pub struct RgbToSpectrumTable {
     z_nodes: Vec<f32>,
-    /// `[largest component][z][y][x][3]`.
-    coeffs: Vec<f32>,
+    /// `[largest component][z][y][x][3]`, little-endian `f32`s.
+    coeffs: Cow<'static, [u8]>,
 }
 
 impl RgbToSpectrumTable {
     /// A table from z nodes and `[3][res][res][res][3]` coefficients.
     pub fn new(z_nodes: Vec<f32>, coeffs: Vec<f32>) -> Result<Self, String> {
+        let bytes = coeffs.iter().flat_map(|c| c.to_le_bytes()).collect();
+        Self::with_coefficient_bytes(z_nodes, Cow::Owned(bytes))
+    }
+
+    fn with_coefficient_bytes(
+        z_nodes: Vec<f32>,
+        coeffs: Cow<'static, [u8]>,
+    ) -> Result<Self, String> {
         let res = z_nodes.len();
-        if res < 2 || coeffs.len() != 9 * res * res * res {
+        if res < 2 || coeffs.len() != 4 * 9 * res * res * res {
             return Err(format!(
                 "RGB to spectrum table: {} z nodes and {} coefficients do not match",
                 res,
-                coeffs.len()
+                coeffs.len() / 4
             ));
         }
         Ok(RgbToSpectrumTable { z_nodes, coeffs })
     }
 
-    /// Decodes a table written by `build.rs`: `res` z nodes, then the
-    /// coefficients, all little-endian `f32`.
-    pub fn from_le_bytes(bytes: &[u8], res: usize) -> Result<Self, String> {
-        let floats: Vec<f32> = bytes
+    /// A table written by `build.rs`: `res` z nodes, then the
+    /// coefficients, all little-endian `f32`s; the coefficients are read
+    /// from `bytes` in place.
+    pub fn from_le_bytes(bytes: &'static [u8], res: usize) -> Result<Self, String> {
+        let Some((z, coeffs)) = bytes.split_at_checked(4 * res) else {
+            return Err("RGB to spectrum table is truncated".into());
+        };
+        let z_nodes = z
             .chunks_exact(4)
             .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
             .collect();
-        if floats.len() < res {
-            return Err("RGB to spectrum table is truncated".into());
-        }
-        let coeffs = floats[res..].to_vec();
-        let mut z = floats;
-        z.truncate(res);
-        Self::new(z, coeffs)
+        Self::with_coefficient_bytes(z_nodes, Cow::Borrowed(coeffs))
+    }
+
+    /// Coefficient `i`.
+    #[inline(always)]
+    fn coeff(&self, i: usize) -> f32 {
+        let b = &self.coeffs[4 * i..4 * i + 4];
+        f32::from_le_bytes([b[0], b[1], b[2], b[3]])
     }
 
     /// The table's resolution along each axis.
@@ -103,7 +121,7 @@ impl RgbToSpectrumTable {
         for (i, ci) in c.iter_mut().enumerate() {
             let co = |ox: usize, oy: usize, oz: usize| {
                 let idx = (((maxc * res + zi + oz) * res + yi + oy) * res + xi + ox) * 3 + i;
-                self.coeffs[idx]
+                self.coeff(idx)
             };
             *ci = lerp(
                 dz,

@@ -369,7 +369,7 @@ fn object_instances() {
     ));
     assert_eq!(s.shapes.len(), 1);
     assert!(s.shapes[0].render_from_object.is_identity());
-    match s.instances[0].render_from_instance {
+    match s.instances.get(0).1 {
         InstanceTransform::Fixed(t) => assert!(close(t.apply_point(origin()), 0.0, 5.0, 0.0)),
         InstanceTransform::Animated(_) => panic!("not animated"),
     }
