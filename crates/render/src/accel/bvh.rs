@@ -637,16 +637,41 @@ fn build_hlbvh(prims: &mut Vec<PrimRef>, max_prims: usize, threads: usize) -> Ve
 }
 
 /// The build references of the `n` primitives whose bounds `bounds` gives,
-/// leaving out those with unusable bounds.
-pub(super) fn prim_refs<F: Fn(u32) -> Bounds3f>(n: usize, bounds: F) -> Vec<PrimRef> {
-    let mut prims = Vec::with_capacity(n);
-    prims.extend((0..n as u32).filter_map(|i| {
-        let b = bounds(i);
-        usable_bounds(&b).then_some(PrimRef {
-            bounds: b,
-            index: i,
-        })
-    }));
+/// leaving out those with unusable bounds, in order. The bounds are found
+/// on up to `threads` threads, each filling its own range of the result
+/// (no second copy of the references is made).
+pub(super) fn prim_refs<F>(n: usize, bounds: F, threads: usize) -> Vec<PrimRef>
+where
+    F: Fn(u32) -> Bounds3f + Sync,
+{
+    let mut prims = vec![
+        PrimRef {
+            bounds: Bounds3f::empty(),
+            index: 0,
+        };
+        n
+    ];
+    let fill = |part: &mut [PrimRef], first: usize| {
+        for (k, p) in part.iter_mut().enumerate() {
+            let i = (first + k) as u32;
+            *p = PrimRef {
+                bounds: bounds(i),
+                index: i,
+            };
+        }
+    };
+    if threads > 1 && n >= PAR_MIN_PRIMS {
+        let chunk = n.div_ceil(threads);
+        std::thread::scope(|s| {
+            for (c, part) in prims.chunks_mut(chunk).enumerate() {
+                let fill = &fill;
+                s.spawn(move || fill(part, c * chunk));
+            }
+        });
+    } else {
+        fill(&mut prims, 0);
+    }
+    prims.retain(|p| usable_bounds(&p.bounds));
     prims
 }
 
@@ -687,7 +712,7 @@ impl Bvh {
     where
         F: Fn(u32) -> Bounds3f + Sync,
     {
-        let mut prims = prim_refs(n, bounds);
+        let mut prims = prim_refs(n, bounds, threads);
         let mut bvh = Bvh {
             n_input: n,
             n_skipped: n - prims.len(),

@@ -62,7 +62,7 @@ pub(super) fn build<const W: usize, F>(
 where
     F: Fn(u32) -> Bounds3f + Sync,
 {
-    let mut prims = prim_refs(n, bounds);
+    let mut prims = prim_refs(n, bounds, threads);
     let n_skipped = n - prims.len();
     if prims.is_empty() {
         return WideBvh::from_parts(Vec::new(), Vec::new(), Bounds3f::empty(), n, n_skipped);
