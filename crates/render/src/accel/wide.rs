@@ -401,9 +401,22 @@ impl Builder {
         let mut nodes = Vec::with_capacity(node_capacity(idx_len));
         nodes.push(root);
         if !par {
-            for (lane, k, refs, idx) in parts {
-                let sub = build(k, refs, idx);
-                nodes[0].child[lane] = append_relocated(&mut nodes, &sub);
+            // Each subtree straight into the tree, its references freed
+            // as soon as it is built.
+            let mut buckets = Vec::new();
+            for (lane, k, mut refs, idx) in parts {
+                let c = self.build_wide(
+                    &mut refs,
+                    idx,
+                    k.start as u32,
+                    &k,
+                    &mut nodes,
+                    &mut buckets,
+                    1,
+                );
+                if let Some(c) = c {
+                    nodes[0].child[lane] = c;
+                }
             }
             return nodes;
         }

@@ -64,10 +64,10 @@ impl RgbToSpectrumTable {
         Self::with_coefficient_bytes(z_nodes, Cow::Borrowed(coeffs))
     }
 
-    /// Coefficient `i`.
+    /// Coefficient `i` of `coeffs` (the table's bytes).
     #[inline(always)]
-    fn coeff(&self, i: usize) -> f32 {
-        let b = &self.coeffs[4 * i..4 * i + 4];
+    fn coeff(coeffs: &[u8], i: usize) -> f32 {
+        let b = &coeffs[4 * i..4 * i + 4];
         f32::from_le_bytes([b[0], b[1], b[2], b[3]])
     }
 
@@ -117,11 +117,12 @@ impl RgbToSpectrumTable {
         let dy = y - yi as Float;
         let dz = (z - self.z_nodes[zi]) / (self.z_nodes[zi + 1] - self.z_nodes[zi]);
         let lerp = |t: Float, a: Float, b: Float| (1.0 - t) * a + t * b;
+        let coeffs: &[u8] = &self.coeffs;
         let mut c = [0.0; 3];
         for (i, ci) in c.iter_mut().enumerate() {
             let co = |ox: usize, oy: usize, oz: usize| {
                 let idx = (((maxc * res + zi + oz) * res + yi + oy) * res + xi + ox) * 3 + i;
-                self.coeff(idx)
+                Self::coeff(coeffs, idx)
             };
             *ci = lerp(
                 dz,
