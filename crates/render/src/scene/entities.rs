@@ -3,7 +3,8 @@
 //! (pbrt-v4 `scene.h`: `SceneEntity`, `TransformedSceneEntity`,
 //! `CameraSceneEntity`, `ShapeSceneEntity`, `AnimatedShapeSceneEntity`,
 //! `LightSceneEntity`, `InstanceDefinitionSceneEntity`,
-//! `InstanceSceneEntity`).
+//! `InstanceSceneEntity`, whose list rpbrt keeps compactly: see
+//! [`InstanceList`](super::instances::InstanceList)).
 //!
 //! Nothing here is a render object yet: parameters are kept as written (after
 //! the pbrt-v3 upgrade) and are read when the renderer creates the objects.
