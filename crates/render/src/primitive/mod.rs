@@ -210,6 +210,23 @@ impl MeshPrimitive {
     }
 }
 
+/// The closest of the hits `hit` finds on each of `entries`, each asked
+/// within (0, the closest so far).
+fn closest_of(
+    entries: impl Iterator<Item = u32>,
+    mut t_max: Float,
+    mut hit: impl FnMut(u32, Float) -> Option<PrimitiveIntersection>,
+) -> Option<PrimitiveIntersection> {
+    let mut closest = None;
+    for i in entries {
+        if let Some(pi) = hit(i, t_max) {
+            t_max = pi.t_hit;
+            closest = Some(pi);
+        }
+    }
+    closest
+}
+
 /// Object instances: shared aggregates (object definitions), each placed
 /// by a fixed transformation. An aggregate gives each instance an entry
 /// of its own, as it gives a mesh's triangles, so a run of instances is
@@ -479,31 +496,13 @@ impl Primitive {
     pub fn intersect(&self, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
         match self {
             Primitive::Geometric(p) => p.intersect(ray, t_max),
-            Primitive::Mesh(p) => {
-                // (Aggregates test a mesh's triangles one by one; this is
-                // for a mesh met on its own.)
-                let mut closest = None;
-                let mut t_max = t_max;
-                for i in p.valid_triangles() {
-                    if let Some(pi) = p.intersect_triangle(i, ray, t_max) {
-                        t_max = pi.t_hit;
-                        closest = Some(pi);
-                    }
-                }
-                closest
-            }
+            // (Aggregates test a mesh's triangles, and a set's instances,
+            // as entries of their own; these are for one met on its own.)
+            Primitive::Mesh(p) => closest_of(p.valid_triangles(), t_max, |i, t| {
+                p.intersect_triangle(i, ray, t)
+            }),
             Primitive::Instances(set) => {
-                // (Aggregates test each instance as an entry; this is for
-                // a set met on its own.)
-                let mut closest = None;
-                let mut t_max = t_max;
-                for i in set.indices() {
-                    if let Some(pi) = set.intersect_one(i, ray, t_max) {
-                        t_max = pi.t_hit;
-                        closest = Some(pi);
-                    }
-                }
-                closest
+                closest_of(set.indices(), t_max, |i, t| set.intersect_one(i, ray, t))
             }
             Primitive::Animated(p) => {
                 let xf = p.render_from_primitive.interpolate(ray.time);
