@@ -24,6 +24,18 @@ impl Default for SquareMatrix4 {
 }
 
 impl SquareMatrix4 {
+    /// Applies this matrix as a transformation to a ray, as
+    /// [`Transform::apply_ray`] does (which reads only the forward matrix):
+    /// for a transformation known by one matrix alone.
+    #[inline]
+    pub fn apply_ray(&self, r: &Ray, t_max: Float) -> (Ray, Float) {
+        Transform {
+            m: *self,
+            m_inv: *self,
+        }
+        .apply_ray(r, t_max)
+    }
+
     /// The identity matrix.
     #[inline]
     pub const fn identity() -> Self {

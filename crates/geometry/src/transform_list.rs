@@ -1,26 +1,35 @@
-//! A list of transformations stored compactly: affine ones without their
-//! matrices' last rows.
+//! A list of transformations stored compactly: affine ones by their
+//! inverse matrices alone, without the last rows.
 //!
 //! Scenes of many placed copies (a million object instances) hold one
-//! transformation and its inverse per copy; nearly all are affine, whose
-//! matrices end in the row (0, 0, 0, 1). Kept without it, a pair takes 96
-//! bytes instead of 128, and gives back, bit for bit, the transformation
-//! it was made from.
+//! transformation per copy; nearly all are affine, whose matrices end in
+//! the row (0, 0, 0, 1). What a copy needs most often is the inverse (each
+//! ray that meets the copy's bounds is taken into its space); the forward
+//! matrix only maps the copy's bounds, once, and the hits found on it. So
+//! an affine transformation is kept as its inverse's first three rows (48
+//! bytes instead of a pair's 128), read back bit for bit, and the forward
+//! matrix is recomputed from it where asked for (in double precision,
+//! rounded once: within an ulp or two of the matrix it was made from,
+//! which pbrt's composed pairs are of each other's inverse too).
 
 use crate::float::Float;
 use crate::transform::{SquareMatrix4, Transform};
 
-/// Transformations in order, each read back bit for bit as pushed. While
-/// every one pushed is affine (both matrices' last rows are (0, 0, 0, 1)
-/// to the bit, `+0`s), they are kept without those rows, 96 bytes each;
-/// the first that is not turns the list into whole transformations.
+/// Transformations in order. An affine one (both matrices' last rows
+/// (0, 0, 0, 1) to the bit, `+0`s, with a finite, invertible inverse)
+/// reads back with its inverse bit for bit and its forward matrix
+/// recomputed from it; any other, bit for bit. While every one pushed is
+/// affine, each is kept as its inverse without the last row, 48 bytes;
+/// the first that is not turns the list into whole transformations (128
+/// bytes each). What a transformation reads back as depends on it alone,
+/// not on the others in the list.
 #[derive(Clone, Debug)]
 pub struct TransformList(Stored);
 
 #[derive(Clone, Debug)]
 enum Stored {
-    /// All affine: without the matrices' last rows.
-    Affine(Vec<AffinePair>),
+    /// All affine: their inverses without the last rows.
+    Affine(Vec<AffineInverse>),
     /// Some not affine: whole.
     Full(Vec<Transform>),
 }
@@ -31,35 +40,81 @@ impl Default for TransformList {
     }
 }
 
-/// An affine transformation and its inverse without their last rows.
+/// The inverse of an affine transformation without its last row.
 #[derive(Clone, Copy, Debug)]
-struct AffinePair {
-    m: [[Float; 4]; 3],
+struct AffineInverse {
     m_inv: [[Float; 4]; 3],
 }
 
-impl AffinePair {
+impl AffineInverse {
     const LAST_ROW: [Float; 4] = [0.0, 0.0, 0.0, 1.0];
 
-    /// `t` without its last rows, when they are (0, 0, 0, 1) to the bit.
-    fn of(t: &Transform) -> Option<AffinePair> {
+    /// `t`'s inverse without its last row, when both of `t`'s matrices end
+    /// in (0, 0, 0, 1) to the bit and the inverse can be inverted back.
+    fn of(t: &Transform) -> Option<AffineInverse> {
         let (m, mi) = (&t.matrix().m, &t.inverse_matrix().m);
         let last = |row: &[Float; 4]| {
             row.iter()
-                .zip(AffinePair::LAST_ROW)
+                .zip(AffineInverse::LAST_ROW)
                 .all(|(a, b)| a.to_bits() == b.to_bits())
         };
-        (last(&m[3]) && last(&mi[3])).then(|| AffinePair {
-            m: [m[0], m[1], m[2]],
+        let a = AffineInverse {
             m_inv: [mi[0], mi[1], mi[2]],
-        })
+        };
+        (last(&m[3]) && last(&mi[3]) && a.forward().is_some()).then_some(a)
+    }
+
+    /// The inverse matrix, whole.
+    #[inline]
+    fn matrix(&self) -> SquareMatrix4 {
+        let r = &self.m_inv;
+        SquareMatrix4::new([r[0], r[1], r[2], AffineInverse::LAST_ROW])
+    }
+
+    /// The forward matrix: the inverse of the stored one, computed in
+    /// double precision (the 3×3 part by its adjugate, then the
+    /// translation) and rounded once; `None` when it is singular or the
+    /// result not finite.
+    fn forward(&self) -> Option<SquareMatrix4> {
+        let a = self.m_inv.map(|row| row.map(f64::from));
+        let cof = |r0: usize, r1: usize, c0: usize, c1: usize| {
+            a[r0][c0] * a[r1][c1] - a[r0][c1] * a[r1][c0]
+        };
+        // Adjugate (transposed cofactors) of the 3×3 part.
+        let adj = [
+            [cof(1, 2, 1, 2), -cof(0, 2, 1, 2), cof(0, 1, 1, 2)],
+            [-cof(1, 2, 0, 2), cof(0, 2, 0, 2), -cof(0, 1, 0, 2)],
+            [cof(1, 2, 0, 1), -cof(0, 2, 0, 1), cof(0, 1, 0, 1)],
+        ];
+        let det = a[0][0] * adj[0][0] + a[0][1] * adj[1][0] + a[0][2] * adj[2][0];
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let mut m = [[0.0 as Float; 4]; 4];
+        for i in 0..3 {
+            // `+ 0.0` makes zeros positive (a cofactor's negation gives
+            // `-0.0`), as composed matrices have them.
+            let inv = adj[i].map(|v| v / det + 0.0);
+            let t = 0.0 - (inv[0] * a[0][3] + inv[1] * a[1][3] + inv[2] * a[2][3]);
+            m[i] = [
+                inv[0] as Float,
+                inv[1] as Float,
+                inv[2] as Float,
+                t as Float,
+            ];
+        }
+        m[3] = AffineInverse::LAST_ROW;
+        m.iter()
+            .flatten()
+            .all(|v| v.is_finite())
+            .then_some(SquareMatrix4::new(m))
     }
 
     #[inline]
     fn transform(&self) -> Transform {
-        let full =
-            |r: &[[Float; 4]; 3]| SquareMatrix4::new([r[0], r[1], r[2], AffinePair::LAST_ROW]);
-        Transform::from_matrices(full(&self.m), full(&self.m_inv))
+        // `of` checked that the forward matrix exists.
+        let m = self.forward().unwrap_or_default();
+        Transform::from_matrices(m, self.matrix())
     }
 }
 
@@ -82,16 +137,18 @@ impl TransformList {
         self.len() == 0
     }
 
-    /// Bytes each transformation takes now (96 while all are affine, 128
+    /// Bytes each transformation takes now (48 while all are affine, 128
     /// after).
     pub fn bytes_each(&self) -> usize {
         match &self.0 {
-            Stored::Affine(_) => std::mem::size_of::<AffinePair>(),
+            Stored::Affine(_) => std::mem::size_of::<AffineInverse>(),
             Stored::Full(_) => std::mem::size_of::<Transform>(),
         }
     }
 
-    /// Transformation `i`, bit for bit as pushed. Panics past the end.
+    /// Transformation `i`: its inverse matrix bit for bit as pushed, its
+    /// forward one too once the list is whole, else recomputed from the
+    /// inverse (see the module's documentation). Panics past the end.
     #[inline]
     pub fn get(&self, i: usize) -> Transform {
         match &self.0 {
@@ -100,22 +157,35 @@ impl TransformList {
         }
     }
 
+    /// The inverse of transformation `i`'s matrix, bit for bit as pushed
+    /// (what takes rays into the space it places). Panics past the end.
+    #[inline]
+    pub fn inverse_matrix(&self, i: usize) -> SquareMatrix4 {
+        match &self.0 {
+            Stored::Affine(v) => v[i].matrix(),
+            Stored::Full(v) => *v[i].inverse_matrix(),
+        }
+    }
+
     /// Appends `t`.
     pub fn push(&mut self, t: Transform) {
+        let affine = AffineInverse::of(&t);
         if let Stored::Affine(v) = &mut self.0 {
-            match AffinePair::of(&t) {
+            match affine {
                 Some(a) => return v.push(a),
                 None => {
                     // The first that is not affine: every one whole from
                     // here on.
                     let mut full = Vec::with_capacity(v.capacity());
-                    full.extend(v.iter().map(AffinePair::transform));
+                    full.extend(v.iter().map(AffineInverse::transform));
                     self.0 = Stored::Full(full);
                 }
             }
         }
         if let Stored::Full(v) = &mut self.0 {
-            v.push(t);
+            // An affine one reads back as in an affine list (its forward
+            // matrix recomputed), whatever came before it.
+            v.push(affine.map_or(t, |a| a.transform()));
         }
     }
 
@@ -166,8 +236,17 @@ mod tests {
         a.same_bits(b)
     }
 
+    /// Every entry of `a` within `rel` of `b`'s, relative to the largest
+    /// entry of `b`'s row.
+    fn close(a: &SquareMatrix4, b: &SquareMatrix4, rel: Float) -> bool {
+        a.m.iter().zip(&b.m).all(|(ra, rb)| {
+            let scale = rb.iter().fold(0.0 as Float, |s, v| s.max(v.abs()));
+            ra.iter().zip(rb).all(|(x, y)| (x - y).abs() <= rel * scale)
+        })
+    }
+
     #[test]
-    fn affine_transformations_come_back_bit_for_bit_in_96_bytes() {
+    fn affine_transformations_keep_their_inverses_bit_for_bit_in_48_bytes() {
         let mut list = TransformList::new();
         let ts: Vec<Transform> = (0..50)
             .map(|k| {
@@ -180,10 +259,36 @@ mod tests {
         for t in &ts {
             list.push(*t);
         }
-        assert_eq!(list.bytes_each(), 96);
+        assert_eq!(list.bytes_each(), 48);
         assert_eq!(list.len(), ts.len());
         for (i, t) in ts.iter().enumerate() {
-            assert!(same(&list.get(i), t), "{i}");
+            let got = list.get(i);
+            assert_eq!(list.inverse_matrix(i), *t.inverse_matrix(), "{i}");
+            assert_eq!(got.inverse_matrix(), t.inverse_matrix(), "{i}");
+            // The forward matrix recomputed: within a few ulps of the one
+            // composed beside the inverse.
+            assert!(close(got.matrix(), t.matrix(), 4e-6), "{i}: {got:?} {t:?}");
+        }
+        // Translations and scales by powers of two invert exactly.
+        let exact =
+            Transform::translate(Vector3f::new(3.5, -2.0, 0.25)) * Transform::scale(2.0, 0.5, -4.0);
+        list.push(exact);
+        assert!(same(&list.get(ts.len()), &exact));
+    }
+
+    #[test]
+    fn a_singular_or_infinite_inverse_keeps_the_list_whole() {
+        for t in [
+            Transform::scale(0.0, 1.0, 1.0),
+            Transform::scale(1e-39, 1.0, 1.0),
+        ] {
+            let mut list = TransformList::new();
+            let a = Transform::translate(Vector3f::new(1.0, 2.0, 3.0));
+            list.push(a);
+            list.push(t);
+            assert_eq!(list.bytes_each(), 128, "{t:?}");
+            assert!(same(&list.get(0), &a));
+            assert!(same(&list.get(1), &t));
         }
     }
 
@@ -204,6 +309,15 @@ mod tests {
         for (i, t) in [a, p, negative_zero, a].iter().enumerate() {
             assert!(same(&list.get(i), t), "{i}");
         }
+        // An affine transformation whose forward matrix is recomputed
+        // reads back the same in an affine list and in a whole one.
+        let r = Transform::rotate(33.0, Vector3f::new(0.3, 1.0, -0.2));
+        let mut affine = TransformList::new();
+        affine.push(r);
+        list.push(r);
+        assert_eq!(affine.bytes_each(), 48);
+        assert!(same(&affine.get(0), &list.get(4)));
+        assert_eq!(list.get(4).inverse_matrix(), r.inverse_matrix());
     }
 
     #[test]

@@ -231,7 +231,8 @@ fn closest_of(
 /// by a fixed transformation. An aggregate gives each instance an entry
 /// of its own, as it gives a mesh's triangles, so a run of instances is
 /// one primitive: per instance a transformation and the index of its
-/// object in flat arrays (100 bytes for an affine transformation), where
+/// object in flat arrays (52 bytes for an affine transformation, kept as
+/// its inverse: see [`TransformList`]), where
 /// a primitive of its own took a 72-byte enum and a boxed 136-byte
 /// transformation and object.
 #[derive(Clone, Debug, Default)]
@@ -327,18 +328,27 @@ impl InstanceSet {
         xf.apply_bounds(&object.bounds())
     }
 
+    /// Instance `i`'s object and `ray` (with `t_max`) taken into its
+    /// space, by the inverse transformation alone (the forward one of an
+    /// affine instance is recomputed, so only a hit asks for it).
+    #[inline]
+    fn ray_into(&self, i: u32, ray: &Ray, t_max: Float) -> (&PrimitiveAggregate, Ray, Float) {
+        let object = &self.objects[self.object_of[i as usize] as usize];
+        let object_from_render = self.render_from_object.inverse_matrix(i as usize);
+        let (r, t) = object_from_render.apply_ray(ray, t_max);
+        (object, r, t)
+    }
+
     /// The closest hit on instance `i` in (0, t_max).
     fn intersect_one(&self, i: u32, ray: &Ray, t_max: Float) -> Option<PrimitiveIntersection> {
-        let (object, xf) = self.get(i);
-        let (r, t) = xf.apply_inverse_ray(ray, t_max);
+        let (object, r, t) = self.ray_into(i, ray, t_max);
         let pi = object.intersect(&r, t)?;
-        Some(transform_hit(pi, &xf))
+        Some(transform_hit(pi, &self.render_from_object.get(i as usize)))
     }
 
     /// Whether instance `i` blocks the ray in (0, t_max).
     fn intersect_p_one(&self, i: u32, ray: &Ray, t_max: Float) -> bool {
-        let (object, xf) = self.get(i);
-        let (r, t) = xf.apply_inverse_ray(ray, t_max);
+        let (object, r, t) = self.ray_into(i, ray, t_max);
         object.intersect_p(&r, t)
     }
 

@@ -144,9 +144,16 @@ fn instance_set_matches_separate_instances() {
         for &(k, xf) in &placed {
             set.push(ids[k], xf);
         }
-        assert_eq!(set.render_from_object.bytes_each() == 96, kind == "affine");
+        assert_eq!(set.render_from_object.bytes_each() == 48, kind == "affine");
         for (i, &(_, xf)) in placed.iter().enumerate() {
-            assert!(set.render_from_object.get(i).same_bits(&xf), "{kind} {i}");
+            // Affine instances keep their inverses bit for bit (the
+            // forward matrices recomputed); the projective one both.
+            let got = set.render_from_object.get(i);
+            assert_eq!(got.inverse_matrix(), xf.inverse_matrix(), "{kind} {i}");
+            assert!(
+                kind == "affine" || i != 17 || got.same_bits(&xf),
+                "{kind} {i}"
+            );
         }
         let mut backwards = InstanceSet::new();
         let ids = objects.clone().map(|o| backwards.add_object(o));

@@ -1,6 +1,6 @@
 //! The description's object instances (`ObjectInstance`), kept compactly:
 //! a scene may hold millions. Per instance, the index of its object's name
-//! and its transformation in a [`TransformList`] (96 bytes when affine),
+//! and its transformation in a [`TransformList`] (48 bytes when affine: its inverse alone),
 //! which the created scene's instance set takes over as they are.
 
 use std::collections::HashMap;
