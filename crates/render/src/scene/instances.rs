@@ -1,7 +1,8 @@
 //! The description's object instances (`ObjectInstance`), kept compactly:
 //! a scene may hold millions. Per instance, the index of its object's name
-//! and its transformation in a [`TransformList`] (48 bytes when affine: its inverse alone),
-//! which the created scene's instance set takes over as they are.
+//! and its transformation in a [`TransformList`] (48 bytes when affine:
+//! its inverse alone), which the created scene's instance set takes over
+//! as they are.
 
 use std::collections::HashMap;
 use std::sync::Arc;
