@@ -112,6 +112,16 @@ struct GeneralKeys {
     has_rotation: bool,
 }
 
+/// `r`, the union of the boxes of `b` at the ends of a straight motion,
+/// padded for the rounding of the interpolation in between.
+fn padded(r: Bounds3f, b: &Bounds3f) -> Bounds3f {
+    let magnitude = [r.p_min, r.p_max]
+        .iter()
+        .flat_map(|p| [p.x.abs(), p.y.abs(), p.z.abs()])
+        .fold(0.0, Float::max);
+    r.expand(1e-6 * ((b.p_max - b.p_min).length() + magnitude))
+}
+
 /// The offset of `t` when `t` is, to the bit, the translation by it.
 fn translation_offset(t: &Transform) -> Option<Vector3f> {
     let m = t.matrix();
@@ -201,6 +211,25 @@ impl AnimatedTransform {
         self.at_fraction(dt)
     }
 
+    /// The offset of the transformation at `time` when both keyframes are
+    /// translations (then [`AnimatedTransform::interpolate`] gives, bit
+    /// for bit, the translation by this offset); `None` for any other
+    /// keyframes.
+    #[inline]
+    pub fn translation_at(&self, time: Float) -> Option<Vector3f> {
+        let Keys::Translations([a, b]) = &self.keys else {
+            return None;
+        };
+        Some(if a == b || time <= self.start_time {
+            *a
+        } else if time >= self.end_time {
+            *b
+        } else {
+            let dt = (time - self.start_time) / (self.end_time - self.start_time);
+            Vector3f::lerp(dt, *a, *b)
+        })
+    }
+
     /// The decompositions' interpolation at `dt` of the keyframe interval
     /// (0 at its start, 1 at its end).
     fn at_fraction(&self, dt: Float) -> Transform {
@@ -274,6 +303,27 @@ impl AnimatedTransform {
         if !self.is_animated() {
             return self.start_transform().apply_bounds(b);
         }
+        if let Keys::Translations([a, c]) = &self.keys {
+            // What the union below gives for translations, by the offsets
+            // alone: a translated corner is the corner plus the offset
+            // (the matrix's other products are by 1 and 0, exact), and
+            // rounding keeps the corners' order, so the box's corners move
+            // to the box's corners. The ends of the interpolation are
+            // `lerp`'s own, which at 1 need not be the end offset's bits.
+            let offsets = [
+                *a,
+                *c,
+                Vector3f::lerp(0.0, *a, *c),
+                Vector3f::lerp(1.0, *a, *c),
+            ];
+            let r = offsets.iter().fold(Bounds3f::empty(), |r, o| {
+                r.union(&Bounds3f {
+                    p_min: b.p_min + *o,
+                    p_max: b.p_max + *o,
+                })
+            });
+            return padded(r, b);
+        }
         let rotating = match &self.keys {
             Keys::General(g) if g.d0.r != g.d1.r => Some(g),
             _ => None,
@@ -289,11 +339,7 @@ impl AnimatedTransform {
                 .union(&self.end_transform().apply_bounds(b))
                 .union(&self.at_fraction(0.0).apply_bounds(b))
                 .union(&self.at_fraction(1.0).apply_bounds(b));
-            let magnitude = [r.p_min, r.p_max]
-                .iter()
-                .flat_map(|p| [p.x.abs(), p.y.abs(), p.z.abs()])
-                .fold(0.0, Float::max);
-            return r.expand(1e-6 * ((b.p_max - b.p_min).length() + magnitude));
+            return padded(r, b);
         };
         let delta = (self.end_time - self.start_time).max(Float::MIN_POSITIVE);
         let theta = g.d0.r.angle_between(g.d1.r) * 2.0;
@@ -379,6 +425,71 @@ mod tests {
         let s = 0.5f32.sqrt();
         assert!((p - Point3f::new(1.0 + s, s, 0.0)).length() < 1e-4, "{p:?}");
         assert!(!AnimatedTransform::fixed(a).is_animated());
+    }
+
+    /// `translation_at` is the offset of `interpolate`'s translation at
+    /// every time, inside the keyframes' interval and out, and `None` for
+    /// other keyframes.
+    #[test]
+    fn translation_at_is_the_interpolated_offset() {
+        let a = Transform::translate(Vector3f::new(0.3, -17.25, 4.0e3));
+        let b = Transform::translate(Vector3f::new(-0.1, -17.5, 4.1e3));
+        for (at, start, end) in [
+            (AnimatedTransform::new(a, 0.25, b, 0.75), 0.25, 0.75),
+            (AnimatedTransform::new(a, 0.0, a, 1.0), 0.0, 1.0),
+        ] {
+            for k in -4..=36 {
+                let time = start + (end - start) * (k as Float / 32.0);
+                let off = at.translation_at(time).expect("translation keys");
+                let m = *at.interpolate(time).matrix();
+                for (i, o) in [off.x, off.y, off.z].into_iter().enumerate() {
+                    assert_eq!(o.to_bits(), m.m[i][3].to_bits(), "time {time}");
+                }
+                for i in 0..3 {
+                    for j in 0..3 {
+                        assert_eq!(m.m[i][j], if i == j { 1.0 } else { 0.0 });
+                    }
+                }
+            }
+        }
+        let rotated = Transform::rotate(30.0, Vector3f::new(0.0, 0.0, 1.0));
+        assert!(AnimatedTransform::new(a, 0.0, rotated, 1.0)
+            .translation_at(0.5)
+            .is_none());
+    }
+
+    /// The translations' motion bounds, from the offsets alone, are what
+    /// the keyframes' and the interpolation ends' transformed boxes give
+    /// (fixed-seed boxes and offsets over many magnitudes).
+    #[test]
+    fn translations_motion_bounds_as_transformed_boxes() {
+        let mut state = 0x3c6e_f372_fe94_f82bu64;
+        let mut next = || {
+            let r = crate::float::xorshift64(&mut state);
+            let m = (r >> 40) as Float / (1u64 << 24) as Float - 0.5;
+            m * (2.0 as Float).powi((r % 30) as i32 - 12)
+        };
+        for _ in 0..3000 {
+            let mut v = || Vector3f::new(next(), next(), next());
+            let (a, c) = (v(), v());
+            let (p, q) = (Point3f::from(v()), Point3f::from(v()));
+            let b = Bounds3f::new(p, q);
+            let at =
+                AnimatedTransform::new(Transform::translate(a), 0.0, Transform::translate(c), 1.0);
+            assert!(matches!(at.keys, Keys::Translations(_)));
+            let r = at
+                .start_transform()
+                .apply_bounds(&b)
+                .union(&at.end_transform().apply_bounds(&b))
+                .union(&at.at_fraction(0.0).apply_bounds(&b))
+                .union(&at.at_fraction(1.0).apply_bounds(&b));
+            let want = padded(r, &b);
+            let got = at.motion_bounds(&b);
+            assert!(
+                got.p_min == want.p_min && got.p_max == want.p_max,
+                "{got:?} against {want:?}"
+            );
+        }
     }
 
     /// Translation keyframes interpolate without the composition, with the

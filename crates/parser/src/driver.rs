@@ -784,7 +784,15 @@ impl<'a> Run<'a> {
                 ));
             }
             let mut p = ParsedParameter::new(ty, name, loc.clone());
-            let first = self.next_required(&format!("a value for \"{decl}\""), &loc)?;
+            // (Not `next_required`: its message would be formatted for
+            // every parameter.)
+            let Some(first) = self.next()? else {
+                self.report(Diagnostic::error(
+                    loc.clone(),
+                    format!("premature end of file: expected a value for \"{decl}\""),
+                ));
+                return Err(Abort);
+            };
             match first.kind {
                 TokenKind::LBracket => {
                     let open = self.loc(&first);

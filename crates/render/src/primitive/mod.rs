@@ -377,6 +377,82 @@ pub struct AnimatedPrimitive {
     pub primitive: Moving,
     /// From the primitive's space to rendering space, over time.
     pub render_from_primitive: AnimatedTransform,
+    /// The primitive's bounds in its own space.
+    bounds: Bounds3f,
+    /// The largest coordinate of those bounds, in magnitude.
+    bounds_magnitude: Float,
+}
+
+impl AnimatedPrimitive {
+    /// `primitive` moved by `render_from_primitive`.
+    pub fn new(primitive: Moving, render_from_primitive: AnimatedTransform) -> Self {
+        let bounds = primitive.bounds();
+        let bounds_magnitude = [bounds.p_min, bounds.p_max]
+            .iter()
+            .flat_map(|p| [p.x.abs(), p.y.abs(), p.z.abs()])
+            .fold(0.0, Float::max);
+        AnimatedPrimitive {
+            primitive,
+            render_from_primitive,
+            bounds,
+            bounds_magnitude,
+        }
+    }
+
+    /// False only when the ray surely misses the primitive: a test of the
+    /// primitive's own box where it is at the ray's time, made before the
+    /// ray is taken into the primitive's space (a transformation, and for
+    /// a sphere an interval test, per primitive met). The box in rendering
+    /// space is the whole motion's, and a ray that meets it mostly misses
+    /// the primitive: 200,000 moving spheres spend most of their render
+    /// in those tests.
+    ///
+    /// Only for keyframes that are both translations, where the primitive
+    /// at the ray's time is its box moved by an offset. The box is padded
+    /// by 10⁻⁴ of the largest coordinate in play, hundreds of times the
+    /// rounding of this test and of the exact one after it (the ray's
+    /// transformation, the shape's test and its error bounds), so a ray
+    /// the exact test finds a hit on is never turned away; a `NaN` keeps
+    /// the exact test.
+    #[inline]
+    fn may_hit(&self, ray: &Ray, t_max: Float) -> bool {
+        let Some(off) = self.render_from_primitive.translation_at(ray.time) else {
+            return true;
+        };
+        let o = [ray.o.x - off.x, ray.o.y - off.y, ray.o.z - off.z];
+        let d = [ray.d.x, ray.d.y, ray.d.z];
+        let magnitude = [ray.o.x, ray.o.y, ray.o.z, off.x, off.y, off.z]
+            .iter()
+            .fold(self.bounds_magnitude, |m, v| m.max(v.abs()));
+        let pad = 1e-4 * magnitude;
+        let b = &self.bounds;
+        let (lo, hi) = (
+            [b.p_min.x, b.p_min.y, b.p_min.z],
+            [b.p_max.x, b.p_max.y, b.p_max.z],
+        );
+        let (mut t_near, mut t_far) = (0.0, t_max);
+        for i in 0..3 {
+            let (near, far) = (lo[i] - pad - o[i], hi[i] + pad - o[i]);
+            if d[i] == 0.0 {
+                if near > 0.0 || far < 0.0 {
+                    return false;
+                }
+                continue;
+            }
+            let (t0, t1) = (near / d[i], far / d[i]);
+            let (t0, t1) = if t0 > t1 { (t1, t0) } else { (t0, t1) };
+            if t0 > t_near {
+                t_near = t0;
+            }
+            if t1 < t_far {
+                t_far = t1;
+            }
+            if t_near > t_far {
+                return false;
+            }
+        }
+        true
+    }
 }
 
 /// What an [`AnimatedPrimitive`] moves: one shape (as pbrt-v4 wraps a
@@ -497,7 +573,7 @@ impl Primitive {
             Primitive::Instances(set) => set
                 .indices()
                 .fold(Bounds3f::empty(), |b, i| b.union(&set.bounds_of(i))),
-            Primitive::Animated(p) => p.render_from_primitive.motion_bounds(&p.primitive.bounds()),
+            Primitive::Animated(p) => p.render_from_primitive.motion_bounds(&p.bounds),
         }
     }
 
@@ -515,6 +591,9 @@ impl Primitive {
                 closest_of(set.indices(), t_max, |i, t| set.intersect_one(i, ray, t))
             }
             Primitive::Animated(p) => {
+                if !p.may_hit(ray, t_max) {
+                    return None;
+                }
                 let xf = p.render_from_primitive.interpolate(ray.time);
                 let (r, t) = xf.apply_inverse_ray(ray, t_max);
                 let pi = p.primitive.intersect(&r, t)?;
@@ -533,6 +612,9 @@ impl Primitive {
                 .any(|i| p.intersect_p_triangle(i, ray, t_max)),
             Primitive::Instances(set) => set.indices().any(|i| set.intersect_p_one(i, ray, t_max)),
             Primitive::Animated(p) => {
+                if !p.may_hit(ray, t_max) {
+                    return false;
+                }
                 let (r, t) = p
                     .render_from_primitive
                     .interpolate(ray.time)

@@ -113,7 +113,7 @@ pub(super) fn reader<'a>(
     e: &'a SceneEntity,
     budget: &MemoryBudget,
 ) -> Result<ParamReader<'a>, Diagnostic> {
-    ParamReader::new(&e.params, &e.loc, &e.color_space).map(|r| r.with_budget(budget))
+    ParamReader::new(&e.params, &e.loc, e.color_space).map(|r| r.with_budget(budget))
 }
 
 /// Reads an `Accelerator` directive's parameters.
@@ -451,10 +451,10 @@ fn place_runs(
         match animated {
             Some(a) => {
                 runs.close(prims);
-                prims.push(Primitive::Animated(Box::new(AnimatedPrimitive {
-                    primitive: Moving::Many(def.clone()),
-                    render_from_primitive: a.clone(),
-                })));
+                prims.push(Primitive::Animated(Box::new(AnimatedPrimitive::new(
+                    Moving::Many(def.clone()),
+                    a.clone(),
+                ))));
             }
             None => runs.add(def, list.fixed.get(i)),
         }
@@ -680,10 +680,10 @@ fn create(
         let (shape, render_from_primitive) = at_origin(s);
         create_primitives(&cx, &shape, lights, p, &mut inner);
         if let Some(moving) = Moving::of(&mut inner, &default_accel) {
-            prims.push(Primitive::Animated(Box::new(AnimatedPrimitive {
-                primitive: moving,
+            prims.push(Primitive::Animated(Box::new(AnimatedPrimitive::new(
+                moving,
                 render_from_primitive,
-            })));
+            ))));
         }
     };
     match taken.animated_shapes {
@@ -732,10 +732,10 @@ fn create(
             let (shape, render_from_primitive) = at_origin(s.clone());
             create_primitives(&cx, &shape, &mut lights, p, &mut shapes);
             if let Some(moving) = Moving::of(&mut shapes, &default_accel) {
-                inner.push(Primitive::Animated(Box::new(AnimatedPrimitive {
-                    primitive: moving,
+                inner.push(Primitive::Animated(Box::new(AnimatedPrimitive::new(
+                    moving,
                     render_from_primitive,
-                })));
+                ))));
             }
         }
         definitions.insert(

@@ -1340,8 +1340,7 @@ impl ParserTarget for SceneBuilder {
                 .iter()
                 .map(ParsedParameter::memory_bytes)
                 .sum::<usize>()
-            + heap(name.capacity())
-            + heap(self.state.color_space.len());
+            + heap(name.capacity());
         let light = self
             .state
             .area_light

@@ -32,8 +32,9 @@ pub struct SceneEntity {
     pub params: ParameterDictionary,
     /// Where the directive was.
     pub loc: FileLoc,
-    /// The RGB color space in effect (`ColorSpace`), by name.
-    pub color_space: String,
+    /// The RGB color space in effect (`ColorSpace`), by name (one of the
+    /// named spaces, held without a copy: one per shape adds up).
+    pub color_space: &'static str,
 }
 
 impl SceneEntity {
@@ -42,13 +43,13 @@ impl SceneEntity {
         name: impl Into<String>,
         params: ParameterDictionary,
         loc: FileLoc,
-        color_space: impl Into<String>,
+        color_space: &'static str,
     ) -> Self {
         SceneEntity {
             name: name.into(),
             params,
             loc,
-            color_space: color_space.into(),
+            color_space,
         }
     }
 
@@ -56,7 +57,7 @@ impl SceneEntity {
     /// space, parameters), in bytes, for the memory budget.
     pub fn heap_bytes(&self) -> usize {
         use rpbrt_parser::budget::heap;
-        heap(self.name.capacity()) + heap(self.color_space.capacity()) + self.params.memory_bytes()
+        heap(self.name.capacity()) + self.params.memory_bytes()
     }
 
     /// A default entity of type `name` without parameters, in sRGB.

@@ -178,7 +178,7 @@ pub(super) fn create_primitives(
     };
     let area_light = s.attributes.light_index.map(|li| &cx.desc.area_lights[li]);
     let area = match (area_light, material) {
-        (Some(al), Some(_)) => match ParamReader::new(&al.params, &al.loc, &al.color_space) {
+        (Some(al), Some(_)) => match ParamReader::new(&al.params, &al.loc, al.color_space) {
             Ok(r) => Some((al, r)),
             Err(e) => {
                 problems.errors.push(e);

@@ -124,28 +124,30 @@ pub(super) enum Block {
 /// mapping changed anything (it renames, retypes, adds and removes
 /// parameters or changes their value counts; it never edits a value in place).
 pub(super) fn fingerprint(params: &[ParsedParameter]) -> u64 {
-    // A hash (64-bit FNV-1a) rather than a copy of the names: this runs
-    // twice for every directive, and copying would allocate for each
-    // parameter. Two lists that differ hash alike about once in 2^64; then
-    // an upgrade's warnings go unreported (the upgrade itself is applied
+    // A hash rather than a copy of the names: this runs twice for every
+    // directive, and copying would allocate for each parameter. It eats
+    // 64-bit words, FNV-1a's step on each (xor, then a multiplication by
+    // an odd number: a bijection of the state for a given word), so two
+    // lists of the same number of words that differ in one word always
+    // hash apart; other pairs collide about once in 2^64, and then an
+    // upgrade's warnings go unreported (the upgrade itself is applied
     // either way).
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    let mut eat = |bytes: &[u8]| {
-        for &b in bytes {
-            h = (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
-        }
-    };
+    let mut eat = |w: u64| h = (h ^ w).wrapping_mul(0x0000_0100_0000_01b3);
     for p in params {
-        // Each name ends with a byte no name holds, so that ("ab", "c")
-        // and ("a", "bc") differ.
         for text in [&p.name, &p.ty] {
-            eat(text.as_bytes());
-            eat(&[0xff]);
+            // The length first, so that ("ab", "c") and ("a", "bc") differ.
+            eat(text.len() as u64);
+            for chunk in text.as_bytes().chunks(8) {
+                let mut word = [0u8; 8];
+                word[..chunk.len()].copy_from_slice(chunk);
+                eat(u64::from_le_bytes(word));
+            }
         }
         for n in [p.floats.len(), p.ints.len(), p.strings.len(), p.bools.len()] {
-            eat(&(n as u64).to_le_bytes());
+            eat(n as u64);
         }
     }
-    eat(&(params.len() as u64).to_le_bytes());
+    eat(params.len() as u64);
     h
 }

@@ -23,7 +23,7 @@ fn create(text: &str) -> Result<(Medium, Vec<Diagnostic>), Diagnostic> {
         Err(d) => return Err(d.items.into_iter().next().expect("a diagnostic")),
     };
     let e = &desc.media[0];
-    let cs = RgbColorSpace::get(&e.base.color_space).unwrap();
+    let cs = RgbColorSpace::get(e.base.color_space).unwrap();
     let r = ParamReader::with_color_space(&e.base.params, &e.base.loc, cs);
     let m = create_medium(&e.base.name, &r, &e.render_from_object.start_transform())?;
     // The scene's medium loop reads the type the builder put back.
