@@ -354,6 +354,10 @@ struct Run<'a> {
     /// Bytes of scene text charged to the budget, given back when the
     /// parse ends.
     text_charged: u64,
+    /// Room for a directive's parameters as they are read.
+    params_scratch: Vec<ParsedParameter>,
+    /// Room for a parameter's declaration as it is read.
+    decl_scratch: String,
 }
 
 impl<'a> Run<'a> {
@@ -379,6 +383,8 @@ impl<'a> Run<'a> {
             is_import: false,
             held: Vec::new(),
             text_charged: 0,
+            params_scratch: Vec::new(),
+            decl_scratch: String::new(),
         }
     }
 
@@ -745,6 +751,24 @@ impl<'a> Run<'a> {
         }
     }
 
+    /// [`Run::string_of`] into `out` (its room reused).
+    fn string_into(&mut self, t: Token, out: &mut String) -> P<()> {
+        let read = self.cur().map(|tk| {
+            tk.string_value(&t).map(|s| {
+                out.clear();
+                out.push_str(&s);
+            })
+        });
+        match read {
+            Some(Ok(())) => Ok(()),
+            Some(Err(d)) => {
+                self.report(d);
+                Err(Abort)
+            }
+            None => Err(Abort),
+        }
+    }
+
     fn quoted(&mut self, what: &str, at: &FileLoc) -> P<String> {
         let t = self.next_required(what, at)?;
         if !t.is_string() {
@@ -757,18 +781,33 @@ impl<'a> Run<'a> {
         self.string_of(t)
     }
 
+    /// The parameters that follow a directive, in a list of exactly their
+    /// number (it is kept with the scene's entity: no room to spare, and
+    /// none to give back), gathered in room kept from directive to
+    /// directive.
     fn params(&mut self) -> P<Vec<ParsedParameter>> {
-        let mut out = Vec::new();
+        let mut gathered = std::mem::take(&mut self.params_scratch);
+        let mut decl = std::mem::take(&mut self.decl_scratch);
+        let r = self.params_into(&mut gathered, &mut decl);
+        let out: Vec<ParsedParameter> = gathered.drain(..).collect();
+        self.params_scratch = gathered;
+        self.decl_scratch = decl;
+        r.map(|()| out)
+    }
+
+    /// [`Run::params`] into `out`; `decl_buf` holds each declaration.
+    fn params_into(&mut self, out: &mut Vec<ParsedParameter>, decl_buf: &mut String) -> P<()> {
         loop {
             let Some(t) = self.next()? else {
-                return Ok(out);
+                return Ok(());
             };
             if !t.is_string() {
                 self.unget = Some(t);
-                return Ok(out);
+                return Ok(());
             }
             let loc = self.loc(&t);
-            let decl = self.string_of(t)?;
+            self.string_into(t, decl_buf)?;
+            let decl: &str = decl_buf;
             let (ty, name) = match split_declaration(&decl) {
                 Ok(x) => x,
                 Err(msg) => {

@@ -47,6 +47,10 @@ pub struct SceneBuilder {
     block: Block,
     state: GraphicsState,
     pushed: Vec<Pushed>,
+    /// Boxes of states popped by `AttributeEnd`, reused by the next
+    /// `AttributeBegin` (a scene of many small attribute blocks would
+    /// otherwise allocate and free one for each).
+    spare_states: Vec<Box<GraphicsState>>,
     named_coordinate_systems: HashMap<String, TransformSet>,
     render_from_world: Transform,
     camera_defined: bool,
@@ -100,6 +104,10 @@ fn default_int(name: &str, v: i32) -> ParsedParameter {
     p
 }
 
+/// At most this many popped states' boxes are kept for reuse (the depth
+/// of nesting that gains from it).
+const MAX_SPARE_STATES: usize = 16;
+
 /// An entity standing for a default.
 fn default_entity(name: &str, params: Vec<ParsedParameter>) -> SceneEntity {
     SceneEntity::new(
@@ -129,6 +137,7 @@ impl SceneBuilder {
             block: Block::Options,
             state: GraphicsState::default(),
             pushed: Vec::new(),
+            spare_states: Vec::new(),
             named_coordinate_systems: HashMap::new(),
             render_from_world: Transform::identity(),
             camera_defined: false,
@@ -700,7 +709,12 @@ impl SceneBuilder {
         });
         self.scene.budget.release(PUSHED_BYTES as u64);
         match top {
-            Pushed::Attribute(state, _) => self.state = *state,
+            Pushed::Attribute(mut state, _) => {
+                std::mem::swap(&mut self.state, &mut state);
+                if self.spare_states.len() < MAX_SPARE_STATES {
+                    self.spare_states.push(state);
+                }
+            }
             Pushed::Transform(ctm, active, _) => {
                 self.state.ctm = *ctm;
                 self.state.active = active;
@@ -1079,8 +1093,14 @@ impl ParserTarget for SceneBuilder {
     fn attribute_begin(&mut self, loc: FileLoc) -> DirectiveResult {
         self.verify_world("AttributeBegin", &loc)?;
         self.charge(PUSHED_BYTES, "AttributeBegin", &loc)?;
-        self.pushed
-            .push(Pushed::Attribute(Box::new(self.state.clone()), loc));
+        let saved = match self.spare_states.pop() {
+            Some(mut b) => {
+                (*b).clone_from(&self.state);
+                b
+            }
+            None => Box::new(self.state.clone()),
+        };
+        self.pushed.push(Pushed::Attribute(saved, loc));
         Ok(())
     }
 
