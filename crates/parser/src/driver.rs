@@ -789,6 +789,9 @@ impl<'a> Run<'a> {
         let mut gathered = std::mem::take(&mut self.params_scratch);
         let mut decl = std::mem::take(&mut self.decl_scratch);
         let r = self.params_into(&mut gathered, &mut decl);
+        // Drained, not taken: a new list of exactly their number, the
+        // kept room staying here.
+        #[allow(clippy::drain_collect)]
         let out: Vec<ParsedParameter> = gathered.drain(..).collect();
         self.params_scratch = gathered;
         self.decl_scratch = decl;
@@ -808,7 +811,7 @@ impl<'a> Run<'a> {
             let loc = self.loc(&t);
             self.string_into(t, decl_buf)?;
             let decl: &str = decl_buf;
-            let (ty, name) = match split_declaration(&decl) {
+            let (ty, name) = match split_declaration(decl) {
                 Ok(x) => x,
                 Err(msg) => {
                     self.report(Diagnostic::error(loc, msg));
@@ -858,7 +861,7 @@ impl<'a> Run<'a> {
                                 format!("unexpected '[' inside the values of \"{decl}\""),
                             ));
                         }
-                        self.add_value(&mut p, kind, v, &decl, Some(&open))?;
+                        self.add_value(&mut p, kind, v, decl, Some(&open))?;
                         if p.value_count() > self.opts.max_values {
                             self.report(Diagnostic::error(
                                 loc,
@@ -871,7 +874,7 @@ impl<'a> Run<'a> {
                 TokenKind::RBracket => {
                     return Err(self.fail_at(first, format!("unexpected ']' after \"{decl}\"")));
                 }
-                _ => self.add_value(&mut p, kind, first, &decl, None)?,
+                _ => self.add_value(&mut p, kind, first, decl, None)?,
             }
             if kind.is_some() {
                 out.push(p);

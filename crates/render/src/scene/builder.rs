@@ -49,7 +49,9 @@ pub struct SceneBuilder {
     pushed: Vec<Pushed>,
     /// Boxes of states popped by `AttributeEnd`, reused by the next
     /// `AttributeBegin` (a scene of many small attribute blocks would
-    /// otherwise allocate and free one for each).
+    /// otherwise allocate and free one for each). Boxed: the boxes
+    /// themselves move into and out of `pushed`.
+    #[allow(clippy::vec_box)]
     spare_states: Vec<Box<GraphicsState>>,
     named_coordinate_systems: HashMap<String, TransformSet>,
     render_from_world: Transform,
