@@ -464,11 +464,7 @@ mod tests {
     #[test]
     fn translations_motion_bounds_as_transformed_boxes() {
         let mut state = 0x3c6e_f372_fe94_f82bu64;
-        let mut next = || {
-            let r = crate::float::xorshift64(&mut state);
-            let m = (r >> 40) as Float / (1u64 << 24) as Float - 0.5;
-            m * (2.0 as Float).powi((r % 30) as i32 - 12)
-        };
+        let mut next = || crate::float::spread_value(&mut state, 30, -12);
         for _ in 0..3000 {
             let mut v = || Vector3f::new(next(), next(), next());
             let (a, c) = (v(), v());
@@ -498,11 +494,7 @@ mod tests {
     #[test]
     fn translations_interpolate_as_the_composition_does() {
         let mut state = 0x6a09_e667_f3bc_c909u64;
-        let mut next = || {
-            let r = crate::float::xorshift64(&mut state);
-            let m = (r >> 40) as Float / (1u64 << 24) as Float - 0.5;
-            m * (2.0 as Float).powi((r % 24) as i32 - 8)
-        };
+        let mut next = || crate::float::spread_value(&mut state, 24, -8);
         for _ in 0..2000 {
             let a = Transform::translate(Vector3f::new(next(), next(), next()));
             let b = Transform::translate(Vector3f::new(next(), next(), next()));

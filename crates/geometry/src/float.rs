@@ -219,6 +219,16 @@ pub(crate) fn xorshift64(state: &mut u64) -> u64 {
     *state
 }
 
+/// A fixed-seed value for tests (advancing `state`): of either sign, a
+/// 24-bit fraction below ½ times `2^e` for an `e` from `lowest` to
+/// `lowest + octaves − 1`, so magnitudes over many orders.
+#[cfg(test)]
+pub(crate) fn spread_value(state: &mut u64, octaves: u64, lowest: i32) -> Float {
+    let r = xorshift64(state);
+    let m = (r >> 40) as Float / (1u64 << 24) as Float - 0.5;
+    m * (2.0 as Float).powi((r % octaves) as i32 + lowest)
+}
+
 /// Linear interpolation `(1 − t)·a + t·b`.
 #[inline]
 pub fn lerp(t: Float, a: Float, b: Float) -> Float {

@@ -831,11 +831,7 @@ mod tests {
     #[test]
     fn translated_bounds_as_corners() {
         let mut state = 0x510e_527f_ade6_82d1u64;
-        let mut next = || {
-            let r = crate::float::xorshift64(&mut state);
-            let m = (r >> 40) as Float / (1u64 << 24) as Float - 0.5;
-            m * (2.0 as Float).powi((r % 30) as i32 - 12)
-        };
+        let mut next = || crate::float::spread_value(&mut state, 30, -12);
         for k in 0..3000 {
             let mut v = || Vector3f::new(next(), next(), next());
             let (t, p, q) = (v(), v(), v());
