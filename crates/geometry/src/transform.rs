@@ -709,23 +709,10 @@ impl Transform {
     /// offset (or the identity).
     #[inline]
     fn finite_translation(&self) -> Option<Vector3f> {
-        let m = &self.m.m;
-        let upper = m[0][0] == 1.0
-            && m[1][1] == 1.0
-            && m[2][2] == 1.0
-            && m[0][1] == 0.0
-            && m[0][2] == 0.0
-            && m[1][0] == 0.0
-            && m[1][2] == 0.0
-            && m[2][0] == 0.0
-            && m[2][1] == 0.0;
-        let t = Vector3f::new(m[0][3], m[1][3], m[2][3]);
-        (upper
-            && m[3] == [0.0, 0.0, 0.0, 1.0]
-            && t.x.is_finite()
-            && t.y.is_finite()
-            && t.z.is_finite())
-        .then_some(t)
+        self.m
+            .translation()
+            .filter(|t| t.iter().all(|v| v.is_finite()))
+            .map(|[x, y, z]| Vector3f::new(x, y, z))
     }
 
     /// The tight bounds of a transformed box: the box of its eight
