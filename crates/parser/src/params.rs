@@ -7,6 +7,7 @@
 //! lookup marks the parameter used, so that typos can be reported with
 //! [`ParameterDictionary::report_unused`].
 
+use std::borrow::Cow;
 use std::fmt;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -51,6 +52,34 @@ pub fn canonical_type(ty: &str) -> Option<&'static str> {
     })
 }
 
+/// `ty` as written, held without a copy when it is one of the type names
+/// (canonical or alias) every parameter list is made of.
+fn written_type(ty: &str) -> Cow<'static, str> {
+    const NAMES: [&str; 17] = [
+        "float",
+        "integer",
+        "bool",
+        "string",
+        "texture",
+        "point2",
+        "vector2",
+        "point3",
+        "point",
+        "vector3",
+        "vector",
+        "normal",
+        "normal3",
+        "rgb",
+        "color",
+        "spectrum",
+        "blackbody",
+    ];
+    match NAMES.iter().find(|&&n| n == ty) {
+        Some(&n) => Cow::Borrowed(n),
+        None => Cow::Owned(ty.to_string()),
+    }
+}
+
 /// The kind of values a (canonical or alias) type name holds.
 pub fn value_kind(ty: &str) -> Option<ValueKind> {
     Some(match canonical_type(ty)? {
@@ -85,7 +114,7 @@ pub fn split_declaration(decl: &str) -> Result<(&str, &str), String> {
 #[derive(Debug)]
 pub struct ParsedParameter {
     /// Type as written (`float`, `point3`, `rgb`, or a pbrt-v3 alias).
-    pub ty: String,
+    pub ty: Cow<'static, str>,
     /// Parameter name.
     pub name: String,
     /// Location of the declaration string.
@@ -139,7 +168,10 @@ impl ParsedParameter {
     pub fn memory_bytes(&self) -> usize {
         use crate::budget::heap;
         std::mem::size_of::<Self>()
-            + heap(self.ty.capacity())
+            + match &self.ty {
+                Cow::Owned(s) => heap(s.capacity()),
+                Cow::Borrowed(_) => 0,
+            }
             + heap(self.name.capacity())
             + heap(self.floats.capacity() * std::mem::size_of::<f32>())
             + heap(self.ints.capacity() * std::mem::size_of::<i32>())
@@ -153,9 +185,9 @@ impl ParsedParameter {
     }
 
     /// A parameter without values.
-    pub fn new(ty: impl Into<String>, name: impl Into<String>, loc: FileLoc) -> Self {
+    pub fn new(ty: impl AsRef<str>, name: impl Into<String>, loc: FileLoc) -> Self {
         ParsedParameter {
-            ty: ty.into(),
+            ty: written_type(ty.as_ref()),
             name: name.into(),
             loc,
             floats: Vec::new(),
@@ -393,7 +425,7 @@ impl ParameterDictionary {
                 Err(ParamError::WrongType {
                     loc: p.loc.clone(),
                     name: name.to_string(),
-                    found: p.ty.clone(),
+                    found: p.ty.to_string(),
                     expected: expected.to_string(),
                 })
             }
@@ -411,7 +443,7 @@ impl ParameterDictionary {
             ParamError::WrongCount {
                 loc: p.loc.clone(),
                 name: p.name.clone(),
-                ty: p.ty.clone(),
+                ty: p.ty.to_string(),
                 count: p.value_count(),
                 expected,
             }
@@ -696,7 +728,7 @@ impl ParameterDictionary {
 
     /// The type of the latest parameter named `name`, as written.
     pub fn param_type(&self, name: &str) -> Option<&str> {
-        self.named(name).next().map(|p| p.ty.as_str())
+        self.named(name).next().map(|p| &*p.ty)
     }
 
     /// The location of the latest parameter named `name`.

@@ -28,7 +28,7 @@ pub fn upgrade_param_types(params: &mut [ParsedParameter]) {
     for p in params {
         if let Some(ct) = canonical_type(&p.ty) {
             if ct != p.ty {
-                p.ty = ct.to_string();
+                p.ty = std::borrow::Cow::Borrowed(ct);
             }
         }
     }

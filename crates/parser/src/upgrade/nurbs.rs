@@ -504,10 +504,7 @@ mod tests {
         assert!(u.diagnostics.is_empty(), "{:?}", u.diagnostics);
         assert_eq!(u.name, "trianglemesh");
         let (p, n, uv) = (param(&u, "P"), param(&u, "N"), param(&u, "uv"));
-        assert_eq!(
-            (p.ty.as_str(), n.ty.as_str(), uv.ty.as_str()),
-            ("point3", "normal", "point2")
-        );
+        assert_eq!((&*p.ty, &*n.ty, &*uv.ty), ("point3", "normal", "point2"));
         assert_eq!(p.floats.len(), 3 * DICE * DICE);
         assert_eq!(param(&u, "indices").ints.len(), 6 * (DICE - 1) * (DICE - 1));
         for i in 0..DICE * DICE {

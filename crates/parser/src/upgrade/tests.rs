@@ -30,7 +30,7 @@ fn param_types() {
         f("normal3", "N", &[0.; 3]),
     ];
     upgrade_param_types(&mut p);
-    let t: Vec<&str> = p.iter().map(|p| p.ty.as_str()).collect();
+    let t: Vec<&str> = p.iter().map(|p| &*p.ty).collect();
     assert_eq!(t, ["point3", "vector3", "rgb", "normal"]);
 }
 

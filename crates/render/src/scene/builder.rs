@@ -524,7 +524,7 @@ impl SceneBuilder {
     /// renamed (it reads them only when upgrading) or a `mapname`.
     fn note_pbrt_v3_params(&mut self, params: &[ParsedParameter]) {
         let v3 = params.iter().find(|p| {
-            matches!(p.ty.as_str(), "color" | "point" | "vector")
+            matches!(&*p.ty, "color" | "point" | "vector")
                 || (p.name == "mapname" && p.ty == "string")
         });
         if let Some(p) = v3 {

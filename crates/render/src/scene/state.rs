@@ -135,7 +135,7 @@ pub(super) fn fingerprint(params: &[ParsedParameter]) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     let mut eat = |w: u64| h = (h ^ w).wrapping_mul(0x0000_0100_0000_01b3);
     for p in params {
-        for text in [&p.name, &p.ty] {
+        for text in [p.name.as_str(), &*p.ty] {
             // The length first, so that ("ab", "c") and ("a", "bc") differ.
             eat(text.len() as u64);
             for chunk in text.as_bytes().chunks(8) {

@@ -406,7 +406,7 @@ fn pbrt_v3_matte_becomes_diffuse() {
     let m = &s.materials[1];
     assert_eq!(m.name, "diffuse");
     let p = &m.params.params()[0];
-    assert_eq!((p.ty.as_str(), p.name.as_str()), ("rgb", "reflectance"));
+    assert_eq!((&*p.ty, p.name.as_str()), ("rgb", "reflectance"));
     assert_eq!(p.floats, vec![0.5, 0.25, 0.125]);
     assert!(diags.iter().all(|d| !d.is_error()));
 }

@@ -36,7 +36,7 @@ pub(super) fn spectral_emission_as_rgb(
 ) -> Result<(), Diagnostic> {
     let non_uniform_scale = params.iter().any(|p| {
         p.name == "scale"
-            && matches!(p.ty.as_str(), "rgb" | "color")
+            && matches!(&*p.ty, "rgb" | "color")
             && p.floats.len() == 3
             && !(p.floats[0] == p.floats[1] && p.floats[1] == p.floats[2])
     });
@@ -50,7 +50,7 @@ pub(super) fn spectral_emission_as_rgb(
     let Some(p) = params
         .iter_mut()
         .rev()
-        .find(|p| p.name == emission && matches!(p.ty.as_str(), "spectrum" | "blackbody"))
+        .find(|p| p.name == emission && matches!(&*p.ty, "spectrum" | "blackbody"))
     else {
         return Ok(());
     };
