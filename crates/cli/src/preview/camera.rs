@@ -296,7 +296,7 @@ impl CameraDirective {
             })
             .collect();
         CameraDirective {
-            name: entity.name.clone(),
+            name: entity.name.to_string(),
             params,
         }
     }

@@ -275,7 +275,7 @@ fn check_integrator_support(
         used,
         lights,
     } = *support;
-    let name = desc.integrator.name.as_str();
+    let name = &*desc.integrator.name;
     let loc = &desc.integrator.loc;
     // pbrt-v4's list: the integrators that trace through media.
     let volumetric = matches!(

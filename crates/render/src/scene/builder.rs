@@ -111,7 +111,7 @@ fn default_int(name: &str, v: i32) -> ParsedParameter {
 const MAX_SPARE_STATES: usize = 16;
 
 /// An entity standing for a default.
-fn default_entity(name: &str, params: Vec<ParsedParameter>) -> SceneEntity {
+fn default_entity(name: &'static str, params: Vec<ParsedParameter>) -> SceneEntity {
     SceneEntity::new(
         name,
         ParameterDictionary::new(params),
@@ -632,6 +632,7 @@ impl SceneBuilder {
 
     fn entity_with(
         &self,
+        kind: EntityKind,
         name: String,
         params: ParamList,
         inherited: &Arc<Vec<ParsedParameter>>,
@@ -639,7 +640,7 @@ impl SceneBuilder {
     ) -> SceneEntity {
         let params = self.renamed_refs(params);
         let dict = ParameterDictionary::with_inherited(params, inherited.as_ref().clone());
-        SceneEntity::new(name, dict, loc, self.state.color_space)
+        SceneEntity::new(kind.interned(name), dict, loc, self.state.color_space)
     }
 
     /// Film, Sampler, PixelFilter, Integrator and Accelerator.
@@ -1027,7 +1028,7 @@ impl ParserTarget for SceneBuilder {
             ParsedParameter::with_strings("string", "type", ty_loc, vec![ty.clone()]),
         );
         let attrs = self.state.medium_attributes.clone();
-        let base = self.entity_with(ty, params, &attrs, loc);
+        let base = self.entity_with(EntityKind::Medium, ty, params, &attrs, loc);
         self.charge_entity::<MediumSceneEntity>(&base, "MakeNamedMedium")?;
         let render_from_object = self.render_from_object();
         self.scene.media.push(MediumSceneEntity {
@@ -1203,7 +1204,7 @@ impl ParserTarget for SceneBuilder {
         );
         let attrs = self.state.texture_attributes.clone();
         // Its own references still mean the earlier definitions.
-        let base = self.entity_with(u.name, u.params, &attrs, loc);
+        let base = self.entity_with(EntityKind::Texture, u.name, u.params, &attrs, loc);
         self.charge_entity::<TextureSceneEntity>(&base, "Texture")?;
         match kind {
             TextureKind::Float => self.float_texture_names.insert(stored.clone()),
@@ -1231,7 +1232,7 @@ impl ParserTarget for SceneBuilder {
             self.upgraded(upgrade::upgrade_material_for_render, name, params, &loc);
         EntityKind::Material.check(&name, &loc)?;
         let attrs = self.state.material_attributes.clone();
-        let entity = self.entity_with(name, params, &attrs, loc);
+        let entity = self.entity_with(EntityKind::Material, name, params, &attrs, loc);
         self.charge_entity::<SceneEntity>(&entity, "Material")?;
         self.scene.materials.push(entity);
         self.state.material = MaterialRef::Index(self.scene.materials.len() - 1);
@@ -1268,7 +1269,7 @@ impl ParserTarget for SceneBuilder {
             ParsedParameter::with_strings("string", "type", ty_loc, vec![ty.clone()]),
         );
         let attrs = self.state.material_attributes.clone();
-        let entity = self.entity_with(ty, params, &attrs, loc);
+        let entity = self.entity_with(EntityKind::Material, ty, params, &attrs, loc);
         self.charge_entity::<(String, SceneEntity)>(&entity, "MakeNamedMaterial")?;
         self.named_material_names.insert(stored.clone());
         self.note_definition(Reference::NamedMaterial, name, &stored);
@@ -1304,7 +1305,7 @@ impl ParserTarget for SceneBuilder {
             self.v2_point_from(&mut params);
         }
         let attrs = self.state.light_attributes.clone();
-        let base = self.entity_with(name, params, &attrs, loc);
+        let base = self.entity_with(EntityKind::Light, name, params, &attrs, loc);
         self.charge_entity::<LightSceneEntity>(&base, "LightSource")?;
         let light = LightSceneEntity {
             base,
@@ -1328,7 +1329,7 @@ impl ParserTarget for SceneBuilder {
         let (name, params) = self.upgraded(upgrade::upgrade_area_light, name, params, &loc);
         EntityKind::AreaLight.check(&name, &loc)?;
         let attrs = self.state.light_attributes.clone();
-        let entity = self.entity_with(name, params, &attrs, loc);
+        let entity = self.entity_with(EntityKind::AreaLight, name, params, &attrs, loc);
         self.state.area_light = Some(Arc::new(entity));
         Ok(())
     }
@@ -1383,7 +1384,7 @@ impl ParserTarget for SceneBuilder {
             None => None,
         };
         let attrs = self.state.shape_attributes.clone();
-        let base = self.entity_with(name, params, &attrs, loc);
+        let base = self.entity_with(EntityKind::Shape, name, params, &attrs, loc);
         let attributes = self.shape_attributes(light_index);
         if self.ctm_is_animated() {
             let shape = AnimatedShapeSceneEntity {

@@ -9,6 +9,7 @@
 //! Nothing here is a render object yet: parameters are kept as written (after
 //! the pbrt-v3 upgrade) and are read when the renderer creates the objects.
 
+use std::borrow::Cow;
 use std::fmt::Write as _;
 use std::sync::Arc;
 
@@ -26,8 +27,9 @@ pub fn default_loc() -> FileLoc {
 /// A directive's type name, parameters and location.
 #[derive(Clone, Debug)]
 pub struct SceneEntity {
-    /// The entity's type, e.g. `"sphere"` or `"diffuse"`.
-    pub name: String,
+    /// The entity's type, e.g. `"sphere"` or `"diffuse"` (one of the
+    /// known names, held without a copy, where the builder checked it).
+    pub name: Cow<'static, str>,
     /// Its parameters (with the `Attribute` defaults in effect, if any).
     pub params: ParameterDictionary,
     /// Where the directive was.
@@ -40,7 +42,7 @@ pub struct SceneEntity {
 impl SceneEntity {
     /// An entity with the given parts.
     pub fn new(
-        name: impl Into<String>,
+        name: impl Into<Cow<'static, str>>,
         params: ParameterDictionary,
         loc: FileLoc,
         color_space: &'static str,
@@ -57,12 +59,21 @@ impl SceneEntity {
     /// space, parameters), in bytes, for the memory budget.
     pub fn heap_bytes(&self) -> usize {
         use rpbrt_parser::budget::heap;
-        heap(self.name.capacity()) + self.params.memory_bytes()
+        let name = match &self.name {
+            Cow::Owned(s) => heap(s.capacity()),
+            Cow::Borrowed(_) => 0,
+        };
+        name + self.params.memory_bytes()
     }
 
     /// A default entity of type `name` without parameters, in sRGB.
     pub fn default_named(name: &str) -> Self {
-        SceneEntity::new(name, ParameterDictionary::default(), default_loc(), "srgb")
+        SceneEntity::new(
+            name.to_string(),
+            ParameterDictionary::default(),
+            default_loc(),
+            "srgb",
+        )
     }
 }
 

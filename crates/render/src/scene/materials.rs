@@ -161,7 +161,7 @@ pub(super) fn create_materials(
         // `MakeNamedMaterial` gives its type as `"string type"`.
         let ty = match e.params.get_one_string("type", "") {
             Ok(t) if !t.is_empty() => t,
-            Ok(_) => e.name.clone(),
+            Ok(_) => e.name.to_string(),
             Err(err) => {
                 problems.errors.push(err.into());
                 continue;

@@ -273,7 +273,7 @@ fn named_materials_textures_and_media() {
         MaterialRef::Named("gold".into())
     );
     assert_eq!(
-        s.spectrum_texture("checks").map(|t| t.base.name.as_str()),
+        s.spectrum_texture("checks").map(|t| t.base.name.as_ref()),
         Some("checkerboard")
     );
     assert_eq!(
@@ -282,7 +282,7 @@ fn named_materials_textures_and_media() {
     );
     assert!(s.float_texture("checks").is_none());
     assert_eq!(
-        s.medium("smoke").map(|m| m.base.name.as_str()),
+        s.medium("smoke").map(|m| m.base.name.as_ref()),
         Some("homogeneous")
     );
 
@@ -664,7 +664,7 @@ fn pbrt_v3_file_and_its_upgrade_agree() {
     assert_eq!(a.sampler.name, "paddedsobol");
     assert_eq!(a.integrator.name, "path");
     assert_eq!(
-        a.named_material("glassy").map(|m| m.name.as_str()),
+        a.named_material("glassy").map(|m| &*m.name),
         Some("dielectric")
     );
     assert_eq!(a.area_lights[0].name, "diffuse");
@@ -761,7 +761,7 @@ fn imports_build_the_scene_a_one_thread_parse_builds() {
     let (par, seq) = (run(true), run(false));
     let describe = |s: &SceneDescription| format!("{:?}", s.shapes);
     assert_eq!(describe(&par), describe(&seq));
-    let names: Vec<&str> = par.shapes.iter().map(|s| s.base.name.as_str()).collect();
+    let names: Vec<&str> = par.shapes.iter().map(|s| s.base.name.as_ref()).collect();
     assert_eq!(names, ["sphere", "sphere", "cylinder", "disk"]);
     // The import's Translate and Material stay inside it.
     let at = |i: usize| par.shapes[i].render_from_object.apply_point(origin());
@@ -800,7 +800,7 @@ fn v2_integrator(opts: &str, world: &str) -> (String, Vec<(String, i32)>, Vec<St
         .map(|p| (p.name.clone(), p.ints[0]))
         .collect();
     let msgs = diags.iter().map(|d| d.to_string()).collect();
-    (s.integrator.name.clone(), ints, msgs)
+    (s.integrator.name.to_string(), ints, msgs)
 }
 
 #[test]
