@@ -328,6 +328,21 @@ fn read_plain_in_parts(_: &Path, _: u64, _: usize) -> io::Result<Option<Vec<u8>>
     Ok(None)
 }
 
+/// `len` bytes of xorshift noise from `seed` (nonzero), for tests that
+/// need bytes no two of which are alike for long.
+#[cfg(test)]
+pub(crate) fn noise_bytes(seed: u64, len: usize) -> Vec<u8> {
+    let mut x = seed;
+    (0..len)
+        .map(|_| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x as u8
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -371,15 +386,7 @@ mod tests {
     fn a_file_read_in_parts_is_the_file() {
         // Bytes that differ from part to part, in sizes around the parts'
         // 64 KiB alignment.
-        let mut state = 0x9e37_79b9_u32;
-        let bytes: Vec<u8> = (0..(3 << 16) + 123)
-            .map(|_| {
-                state ^= state << 13;
-                state ^= state >> 17;
-                state ^= state << 5;
-                state as u8
-            })
-            .collect();
+        let bytes = noise_bytes(0x9e37_79b9, (3 << 16) + 123);
         for len in [0, 1, 1 << 16, (1 << 16) + 1, (2 << 16) - 1, bytes.len()] {
             let path = temp(&format!("parts-{len}.bin"), &bytes[..len]);
             for parts in 1..=5 {

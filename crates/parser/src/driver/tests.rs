@@ -714,16 +714,8 @@ fn absurd_numbers_are_errors() {
 
 #[test]
 fn binary_garbage_and_truncation_never_panic() {
-    let mut x: u64 = 0x1234_5678_9abc_def1;
     for len in [0usize, 1, 7, 100, 5000] {
-        let bytes: Vec<u8> = (0..len)
-            .map(|_| {
-                x ^= x << 13;
-                x ^= x >> 7;
-                x ^= x << 17;
-                x as u8
-            })
-            .collect();
+        let bytes = crate::input::noise_bytes(0x1234_5678_9abc_def1 + len as u64, len);
         let p = Parser::default();
         let _ = p.parse_bytes("g", Arc::from(bytes), Path::new("."), &mut Rec::default());
     }
