@@ -52,31 +52,13 @@ pub fn canonical_type(ty: &str) -> Option<&'static str> {
     })
 }
 
-/// `ty` as written, held without a copy when it is one of the type names
-/// (canonical or alias) every parameter list is made of.
+/// `ty` as written, held without a copy when it is a pbrt-v4 type name
+/// (pbrt-v3's aliases are copied; their upgrade renames them to the
+/// canonical name, which is then held without a copy too).
 fn written_type(ty: &str) -> Cow<'static, str> {
-    const NAMES: [&str; 17] = [
-        "float",
-        "integer",
-        "bool",
-        "string",
-        "texture",
-        "point2",
-        "vector2",
-        "point3",
-        "point",
-        "vector3",
-        "vector",
-        "normal",
-        "normal3",
-        "rgb",
-        "color",
-        "spectrum",
-        "blackbody",
-    ];
-    match NAMES.iter().find(|&&n| n == ty) {
-        Some(&n) => Cow::Borrowed(n),
-        None => Cow::Owned(ty.to_string()),
+    match canonical_type(ty) {
+        Some(c) if c == ty => Cow::Borrowed(c),
+        _ => Cow::Owned(ty.to_string()),
     }
 }
 
@@ -806,6 +788,16 @@ mod tests {
 
     fn fl(ty: &str, name: &str, line: u32, v: &[f32]) -> ParsedParameter {
         ParsedParameter::with_floats(ty, name, loc(line), v.to_vec())
+    }
+
+    #[test]
+    fn type_names_as_written() {
+        for ty in ["float", "rgb", "point3", "blackbody"] {
+            assert!(matches!(written_type(ty), Cow::Borrowed(t) if t == ty));
+        }
+        for ty in ["color", "point", "normal3", "floot"] {
+            assert!(matches!(written_type(ty), Cow::Owned(t) if t == ty));
+        }
     }
 
     #[test]
