@@ -12,6 +12,7 @@ use rpbrt_geometry::Transform;
 use rpbrt_parser::{Diagnostic, MemoryBudget};
 
 use super::entities::*;
+use super::entity_list::EntityList;
 use super::instances::InstanceList;
 use super::materials::{create_materials, create_textures};
 use super::shapes::{at_origin, create_primitives, ShapeContext};
@@ -348,7 +349,7 @@ pub fn create_scene_taking_entities(
 #[derive(Default)]
 struct Taken {
     instances: Option<InstanceList>,
-    animated_shapes: Option<Vec<AnimatedShapeSceneEntity>>,
+    animated_shapes: Option<EntityList<AnimatedShapeSceneEntity>>,
 }
 
 /// Appends the primitives of the description's object instances to
@@ -491,22 +492,6 @@ impl InstanceRuns {
             prims.push(Primitive::Instances(Box::new(set)));
         }
         self.objects.clear();
-    }
-}
-
-/// Calls `f` on each entry of `list`, the last first, shrinking the list
-/// as it goes (a large allocation gives its tail's pages back), so that
-/// the entries and what `f` makes of them are not both held whole.
-fn take_from_end<T>(mut list: Vec<T>, mut f: impl FnMut(T)) {
-    let chunk = (list.len() / 16).max(1 << 12);
-    let mut since = 0;
-    while let Some(entry) = list.pop() {
-        f(entry);
-        since += 1;
-        if since == chunk {
-            list.shrink_to_fit();
-            since = 0;
-        }
     }
 }
 
@@ -693,18 +678,20 @@ fn create(
             }
         }
         Some(list) => {
-            // Taken from the description: made from the last, the list
-            // shrunk as it goes (as the instances below), each shape's
-            // problems kept apart and reported in the files' order.
+            // Taken from the description: made from the last, each chunk
+            // of the list freed as it empties (its memory reused for the
+            // primitives), each shape's problems kept apart and reported
+            // in the files' order.
             let (base, n_lights) = (prims.len(), lights.len());
             let mut reported = Vec::new();
-            take_from_end(list, |s| {
+            let mut list = list;
+            while let Some(s) = list.pop() {
                 let mut own = Problems::default();
                 animated(s, &mut lights, &mut own, &mut prims);
                 if !own.errors.is_empty() || !own.warnings.is_empty() {
                     reported.push(own);
                 }
-            });
+            }
             debug_assert_eq!(lights.len(), n_lights);
             prims[base..].reverse();
             for own in reported.into_iter().rev() {

@@ -24,6 +24,7 @@ use rpbrt_parser::{
 };
 
 use super::entities::*;
+use super::entity_list::EntityList;
 use super::names::*;
 use super::state::*;
 use crate::bxdf::LAFORTUNE_MATERIALS;
@@ -1434,8 +1435,8 @@ impl ParserTarget for SceneBuilder {
             self.active_definition = Some(InstanceDefinitionSceneEntity {
                 name: name.to_string(),
                 loc: loc.clone(),
-                shapes: Vec::new(),
-                animated_shapes: Vec::new(),
+                shapes: EntityList::new(),
+                animated_shapes: EntityList::new(),
             });
         }
         self.pushed.push(Pushed::Object { state, loc, opened });

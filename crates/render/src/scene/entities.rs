@@ -16,6 +16,7 @@ use std::sync::Arc;
 use rpbrt_geometry::{AnimatedTransform, Float, Transform};
 use rpbrt_parser::{Diagnostic, FileLoc, MemoryBudget, ParameterDictionary, ParsedParameter};
 
+use super::entity_list::EntityList;
 use super::instances::InstanceList;
 use crate::camera::{CameraTransform, RenderingCoordinateSystem};
 
@@ -211,9 +212,9 @@ pub struct InstanceDefinitionSceneEntity {
     /// Where `ObjectBegin` was.
     pub loc: FileLoc,
     /// Its shapes with fixed transformations.
-    pub shapes: Vec<ShapeSceneEntity>,
+    pub shapes: EntityList<ShapeSceneEntity>,
     /// Its shapes with animated transformations.
-    pub animated_shapes: Vec<AnimatedShapeSceneEntity>,
+    pub animated_shapes: EntityList<AnimatedShapeSceneEntity>,
 }
 
 /// How an instance is placed.
@@ -267,9 +268,9 @@ pub struct SceneDescription {
     /// The rendering coordinate system used.
     pub render_coord_sys: RenderingCoordinateSystem,
     /// Shapes outside object definitions, fixed transformations.
-    pub shapes: Vec<ShapeSceneEntity>,
+    pub shapes: EntityList<ShapeSceneEntity>,
     /// Shapes outside object definitions, animated transformations.
-    pub animated_shapes: Vec<AnimatedShapeSceneEntity>,
+    pub animated_shapes: EntityList<AnimatedShapeSceneEntity>,
     /// `LightSource`s.
     pub lights: Vec<LightSceneEntity>,
     /// One area light per shape created under an `AreaLightSource`.
@@ -338,8 +339,8 @@ impl Default for SceneDescription {
                 medium: String::new(),
             },
             render_coord_sys: RenderingCoordinateSystem::default(),
-            shapes: Vec::new(),
-            animated_shapes: Vec::new(),
+            shapes: EntityList::new(),
+            animated_shapes: EntityList::new(),
             lights: Vec::new(),
             area_lights: Vec::new(),
             materials: vec![SceneEntity::default_named("diffuse")],

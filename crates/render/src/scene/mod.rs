@@ -10,6 +10,7 @@
 pub mod assemble;
 pub mod builder;
 pub mod entities;
+mod entity_list;
 pub mod files;
 pub mod instances;
 mod materials;
@@ -29,6 +30,7 @@ use crate::camera::RenderingCoordinateSystem;
 
 pub use builder::SceneBuilder;
 pub use entities::*;
+pub use entity_list::EntityList;
 pub use instances::InstanceList;
 pub use names::EntityKind;
 
