@@ -150,7 +150,10 @@ mod tests {
             }
             assert_eq!(list.get(n), None);
             // No chunk beyond the largest, and none empty.
-            assert!(list.chunks.iter().all(|c| !c.is_empty() && c.capacity() <= EntityList::<usize>::MAX_CHUNK));
+            assert!(list
+                .chunks
+                .iter()
+                .all(|c| !c.is_empty() && c.capacity() <= EntityList::<usize>::MAX_CHUNK));
 
             let mut list = list;
             let mut back = Vec::new();
